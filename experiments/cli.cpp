@@ -1,0 +1,206 @@
+#include "experiments/cli.hpp"
+
+#include "experiments/results.hpp"
+#include "experiments/runner.hpp"
+#include "solver/fk_solver.hpp"
+#include "solver/mesh_io.hpp"
+#include "solver/robots.hpp"
+#include "solver/scene_json.hpp"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <iostream>
+#include <sstream>
+
+namespace softkin {
+
+namespace {
+
+/// Parses "v1,v2,..." into numbers; throws invalid_argument naming the option.
+Eigen::VectorXd ParseVector(const std::string& text, const std::string& option) {
+  std::vector<double> v;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    size_t pos = 0;
+    double x = 0;
+    try {
+      x = std::stod(item, &pos);
+    } catch (const std::exception&) {
+      pos = 0;
+    }
+    while (pos < item.size() && isspace(static_cast<unsigned char>(item[pos]))) ++pos;
+    if (item.empty() || pos != item.size() || !std::isfinite(x))
+      throw std::invalid_argument(option + ": expected comma-separated finite numbers, got '" +
+                                  text + "'");
+    v.push_back(x);
+  }
+  if (v.empty()) throw std::invalid_argument(option + ": expected at least one number");
+  return Eigen::Map<Eigen::VectorXd>(v.data(), v.size());
+}
+
+nlohmann::json RobotsJson() {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& info : ListRobots()) {
+    Scene s = MakeRobot(info.name, 0);
+    nlohmann::json acts = nlohmann::json::array();
+    for (const auto& a : s.actuators)
+      acts.push_back({{"name", a.name}, {"type", ActuatorTypeToString(a.type)},
+                      {"range", {a.min, a.max}}, {"rest", a.rest}});
+    nlohmann::json markers = nlohmann::json::array();
+    for (const auto& m : s.markers) markers.push_back(m.name);
+    out.push_back({{"name", info.name}, {"description", info.description},
+                   {"default_resolution", info.default_resolution},
+                   {"resolution", info.resolution_doc}, {"actuators", acts}, {"markers", markers},
+                   {"n_vertices", s.mesh.num_vertices()}, {"n_tets", s.mesh.num_tets()},
+                   {"n_prisms", s.mesh.num_prisms()}, {"n_fixed", s.fixed.size()}});
+  }
+  return out;
+}
+
+}  // namespace
+
+int RunCli(int argc, char** argv) {
+  CLI::App app{"SoftKin: geometry-based kinematics of soft robots (forward kinematics, "
+               "experiments). Units: mm."};
+  app.require_subcommand(1);
+  app.set_help_all_flag("--help-all", "Help for every command");
+
+  // robots
+  auto* robots = app.add_subcommand("robots", "List the embedded robots: actuators, markers, sizes");
+  bool robots_json = false;
+  robots->add_flag("--json", robots_json, "Print JSON instead of a table");
+
+  // fk
+  auto* fk = app.add_subcommand("fk", "Solve forward kinematics for one actuation");
+  std::string robot, scene_file, actuation, solver_name, json_out, vtu_out, obj_out;
+  int res = 0, continuation = 0, max_iter = 0;
+  double tolerance = 0;
+  auto* o_robot = fk->add_option("--robot", robot, "Embedded robot name (see `softkin robots`)");
+  auto* o_scene = fk->add_option("--scene", scene_file, "Scene JSON file (see `softkin scene --schema`)");
+  o_robot->excludes(o_scene);
+  fk->add_option("--res", res, "Robot resolution (default: the robot's own)")->needs(o_robot);
+  fk->add_option("--actuation", actuation, "Actuation values v1,v2,... in actuator order")->required();
+  fk->add_option("--solver", solver_name, "FK solver: lg (plain local-global) or lg-aa (Anderson)");
+  fk->add_option("--continuation", continuation, "Apply the actuation in this many steps");
+  fk->add_option("--max-iterations", max_iter, "Iteration cap");
+  fk->add_option("--tolerance", tolerance, "Per-iteration vertex move tolerance, relative to model size");
+  fk->add_option("--json", json_out, "Write the result as JSON to this file");
+  fk->add_option("--vtu", vtu_out, "Write the deformed mesh as ParaView .vtu");
+  fk->add_option("--obj", obj_out, "Write the deformed surface as .obj");
+
+  // run
+  auto* run = app.add_subcommand("run", "Run an experiment config (experiments/<name>.json)");
+  std::string config;
+  RunOptions ropt;
+  bool no_plot = false;
+  run->add_option("config", config, "Experiment config JSON")->required();
+  run->add_flag("--quick", ropt.quick, "Quick mode: the config's small 'quick' settings (for CI)");
+  run->add_flag("--no-plot", no_plot, "Do not run the paper_figs plot script");
+  run->add_option("--results", ropt.results_root, "Results root folder (default: results)");
+
+  // scene
+  auto* scene_cmd = app.add_subcommand("scene", "Check a scene JSON, or print its schema");
+  bool schema = false;
+  std::string scene_check;
+  scene_cmd->add_flag("--schema", schema, "Print every key with its type, default and doc");
+  scene_cmd->add_option("file", scene_check, "Scene JSON to load and summarise");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+
+  try {
+    if (robots->parsed()) {
+      nlohmann::json j = RobotsJson();
+      if (robots_json) {
+        std::cout << j.dump(2) << "\n";
+      } else {
+        for (const auto& r : j) {
+          std::cout << r["name"].get<std::string>() << ": " << r["n_tets"] << " tets, "
+                    << r["n_vertices"] << " vertices (default res " << r["default_resolution"]
+                    << ")\n  " << r["description"].get<std::string>() << "\n  actuators:";
+          for (const auto& a : r["actuators"])
+            std::cout << " " << a["name"].get<std::string>() << " (" << a["type"].get<std::string>()
+                      << ", [" << a["range"][0] << ", " << a["range"][1] << "])";
+          std::cout << "\n  markers:";
+          for (const auto& m : r["markers"]) std::cout << " " << m.get<std::string>();
+          std::cout << "\n";
+        }
+      }
+      return 0;
+    }
+    if (scene_cmd->parsed()) {
+      if (schema) {
+        std::cout << SceneSchema();
+        return 0;
+      }
+      if (scene_check.empty()) throw std::invalid_argument("scene: give a scene JSON file or --schema");
+      Scene s = LoadSceneJson(scene_check);
+      std::cout << scene_check << ": " << s.mesh.num_vertices() << " vertices, "
+                << s.mesh.num_elements() << " elements, " << s.num_actuators() << " actuator(s), "
+                << s.fixed.size() << " fixed vertices, " << s.markers.size() << " marker(s)\n";
+      return 0;
+    }
+    if (fk->parsed()) {
+      if (robot.empty() == scene_file.empty())
+        throw std::invalid_argument("fk: give exactly one of --robot NAME or --scene FILE");
+      if (res < 0) throw std::invalid_argument("--res: expected a positive integer");
+      Scene scene = robot.empty() ? LoadSceneJson(scene_file) : MakeRobot(robot, res);
+      FkOptions opt = scene.solver;
+      if (!solver_name.empty()) opt.solver = solver_name;
+      if (continuation != 0) opt.continuation_steps = continuation;
+      if (max_iter != 0) opt.max_iterations = max_iter;
+      if (tolerance != 0) opt.tolerance = tolerance;
+      std::string why;
+      if (!opt.IsValid(&why)) throw std::invalid_argument("option " + why);
+      const Eigen::VectorXd c = ParseVector(actuation, "--actuation");
+      auto model = std::make_shared<const Model>(scene);
+      FkResult r = MakeFkSolver(model, opt)->Solve(c);
+      if (r.status == FkStatus::InvalidInput) throw std::invalid_argument("--actuation: " + r.message);
+      std::cerr << r.BriefReport() << "\n";
+      nlohmann::json j;
+      j["status"] = FkStatusToString(r.status);
+      j["message"] = r.message;
+      j["solver"] = r.solver;
+      j["iterations"] = r.iterations;
+      j["energy"] = r.energy;
+      j["time_s"] = r.time_s;
+      j["local_time_s"] = r.local_time_s;
+      j["global_time_s"] = r.global_time_s;
+      j["n_vertices"] = scene.mesh.num_vertices();
+      j["n_elements"] = scene.mesh.num_elements();
+      j["actuation"] = std::vector<double>(c.data(), c.data() + c.size());
+      j["volume_ratios"] = r.volume_ratios;
+      j["residual_ratio"] = r.gradient_ratio;
+      const Eigen::MatrixX3d P = scene.marker_positions(r.positions);
+      nlohmann::json markers = nlohmann::json::object();
+      for (size_t i = 0; i < scene.markers.size(); ++i)
+        markers[scene.markers[i].name] = {P(i, 0), P(i, 1), P(i, 2)};
+      j["markers"] = markers;
+      if (!json_out.empty()) WriteJson(json_out, j);
+      else std::cout << j.dump(2) << "\n";
+      if (!vtu_out.empty()) WriteVtu(vtu_out, scene.mesh, r.positions);
+      if (!obj_out.empty()) WriteSurfaceObj(obj_out, scene.mesh, r.positions);
+      return r.status == FkStatus::Converged ? 0 : 1;
+    }
+    if (run->parsed()) {
+      ropt.plot = !no_plot;
+      RunExperiment(config, ropt);
+      return 0;
+    }
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "softkin: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "softkin: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace softkin

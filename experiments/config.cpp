@@ -1,0 +1,171 @@
+#include "experiments/config.hpp"
+
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace softkin {
+
+namespace {
+std::string Dump(const nlohmann::json& v) {
+  std::string s = v.dump();
+  return s.size() > 60 ? s.substr(0, 57) + "..." : s;
+}
+}  // namespace
+
+Config Config::Load(const std::string& path, bool quick) {
+  Config c;
+  c.path_ = path;
+  c.quick_ = quick;
+  std::ifstream f(path);
+  if (!f) throw std::invalid_argument(path + ": cannot open experiment config");
+  std::stringstream ss;
+  ss << f.rdbuf();
+  const std::string text = ss.str();
+  try {
+    c.j_ = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    size_t line = 1, col = 1;
+    for (size_t i = 0; i < e.byte && i < text.size() + 1 && i < text.size(); ++i) {
+      if (text[i] == '\n') { ++line; col = 1; } else { ++col; }
+    }
+    throw std::invalid_argument(path + ":" + std::to_string(line) + ":" + std::to_string(col) +
+                                ": invalid JSON (" + e.what() + ")");
+  }
+  if (!c.j_.is_object()) throw std::invalid_argument(path + ": expected a JSON object at the top");
+  if (c.j_.contains("quick")) {
+    if (!c.j_["quick"].is_object()) c.Fail("quick", "an object of overrides");
+    nlohmann::json q = c.j_["quick"];
+    if (quick)
+      for (auto it = q.begin(); it != q.end(); ++it) {
+        if (!c.j_.contains(it.key()))
+          throw std::invalid_argument(path + ": quick." + it.key() +
+                                      ": overrides a key that the config does not have");
+        c.j_[it.key()] = it.value();
+      }
+    c.j_.erase("quick");
+  }
+  c.name_ = c.String("name", "");
+  if (c.name_.empty()) c.Fail("name", "a non-empty string");
+  for (char ch : c.name_)
+    if (!(isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-'))
+      c.Fail("name", "letters, digits, '_' or '-' only");
+  c.type_ = c.String("experiment", "");
+  if (!c.j_.contains("seed")) c.Fail("seed", "an integer seed (every config carries its seed)");
+  c.seed_ = static_cast<unsigned>(c.Int("seed", 0));
+  c.String("description", "");
+  return c;
+}
+
+void Config::Fail(const std::string& key, const std::string& expected) const {
+  std::string got = j_.contains(key) ? ", got " + Dump(j_.at(key)) : " (missing)";
+  throw std::invalid_argument(path_ + ": " + key + ": expected " + expected + got);
+}
+
+std::string Config::String(const std::string& key, const std::string& def) const {
+  used_.insert(key);
+  if (!j_.contains(key)) return def;
+  if (!j_[key].is_string()) Fail(key, "a string");
+  return j_[key].get<std::string>();
+}
+
+double Config::Number(const std::string& key, double def) const {
+  used_.insert(key);
+  if (!j_.contains(key)) return def;
+  if (!j_[key].is_number()) Fail(key, "a number");
+  return j_[key].get<double>();
+}
+
+int Config::Int(const std::string& key, int def) const {
+  used_.insert(key);
+  if (!j_.contains(key)) return def;
+  if (!j_[key].is_number_integer()) Fail(key, "an integer");
+  return j_[key].get<int>();
+}
+
+bool Config::Bool(const std::string& key, bool def) const {
+  used_.insert(key);
+  if (!j_.contains(key)) return def;
+  if (!j_[key].is_boolean()) Fail(key, "true or false");
+  return j_[key].get<bool>();
+}
+
+std::vector<int> Config::IntList(const std::string& key, const std::vector<int>& def) const {
+  used_.insert(key);
+  if (!j_.contains(key)) return def;
+  const auto& v = j_[key];
+  if (!v.is_array()) Fail(key, "an array of integers");
+  std::vector<int> out;
+  for (const auto& x : v) {
+    if (!x.is_number_integer()) Fail(key, "an array of integers");
+    out.push_back(x.get<int>());
+  }
+  return out;
+}
+
+std::vector<double> Config::NumberList(const std::string& key, const std::vector<double>& def) const {
+  used_.insert(key);
+  if (!j_.contains(key)) return def;
+  const auto& v = j_[key];
+  if (!v.is_array()) Fail(key, "an array of numbers");
+  std::vector<double> out;
+  for (const auto& x : v) {
+    if (!x.is_number()) Fail(key, "an array of numbers");
+    out.push_back(x.get<double>());
+  }
+  return out;
+}
+
+std::vector<std::string> Config::StringList(const std::string& key,
+                                            const std::vector<std::string>& def) const {
+  used_.insert(key);
+  if (!j_.contains(key)) return def;
+  const auto& v = j_[key];
+  if (!v.is_array()) Fail(key, "an array of strings");
+  std::vector<std::string> out;
+  for (const auto& x : v) {
+    if (!x.is_string()) Fail(key, "an array of strings");
+    out.push_back(x.get<std::string>());
+  }
+  return out;
+}
+
+void ApplySolverJson(const nlohmann::json& j, const std::string& where, FkOptions* o) {
+  if (!j.is_object()) throw std::invalid_argument(where + ": expected an object of solver options");
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string& k = it.key();
+    const auto& v = it.value();
+    auto need = [&](bool ok, const char* what) {
+      if (!ok) throw std::invalid_argument(where + "." + k + ": expected " + what + ", got " + Dump(v));
+    };
+    if (k == "solver") { need(v.is_string(), "a solver name (lg, lg-aa)"); o->solver = v.get<std::string>(); }
+    else if (k == "max_iterations") { need(v.is_number_integer(), "an integer"); o->max_iterations = v.get<int>(); }
+    else if (k == "tolerance") { need(v.is_number(), "a number"); o->tolerance = v.get<double>(); }
+    else if (k == "gradient_tolerance") { need(v.is_number(), "a number"); o->gradient_tolerance = v.get<double>(); }
+    else if (k == "anderson_window") { need(v.is_number_integer(), "an integer"); o->anderson_window = v.get<int>(); }
+    else if (k == "continuation_steps") { need(v.is_number_integer(), "an integer"); o->continuation_steps = v.get<int>(); }
+    else if (k == "threads") { need(v.is_number_integer(), "an integer"); o->threads = v.get<int>(); }
+    else
+      throw std::invalid_argument(where + "." + k + ": unknown key (expected one of solver, "
+                                  "max_iterations, tolerance, gradient_tolerance, anderson_window, "
+                                  "continuation_steps, threads)");
+  }
+  std::string why;
+  if (!o->IsValid(&why)) throw std::invalid_argument(where + ": " + why);
+}
+
+FkOptions Config::Solver(const FkOptions& base) const {
+  used_.insert("solver");
+  FkOptions o = base;
+  if (j_.contains("solver")) ApplySolverJson(j_["solver"], path_ + ": solver", &o);
+  return o;
+}
+
+void Config::CheckNoUnknownKeys() const {
+  for (auto it = j_.begin(); it != j_.end(); ++it)
+    if (!used_.count(it.key()))
+      throw std::invalid_argument(path_ + ": " + it.key() + ": unknown key for experiment '" +
+                                  type_ + "'");
+}
+
+}  // namespace softkin

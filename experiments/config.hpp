@@ -1,0 +1,57 @@
+#pragma once
+/// \file config.hpp
+/// Experiment configs: JSON files in experiments/ with a name, an experiment type, a seed, the
+/// experiment's parameters and an optional "quick" object whose keys override the top-level ones
+/// in --quick mode (for CI). Every key is checked: unknown keys and wrong types are errors that name
+/// the config file and the key.
+#include "solver/fk_options.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <set>
+#include <string>
+#include <vector>
+
+namespace softkin {
+
+class Config {
+ public:
+  /// Loads `path`, merges "quick" over the top level if quick is set, and checks the common keys.
+  static Config Load(const std::string& path, bool quick);
+
+  const std::string& name() const { return name_; }
+  const std::string& type() const { return type_; }
+  const std::string& path() const { return path_; }
+  unsigned seed() const { return seed_; }
+  bool quick() const { return quick_; }
+  /// The effective config (after merging quick), as recorded in results.
+  const nlohmann::json& json() const { return j_; }
+
+  /// Typed getters; each marks the key as known. Missing keys give the default.
+  std::string String(const std::string& key, const std::string& def) const;
+  double Number(const std::string& key, double def) const;
+  int Int(const std::string& key, int def) const;
+  bool Bool(const std::string& key, bool def) const;
+  std::vector<int> IntList(const std::string& key, const std::vector<int>& def) const;
+  std::vector<double> NumberList(const std::string& key, const std::vector<double>& def) const;
+  std::vector<std::string> StringList(const std::string& key,
+                                      const std::vector<std::string>& def) const;
+  /// Solver options from the "solver" object on top of `base`.
+  FkOptions Solver(const FkOptions& base) const;
+  /// Throws if the config has keys that no getter asked for.
+  void CheckNoUnknownKeys() const;
+  [[noreturn]] void Fail(const std::string& key, const std::string& expected) const;
+
+ private:
+  std::string path_, name_, type_;
+  unsigned seed_ = 0;
+  bool quick_ = false;
+  nlohmann::json j_;
+  mutable std::set<std::string> used_;
+};
+
+/// Applies a JSON object of solver options (keys as in FkOptions) onto opts; `where` names it in
+/// errors (e.g. "config.json: solver"). Unknown keys and wrong types throw std::invalid_argument.
+void ApplySolverJson(const nlohmann::json& j, const std::string& where, FkOptions* opts);
+
+}  // namespace softkin

@@ -1,0 +1,101 @@
+#include "experiments/results.hpp"
+
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include <sys/utsname.h>
+
+namespace softkin {
+
+namespace fs = std::filesystem;
+
+std::string ResultDir(const std::string& root, const std::string& name) {
+  fs::path p = fs::path(root) / name;
+  std::error_code ec;
+  fs::create_directories(p, ec);
+  if (ec) throw std::runtime_error("cannot create result folder " + p.string() + ": " + ec.message());
+  return p.string();
+}
+
+std::string GitCommit() {
+  std::string cmd = std::string("git -C '") + SOFTKIN_SOURCE_DIR +
+                    "' rev-parse HEAD 2>/dev/null";
+  FILE* f = popen(cmd.c_str(), "r");
+  if (!f) return "unknown";
+  char buf[128] = {0};
+  std::string out;
+  if (fgets(buf, sizeof(buf), f)) out = buf;
+  pclose(f);
+  while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
+  if (out.empty()) return "unknown";
+  FILE* g = popen((std::string("git -C '") + SOFTKIN_SOURCE_DIR +
+                   "' status --porcelain --untracked-files=no 2>/dev/null").c_str(), "r");
+  if (g) {
+    if (fgets(buf, sizeof(buf), g)) out += "-dirty";
+    pclose(g);
+  }
+  return out;
+}
+
+nlohmann::json MachineInfo() {
+  nlohmann::json j;
+  struct utsname u;
+  if (uname(&u) == 0) {
+    j["host"] = u.nodename;
+    j["system"] = std::string(u.sysname) + " " + u.release;
+    j["arch"] = u.machine;
+  }
+  j["hardware_threads"] = std::thread::hardware_concurrency();
+  std::ifstream cpu("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(cpu, line))
+    if (line.rfind("model name", 0) == 0) {
+      j["cpu"] = line.substr(line.find(':') + 2);
+      break;
+    }
+  std::time_t t = std::time(nullptr);
+  char ts[64];
+  std::strftime(ts, sizeof(ts), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  j["utc"] = ts;
+  return j;
+}
+
+void WriteJson(const std::string& path, const nlohmann::json& j) {
+  std::ofstream f(path);
+  if (!f) throw std::runtime_error("cannot write " + path);
+  f << std::setw(2) << j << "\n";
+  if (!f) throw std::runtime_error("error while writing " + path);
+}
+
+CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& header)
+    : path_(path), out_(path), cols_(header.size()) {
+  if (!out_) throw std::runtime_error("cannot write " + path);
+  RowStrings(header);
+}
+
+void CsvWriter::Row(const std::vector<double>& values) {
+  std::vector<std::string> s;
+  s.reserve(values.size());
+  for (double v : values) {
+    std::ostringstream os;
+    os << std::setprecision(10) << v;
+    s.push_back(os.str());
+  }
+  RowStrings(s);
+}
+
+void CsvWriter::RowStrings(const std::vector<std::string>& values) {
+  if (values.size() != cols_)
+    throw std::logic_error(path_ + ": row has " + std::to_string(values.size()) +
+                           " values, header has " + std::to_string(cols_));
+  for (size_t i = 0; i < values.size(); ++i) out_ << (i ? "," : "") << values[i];
+  out_ << "\n";
+  out_.flush();
+}
+
+}  // namespace softkin

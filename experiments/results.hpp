@@ -1,0 +1,35 @@
+#pragma once
+/// \file results.hpp
+/// Writing experiment results: results/<name>/{summary.json, config.json, run.json, *.csv}.
+/// run.json records the git commit, the machine and the wall time so results are traceable.
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace softkin {
+
+/// Creates (if needed) and returns the result folder `root`/`name`.
+std::string ResultDir(const std::string& root, const std::string& name);
+/// The git commit of the source tree (or "unknown"), and a description of the machine.
+std::string GitCommit();
+nlohmann::json MachineInfo();
+/// Writes JSON with 2-space indentation; throws std::runtime_error naming the path on failure.
+void WriteJson(const std::string& path, const nlohmann::json& j);
+
+/// A CSV file written row by row and flushed after each row, so finished rows survive a crash.
+class CsvWriter {
+ public:
+  CsvWriter(const std::string& path, const std::vector<std::string>& header);
+  void Row(const std::vector<double>& values);
+  void RowStrings(const std::vector<std::string>& values);
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  std::ofstream out_;
+  size_t cols_;
+};
+
+}  // namespace softkin

@@ -1,0 +1,89 @@
+#include "experiments/runner.hpp"
+
+#include "experiments/results.hpp"
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <stdexcept>
+
+namespace softkin {
+
+namespace fs = std::filesystem;
+
+namespace {
+struct Entry {
+  const char* type;
+  ExperimentFn fn;
+};
+const Entry kExperiments[] = {
+    {"pneumatic_bending", &RunPneumaticBending},
+    {"resolution_sweep", &RunResolutionSweep},
+    {"aa_ablation", &RunAaAblation},
+};
+}  // namespace
+
+std::vector<std::string> ExperimentTypes() {
+  std::vector<std::string> v;
+  for (const auto& e : kExperiments) v.push_back(e.type);
+  return v;
+}
+
+ExperimentFn FindExperiment(const std::string& type) {
+  for (const auto& e : kExperiments)
+    if (type == e.type) return e.fn;
+  return nullptr;
+}
+
+nlohmann::json RunExperiment(const std::string& config_path, const RunOptions& opt) {
+  Config cfg = Config::Load(config_path, opt.quick);
+  ExperimentFn fn = FindExperiment(cfg.type());
+  if (!fn) {
+    std::string known;
+    for (const auto& t : ExperimentTypes()) known += (known.empty() ? "" : ", ") + t;
+    cfg.Fail("experiment", "one of " + known);
+  }
+  const std::string dir = ResultDir(opt.results_root, cfg.name());
+  WriteJson(dir + "/config.json", cfg.json());
+  nlohmann::json run;
+  run["config_path"] = config_path;
+  run["quick"] = opt.quick;
+  run["git_commit"] = GitCommit();
+  run["machine"] = MachineInfo();
+  run["seed"] = cfg.seed();
+  const auto t0 = std::chrono::steady_clock::now();
+  if (opt.verbose) std::cerr << "softkin: running " << cfg.name() << (opt.quick ? " (quick)" : "") << "\n";
+  nlohmann::json summary = fn(cfg, dir, opt.verbose);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  run["wall_time_s"] = wall;
+  summary["name"] = cfg.name();
+  summary["experiment"] = cfg.type();
+  summary["quick"] = opt.quick;
+  summary["seed"] = cfg.seed();
+  summary["git_commit"] = run["git_commit"];
+  summary["machine"] = run["machine"];
+  summary["config"] = cfg.json();
+  summary["wall_time_s"] = wall;
+  WriteJson(dir + "/summary.json", summary);
+  WriteJson(dir + "/run.json", run);
+  if (opt.verbose) std::cerr << "softkin: wrote " << dir << "/summary.json (" << wall << " s)\n";
+
+  if (opt.plot) {
+    const fs::path script = fs::path(SOFTKIN_SOURCE_DIR) / "paper_figs" / (cfg.name() + ".py");
+    if (fs::exists(script)) {
+      const std::string cmd = "/usr/bin/python3 '" + script.string() + "' '" + dir + "'";
+      if (opt.verbose) std::cerr << "softkin: plotting: " << cmd << "\n";
+      const int rc = std::system(cmd.c_str());
+      if (rc != 0)
+        throw std::runtime_error("the plot script " + script.string() + " failed (exit " +
+                                 std::to_string(rc) + "); results are in " + dir +
+                                 "; is python3-matplotlib installed?");
+    } else if (opt.verbose) {
+      std::cerr << "softkin: no plot script " << script.string() << "\n";
+    }
+  }
+  return summary;
+}
+
+}  // namespace softkin

@@ -1,0 +1,39 @@
+#pragma once
+/// \file runner.hpp
+/// `softkin run CONFIG`: dispatches an experiment config to its experiment, writes
+/// results/<name>/{summary.json, config.json, run.json, *.csv} and, unless disabled, runs the
+/// matching paper_figs/<name>.py to make the PNG.
+#include "experiments/config.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <vector>
+
+namespace softkin {
+
+struct RunOptions {
+  bool quick = false;
+  bool plot = true;
+  std::string results_root = "results";
+  bool verbose = true;  ///< progress on stderr
+};
+
+/// An experiment reads its keys from the config (then CheckNoUnknownKeys), runs, writes CSVs into
+/// `dir` and returns its summary (headline numbers).
+using ExperimentFn = nlohmann::json (*)(const Config& cfg, const std::string& dir, bool verbose);
+
+/// Registered experiment types ("pneumatic_bending", "resolution_sweep", "aa_ablation").
+std::vector<std::string> ExperimentTypes();
+ExperimentFn FindExperiment(const std::string& type);
+
+/// Runs one config; returns the summary written. Throws std::invalid_argument for bad configs and
+/// std::runtime_error if a step fails (finished CSV rows are kept).
+nlohmann::json RunExperiment(const std::string& config_path, const RunOptions& options);
+
+// Experiments (each in its own file).
+nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bool verbose);
+nlohmann::json RunResolutionSweep(const Config& cfg, const std::string& dir, bool verbose);
+nlohmann::json RunAaAblation(const Config& cfg, const std::string& dir, bool verbose);
+
+}  // namespace softkin

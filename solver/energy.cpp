@@ -1,0 +1,131 @@
+#include "solver/energy.hpp"
+
+#include "solver/rotation.hpp"
+#include "solver/targets.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace softkin {
+
+void CheckActuation(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& c) {
+  const auto& acts = model.scene().actuators;
+  if (c.size() != static_cast<Eigen::Index>(acts.size())) {
+    std::ostringstream os;
+    os << "actuation: expected " << acts.size() << " value(s) (";
+    for (size_t a = 0; a < acts.size(); ++a) os << (a ? ", " : "") << acts[a].name;
+    os << "), got " << c.size();
+    throw std::invalid_argument(os.str());
+  }
+  for (size_t a = 0; a < acts.size(); ++a) {
+    if (!std::isfinite(c[a]) || c[a] < acts[a].min || c[a] > acts[a].max) {
+      std::ostringstream os;
+      os << "actuation of '" << acts[a].name << "': expected a number in [" << acts[a].min << ", "
+         << acts[a].max << "], got " << c[a];
+      throw std::invalid_argument(os.str());
+    }
+  }
+}
+
+double Energy(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+              const Eigen::Ref<const Eigen::VectorXd>& c) {
+  std::vector<double> ratios;
+  ComputeLocalRatios(model, X, c, &ratios);
+  std::vector<ElemRows> w;
+  return LocalStep(model, X, ratios, &w);
+}
+
+double FrozenTargetGradient(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                            const Eigen::Ref<const Eigen::VectorXd>& c, Eigen::MatrixX3d* grad) {
+  std::vector<double> ratios;
+  ComputeLocalRatios(model, X, c, &ratios);
+  std::vector<ElemRows> w;
+  const double E = LocalStep(model, X, ratios, &w);
+  Eigen::MatrixX3d B;
+  AssembleRhs(model, w, &B);
+  *grad = 2.0 * (model.A() * X - B);
+  return E;
+}
+
+double EnergyAndGradient(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                         const Eigen::Ref<const Eigen::VectorXd>& c, Eigen::MatrixX3d* grad) {
+  const auto& els = model.elements();
+  const int ne = static_cast<int>(els.size());
+  std::vector<double> ratios;
+  ComputeLocalRatios(model, X, c, &ratios);
+  grad->setZero(model.num_vertices(), 3);
+  // dE_i/dc_i for pneumatic elements, with c_i = cbrt(alpha_i): needed for the chain rule through
+  // the volume-proportional ratio distribution.
+  std::vector<double> dE_dscale(ne, 0.0);
+  double E = 0.0;
+  for (int i = 0; i < ne; ++i) {
+    const ModelElement& e = els[i];
+    const int k = e.k;
+    ElemRows D = ElemRows::Zero();
+    for (int j = 0; j < k; ++j) D.row(j) = X.row(e.v[j]);
+    CenterRows(D, k);
+    const Eigen::Matrix3d R = BestRotation(D.topRows(k).transpose() * e.rest.topRows(k));
+    ElemRows RP = ElemRows::Zero();
+    RP.topRows(k) = e.rest.topRows(k) * R.transpose();
+    ElemRows G = ElemRows::Zero();  // dE_i/dD (centred rows)
+    if (e.role == ElementRole::Body) {
+      // E_i = wv || beta D - Rw R P ||^2, beta = 1 - (1 - Rw) s(Vol(D)).
+      const double vd = RowsVolume(D, k);
+      double s = 1.0;
+      bool s_varies = false;
+      if (e.r_omega < 1.0 && vd > 1e-9 * e.rest_volume) {
+        s = std::cbrt(e.rest_volume / vd);
+        s_varies = s < 10.0;
+        s = std::min(s, 10.0);
+      }
+      const double beta = 1.0 - (1.0 - e.r_omega) * s;
+      const ElemRows r = beta * D - e.r_omega * RP;
+      E += e.wv * r.squaredNorm();
+      G = 2.0 * e.wv * beta * r;
+      if (s_varies) {
+        // dbeta/dD = -(1 - Rw) ds/dVol dVol/dD, ds/dVol = -s / (3 Vol).
+        const double dE_dbeta = 2.0 * e.wv * (r.topRows(k).cwiseProduct(D.topRows(k))).sum();
+        const double dbeta_dvol = (1.0 - e.r_omega) * s / (3.0 * vd);
+        G += dE_dbeta * dbeta_dvol * RowsVolumeGradient(D, k);
+      }
+    } else {
+      const double cs = std::cbrt(ratios[i]);
+      const ElemRows r = D - cs * RP;
+      E += e.wv * r.squaredNorm();
+      G = 2.0 * e.wv * r;
+      dE_dscale[i] = -2.0 * e.wv * (r.topRows(k).cwiseProduct(RP.topRows(k))).sum();
+    }
+    // D = N V: dE/dV = N^T dE/dD = dE/dD centred.
+    CenterRows(G, k);
+    for (int j = 0; j < k; ++j) grad->row(e.v[j]) += G.row(j);
+  }
+  // Chain rule through alpha_i = Vol_i^d * alpha U / (u_i U^d):
+  // dcbrt(alpha_i)/dVol_j = cbrt(alpha_i)/3 * (delta_ij / Vol_i - 1 / U^d).
+  for (int a = 0; a < model.num_actuators(); ++a) {
+    const auto& ids = model.actuator_elements(a);
+    double Ud = 0.0, sum_gc = 0.0;
+    std::vector<double> vol(ids.size());
+    for (size_t q = 0; q < ids.size(); ++q) {
+      const ModelElement& e = els[ids[q]];
+      ElemRows P;
+      for (int j = 0; j < e.k; ++j) P.row(j) = X.row(e.v[j]);
+      vol[q] = RowsVolume(P, e.k);
+      Ud += std::max(vol[q], 1e-6 * e.rest_volume);
+      sum_gc += dE_dscale[ids[q]] * std::cbrt(ratios[ids[q]]);
+    }
+    for (size_t q = 0; q < ids.size(); ++q) {
+      const ModelElement& e = els[ids[q]];
+      const double cs = std::cbrt(ratios[ids[q]]);
+      double coef = -sum_gc / (3.0 * Ud);
+      if (vol[q] > 1e-6 * e.rest_volume) coef += dE_dscale[ids[q]] * cs / (3.0 * vol[q]);
+      ElemRows P;
+      for (int j = 0; j < e.k; ++j) P.row(j) = X.row(e.v[j]);
+      const ElemRows gV = RowsVolumeGradient(P, e.k);
+      for (int j = 0; j < e.k; ++j) grad->row(e.v[j]) += coef * gV.row(j);
+    }
+  }
+  return E;
+}
+
+}  // namespace softkin

@@ -1,0 +1,22 @@
+#include "solver/fk_options.hpp"
+
+#include <cmath>
+
+namespace softkin {
+
+bool FkOptions::IsValid(std::string* why) const {
+  auto bad = [&](const std::string& m) { if (why) *why = m; return false; };
+  if (solver != "lg" && solver != "lg-aa")
+    return bad("solver: expected one of lg, lg-aa; got '" + solver + "'");
+  if (max_iterations < 1) return bad("max_iterations: expected an integer >= 1");
+  if (!(tolerance > 0.0) || !std::isfinite(tolerance)) return bad("tolerance: expected a number > 0");
+  if (!(gradient_tolerance > 0.0) || !std::isfinite(gradient_tolerance))
+    return bad("gradient_tolerance: expected a number > 0");
+  if (anderson_window < 1 || anderson_window > 50)
+    return bad("anderson_window: expected an integer in [1, 50]");
+  if (continuation_steps < 1) return bad("continuation_steps: expected an integer >= 1");
+  if (threads < 0) return bad("threads: expected an integer >= 0");
+  return true;
+}
+
+}  // namespace softkin

@@ -1,0 +1,57 @@
+#include "solver/fk_solver.hpp"
+
+#include "solver/local_global.hpp"
+
+#include <cstdio>
+#include <stdexcept>
+
+namespace softkin {
+
+const char* FkStatusToString(FkStatus s) {
+  switch (s) {
+    case FkStatus::Converged: return "converged";
+    case FkStatus::IterationCap: return "iteration_cap";
+    case FkStatus::Diverged: return "diverged";
+    case FkStatus::InvalidInput: return "invalid_input";
+  }
+  return "unknown";
+}
+
+bool FkStatusFromString(const std::string& s, FkStatus* out) {
+  for (FkStatus v : {FkStatus::Converged, FkStatus::IterationCap, FkStatus::Diverged,
+                     FkStatus::InvalidInput})
+    if (s == FkStatusToString(v)) {
+      *out = v;
+      return true;
+    }
+  return false;
+}
+
+std::string FkResult::BriefReport() const {
+  char buf[256];
+  std::snprintf(buf, sizeof(buf), "%s: %s, %d iterations, energy %.6g, residual ratio %.3g, %.3f s",
+                solver.c_str(), FkStatusToString(status), iterations, energy, gradient_ratio,
+                time_s);
+  std::string s = buf;
+  if (!message.empty()) s += " (" + message + ")";
+  return s;
+}
+
+std::vector<std::string> FkSolverNames() { return {"lg", "lg-aa"}; }
+
+std::unique_ptr<FkSolver> MakeFkSolver(std::shared_ptr<const Model> model, const FkOptions& options) {
+  std::string why;
+  if (!options.IsValid(&why)) throw std::invalid_argument("solver options: " + why);
+  if (options.solver == "lg" || options.solver == "lg-aa")
+    return std::make_unique<LocalGlobalSolver>(std::move(model), options);
+  throw std::invalid_argument("unknown FK solver '" + options.solver + "'");
+}
+
+FkResult SolveFk(const Scene& scene, const Eigen::Ref<const Eigen::VectorXd>& c,
+                 const FkOptions* options) {
+  auto model = std::make_shared<const Model>(scene);
+  auto solver = MakeFkSolver(model, options ? *options : scene.solver);
+  return solver->Solve(c);
+}
+
+}  // namespace softkin

@@ -1,0 +1,171 @@
+#include "solver/local_global.hpp"
+
+#include "solver/anderson.hpp"
+#include "solver/energy.hpp"
+#include "solver/targets.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+namespace softkin {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double Seconds(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+}  // namespace
+
+LocalGlobalSolver::LocalGlobalSolver(std::shared_ptr<const Model> model, const FkOptions& options)
+    : FkSolver(std::move(model)), options_(options) {
+  std::string why;
+  if (!options_.IsValid(&why)) throw std::invalid_argument("solver options: " + why);
+}
+
+void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* Xp, FkResult* r) {
+  const Model& m = *model_;
+  Eigen::MatrixX3d& X = *Xp;
+  const auto& fv = m.free_vertices();
+  const int nf = m.num_free();
+  const int nt = options_.threads;
+  const bool aa_on = options_.solver == "lg-aa";
+  const double tol = options_.tolerance;
+  const double gtol = options_.gradient_tolerance;
+
+  Eigen::MatrixX3d Xc(m.fixed_vertices().size(), 3);
+  for (size_t q = 0; q < m.fixed_vertices().size(); ++q)
+    Xc.row(q) = m.rest_positions().row(m.fixed_vertices()[q]);
+  const Eigen::MatrixX3d Cfix = m.A_fc() * Xc;
+
+  Eigen::MatrixX3d B(m.num_vertices(), 3), Bf(nf, 3), xf(nf, 3), Gf(nf, 3), Gprev(nf, 3);
+  auto local = [&](double* E) {
+    const auto t0 = Clock::now();
+    ComputeLocalRatios(m, X, c, &ratios_);
+    *E = LocalStep(m, X, ratios_, &weighted_, nt);
+    AssembleRhs(m, weighted_, &B, nt);
+    for (int i = 0; i < nf; ++i) Bf.row(i) = B.row(fv[i]);
+    r->local_time_s += Seconds(t0, Clock::now());
+  };
+  auto load_free = [&]() {
+    for (int i = 0; i < nf; ++i) xf.row(i) = X.row(fv[i]);
+  };
+  auto store_free = [&](const Eigen::MatrixX3d& Y) {
+    for (int i = 0; i < nf; ++i) X.row(fv[i]) = Y.row(i);
+  };
+
+  // Reference residual: the residual at the rest shape for this actuation.
+  double ref = 0.0;
+  {
+    const Eigen::MatrixX3d keep = X;
+    X = m.rest_positions();
+    double E0;
+    local(&E0);
+    load_free();
+    ref = 2.0 * (m.A_ff() * xf + Cfix - Bf).norm();
+    X = keep;
+  }
+
+  Anderson aa(3 * nf, options_.anderson_window);
+  Eigen::MatrixX3d X_good = X;
+  double E_acc = 0.0;
+  bool accelerated = false;
+  for (int it = 0; it < options_.max_iterations; ++it) {
+    double E;
+    local(&E);
+    if (aa_on && accelerated && !(E <= E_acc)) {
+      // Safeguard: the accelerated iterate raised the energy; take the plain step instead.
+      store_free(Gprev);
+      aa.Reset();
+      ++r->aa_rejected;
+      local(&E);
+    } else if (accelerated) {
+      ++r->aa_accepted;
+    }
+    if (!std::isfinite(E) || !X.allFinite()) {
+      X = X_good;
+      r->status = FkStatus::Diverged;
+      r->message = "non-finite energy or positions at iteration " + std::to_string(r->iterations);
+      return;
+    }
+    X_good = X;
+    E_acc = E;
+    load_free();
+    const double grad = 2.0 * (m.A_ff() * xf + Cfix - Bf).norm();
+    if (it == 0) ref = std::max(ref, grad);
+    r->gradient_ratio = ref > 0 ? grad / ref : 0.0;
+
+    const auto t1 = Clock::now();
+    Gf = m.SolveFree(Bf - Cfix);
+    r->global_time_s += Seconds(t1, Clock::now());
+    ++r->iterations;
+
+    const double move = (Gf - xf).rowwise().norm().maxCoeff() / m.size();
+    r->max_move = move;
+    if (!Gf.allFinite()) {
+      r->status = FkStatus::Diverged;
+      r->message = "the global step produced non-finite positions";
+      return;
+    }
+    if (move < tol && r->gradient_ratio < gtol) {
+      store_free(Gf);
+      r->status = FkStatus::Converged;
+      return;
+    }
+    if (aa_on) {
+      Eigen::Map<const Eigen::VectorXd> g(Gf.data(), 3 * nf);
+      const Eigen::VectorXd f = g - Eigen::Map<const Eigen::VectorXd>(xf.data(), 3 * nf);
+      const Eigen::VectorXd& xn = aa.Compute(g, f);
+      Gprev = Gf;
+      accelerated = aa.history() > 0;
+      Eigen::Map<const Eigen::MatrixXd> xnm(xn.data(), nf, 3);
+      store_free(xnm);
+    } else {
+      store_free(Gf);
+    }
+  }
+  r->status = FkStatus::IterationCap;
+  r->message = "iteration cap of " + std::to_string(options_.max_iterations) + " reached";
+}
+
+FkResult LocalGlobalSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
+                                  const Eigen::MatrixX3d* warm_start) {
+  const Model& m = *model_;
+  const auto t0 = Clock::now();
+  FkResult r;
+  r.solver = name();
+  r.actuation = c;
+  r.positions = m.rest_positions();
+  try {
+    CheckActuation(m, c);
+    if (warm_start) {
+      if (warm_start->rows() != m.num_vertices())
+        throw std::invalid_argument("warm start: expected " + std::to_string(m.num_vertices()) +
+                                    " x 3 positions, got " + std::to_string(warm_start->rows()) +
+                                    " rows");
+      if (!warm_start->allFinite())
+        throw std::invalid_argument("warm start: positions must be finite");
+      r.positions = *warm_start;
+      for (int v : m.fixed_vertices()) r.positions.row(v) = m.rest_positions().row(v);
+    }
+  } catch (const std::invalid_argument& e) {
+    r.status = FkStatus::InvalidInput;
+    r.message = e.what();
+    r.time_s = Seconds(t0, Clock::now());
+    return r;
+  }
+  const Eigen::VectorXd rest = m.scene().rest_actuation();
+  const int K = warm_start ? 1 : options_.continuation_steps;  // a warm start is already close
+  for (int s = 1; s <= K; ++s) {
+    const Eigen::VectorXd cs = (K == 1) ? Eigen::VectorXd(c)
+                                        : Eigen::VectorXd(rest + (c - rest) * (double(s) / K));
+    SolveStage(cs, &r.positions, &r);
+    if (r.status == FkStatus::Diverged) break;
+  }
+  ComputeLocalRatios(m, r.positions, c, &ratios_, &r.volume_ratios);
+  r.energy = LocalStep(m, r.positions, ratios_, &weighted_, options_.threads);
+  r.time_s = Seconds(t0, Clock::now());
+  return r;
+}
+
+}  // namespace softkin

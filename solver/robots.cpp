@@ -1,0 +1,251 @@
+#include <cstdlib>
+#include "solver/robots.hpp"
+
+#include "solver/mesh_gen.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace softkin {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// ================================================================================================
+// pneumatic_finger (thesis Fig. 2.11): PneuNet-style bending actuator on a voxel grid.
+//
+// Axes: x = long axis (proximal end x = 0, fixed; distal end x = 100), y = width [0, 20],
+// z = height [0, 20]. The inextensible layer is at the bottom and the chambers above it, so
+// inflation lengthens the top side and the finger curls towards -z (tip down, then back).
+// Nominal geometry (mm), snapped to the grid of cell size h = 20 / res:
+//   base layer z in [0, 3]            region 2 "inextensible" (r_omega 1, weight 1)
+//   proximal block x in [0, ~8]       region 0 solid, its x = 0 face is fixed
+//   9 chamber blocks of length ~8.2, each preceded by a 2 mm empty gap (also between the
+//   proximal block and the first chamber block), full width and height;
+//   each block: 2 mm walls (x ends, y sides, top), region 0 "body" (r_omega 1, weight 1),
+//   around a cavity that sits on the base layer and is filled with region-1 tets: the
+//   pneumatic actuation elements of the single actuator "chamber".
+// Every feature is >= 1 cell at every allowed resolution; at coarse resolutions (res < 8) the
+// number of chambers drops so that the finger stays 100 mm long. The proximal block absorbs the
+// rounding so the total length is exactly 100 mm. At the default res 12 (h = 1.667 mm): base
+// 2 cells (3.33 mm), walls and gaps 1 cell (1.67 mm), blocks 5 cells (8.33 mm; cavity 5 x 16.7 x
+// 15 mm), proximal block 6 cells (10 mm); 45,360 tets, 10,309 vertices.
+// ================================================================================================
+
+constexpr int kFingerMinRes = 4, kFingerMaxRes = 40, kFingerDefaultRes = 12;
+constexpr double kFingerLength = 100.0, kFingerWidth = 20.0, kFingerHeight = 20.0;
+constexpr double kFingerBase = 1.5, kFingerWall = 2.0, kFingerGap = 2.0, kFingerProximal = 8.0;
+constexpr int kFingerBlocks = 9;
+
+/// The finger's layout in cells.
+struct FingerLayout {
+  double h = 1.0;        // cell size, mm
+  int nx = 0, ny = 0, nz = 0;
+  int base = 0;          // base layer thickness (cells)
+  int top = 0;           // top wall
+  int side = 0;          // side walls (y)
+  int wall = 0;          // end walls of each block (x)
+  int gap = 0;           // empty gap between blocks
+  int blocks = 0;        // number of chamber blocks
+  int block = 0;         // block length
+  int proximal = 0;      // proximal solid block length
+};
+
+int Cells(double mm, double h) { return std::max(1, static_cast<int>(std::lround(mm / h))); }
+
+FingerLayout MakeFingerLayout(int res) {
+  FingerLayout L;
+  L.h = kFingerWidth / res;
+  L.ny = res;
+  L.nx = static_cast<int>(std::lround(kFingerLength / L.h));   // = 5 res
+  L.nz = static_cast<int>(std::lround(kFingerHeight / L.h));   // = res
+  L.base = Cells(kFingerBase, L.h);
+  L.top = Cells(kFingerWall, L.h);
+  L.side = Cells(kFingerWall, L.h);
+  L.wall = Cells(kFingerWall, L.h);
+  L.gap = Cells(kFingerGap, L.h);
+  const int prox_min = Cells(kFingerProximal, L.h);
+  const int min_block = 2 * L.wall + 1;
+  // Nominal block length: 9 (gap, block) pairs fill the 92 mm after the proximal block.
+  const double block_mm =
+      (kFingerLength - kFingerProximal - kFingerBlocks * kFingerGap) / kFingerBlocks;
+  const int avail = L.nx - prox_min;  // cells for gaps and blocks
+  L.blocks = std::min(kFingerBlocks, avail / (min_block + L.gap));
+  L.block = std::max(min_block, Cells(block_mm, L.h));
+  L.block = std::min(L.block, avail / L.blocks - L.gap);
+  L.proximal = L.nx - L.blocks * (L.gap + L.block);
+  return L;
+}
+
+/// Region of cell (i, j, k): 2 base layer, 0 wall/proximal block, 1 cavity, -1 gap (empty).
+int FingerCell(const FingerLayout& L, int i, int j, int k) {
+  if (k < L.base) return 2;
+  if (i < L.proximal) return 0;
+  const int pitch = L.gap + L.block;
+  const int u = (i - L.proximal) % pitch - L.gap;  // position in the block, < 0 in the gap
+  if (u < 0) return -1;  // gap in front of the block
+  const bool cavity = u >= L.wall && u < L.block - L.wall && j >= L.side && j < L.ny - L.side &&
+                      k < L.nz - L.top;
+  return cavity ? 1 : 0;
+}
+
+Scene MakePneumaticFinger(int res) {
+  const FingerLayout L = MakeFingerLayout(res);
+  Scene s;
+  s.name = "pneumatic_finger";
+  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), L.h, Eigen::Vector3i(L.nx, L.ny, L.nz),
+                        [&L](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
+                          return FingerCell(L, c[0], c[1], c[2]);
+                        });
+  s.body[0] = Material{"body", getenv("SK_RB")?atof(getenv("SK_RB")):1.0, 1.0};
+  s.body[2] = Material{"inextensible", 1.0, getenv("SK_WL")?atof(getenv("SK_WL")):1.0};
+  Actuator a;
+  a.name = "chamber";
+  a.type = ActuatorType::Pneumatic;
+  a.regions = {1};
+  a.rest = 1.0;
+  a.min = 1.0;
+  a.max = 8.0;
+  s.actuators.push_back(a);
+
+  const double eps = 1e-6 * L.h;
+  const double xmax = L.nx * L.h, zmax = L.nz * L.h;
+  s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
+  s.markers.push_back({"tip", VerticesInBox(s.mesh, Eigen::Vector3d(xmax - eps, -kInf, -kInf),
+                                            Eigen::Vector3d(xmax + eps, kInf, kInf))});
+  s.markers.push_back(
+      {"tip_top", VerticesInBox(s.mesh, Eigen::Vector3d(xmax - eps, -kInf, 0.75 * zmax - eps),
+                                Eigen::Vector3d(xmax + eps, kInf, kInf))});
+  s.markers.push_back(
+      {"tip_bottom", VerticesInBox(s.mesh, Eigen::Vector3d(xmax - eps, -kInf, -kInf),
+                                   Eigen::Vector3d(xmax + eps, kInf, 0.25 * zmax + eps))});
+  s.validate();
+  return s;
+}
+
+// ================================================================================================
+// three_chamber (thesis Fig. 2.12, Chapter 5): 48 x 48 x 136 mm cylinder with three chambers.
+//
+// Axes: y = long axis (base face y = 0, fixed; tip face y = 136), as in the real trajectory data
+// (flower_trajectory.txt). The cross-section is the x-z plane; angles phi are measured in it from
+// +x towards +z, i.e. phi = atan2(z, x). Chamber k (k = 0, 1, 2; actuator "c<k+1>", region k+1)
+// is a cylinder of radius 7 mm around the line at distance 13 mm from the axis at angle
+//   phi_k = 180 + 120 k degrees   (c1 on -x, c2 at 300 deg, c3 at 60 deg),
+// spanning y in [8, 128]. Rotation by +120 degrees in phi maps chamber k onto chamber k+1.
+// Inflating chamber k alone bends the tip away from it, towards phi_k + 180 = 0, 120, 240 deg:
+// the three petal directions of the 'flower' trajectory, visited in the order c1, c2, c3.
+// Chamber elements are the tets whose centroid lies inside a chamber; tags are assigned on the
+// canonical (sector-0) copy of every tet, so the tagging is exactly 3-fold symmetric.
+// ================================================================================================
+
+constexpr int kThreeMinRes = 3, kThreeMaxRes = 16, kThreeDefaultRes = 7;
+constexpr double kThreeRadius = 24.0, kThreeLength = 136.0;
+constexpr double kChamberRadius = 7.0, kChamberOffset = 13.0, kChamberY0 = 8.0, kChamberY1 = 128.0;
+constexpr double kChamberAngle0 = 180.0;  // degrees, chamber 0 (c1)
+
+Scene MakeThreeChamber(int res) {
+  DiskExtrusion p;
+  p.radius = kThreeRadius;
+  p.rings = res;
+  p.length = kThreeLength;
+  p.axis = 1;
+  p.base = 0.0;
+  p.layers = std::max(1, static_cast<int>(std::lround(kThreeLength / (kThreeRadius / res))));
+  const double pi = std::acos(-1.0);
+  Eigen::Vector2d centre[3];  // (x, z) of each chamber's axis
+  for (int k = 0; k < 3; ++k) {
+    const double a = (kChamberAngle0 + 120.0 * k) * pi / 180.0;
+    centre[k] = kChamberOffset * Eigen::Vector2d(std::cos(a), std::sin(a));
+  }
+  auto region = [&centre](const DiskElementInfo& e) {
+    const Eigen::Vector3d& c = e.canonical_centroid;
+    if (c.y() < kChamberY0 || c.y() > kChamberY1) return 0;
+    for (int k = 0; k < 3; ++k)
+      if ((Eigen::Vector2d(c.x(), c.z()) - centre[k]).norm() <= kChamberRadius)
+        return 1 + (k + e.sector) % 3;
+    return 0;
+  };
+  Scene s;
+  s.name = "three_chamber";
+  s.mesh = ExtrudedDiskTetMesh(p, region);
+  s.body[0] = Material{"body", 1.0, 1.0};
+  for (int k = 0; k < 3; ++k) {
+    Actuator a;
+    a.name = "c" + std::to_string(k + 1);
+    a.type = ActuatorType::Pneumatic;
+    a.regions = {k + 1};
+    a.rest = 1.0;
+    a.min = 1.0;
+    a.max = 3.0;
+    s.actuators.push_back(a);
+  }
+  const double eps = 1e-6 * kThreeLength / p.layers;
+  s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitY(), eps);
+  s.markers.push_back({"tip", VerticesOnPlane(s.mesh, Eigen::Vector3d(0.0, kThreeLength, 0.0),
+                                              Eigen::Vector3d::UnitY(), eps)});
+  s.validate();
+  return s;
+}
+
+struct RobotEntry {
+  RobotInfo info;
+  int min_res, max_res;
+  Scene (*make)(int);
+};
+
+const std::vector<RobotEntry>& Registry() {
+  static const std::vector<RobotEntry> kRobots = {
+      {{"pneumatic_finger",
+        "PneuNet-style pneumatic bending finger (thesis Fig. 2.11), voxel tet mesh. x = long axis "
+        "[0, 100] mm (x = 0 fixed), y = width [0, 20], z = height [0, 20]; inextensible base layer "
+        "z in [0, 3] (region 2), a solid proximal block and 9 chamber blocks (2 mm walls, region 0) "
+        "separated by 2 mm empty gaps; the filled cavities (region 1) form one pneumatic actuator "
+        "'chamber' (volume ratio in [1, 8]). Markers: tip (distal face x = 100), tip_top / "
+        "tip_bottom (top / bottom quarter of the distal face).",
+        kFingerDefaultRes,
+        "cells across the 20 mm width (cell size 20/res mm), integer in [4, 40]; ~26 res^3 tets; "
+        "fewer than 9 chambers below res 8"},
+       kFingerMinRes, kFingerMaxRes, &MakePneumaticFinger},
+      {{"three_chamber",
+        "Three-chamber pneumatic actuator (thesis Fig. 2.12, Chapter 5): 48 x 48 x 136 mm cylinder. "
+        "y = long axis (y = 0 fixed, tip face y = 136); angles phi = atan2(z, x) in the x-z plane. "
+        "Chambers c1, c2, c3 (regions 1-3, pneumatic, volume ratio in [1, 3]): radius 7 mm, 13 mm "
+        "from the axis at phi = 180, 300, 60 degrees, y in [8, 128]; body region 0. The mesh is "
+        "exactly invariant under rotation by 120 degrees about y (c1 -> c2 -> c3). Marker: tip "
+        "(top face y = 136).",
+        kThreeDefaultRes,
+        "number of concentric rings of the cross-section disk (radial spacing 24/res mm; layers "
+        "along y of about the same size), integer in [3, 16]; ~102 res^3 tets"},
+       kThreeMinRes, kThreeMaxRes, &MakeThreeChamber},
+  };
+  return kRobots;
+}
+
+}  // namespace
+
+std::vector<RobotInfo> ListRobots() {
+  std::vector<RobotInfo> out;
+  for (const auto& r : Registry()) out.push_back(r.info);
+  return out;
+}
+
+Scene MakeRobot(const std::string& name, int res) {
+  for (const auto& r : Registry()) {
+    if (r.info.name != name) continue;
+    if (res <= 0) res = r.info.default_resolution;
+    if (res < r.min_res || res > r.max_res)
+      throw std::invalid_argument(name + ": --res must be an integer in [" +
+                                  std::to_string(r.min_res) + ", " + std::to_string(r.max_res) +
+                                  "], got " + std::to_string(res));
+    return r.make(res);
+  }
+  std::string known;
+  for (const auto& r : Registry()) known += (known.empty() ? "" : ", ") + r.info.name;
+  throw std::invalid_argument("unknown robot '" + name + "'; known robots: " + known);
+}
+
+}  // namespace softkin

@@ -1,0 +1,149 @@
+#include "solver/scene.hpp"
+
+#include <algorithm>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace softkin {
+
+const char* ActuatorTypeToString(ActuatorType t) {
+  switch (t) {
+    case ActuatorType::Pneumatic: return "pneumatic";
+    case ActuatorType::Cable: return "cable";
+    case ActuatorType::Dea: return "dea";
+  }
+  return "unknown";
+}
+
+bool ActuatorTypeFromString(const std::string& s, ActuatorType* t) {
+  if (s == "pneumatic") { *t = ActuatorType::Pneumatic; return true; }
+  if (s == "cable") { *t = ActuatorType::Cable; return true; }
+  if (s == "dea") { *t = ActuatorType::Dea; return true; }
+  return false;
+}
+
+int Scene::actuator_index(const std::string& n) const {
+  for (int i = 0; i < num_actuators(); ++i)
+    if (actuators[i].name == n) return i;
+  return -1;
+}
+
+int Scene::marker_index(const std::string& n) const {
+  for (int i = 0; i < static_cast<int>(markers.size()); ++i)
+    if (markers[i].name == n) return i;
+  return -1;
+}
+
+Eigen::VectorXd Scene::rest_actuation() const {
+  Eigen::VectorXd c(num_actuators());
+  for (int i = 0; i < num_actuators(); ++i) c[i] = actuators[i].rest;
+  return c;
+}
+
+Eigen::MatrixX3d Scene::marker_positions(const Eigen::Ref<const Eigen::MatrixX3d>& X) const {
+  Eigen::MatrixX3d P(markers.size(), 3);
+  for (size_t i = 0; i < markers.size(); ++i) {
+    Eigen::RowVector3d s = Eigen::RowVector3d::Zero();
+    for (int v : markers[i].vertices) s += X.row(v);
+    P.row(i) = s / std::max<size_t>(1, markers[i].vertices.size());
+  }
+  return P;
+}
+
+void Scene::validate() const {
+  auto fail = [&](const std::string& m) {
+    throw std::invalid_argument("scene '" + name + "': " + m);
+  };
+  if (mesh.num_elements() == 0) fail("the mesh has no elements");
+  std::map<int, std::string> role;
+  for (const auto& [tag, mat] : body) {
+    role[tag] = "body material '" + mat.name + "'";
+    if (!(mat.r_omega >= 0.0 && mat.r_omega <= 1.0))
+      fail("body region " + std::to_string(tag) + ": r_omega must be in [0, 1], got " +
+           std::to_string(mat.r_omega));
+    if (!(mat.weight > 0.0))
+      fail("body region " + std::to_string(tag) + ": weight must be > 0");
+  }
+  std::set<std::string> names;
+  for (const auto& a : actuators) {
+    if (a.name.empty()) fail("an actuator has an empty name");
+    if (!names.insert(a.name).second) fail("actuator name '" + a.name + "' is used twice");
+    if (!(a.min <= a.rest && a.rest <= a.max) || !(a.min > 0.0))
+      fail("actuator '" + a.name + "': expected 0 < min <= rest <= max");
+    if (!(a.weight > 0.0)) fail("actuator '" + a.name + "': weight must be > 0");
+    if (a.regions.empty()) fail("actuator '" + a.name + "' has no regions");
+    for (int r : a.regions) {
+      auto it = role.find(r);
+      if (it != role.end())
+        fail("region " + std::to_string(r) + " is both " + it->second + " and actuator '" +
+             a.name + "'");
+      role[r] = "actuator '" + a.name + "'";
+    }
+  }
+  std::set<int> used;
+  for (const auto& e : mesh.elements) used.insert(e.region);
+  for (int r : used)
+    if (!role.count(r))
+      fail("region " + std::to_string(r) + " has elements but no role (body or actuator)");
+  for (const auto& a : actuators) {
+    bool any = false;
+    for (int r : a.regions) any = any || used.count(r);
+    if (!any) fail("actuator '" + a.name + "' has no elements in the mesh");
+  }
+  if (fixed.empty()) fail("no fixed vertices: the problem would have a rigid-motion null space");
+  for (int v : fixed)
+    if (v < 0 || v >= mesh.num_vertices())
+      fail("fixed vertex " + std::to_string(v) + " is out of range");
+  std::set<std::string> mnames;
+  for (const auto& m : markers) {
+    if (!mnames.insert(m.name).second) fail("marker name '" + m.name + "' is used twice");
+    if (m.vertices.empty()) fail("marker '" + m.name + "' selects no vertex");
+    for (int v : m.vertices)
+      if (v < 0 || v >= mesh.num_vertices())
+        fail("marker '" + m.name + "': vertex " + std::to_string(v) + " is out of range");
+  }
+  std::string why;
+  if (!solver.IsValid(&why)) fail("solver options: " + why);
+}
+
+std::vector<int> VerticesInBox(const Mesh& m, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  std::vector<int> out;
+  for (int i = 0; i < m.num_vertices(); ++i) {
+    Eigen::Vector3d x = m.vertices.row(i).transpose();
+    if ((x.array() >= lo.array()).all() && (x.array() <= hi.array()).all()) out.push_back(i);
+  }
+  return out;
+}
+
+std::vector<int> VerticesOnPlane(const Mesh& m, const Eigen::Vector3d& p, const Eigen::Vector3d& n,
+                                 double tol) {
+  std::vector<int> out;
+  const Eigen::Vector3d u = n.normalized();
+  for (int i = 0; i < m.num_vertices(); ++i)
+    if (std::abs(u.dot(m.vertices.row(i).transpose() - p)) <= tol) out.push_back(i);
+  return out;
+}
+
+std::vector<int> VerticesOfRegions(const Mesh& m, const std::vector<int>& regions) {
+  std::vector<char> mark(m.num_vertices(), 0);
+  for (const auto& e : m.elements)
+    if (std::find(regions.begin(), regions.end(), e.region) != regions.end())
+      for (int j = 0; j < e.k(); ++j) mark[e.v[j]] = 1;
+  std::vector<int> out;
+  for (int i = 0; i < m.num_vertices(); ++i)
+    if (mark[i]) out.push_back(i);
+  return out;
+}
+
+int NearestVertex(const Mesh& m, const Eigen::Vector3d& p) {
+  int best = -1;
+  double bd = 0;
+  for (int i = 0; i < m.num_vertices(); ++i) {
+    double d = (m.vertices.row(i).transpose() - p).squaredNorm();
+    if (best < 0 || d < bd) { best = i; bd = d; }
+  }
+  return best;
+}
+
+}  // namespace softkin

@@ -1,0 +1,690 @@
+// Tests of the structured mesh generators (solver/mesh_gen.hpp) and the embedded robots
+// (solver/robots.hpp). The mesh checks here are self-contained (own volume, face and component
+// code) so they test the generators independently of mesh.cpp.
+#include "solver/mesh_gen.hpp"
+#include "solver/robots.hpp"
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <map>
+#include <numeric>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace softkin {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Helpers
+// ---------------------------------------------------------------------------------------------
+
+double TetVol(const Mesh& m, const Element& e) {
+  const Eigen::Vector3d a = m.vertices.row(e.v[0]).transpose();
+  const Eigen::Vector3d b = m.vertices.row(e.v[1]).transpose() - a;
+  const Eigen::Vector3d c = m.vertices.row(e.v[2]).transpose() - a;
+  const Eigen::Vector3d d = m.vertices.row(e.v[3]).transpose() - a;
+  return b.cross(c).dot(d) / 6.0;
+}
+
+double TotalVolume(const Mesh& m, int region = -1) {
+  double v = 0.0;
+  for (const auto& e : m.elements)
+    if (region < 0 || e.region == region) v += TetVol(m, e);
+  return v;
+}
+
+struct FaceStats {
+  int boundary = 0;  // faces used by one tet
+  int interior = 0;  // faces used by two tets
+  int bad = 0;       // faces used by more than two tets
+  std::vector<std::pair<std::array<int, 3>, int>> boundary_faces;  // (face, element)
+};
+
+// Triangle-face usage of a tet mesh.
+FaceStats Faces(const Mesh& m) {
+  struct F {
+    std::array<int, 3> v;
+    int elem;
+  };
+  std::vector<F> faces;
+  faces.reserve(4 * m.elements.size());
+  static const int kFace[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+  for (int i = 0; i < m.num_elements(); ++i) {
+    const auto& e = m.elements[i];
+    for (const auto& f : kFace) {
+      std::array<int, 3> t = {e.v[f[0]], e.v[f[1]], e.v[f[2]]};
+      std::sort(t.begin(), t.end());
+      faces.push_back({t, i});
+    }
+  }
+  std::sort(faces.begin(), faces.end(), [](const F& a, const F& b) { return a.v < b.v; });
+  FaceStats s;
+  for (size_t i = 0; i < faces.size();) {
+    size_t j = i;
+    while (j < faces.size() && faces[j].v == faces[i].v) ++j;
+    const size_t n = j - i;
+    if (n == 1) {
+      ++s.boundary;
+      s.boundary_faces.push_back({faces[i].v, faces[i].elem});
+    } else if (n == 2) {
+      ++s.interior;
+    } else {
+      ++s.bad;
+    }
+    i = j;
+  }
+  return s;
+}
+
+struct UnionFind {
+  std::vector<int> p;
+  explicit UnionFind(int n) : p(n) { std::iota(p.begin(), p.end(), 0); }
+  int find(int x) {
+    while (p[x] != x) x = p[x] = p[p[x]];
+    return x;
+  }
+  void unite(int a, int b) { p[find(a)] = find(b); }
+};
+
+// Connected components (vertex sharing) of the tets accepted by `keep`.
+template <class Keep>
+int Components(const Mesh& m, Keep keep) {
+  UnionFind uf(m.num_vertices());
+  std::vector<char> used(m.num_vertices(), 0);
+  for (const auto& e : m.elements) {
+    if (!keep(e)) continue;
+    for (int j = 0; j < 4; ++j) used[e.v[j]] = 1;
+    for (int j = 1; j < 4; ++j) uf.unite(e.v[0], e.v[j]);
+  }
+  std::set<int> roots;
+  for (int v = 0; v < m.num_vertices(); ++v)
+    if (used[v]) roots.insert(uf.find(v));
+  return static_cast<int>(roots.size());
+}
+int Components(const Mesh& m) {
+  return Components(m, [](const Element&) { return true; });
+}
+
+int UnusedVertices(const Mesh& m) {
+  std::vector<char> used(m.num_vertices(), 0);
+  for (const auto& e : m.elements)
+    for (int j = 0; j < e.k(); ++j) used[e.v[j]] = 1;
+  return static_cast<int>(std::count(used.begin(), used.end(), 0));
+}
+
+// Common structural checks for a generated tet mesh.
+void ExpectWellFormed(const Mesh& m, const std::string& what) {
+  SCOPED_TRACE(what);
+  ASSERT_GT(m.num_elements(), 0);
+  int nonpos = 0, nontet = 0, range = 0;
+  double minvol = 1e300;
+  for (const auto& e : m.elements) {
+    if (e.type != ElementType::Tet) ++nontet;
+    for (int j = 0; j < 4; ++j)
+      if (e.v[j] < 0 || e.v[j] >= m.num_vertices()) ++range;
+    if (range) continue;
+    const double v = TetVol(m, e);
+    minvol = std::min(minvol, v);
+    if (!(v > 0.0)) ++nonpos;
+  }
+  EXPECT_EQ(nontet, 0);
+  ASSERT_EQ(range, 0);
+  EXPECT_EQ(nonpos, 0) << "non-positively oriented tets (min volume " << minvol << ")";
+  const FaceStats f = Faces(m);
+  EXPECT_EQ(f.bad, 0) << "faces shared by more than two tets";
+  EXPECT_EQ(f.boundary + 2 * f.interior, 4 * m.num_elements());
+  EXPECT_EQ(Components(m), 1);
+  EXPECT_EQ(UnusedVertices(m), 0);
+}
+
+// Exact equality of two meshes.
+bool SameMesh(const Mesh& a, const Mesh& b) {
+  if (a.vertices.rows() != b.vertices.rows() || a.elements.size() != b.elements.size())
+    return false;
+  if (!(a.vertices.array() == b.vertices.array()).all()) return false;
+  for (size_t i = 0; i < a.elements.size(); ++i)
+    if (a.elements[i].v != b.elements[i].v || a.elements[i].region != b.elements[i].region ||
+        a.elements[i].type != b.elements[i].type)
+      return false;
+  return true;
+}
+
+// Maps every vertex x to the vertex at f(x) (within tol); -1 where there is none.
+template <class F>
+std::vector<int> VertexMap(const Mesh& m, F f, double tol) {
+  const double q = 1e-3;
+  auto cell = [q](const Eigen::Vector3d& x) {
+    return std::array<std::int64_t, 3>{std::int64_t(std::floor(x[0] / q)),
+                                       std::int64_t(std::floor(x[1] / q)),
+                                       std::int64_t(std::floor(x[2] / q))};
+  };
+  std::map<std::array<std::int64_t, 3>, std::vector<int>> grid;
+  for (int v = 0; v < m.num_vertices(); ++v)
+    grid[cell(m.vertices.row(v).transpose())].push_back(v);
+  std::vector<int> out(m.num_vertices(), -1);
+  for (int v = 0; v < m.num_vertices(); ++v) {
+    const Eigen::Vector3d y = f(Eigen::Vector3d(m.vertices.row(v).transpose()));
+    const auto c = cell(y);
+    for (int dx = -1; dx <= 1 && out[v] < 0; ++dx)
+      for (int dy = -1; dy <= 1 && out[v] < 0; ++dy)
+        for (int dz = -1; dz <= 1 && out[v] < 0; ++dz) {
+          auto it = grid.find({c[0] + dx, c[1] + dy, c[2] + dz});
+          if (it == grid.end()) continue;
+          for (int w : it->second)
+            if ((m.vertices.row(w).transpose() - y).norm() <= tol) {
+              out[v] = w;
+              break;
+            }
+        }
+  }
+  return out;
+}
+
+// Rotation by +120 degrees in the plane of coordinates (a, b), angle from axis a towards axis b.
+Eigen::Vector3d Rot120(const Eigen::Vector3d& x, int a, int b) {
+  const double c = -0.5, s = std::sqrt(3.0) / 2.0;
+  Eigen::Vector3d y = x;
+  y[a] = c * x[a] - s * x[b];
+  y[b] = s * x[a] + c * x[b];
+  return y;
+}
+
+std::array<int, 4> SortedTet(const Element& e, const std::vector<int>& map) {
+  std::array<int, 4> t = {map[e.v[0]], map[e.v[1]], map[e.v[2]], map[e.v[3]]};
+  std::sort(t.begin(), t.end());
+  return t;
+}
+
+// Checks that rotating by 120 degrees maps the vertex set onto itself and every tet with region r
+// onto a tet with region region_map(r).
+template <class RegionMap>
+void ExpectThreeFold(const Mesh& m, int a, int b, RegionMap region_map) {
+  const std::vector<int> map = VertexMap(m, [&](const Eigen::Vector3d& x) { return Rot120(x, a, b); },
+                                         1e-9);
+  const int missing = static_cast<int>(std::count(map.begin(), map.end(), -1));
+  ASSERT_EQ(missing, 0) << "vertices without a rotated image";
+  std::vector<int> sorted = map;
+  std::sort(sorted.begin(), sorted.end());
+  EXPECT_TRUE(std::adjacent_find(sorted.begin(), sorted.end()) == sorted.end())
+      << "the rotation is not a bijection";
+  std::map<std::array<int, 4>, int> tets;
+  std::vector<int> identity(m.num_vertices());
+  std::iota(identity.begin(), identity.end(), 0);
+  for (const auto& e : m.elements) tets[SortedTet(e, identity)] = e.region;
+  int unmatched = 0, wrong_region = 0;
+  for (const auto& e : m.elements) {
+    auto it = tets.find(SortedTet(e, map));
+    if (it == tets.end()) {
+      ++unmatched;
+    } else if (it->second != region_map(e.region)) {
+      ++wrong_region;
+    }
+  }
+  EXPECT_EQ(unmatched, 0);
+  EXPECT_EQ(wrong_region, 0);
+}
+
+Eigen::Vector3d Centroid(const Mesh& m, const std::vector<int>& vs) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (int v : vs) c += m.vertices.row(v).transpose();
+  return c / std::max<size_t>(1, vs.size());
+}
+
+int CountRegion(const Mesh& m, int r) {
+  return static_cast<int>(std::count_if(m.elements.begin(), m.elements.end(),
+                                        [r](const Element& e) { return e.region == r; }));
+}
+
+// Tets of the given regions that have a face on the mesh boundary.
+int RegionTetsOnBoundary(const Mesh& m, const std::set<int>& regions) {
+  const FaceStats f = Faces(m);
+  int n = 0;
+  for (const auto& bf : f.boundary_faces)
+    if (regions.count(m.elements[bf.second].region)) ++n;
+  return n;
+}
+
+// ---------------------------------------------------------------------------------------------
+// MeshGen: VoxelTetMesh
+// ---------------------------------------------------------------------------------------------
+
+TEST(MeshGenVoxel, SingleCellIsSixPositiveTetsSharingTheDiagonal) {
+  const double h = 2.5;
+  const Mesh m = VoxelTetMesh(Eigen::Vector3d(1, 2, 3), h, Eigen::Vector3i(1, 1, 1),
+                              [](const Eigen::Vector3d&, const Eigen::Vector3i&) { return 7; });
+  ASSERT_EQ(m.num_vertices(), 8);
+  ASSERT_EQ(m.num_elements(), 6);
+  for (const auto& e : m.elements) {
+    EXPECT_EQ(e.region, 7);
+    EXPECT_NEAR(TetVol(m, e), h * h * h / 6.0, 1e-12);
+    // Every tet contains the main diagonal: vertices (1,2,3) and (3.5,4.5,5.5).
+    EXPECT_TRUE((m.vertices.row(e.v[0]) - Eigen::RowVector3d(1, 2, 3)).norm() < 1e-12);
+    EXPECT_TRUE((m.vertices.row(e.v[3]) - Eigen::RowVector3d(3.5, 4.5, 5.5)).norm() < 1e-12);
+  }
+  ExpectWellFormed(m, "single cell");
+}
+
+TEST(MeshGenVoxel, ConformingCompactedAndCountsExposedFaces) {
+  const Eigen::Vector3i n(5, 4, 6);
+  // A deterministic pattern of kept cells, kept connected through the full bottom layer.
+  auto keep = [](const Eigen::Vector3i& c) {
+    if (c[2] == 0) return true;
+    const unsigned hsh = unsigned(c[0] * 73856093) ^ unsigned(c[1] * 19349663) ^
+                         unsigned(c[2] * 83492791);
+    return (hsh % 3) != 0 || c[0] == 0;
+  };
+  std::vector<char> kept(n.prod(), 0);
+  auto idx = [&](int i, int j, int k) { return i + n[0] * (j + n[1] * k); };
+  int ncells = 0;
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i)
+        if (keep(Eigen::Vector3i(i, j, k))) kept[idx(i, j, k)] = 1, ++ncells;
+  const double h = 0.7;
+  const Mesh m = VoxelTetMesh(Eigen::Vector3d::Zero(), h, n,
+                              [&](const Eigen::Vector3d& centre, const Eigen::Vector3i& c) {
+                                // The centre is consistent with the index.
+                                EXPECT_NEAR(centre[0], (c[0] + 0.5) * h, 1e-12);
+                                return keep(c) ? c[2] % 2 : -1;
+                              });
+  EXPECT_EQ(m.num_elements(), 6 * ncells);
+  EXPECT_NEAR(TotalVolume(m), ncells * h * h * h, 1e-9);
+  ExpectWellFormed(m, "voxel pattern");
+  // Each exposed square cell face is two boundary triangles.
+  int exposed = 0;
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i) {
+        if (!kept[idx(i, j, k)]) continue;
+        const int nb[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k},
+                              {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
+        for (const auto& q : nb) {
+          const bool in = q[0] >= 0 && q[0] < n[0] && q[1] >= 0 && q[1] < n[1] && q[2] >= 0 &&
+                          q[2] < n[2];
+          if (!in || !kept[idx(q[0], q[1], q[2])]) ++exposed;
+        }
+      }
+  EXPECT_EQ(Faces(m).boundary, 2 * exposed);
+}
+
+TEST(MeshGenVoxel, RejectsBadArguments) {
+  auto all = [](const Eigen::Vector3d&, const Eigen::Vector3i&) { return 0; };
+  EXPECT_THROW(VoxelTetMesh(Eigen::Vector3d::Zero(), 0.0, Eigen::Vector3i(1, 1, 1), all),
+               std::invalid_argument);
+  EXPECT_THROW(VoxelTetMesh(Eigen::Vector3d::Zero(), 1.0, Eigen::Vector3i(1, 0, 1), all),
+               std::invalid_argument);
+  EXPECT_THROW(VoxelTetMesh(Eigen::Vector3d::Zero(), 1.0, Eigen::Vector3i(1, 1, 1), nullptr),
+               std::invalid_argument);
+  // All cells empty: an empty mesh, not an error.
+  const Mesh m = VoxelTetMesh(Eigen::Vector3d::Zero(), 1.0, Eigen::Vector3i(2, 2, 2),
+                              [](const Eigen::Vector3d&, const Eigen::Vector3i&) { return -1; });
+  EXPECT_EQ(m.num_vertices(), 0);
+  EXPECT_EQ(m.num_elements(), 0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// MeshGen: concentric disk and its extrusion
+// ---------------------------------------------------------------------------------------------
+
+TEST(MeshGenDisk, RingsCountsAreaAndCounterClockwise) {
+  for (int nr : {1, 2, 3, 7}) {
+    SCOPED_TRACE(nr);
+    const double R = 3.0;
+    const ConcentricDisk d = MakeConcentricDisk(R, nr);
+    ASSERT_EQ(d.num_points(), 1 + 3 * nr * (nr + 1));
+    ASSERT_EQ(static_cast<int>(d.triangles.size()), 6 * nr * nr);
+    double area = 0.0;
+    int cw = 0;
+    std::set<std::array<int, 3>> seen;
+    for (const auto& t : d.triangles) {
+      const Eigen::Vector2d a = d.points.row(t[0]).transpose();
+      const Eigen::Vector2d u = d.points.row(t[1]).transpose() - a;
+      const Eigen::Vector2d v = d.points.row(t[2]).transpose() - a;
+      const double A = 0.5 * (u.x() * v.y() - u.y() * v.x());
+      if (!(A > 0.0)) ++cw;
+      area += A;
+      std::array<int, 3> s = t;
+      std::sort(s.begin(), s.end());
+      EXPECT_TRUE(seen.insert(s).second) << "duplicate triangle";
+      // Keys are distinct within a triangle.
+      EXPECT_NE(d.key(t[0]), d.key(t[1]));
+      EXPECT_NE(d.key(t[1]), d.key(t[2]));
+      EXPECT_NE(d.key(t[0]), d.key(t[2]));
+    }
+    EXPECT_EQ(cw, 0);
+    const int n = 6 * nr;
+    const double pi = std::acos(-1.0);
+    EXPECT_NEAR(area, 0.5 * n * R * R * std::sin(2 * pi / n), 1e-12);
+    for (int p = 0; p < d.num_points(); ++p) {
+      const double r = d.points.row(p).norm();
+      EXPECT_NEAR(r, R * d.ring[p] / nr, 1e-12);
+      EXPECT_EQ(d.id(d.ring[p], d.index[p]), p);
+      EXPECT_EQ(d.key(d.rotated(p, 1)), d.key(p));
+      EXPECT_EQ(d.rotated(d.rotated(p, 1), -1), p);
+    }
+  }
+}
+
+TEST(MeshGenDisk, ExtrusionIsConformingPositiveAndHasTheExpectedFaces) {
+  for (int axis : {0, 1, 2}) {
+    SCOPED_TRACE(axis);
+    DiskExtrusion p;
+    p.radius = 5.0;
+    p.rings = 4;
+    p.length = 12.0;
+    p.layers = 5;
+    p.axis = axis;
+    p.base = -1.0;
+    const Mesh m = ExtrudedDiskTetMesh(p);
+    const int T = 6 * p.rings * p.rings, np = 1 + 3 * p.rings * (p.rings + 1);
+    ASSERT_EQ(m.num_elements(), 3 * T * p.layers);
+    ASSERT_EQ(m.num_vertices(), np * (p.layers + 1));
+    ExpectWellFormed(m, "extruded disk");
+    const FaceStats f = Faces(m);
+    // Boundary: top and bottom disks (T triangles each) + side quads (6 rings per layer, 2 each).
+    EXPECT_EQ(f.boundary, 2 * T + 2 * 6 * p.rings * p.layers);
+    EXPECT_EQ(f.interior, (4 * m.num_elements() - f.boundary) / 2);
+    const int n = 6 * p.rings;
+    const double pi = std::acos(-1.0);
+    const double area = 0.5 * n * p.radius * p.radius * std::sin(2 * pi / n);
+    EXPECT_NEAR(TotalVolume(m), area * p.length, 1e-9);
+    for (int v = 0; v < m.num_vertices(); ++v) {
+      EXPECT_GE(m.vertices(v, axis), p.base - 1e-12);
+      EXPECT_LE(m.vertices(v, axis), p.base + p.length + 1e-12);
+    }
+  }
+}
+
+TEST(MeshGenDisk, ExtrusionIsExactlyThreeFoldSymmetric) {
+  for (int axis : {0, 1, 2}) {
+    SCOPED_TRACE(axis);
+    DiskExtrusion p;
+    p.radius = 10.0;
+    p.rings = 5;
+    p.length = 8.0;
+    p.layers = 3;
+    p.axis = axis;
+    const std::array<int, 2> pl = DiskPlaneAxes(axis);
+    int checked = 0;
+    // Tag by sector: the rotation must map sector s onto s+1; and the canonical centroid rotated
+    // by the sector must be the centroid.
+    const Mesh m = ExtrudedDiskTetMesh(p, [&](const DiskElementInfo& e) {
+      Eigen::Vector3d c = e.canonical_centroid;
+      for (int s = 0; s < e.sector; ++s) c = Rot120(c, pl[0], pl[1]);
+      EXPECT_LT((c - e.centroid).norm(), 1e-12);
+      ++checked;
+      return e.sector;
+    });
+    EXPECT_EQ(checked, m.num_elements());
+    ExpectThreeFold(m, pl[0], pl[1], [](int r) { return (r + 1) % 3; });
+  }
+}
+
+TEST(MeshGenDisk, RejectsBadArguments) {
+  EXPECT_THROW(MakeConcentricDisk(0.0, 3), std::invalid_argument);
+  EXPECT_THROW(MakeConcentricDisk(1.0, 0), std::invalid_argument);
+  DiskExtrusion p;
+  p.layers = 0;
+  EXPECT_THROW(ExtrudedDiskTetMesh(p), std::invalid_argument);
+  p.layers = 2;
+  p.axis = 3;
+  EXPECT_THROW(ExtrudedDiskTetMesh(p), std::invalid_argument);
+  p.axis = 2;
+  EXPECT_THROW(ExtrudedDiskTetMesh(p, [](const DiskElementInfo&) { return -1; }),
+               std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Robots
+// ---------------------------------------------------------------------------------------------
+
+TEST(Robots, ListsBothRobotsAndRejectsBadInput) {
+  const std::vector<RobotInfo> list = ListRobots();
+  ASSERT_EQ(list.size(), 2u);
+  EXPECT_EQ(list[0].name, "pneumatic_finger");
+  EXPECT_EQ(list[1].name, "three_chamber");
+  for (const auto& r : list) {
+    EXPECT_GT(r.default_resolution, 0);
+    EXPECT_FALSE(r.description.empty());
+    EXPECT_FALSE(r.resolution_doc.empty());
+  }
+  try {
+    MakeRobot("x");
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "unknown robot 'x'; known robots: pneumatic_finger, three_chamber");
+  }
+  try {
+    MakeRobot("pneumatic_finger", 2);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "pneumatic_finger: --res must be an integer in [4, 40], got 2");
+  }
+  EXPECT_THROW(MakeRobot("pneumatic_finger", 41), std::invalid_argument);
+  EXPECT_THROW(MakeRobot("three_chamber", 2), std::invalid_argument);
+  EXPECT_THROW(MakeRobot("three_chamber", 17), std::invalid_argument);
+}
+
+TEST(Robots, EveryRobotIsValidWellFormedAndDeterministic) {
+  for (const auto& info : ListRobots()) {
+    SCOPED_TRACE(info.name);
+    const Scene a = MakeRobot(info.name);
+    const Scene b = MakeRobot(info.name, info.default_resolution);
+    EXPECT_NO_THROW(a.validate());
+    EXPECT_EQ(a.name, info.name);
+    ExpectWellFormed(a.mesh, info.name);
+    EXPECT_TRUE(SameMesh(a.mesh, b.mesh)) << "two builds differ";
+    EXPECT_EQ(a.fixed, b.fixed);
+    ASSERT_EQ(a.markers.size(), b.markers.size());
+    for (size_t i = 0; i < a.markers.size(); ++i) EXPECT_EQ(a.markers[i].vertices, b.markers[i].vertices);
+    EXPECT_TRUE(std::is_sorted(a.fixed.begin(), a.fixed.end()));
+    EXPECT_TRUE(std::adjacent_find(a.fixed.begin(), a.fixed.end()) == a.fixed.end());
+    EXPECT_GE(a.marker_index("tip"), 0);
+    for (const auto& act : a.actuators) {
+      EXPECT_EQ(act.type, ActuatorType::Pneumatic);
+      EXPECT_EQ(act.rest, 1.0);
+      EXPECT_EQ(act.min, 1.0);
+      EXPECT_GT(act.max, 1.0);
+    }
+  }
+}
+
+TEST(Robots, GenerationTimePrintout) {
+  // Information only; performance targets live in bench/.
+  for (const auto& info : ListRobots()) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const Scene s = MakeRobot(info.name);
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("[ info     ] %s res %d: %d tets, %d vertices, %d fixed, generated in %.1f ms\n",
+                info.name.c_str(), info.default_resolution, s.mesh.num_elements(),
+                s.mesh.num_vertices(), static_cast<int>(s.fixed.size()), ms);
+  }
+}
+
+// ---- pneumatic_finger ----
+
+TEST(RobotsPneumaticFinger, DefaultSizeRegionsAndMaterials) {
+  const Scene s = MakeRobot("pneumatic_finger");
+  const int n = s.mesh.num_elements();
+  EXPECT_GE(n, 40500);
+  EXPECT_LE(n, 49500);
+  ASSERT_EQ(s.num_actuators(), 1);
+  EXPECT_EQ(s.actuators[0].name, "chamber");
+  EXPECT_EQ(s.actuators[0].regions, std::vector<int>{1});
+  ASSERT_EQ(s.body.size(), 2u);
+  EXPECT_EQ(s.body.at(0).name, "body");
+  EXPECT_EQ(s.body.at(2).name, "inextensible");
+  std::set<int> regions;
+  for (const auto& e : s.mesh.elements) regions.insert(e.region);
+  EXPECT_EQ(regions, (std::set<int>{0, 1, 2}));
+  EXPECT_GT(CountRegion(s.mesh, 1), n / 10);
+  // Bounding box 100 x 20 x 20 mm.
+  const Eigen::RowVector3d lo = s.mesh.vertices.colwise().minCoeff();
+  const Eigen::RowVector3d hi = s.mesh.vertices.colwise().maxCoeff();
+  EXPECT_LT((lo - Eigen::RowVector3d(0, 0, 0)).norm(), 1e-9);
+  EXPECT_LT((hi - Eigen::RowVector3d(100, 20, 20)).norm(), 1e-9);
+  // The inextensible layer is at the bottom: its tets lie in z <= ~3 mm (snapped to the grid).
+  for (const auto& e : s.mesh.elements) {
+    if (e.region != 2) continue;
+    for (int j = 0; j < 4; ++j) ASSERT_LE(s.mesh.vertices(e.v[j], 2), 4.0);
+  }
+}
+
+TEST(RobotsPneumaticFinger, FixedBaseAndTipMarkers) {
+  const Scene s = MakeRobot("pneumatic_finger");
+  const Mesh& m = s.mesh;
+  int on_plane = 0;
+  for (int v = 0; v < m.num_vertices(); ++v) on_plane += std::abs(m.vertices(v, 0)) < 1e-9;
+  EXPECT_EQ(static_cast<int>(s.fixed.size()), on_plane);
+  for (int v : s.fixed) EXPECT_NEAR(m.vertices(v, 0), 0.0, 1e-9);
+  for (const char* name : {"tip", "tip_top", "tip_bottom"}) {
+    const int k = s.marker_index(name);
+    ASSERT_GE(k, 0) << name;
+    for (int v : s.markers[k].vertices) EXPECT_NEAR(m.vertices(v, 0), 100.0, 1e-9) << name;
+  }
+  const Eigen::MatrixX3d P = s.marker_positions(m.vertices);
+  const Eigen::Vector3d tip = P.row(s.marker_index("tip")).transpose();
+  const Eigen::Vector3d top = P.row(s.marker_index("tip_top")).transpose();
+  const Eigen::Vector3d bot = P.row(s.marker_index("tip_bottom")).transpose();
+  EXPECT_NEAR(tip.x(), 100.0, 1e-9);
+  EXPECT_NEAR(tip.y(), 10.0, 1e-9);
+  EXPECT_NEAR(tip.z(), 10.0, 1e-9);
+  EXPECT_NEAR(top.y(), 10.0, 1e-9);
+  EXPECT_NEAR(bot.y(), 10.0, 1e-9);
+  EXPECT_GE(top.z(), 15.0);
+  EXPECT_LE(bot.z(), 5.0);
+}
+
+TEST(RobotsPneumaticFinger, FeaturesSurviveEveryResolution) {
+  // Walls enclose every cavity, gaps separate the blocks, the base layer exists.
+  for (int res : {4, 5, 6, 7, 8, 9, 10, 12, 15, 16, 20}) {
+    SCOPED_TRACE(res);
+    const Scene s = MakeRobot("pneumatic_finger", res);
+    const Mesh& m = s.mesh;
+    ExpectWellFormed(m, "finger");
+    EXPECT_GT(CountRegion(m, 2), 0);
+    EXPECT_EQ(RegionTetsOnBoundary(m, {1}), 0) << "a cavity element lies on the outer surface";
+    const int chambers = Components(m, [](const Element& e) { return e.region == 1; });
+    const int blocks = Components(m, [](const Element& e) { return e.region != 2; });
+    EXPECT_EQ(blocks, chambers + 1) << "chamber blocks + the proximal block";
+    if (res >= 8) {
+      EXPECT_EQ(chambers, 9);
+    }
+    EXPECT_GE(chambers, 3);
+    const Eigen::RowVector3d hi = m.vertices.colwise().maxCoeff();
+    EXPECT_LT((hi - Eigen::RowVector3d(100, 20, 20)).norm(), 1e-9);
+  }
+}
+
+TEST(RobotsPneumaticFinger, CellCountScalesAsResCubed) {
+  auto tets = [](int res) { return double(MakeRobot("pneumatic_finger", res).mesh.num_elements()); };
+  const double n8 = tets(8), n12 = tets(12), n16 = tets(16), n24 = tets(24);
+  EXPECT_NEAR(n16 / n8, 8.0, 8.0 * 0.2);
+  EXPECT_NEAR(n24 / n12, 8.0, 8.0 * 0.2);
+  // tets / res^3 stays roughly constant.
+  for (auto [n, r] : {std::pair<double, int>{n8, 8}, {n12, 12}, {n16, 16}, {n24, 24}})
+    EXPECT_NEAR(n / (r * r * r), 27.0, 5.0) << "res " << r;
+}
+
+// ---- three_chamber ----
+
+TEST(RobotsThreeChamber, DimensionsActuatorsFixedAndTip) {
+  const Scene s = MakeRobot("three_chamber");
+  const Mesh& m = s.mesh;
+  const int n = m.num_elements();
+  EXPECT_GE(n, 30000);
+  EXPECT_LE(n, 40000);
+  const Eigen::RowVector3d lo = m.vertices.colwise().minCoeff();
+  const Eigen::RowVector3d hi = m.vertices.colwise().maxCoeff();
+  EXPECT_NEAR(lo.y(), 0.0, 1e-12);
+  EXPECT_NEAR(hi.y(), 136.0, 1e-9);
+  EXPECT_NEAR(hi.x() - lo.x(), 48.0, 1e-9);
+  EXPECT_NEAR(hi.z() - lo.z(), 48.0, 0.5);  // polygonal disk: 48 cos(pi / 6 res) in z
+  ASSERT_EQ(s.num_actuators(), 3);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(s.actuators[k].name, "c" + std::to_string(k + 1));
+    EXPECT_EQ(s.actuators[k].regions, std::vector<int>{k + 1});
+    EXPECT_GT(CountRegion(m, k + 1), 0);
+  }
+  EXPECT_EQ(s.body.size(), 1u);
+  EXPECT_EQ(s.body.at(0).name, "body");
+  int on_plane = 0;
+  for (int v = 0; v < m.num_vertices(); ++v) on_plane += std::abs(m.vertices(v, 1)) < 1e-9;
+  EXPECT_EQ(static_cast<int>(s.fixed.size()), on_plane);
+  for (int v : s.fixed) EXPECT_NEAR(m.vertices(v, 1), 0.0, 1e-12);
+  const int t = s.marker_index("tip");
+  ASSERT_GE(t, 0);
+  for (int v : s.markers[t].vertices) EXPECT_NEAR(m.vertices(v, 1), 136.0, 1e-9);
+  const Eigen::Vector3d tip = Centroid(m, s.markers[t].vertices);
+  EXPECT_LT((tip - Eigen::Vector3d(0, 136, 0)).norm(), 1e-9);
+  // Chamber c1 is centred on -x (phi = 180 deg), at ~13 mm from the axis.
+  Eigen::Vector3d c1 = Eigen::Vector3d::Zero();
+  double vol = 0.0;
+  for (const auto& e : m.elements) {
+    if (e.region != 1) continue;
+    const double v = TetVol(m, e);
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (int j = 0; j < 4; ++j) c += m.vertices.row(e.v[j]).transpose() / 4.0;
+    c1 += v * c;
+    vol += v;
+  }
+  c1 /= vol;
+  EXPECT_NEAR(c1.x(), -13.0, 1.5);
+  EXPECT_NEAR(c1.z(), 0.0, 0.05);  // the mesh is 3-fold but not mirror symmetric
+  EXPECT_NEAR(c1.y(), 68.0, 2.0);
+}
+
+TEST(RobotsThreeChamber, ExactlyThreeFoldSymmetricWithEqualChambers) {
+  for (int res : {3, 7}) {
+    SCOPED_TRACE(res);
+    const Scene s = MakeRobot("three_chamber", res);
+    // phi = atan2(z, x): rotate from +x towards +z; chamber k -> k+1, body -> body.
+    ExpectThreeFold(s.mesh, 0, 2, [](int r) { return r == 0 ? 0 : 1 + r % 3; });
+    const double v1 = TotalVolume(s.mesh, 1), v2 = TotalVolume(s.mesh, 2),
+                 v3 = TotalVolume(s.mesh, 3);
+    EXPECT_GT(v1, 0.0);
+    EXPECT_NEAR(v2, v1, 1e-9 * v1);
+    EXPECT_NEAR(v3, v1, 1e-9 * v1);
+    EXPECT_EQ(CountRegion(s.mesh, 1), CountRegion(s.mesh, 2));
+    EXPECT_EQ(CountRegion(s.mesh, 1), CountRegion(s.mesh, 3));
+  }
+}
+
+TEST(RobotsThreeChamber, ChambersAreEnclosedAndSeparateAtEveryResolution) {
+  for (int res = 3; res <= 12; ++res) {
+    SCOPED_TRACE(res);
+    const Scene s = MakeRobot("three_chamber", res);
+    const Mesh& m = s.mesh;
+    if (res <= 8) ExpectWellFormed(m, "three_chamber");
+    EXPECT_EQ(RegionTetsOnBoundary(m, {1, 2, 3}), 0);
+    // No vertex is shared by two different chambers; each chamber is one piece.
+    std::vector<int> owner(m.num_vertices(), 0);
+    int shared = 0;
+    for (const auto& e : m.elements) {
+      if (e.region == 0) continue;
+      for (int j = 0; j < 4; ++j) {
+        int& o = owner[e.v[j]];
+        if (o != 0 && o != e.region) ++shared;
+        o = e.region;
+      }
+    }
+    EXPECT_EQ(shared, 0);
+    for (int r = 1; r <= 3; ++r)
+      EXPECT_EQ(Components(m, [r](const Element& e) { return e.region == r; }), 1);
+  }
+}
+
+}  // namespace
+}  // namespace softkin
