@@ -1,1 +1,446 @@
-int main() { return 0; }
+// Google Benchmark suite for the forward-kinematics solver (local-global + Anderson acceleration).
+//
+// Every benchmark except BM_FullBend sweeps the pneumatic_finger resolution (the `res` argument:
+// cells across the 20 mm width, ~26 res^3 tets) and reports the counters
+//   tets, vertices, free      mesh size (elements, vertices, non-fixed vertices)
+//   per_vertex                wall time per vertex (per iteration of the benchmark)
+//   per_tet                   wall time per element (element loops only)
+// All timings are wall-clock (UseRealTime): the local step and the passes run with OpenMP.
+//
+// See docs/benchmarks.md for what each benchmark measures and how to run them.
+#include "solver/anderson.hpp"
+#include "solver/fk_solver.hpp"
+#include "solver/local_global.hpp"
+#include "solver/model.hpp"
+#include "solver/robots.hpp"
+#include "solver/rotation.hpp"
+#include "solver/targets.hpp"
+
+#include <benchmark/benchmark.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace softkin {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+constexpr const char* kRobot = "pneumatic_finger";
+/// Resolutions of the sweep: ~5.6k, 13k, 26k, 45k, 71k and 152k tets.
+const std::vector<int> kResolutions = {6, 8, 10, 12, 14, 18};
+/// Actuation (chamber volume ratio) of the deformed configuration used by the per-step benchmarks.
+constexpr double kAlpha = 3.0;
+/// Local-global iterations (lg-aa, from rest) used to reach that deformed configuration.
+constexpr int kSetupIterations = 40;
+
+/// Everything a per-step benchmark needs for one resolution, built once and cached.
+struct Fixture {
+  int res = 0;
+  std::shared_ptr<const Model> model;
+  Eigen::VectorXd c;             ///< actuation of the deformed configuration
+  Eigen::MatrixX3d X;            ///< deformed positions (#V x 3), a partly converged lg-aa solve
+  Eigen::MatrixX3d rhs_free;     ///< B_f - A_fc X_c at X: the right-hand side of the global step
+  std::vector<Eigen::Matrix3d> M;  ///< per-element cross-covariance D^T P at X
+  int tets = 0, vertices = 0, free = 0;
+};
+
+const Fixture& GetFixture(int res) {
+  static std::map<int, std::unique_ptr<Fixture>> cache;
+  auto it = cache.find(res);
+  if (it != cache.end()) return *it->second;
+
+  auto f = std::make_unique<Fixture>();
+  f->res = res;
+  f->model = std::make_shared<const Model>(MakeRobot(kRobot, res));
+  const Model& m = *f->model;
+  f->tets = static_cast<int>(m.elements().size());
+  f->vertices = m.num_vertices();
+  f->free = m.num_free();
+
+  f->c = m.scene().rest_actuation();
+  f->c[0] = kAlpha;
+  FkOptions opts = m.scene().solver;
+  opts.solver = "lg-aa";
+  opts.max_iterations = kSetupIterations;
+  opts.continuation_steps = 1;
+  auto solver = MakeFkSolver(f->model, opts);
+  const FkResult r = solver->Solve(f->c);
+  f->X = r.positions;
+
+  // Right-hand side of the global step at X (as in LocalGlobalSolver).
+  std::vector<double> ratios;
+  std::vector<ElemRows> weighted;
+  Eigen::MatrixX3d B;
+  ComputeLocalRatios(m, f->X, f->c, &ratios);
+  LocalStep(m, f->X, ratios, &weighted);
+  AssembleRhs(m, weighted, &B);
+  const auto& fixed = m.fixed_vertices();
+  Eigen::MatrixX3d Xc(fixed.size(), 3);
+  for (size_t q = 0; q < fixed.size(); ++q) Xc.row(q) = m.rest_positions().row(fixed[q]);
+  const Eigen::MatrixX3d Cfix = m.A_fc() * Xc;
+  f->rhs_free.resize(m.num_free(), 3);
+  for (int i = 0; i < m.num_free(); ++i) f->rhs_free.row(i) = B.row(m.free_vertices()[i]);
+  f->rhs_free -= Cfix;
+
+  // Cross-covariances M_i = D_i^T P_i (current centred rows vs rest centred rows), as in the
+  // local step.
+  f->M.resize(m.elements().size());
+  for (size_t i = 0; i < m.elements().size(); ++i) {
+    const ModelElement& e = m.elements()[i];
+    ElemRows D;
+    for (int j = 0; j < e.k; ++j) D.row(j) = f->X.row(e.v[j]);
+    CenterRows(D, e.k);
+    f->M[i] = D.topRows(e.k).transpose() * e.rest.topRows(e.k);
+  }
+  std::fprintf(stderr, "[fixture] res %d: %d tets, %d vertices (%d free); setup solve %s\n", res,
+               f->tets, f->vertices, f->free, r.BriefReport().c_str());
+  return *cache.emplace(res, std::move(f)).first->second;
+}
+
+void SizeCounters(benchmark::State& state, const Fixture& f, bool per_tet) {
+  state.counters["tets"] = f.tets;
+  state.counters["vertices"] = f.vertices;
+  state.counters["free"] = f.free;
+  // Rate counters with kInvert: seconds per vertex / per tet of one benchmark iteration.
+  state.counters["per_vertex"] = benchmark::Counter(
+      f.vertices, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  if (per_tet)
+    state.counters["per_tet"] = benchmark::Counter(
+        f.tets, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
+/// One pass of a 3x3 rotation fit over all cross-covariances, parallelised like the local step
+/// (threads = 0: OpenMP default). Returns a checksum so the work cannot be optimised away.
+template <class Fit>
+double RotationPass(const std::vector<Eigen::Matrix3d>& M, int threads, Fit fit) {
+  const int n = static_cast<int>(M.size());
+  const int nt = threads > 0 ? threads : omp_get_max_threads();
+  double sink = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : sink) num_threads(nt)
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Matrix3d R = fit(M[i]);
+    sink += R(0, 0) + R(1, 1) + R(2, 2);
+  }
+  return sink;
+}
+double SvdPass(const std::vector<Eigen::Matrix3d>& M, int threads) {
+  return RotationPass(M, threads, [](const Eigen::Matrix3d& A) { return BestRotationSvd(A); });
+}
+double PolarPass(const std::vector<Eigen::Matrix3d>& M, int threads) {
+  return RotationPass(M, threads, [](const Eigen::Matrix3d& A) { return BestRotation(A); });
+}
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/// Baseline of one iteration: the bare global solve (3 RHS) + the bare SVD pass (default threads),
+/// medians of `reps` timed repetitions after one warm-up.
+/// Also times the polar pass (BestRotation), for the stricter ratio against the solver's own
+/// rotation fit.
+struct Baseline {
+  double solve_s = 0, svd_s = 0, polar_s = 0;
+  double total() const { return solve_s + svd_s; }
+  double total_polar() const { return solve_s + polar_s; }
+};
+Baseline MeasureBaseline(const Fixture& f, int reps = 7) {
+  std::vector<double> ts, tv, tp;
+  benchmark::DoNotOptimize(f.model->SolveFree(f.rhs_free));
+  benchmark::DoNotOptimize(SvdPass(f.M, 0));
+  benchmark::DoNotOptimize(PolarPass(f.M, 0));
+  for (int k = 0; k < reps; ++k) {
+    auto t0 = Clock::now();
+    Eigen::MatrixX3d Y = f.model->SolveFree(f.rhs_free);
+    benchmark::DoNotOptimize(Y.data());
+    ts.push_back(Since(t0));
+    t0 = Clock::now();
+    double s = SvdPass(f.M, 0);
+    benchmark::DoNotOptimize(s);
+    tv.push_back(Since(t0));
+    t0 = Clock::now();
+    s = PolarPass(f.M, 0);
+    benchmark::DoNotOptimize(s);
+    tp.push_back(Since(t0));
+  }
+  return {Median(ts), Median(tv), Median(tp)};
+}
+
+FkOptions OneIterationOptions(const Model& m, int max_iterations) {
+  FkOptions o = m.scene().solver;
+  o.solver = "lg-aa";
+  o.max_iterations = max_iterations;
+  o.tolerance = 1e-300;  // never converge: every call runs exactly max_iterations iterations
+  o.gradient_tolerance = 1e-300;
+  o.continuation_steps = 1;
+  o.threads = 0;
+  return o;
+}
+
+void ResolutionSweep(benchmark::internal::Benchmark* b) {
+  b->ArgName("res");
+  for (int r : kResolutions) b->Arg(r);
+}
+void ResolutionThreadSweep(benchmark::internal::Benchmark* b) {
+  b->ArgNames({"res", "threads"});
+  for (int r : kResolutions)
+    for (int t : {1, 0}) b->Args({r, t});
+}
+
+// ---- benchmarks --------------------------------------------------------------------------------
+
+/// Model construction: element constants, assembly of A, A_ff, A_fc, CHOLMOD analyse + factor.
+void BM_Factorization(benchmark::State& state) {
+  const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
+  const Scene scene = f.model->scene();
+  double factor_s = 0.0;
+  for (auto _ : state) {
+    Model m(scene);
+    factor_s += m.factor_time_s();
+    benchmark::DoNotOptimize(&m);
+  }
+  SizeCounters(state, f, false);
+  state.counters["factor_s"] = benchmark::Counter(factor_s, benchmark::Counter::kAvgIterations);
+  state.counters["nnz_Aff"] = static_cast<double>(f.model->A_ff().nonZeros());
+}
+BENCHMARK(BM_Factorization)->Apply(ResolutionSweep)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// Local step: per-element local ratios, then targets (best rotation + blending) and energy.
+void BM_LocalStep(benchmark::State& state) {
+  const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
+  const Model& m = *f.model;
+  std::vector<double> ratios;
+  std::vector<ElemRows> weighted;
+  ComputeLocalRatios(m, f.X, f.c, &ratios);
+  LocalStep(m, f.X, ratios, &weighted);  // allocate outside the loop
+  for (auto _ : state) {
+    ComputeLocalRatios(m, f.X, f.c, &ratios);
+    double E = LocalStep(m, f.X, ratios, &weighted);
+    benchmark::DoNotOptimize(E);
+  }
+  SizeCounters(state, f, true);
+}
+BENCHMARK(BM_LocalStep)->Apply(ResolutionSweep)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// Right-hand side gather sum_i w_i Vol_i S_i^T T_i (#V x 3).
+void BM_AssembleRhs(benchmark::State& state) {
+  const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
+  const Model& m = *f.model;
+  std::vector<double> ratios;
+  std::vector<ElemRows> weighted;
+  ComputeLocalRatios(m, f.X, f.c, &ratios);
+  LocalStep(m, f.X, ratios, &weighted);
+  Eigen::MatrixX3d B(m.num_vertices(), 3);
+  for (auto _ : state) {
+    AssembleRhs(m, weighted, &B);
+    benchmark::DoNotOptimize(B.data());
+    benchmark::ClobberMemory();
+  }
+  SizeCounters(state, f, false);
+}
+BENCHMARK(BM_AssembleRhs)->Apply(ResolutionSweep)->Unit(benchmark::kMicrosecond)->UseRealTime();
+
+/// Global step: the prefactored CHOLMOD solve A_ff Y = rhs with #free x 3 right-hand sides.
+void BM_GlobalSolve(benchmark::State& state) {
+  const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
+  for (auto _ : state) {
+    Eigen::MatrixX3d Y = f.model->SolveFree(f.rhs_free);
+    benchmark::DoNotOptimize(Y.data());
+  }
+  SizeCounters(state, f, false);
+}
+BENCHMARK(BM_GlobalSolve)->Apply(ResolutionSweep)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// Bare SVD pass: BestRotationSvd (3x3 JacobiSVD) over every element's precomputed D^T P.
+/// threads = 1: serial; threads = 0: OpenMP default (what the local step uses).
+void BM_SvdPass(benchmark::State& state) {
+  const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
+  const int threads = static_cast<int>(state.range(1));
+  for (auto _ : state) benchmark::DoNotOptimize(SvdPass(f.M, threads));
+  SizeCounters(state, f, true);
+}
+BENCHMARK(BM_SvdPass)->Apply(ResolutionThreadSweep)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// The same pass with BestRotation (closed-form polar factor used by the solver).
+void BM_PolarPass(benchmark::State& state) {
+  const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
+  const int threads = static_cast<int>(state.range(1));
+  for (auto _ : state) benchmark::DoNotOptimize(PolarPass(f.M, threads));
+  SizeCounters(state, f, true);
+}
+BENCHMARK(BM_PolarPass)->Apply(ResolutionThreadSweep)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// One full local-global iteration through the public solver API: LocalGlobalSolver::Solve with
+/// max_iterations = 1 from a warm start (nothing subtracted, so the per-call overhead of Solve is
+/// included). ratio_to_baseline = median iteration time / (bare global solve + bare SVD pass),
+/// the baseline timed in the same process just before the loop.
+void BM_Iteration(benchmark::State& state) {
+  const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
+  LocalGlobalSolver solver(f.model, OneIterationOptions(*f.model, 1));
+  const Baseline base = MeasureBaseline(f);
+  benchmark::DoNotOptimize(solver.Solve(f.c, &f.X).energy);  // warm-up
+  std::vector<double> times;
+  double local_s = 0, global_s = 0;
+  int bad = 0;
+  for (auto _ : state) {
+    const auto t0 = Clock::now();
+    FkResult r = solver.Solve(f.c, &f.X);
+    times.push_back(Since(t0));
+    benchmark::DoNotOptimize(r.energy);
+    local_s += r.local_time_s;
+    global_s += r.global_time_s;
+    if (r.iterations != 1) ++bad;
+  }
+  SizeCounters(state, f, false);
+  const double it_med = Median(times);
+  state.counters["baseline_ms"] = 1e3 * base.total();
+  state.counters["base_solve_ms"] = 1e3 * base.solve_s;
+  state.counters["base_svd_ms"] = 1e3 * base.svd_s;
+  state.counters["base_polar_ms"] = 1e3 * base.polar_s;
+  state.counters["iter_median_ms"] = 1e3 * it_med;
+  state.counters["ratio_to_baseline"] = it_med / base.total();
+  state.counters["ratio_to_polar_base"] = it_med / base.total_polar();
+  // Solver-internal split (the local part includes the reference-residual local step at rest).
+  state.counters["local_ms"] =
+      benchmark::Counter(1e3 * local_s, benchmark::Counter::kAvgIterations);
+  state.counters["global_ms"] =
+      benchmark::Counter(1e3 * global_s, benchmark::Counter::kAvgIterations);
+  if (bad) state.SkipWithError("Solve did not run exactly one iteration");
+}
+BENCHMARK(BM_Iteration)->Apply(ResolutionSweep)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// Marginal cost of one iteration inside a Solve: (t(Solve, 1 + K iterations) - t(Solve, 1)) / K,
+/// i.e. BM_Iteration without the per-call setup (reference residual, final energy, copies).
+/// Includes Anderson and any safeguard re-evaluations (aa_rejected counts them).
+void BM_IterationMarginal(benchmark::State& state) {
+  constexpr int K = 5;
+  const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
+  LocalGlobalSolver one(f.model, OneIterationOptions(*f.model, 1));
+  LocalGlobalSolver many(f.model, OneIterationOptions(*f.model, 1 + K));
+  const Baseline base = MeasureBaseline(f);
+  std::vector<double> times;
+  int rejected = 0, accepted = 0;
+  for (auto _ : state) {
+    auto t0 = Clock::now();
+    FkResult r1 = one.Solve(f.c, &f.X);
+    const double t1 = Since(t0);
+    t0 = Clock::now();
+    FkResult rk = many.Solve(f.c, &f.X);
+    const double tk = Since(t0);
+    benchmark::DoNotOptimize(r1.energy + rk.energy);
+    rejected += rk.aa_rejected;
+    accepted += rk.aa_accepted;
+    const double dt = std::max(0.0, (tk - t1) / K);
+    times.push_back(dt);
+    state.SetIterationTime(dt);
+  }
+  SizeCounters(state, f, false);
+  const double it_med = Median(times);
+  state.counters["baseline_ms"] = 1e3 * base.total();
+  state.counters["ratio_to_baseline"] = it_med / base.total();
+  state.counters["ratio_to_polar_base"] = it_med / base.total_polar();
+  state.counters["aa_rejected"] = benchmark::Counter(rejected, benchmark::Counter::kAvgIterations);
+  state.counters["aa_accepted"] = benchmark::Counter(accepted, benchmark::Counter::kAvgIterations);
+}
+BENCHMARK(BM_IterationMarginal)
+    ->Apply(ResolutionSweep)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime();
+
+/// Anderson::Compute on vectors of size 3 * #free with window 6, history full (steady state).
+void BM_AndersonOverhead(benchmark::State& state) {
+  const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
+  const int dim = 3 * f.free;
+  constexpr int kWindow = 6, kPool = 9;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> nd;
+  std::vector<Eigen::VectorXd> G(kPool), F(kPool);
+  for (int k = 0; k < kPool; ++k) {
+    G[k] = Eigen::VectorXd::NullaryExpr(dim, [&]() { return nd(rng); });
+    F[k] = Eigen::VectorXd::NullaryExpr(dim, [&]() { return nd(rng); });
+  }
+  Anderson aa(dim, kWindow);
+  int k = 0;
+  for (; k < kWindow + 2; ++k) aa.Compute(G[k % kPool], F[k % kPool]);  // fill the history
+  for (auto _ : state) {
+    const Eigen::VectorXd& x = aa.Compute(G[k % kPool], F[k % kPool]);
+    benchmark::DoNotOptimize(x.data());
+    ++k;
+  }
+  SizeCounters(state, f, false);
+  state.counters["dim"] = dim;
+}
+BENCHMARK(BM_AndersonOverhead)
+    ->Apply(ResolutionSweep)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+
+/// The full bend of the default finger (res 12): alpha from 1 to the actuator max in 24 equal
+/// warm-started steps with lg-aa and the scene's default tolerances.
+void BM_FullBend(benchmark::State& state) {
+  constexpr int kSteps = 24;
+  const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
+  const Model& m = *f.model;
+  FkOptions opts = m.scene().solver;
+  opts.solver = "lg-aa";
+  auto solver = MakeFkSolver(f.model, opts);
+  const Actuator& act = m.scene().actuators[0];
+  double total = 0, solver_s = 0, local_s = 0, global_s = 0;
+  int iters = 0, not_converged = 0, max_iters = 0;
+  double final_ratio = 0;
+  for (auto _ : state) {
+    Eigen::VectorXd c = m.scene().rest_actuation();
+    Eigen::MatrixX3d X = m.rest_positions();
+    const auto t0 = Clock::now();
+    for (int s = 1; s <= kSteps; ++s) {
+      c[0] = act.rest + (act.max - act.rest) * double(s) / kSteps;
+      FkResult r = solver->Solve(c, &X);
+      X = r.positions;
+      iters += r.iterations;
+      max_iters = std::max(max_iters, r.iterations);
+      solver_s += r.time_s;
+      local_s += r.local_time_s;
+      global_s += r.global_time_s;
+      if (r.status != FkStatus::Converged) ++not_converged;
+      final_ratio = r.volume_ratios.empty() ? 0.0 : r.volume_ratios[0];
+    }
+    total += Since(t0);
+  }
+  SizeCounters(state, f, false);
+  using C = benchmark::Counter;
+  state.counters["total_s"] = C(total, C::kAvgIterations);
+  state.counters["solver_s"] = C(solver_s, C::kAvgIterations);
+  state.counters["local_s"] = C(local_s, C::kAvgIterations);
+  state.counters["global_s"] = C(global_s, C::kAvgIterations);
+  state.counters["iterations"] = C(iters, C::kAvgIterations);
+  state.counters["max_step_iters"] = max_iters;
+  state.counters["not_converged"] = C(not_converged, C::kAvgIterations);
+  state.counters["ms_per_iter"] = iters > 0 ? 1e3 * total / iters : 0.0;
+  state.counters["final_vol_ratio"] = final_ratio;
+}
+BENCHMARK(BM_FullBend)->Arg(12)->ArgName("res")->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+
+}  // namespace
+}  // namespace softkin
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::AddCustomContext("omp_max_threads", std::to_string(omp_get_max_threads()));
+  benchmark::AddCustomContext("robot", softkin::kRobot);
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

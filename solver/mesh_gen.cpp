@@ -90,14 +90,21 @@ Mesh VoxelTetMesh(const Eigen::Vector3d& origin, double h, const Eigen::Vector3i
       for (std::int64_t i = 0; i < nx; ++i) {
         const int t = tag[i + nx * (j + ny * k)];
         if (t < 0) continue;
+        // Mirror the split in every axis whose cell index is odd: corner c maps to c ^ mirror.
+        // Opposite faces of the Kuhn cube carry the same diagonal pattern, so the mirrored
+        // cells still match their neighbours, and the mesh gains the reflection symmetries of
+        // the grid (a single unmirrored diagonal biases large deformations towards (1,1,1)).
+        const int mirror = int(i & 1) | int(j & 1) << 1 | int(k & 1) << 2;
+        const bool odd_mirror = ((mirror & 1) ^ ((mirror >> 1) & 1) ^ ((mirror >> 2) & 1)) != 0;
         auto corner = [&](int c) {
+          c ^= mirror;
           return newid[vid(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1))];
         };
         for (int o = 0; o < 6; ++o) {
           const int c1 = 1 << kOrders[o][0];
           const int c2 = c1 | (1 << kOrders[o][1]);
           int v1 = corner(c1), v2 = corner(c2);
-          if (o >= 3) std::swap(v1, v2);
+          if ((o >= 3) != odd_mirror) std::swap(v1, v2);
           mesh.elements.push_back(MakeTet(corner(0), v1, v2, corner(7), t));
         }
       }

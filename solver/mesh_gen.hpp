@@ -29,7 +29,9 @@ using VoxelClassifier = std::function<int(const Eigen::Vector3d& centre, const E
 /// Regular grid of cubic cells of edge `h` (mm) covering the box
 /// [origin, origin + h * cells] (cells = number of cells along x, y, z; each >= 1).
 /// Every cell for which `classify` returns a tag >= 0 is split into 6 tets by the Kuhn
-/// (Freudenthal) split: all 6 tets share the cell's main diagonal from corner (0,0,0) to (1,1,1),
+/// (Freudenthal) split, mirrored in each axis whose cell index is odd (so the mesh keeps the
+/// grid's reflection symmetries): all 6 tets share the cell's main diagonal (for an unmirrored
+/// cell from corner (0,0,0) to (1,1,1)),
 /// and each follows one monotone path (0,0,0) -> +e_a -> +e_a+e_b -> (1,1,1) over the 6 axis
 /// orders (a, b, c). The same split in every cell makes shared faces match, so the mesh is
 /// conforming. Grid vertices not used by any kept cell are removed and the remaining ones are

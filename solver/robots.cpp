@@ -1,4 +1,3 @@
-#include <cstdlib>
 #include "solver/robots.hpp"
 
 #include "solver/mesh_gen.hpp"
@@ -19,16 +18,18 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // pneumatic_finger (thesis Fig. 2.11): PneuNet-style bending actuator on a voxel grid.
 //
 // Axes: x = long axis (proximal end x = 0, fixed; distal end x = 100), y = width [0, 20],
-// z = height [0, 20]. The inextensible layer is at the bottom and the chambers above it, so
-// inflation lengthens the top side and the finger curls towards -z (tip down, then back).
+// z = height [0, 20]. The inextensible layer is at the bottom and the chambers in the upper part,
+// so inflation lengthens the top side and the finger curls towards -z (tip down, then back).
 // Nominal geometry (mm), snapped to the grid of cell size h = 20 / res:
-//   base layer z in [0, 3]            region 2 "inextensible" (r_omega 1, weight 1)
+//   base layer z in [0, 1.5]          region 2 "inextensible" (r_omega 1, weight 5)
 //   proximal block x in [0, ~8]       region 0 solid, its x = 0 face is fixed
-//   9 chamber blocks of length ~8.2, each preceded by a 2 mm empty gap (also between the
-//   proximal block and the first chamber block), full width and height;
+//   9 chamber blocks of length ~10 sharing their end walls (no gaps: an isotropically inflating
+//   cavity next to an empty gap only balloons into the gap and pushes the base down, which
+//   bends the finger the wrong way), full width and height;
 //   each block: 2 mm walls (x ends, y sides, top), region 0 "body" (r_omega 1, weight 1),
-//   around a cavity that sits on the base layer and is filled with region-1 tets: the
-//   pneumatic actuation elements of the single actuator "chamber".
+//   around a cavity from z = 8 mm to the top wall, filled with region-1 tets: the
+//   pneumatic actuation elements of the single actuator "chamber". The solid body below the
+//   cavities makes the expansion one-sided.
 // Every feature is >= 1 cell at every allowed resolution; at coarse resolutions (res < 8) the
 // number of chambers drops so that the finger stays 100 mm long. The proximal block absorbs the
 // rounding so the total length is exactly 100 mm. At the default res 12 (h = 1.667 mm): base
@@ -40,6 +41,12 @@ constexpr int kFingerMinRes = 4, kFingerMaxRes = 40, kFingerDefaultRes = 12;
 constexpr double kFingerLength = 100.0, kFingerWidth = 20.0, kFingerHeight = 20.0;
 constexpr double kFingerBase = 1.5, kFingerWall = 2.0, kFingerGap = 2.0, kFingerProximal = 8.0;
 constexpr int kFingerBlocks = 9;
+/// Cavities start at this height (mm): the lower part is solid body, so inflation lengthens the top.
+constexpr double kFingerCavityFloor = 8.0;
+/// Weight of the inextensible layer relative to the body (it resists stretching; being one or two
+/// cells thin, it still bends).
+constexpr double kFingerLayerWeight = 5.0;
+constexpr double kFingerBodyROmega = 1.0;
 
 /// The finger's layout in cells.
 struct FingerLayout {
@@ -53,6 +60,7 @@ struct FingerLayout {
   int blocks = 0;        // number of chamber blocks
   int block = 0;         // block length
   int proximal = 0;      // proximal solid block length
+  int cavity_floor = 0;  // first cell layer (z) of the cavities
 };
 
 int Cells(double mm, double h) { return std::max(1, static_cast<int>(std::lround(mm / h))); }
@@ -67,7 +75,8 @@ FingerLayout MakeFingerLayout(int res) {
   L.top = Cells(kFingerWall, L.h);
   L.side = Cells(kFingerWall, L.h);
   L.wall = Cells(kFingerWall, L.h);
-  L.gap = Cells(kFingerGap, L.h);
+  L.gap = 0;  // chambers share their walls (see the layout comment)
+  L.cavity_floor = std::max(L.base + 1, static_cast<int>(std::lround(kFingerCavityFloor / L.h)));
   const int prox_min = Cells(kFingerProximal, L.h);
   const int min_block = 2 * L.wall + 1;
   // Nominal block length: 9 (gap, block) pairs fill the 92 mm after the proximal block.
@@ -89,7 +98,7 @@ int FingerCell(const FingerLayout& L, int i, int j, int k) {
   const int u = (i - L.proximal) % pitch - L.gap;  // position in the block, < 0 in the gap
   if (u < 0) return -1;  // gap in front of the block
   const bool cavity = u >= L.wall && u < L.block - L.wall && j >= L.side && j < L.ny - L.side &&
-                      k < L.nz - L.top;
+                      k < L.nz - L.top && k >= L.cavity_floor;
   return cavity ? 1 : 0;
 }
 
@@ -101,8 +110,8 @@ Scene MakePneumaticFinger(int res) {
                         [&L](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
                           return FingerCell(L, c[0], c[1], c[2]);
                         });
-  s.body[0] = Material{"body", getenv("SK_RB")?atof(getenv("SK_RB")):1.0, 1.0};
-  s.body[2] = Material{"inextensible", 1.0, getenv("SK_WL")?atof(getenv("SK_WL")):1.0};
+  s.body[0] = Material{"body", kFingerBodyROmega, 1.0};
+  s.body[2] = Material{"inextensible", 1.0, kFingerLayerWeight};
   Actuator a;
   a.name = "chamber";
   a.type = ActuatorType::Pneumatic;
@@ -202,8 +211,8 @@ const std::vector<RobotEntry>& Registry() {
       {{"pneumatic_finger",
         "PneuNet-style pneumatic bending finger (thesis Fig. 2.11), voxel tet mesh. x = long axis "
         "[0, 100] mm (x = 0 fixed), y = width [0, 20], z = height [0, 20]; inextensible base layer "
-        "z in [0, 3] (region 2), a solid proximal block and 9 chamber blocks (2 mm walls, region 0) "
-        "separated by 2 mm empty gaps; the filled cavities (region 1) form one pneumatic actuator "
+        "z in [0, 1.5] (region 2, weight 5), a solid proximal block and 9 chamber blocks sharing 2 mm "
+        "walls (region 0) over a solid lower body; the filled cavities (z >= 8, region 1) form one pneumatic actuator "
         "'chamber' (volume ratio in [1, 8]). Markers: tip (distal face x = 100), tip_top / "
         "tip_bottom (top / bottom quarter of the distal face).",
         kFingerDefaultRes,

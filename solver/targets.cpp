@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 
 #include <omp.h>
 
@@ -40,7 +39,6 @@ void ComputeLocalRatios(const Model& model, const Eigen::Ref<const Eigen::Matrix
     if (achieved) (*achieved)[a] = Ud / U;
     // alpha_i u_i = Vol_i^d * (alpha U / U^d): proportional to the current volume, exact total.
     const double scale = c[a] * U / Ud;
-    if (getenv("SK_UNIFORM")) { for (int i : ids) (*ratios)[i] = c[a]; continue; }
     for (int i : ids) (*ratios)[i] = (*ratios)[i] * scale / els[i].rest_volume;
   }
 }

@@ -1,0 +1,140 @@
+#!/usr/bin/env python3
+"""Ablation of Anderson acceleration on the local-global FK solver (thesis Alg. 1, Sec. 2.5; AA is used in Sec. 3.3).
+
+Usage: aa_ablation.py RESULTS_DIR
+
+Reads RESULTS_DIR/aa_ablation.csv (written by `softkin run experiments/aa_ablation.json`) and, if
+present, RESULTS_DIR/summary.json. Writes RESULTS_DIR/aa_ablation.png: grouped bars of the
+iteration count of plain local-global (lg) and Anderson-accelerated local-global (lg-aa) for
+every robot and actuation level, on a log scale. Bars of runs that did not converge are hatched.
+Exit status 2 with a message on stderr if the CSV is missing or malformed.
+"""
+import csv
+import json
+import os
+import sys
+
+NAME = "aa_ablation"
+COLUMNS = ["robot", "level", "solver", "iterations", "time_s", "energy", "status", "aa_rejected"]
+NUMERIC = ["level", "iterations", "time_s", "energy", "aa_rejected"]
+SOLVERS = ("lg", "lg-aa")
+COLORS = {"lg": "tab:gray", "lg-aa": "tab:blue"}
+
+
+def fail(msg):
+    print(f"{NAME}.py: error: {msg}", file=sys.stderr)
+    sys.exit(2)
+
+
+def read_table(path):
+    """Rows of `path`; numeric columns as floats. Fails with the file and line of any bad value."""
+    if not os.path.isfile(path):
+        fail(f"{path} not found (run `softkin run experiments/{NAME}.json` first)")
+    rows = []
+    with open(path, newline="") as f:
+        reader = csv.DictReader(f)
+        header = reader.fieldnames or []
+        missing = [c for c in COLUMNS if c not in header]
+        if missing:
+            fail(f"{path}: header lacks column(s) {', '.join(missing)}; expected {','.join(COLUMNS)}")
+        for row in reader:
+            line = reader.line_num
+            if None in row or any(row.get(c) is None for c in COLUMNS):
+                fail(f"{path}:{line}: expected {len(header)} values")
+            vals = dict(row)
+            for c in NUMERIC:
+                try:
+                    vals[c] = float(row[c])
+                except ValueError:
+                    fail(f"{path}:{line}: column '{c}' is '{row[c]}', expected a number")
+            if vals["solver"] not in SOLVERS:
+                fail(f"{path}:{line}: solver is '{vals['solver']}', expected one of {', '.join(SOLVERS)}")
+            rows.append(vals)
+    if not rows:
+        fail(f"{path}: no data rows")
+    return rows
+
+
+def read_summary(path):
+    if not os.path.isfile(path):
+        return {}
+    try:
+        with open(path) as f:
+            data = json.load(f)
+    except (OSError, ValueError) as e:
+        fail(f"{path}: not valid JSON ({e})")
+    return data if isinstance(data, dict) else {}
+
+
+def main(argv):
+    if len(argv) != 2 or argv[1] in ("-h", "--help"):
+        print(__doc__.strip(), file=sys.stderr)
+        sys.exit(0 if len(argv) == 2 else 2)
+    results = argv[1]
+    if not os.path.isdir(results):
+        fail(f"results folder {results} does not exist")
+    rows = read_table(os.path.join(results, "aa_ablation.csv"))
+    summary = read_summary(os.path.join(results, "summary.json"))
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Patch
+
+    # Groups (robot, level) in the order they first appear; one bar per solver inside each.
+    groups, table = [], {}
+    for r in rows:
+        key = (r["robot"], r["level"])
+        if key not in table:
+            groups.append(key)
+            table[key] = {}
+        table[key][r["solver"]] = r
+
+    width = 0.38
+    fig, ax = plt.subplots(figsize=(max(6.5, 1.5 * len(groups) + 2.5), 5.0))
+    any_failed = False
+    for s_i, solver in enumerate(SOLVERS):
+        for g_i, key in enumerate(groups):
+            r = table[key].get(solver)
+            if r is None:
+                continue
+            xpos = g_i + (s_i - 0.5) * width
+            failed = r["status"] != "converged"
+            any_failed |= failed
+            height = max(r["iterations"], 1.0)  # log axis: show 0 iterations as 1
+            ax.bar(xpos, height, width, color=COLORS[solver], edgecolor="k", linewidth=0.6,
+                   hatch="//" if failed else None)
+            ax.text(xpos, height * 1.05, f"{r['iterations']:.0f}", ha="center", va="bottom",
+                    fontsize=8)
+    for g_i, key in enumerate(groups):
+        pair = table[key]
+        if all(s in pair for s in SOLVERS) and pair["lg-aa"]["iterations"] > 0:
+            ratio = pair["lg"]["iterations"] / pair["lg-aa"]["iterations"]
+            ax.annotate(f"\N{MULTIPLICATION SIGN}{ratio:.1f}", xy=(g_i, 0), xycoords=("data", "axes fraction"),
+                        xytext=(0, -30), textcoords="offset points", ha="center", fontsize=8,
+                        color="tab:blue")
+
+    ax.set_yscale("log")
+    ax.set_xticks(range(len(groups)))
+    ax.set_xticklabels([f"{robot}\nlevel {level:g}" for robot, level in groups], fontsize=8)
+    ax.set_ylabel("FK iterations to converge (log)")
+    ax.grid(True, axis="y", which="both", alpha=0.3)
+    ax.margins(y=0.15)
+    handles = [Patch(facecolor=COLORS[s], edgecolor="k", label=s) for s in SOLVERS]
+    handles[0].set_label("lg (plain local-global)")
+    handles[1].set_label("lg-aa (Anderson accelerated)")
+    if any_failed:
+        handles.append(Patch(facecolor="white", edgecolor="k", hatch="//", label="not converged"))
+    ax.legend(handles=handles, loc="upper left", fontsize=8)
+    quick = " (quick run)" if summary.get("quick") else ""
+    ax.set_title("Ablation (no thesis figure): Alg. 1 local-global (Sec. 2.5) with and without Anderson "
+                 f"acceleration{quick}\nbelow the bars: lg / lg-aa iteration ratio", fontsize=10)
+    fig.tight_layout()
+    out = os.path.join(results, f"{NAME}.png")
+    fig.savefig(out, dpi=130)
+    print(f"wrote {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
