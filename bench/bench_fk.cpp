@@ -415,6 +415,8 @@ void BM_FullBend(benchmark::State& state) {
       global_s += r.global_time_s;
       if (r.status != FkStatus::Converged) ++not_converged;
       final_ratio = r.volume_ratios.empty() ? 0.0 : r.volume_ratios[0];
+      std::fprintf(stderr, "[full bend] step %2d alpha %.3f: %s (aa %d/%d accepted/rejected)\n", s,
+                   c[0], r.BriefReport().c_str(), r.aa_accepted, r.aa_rejected);
     }
     total += Since(t0);
   }

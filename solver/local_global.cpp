@@ -66,33 +66,45 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     X = keep;
   }
 
+  if (total_weight_ == 0.0)
+    for (const auto& e : m.elements()) total_weight_ += e.wv;
   Anderson aa(3 * nf, options_.anderson_window);
   Eigen::MatrixX3d X_good = X;
-  double E_acc = 0.0;
+  auto residual = [&]() {
+    load_free();
+    return 2.0 * (m.A_ff() * xf + Cfix - Bf).norm();
+  };
+  double res_acc = 0.0;
   bool accelerated = false;
   for (int it = 0; it < options_.max_iterations; ++it) {
     double E;
     local(&E);
-    if (aa_on && accelerated && !(E <= E_acc)) {
-      // Safeguard: the accelerated iterate raised the energy; take the plain step instead.
+    double grad = residual();
+    // Safeguard on the local-global residual ||2 (A X - B)||. (The energy is not a valid merit
+    // function here: with volume-proportional local ratios or blended targets the fixed point of
+    // Algorithm 1 is not a minimum of E, and plain steps can raise E near it.)
+    if (aa_on && accelerated && !(grad <= res_acc)) {
       store_free(Gprev);
       aa.Reset();
       ++r->aa_rejected;
       local(&E);
+      grad = residual();
     } else if (accelerated) {
       ++r->aa_accepted;
     }
-    if (!std::isfinite(E) || !X.allFinite()) {
+    if (!std::isfinite(E) || !X.allFinite() || !std::isfinite(grad)) {
       X = X_good;
       r->status = FkStatus::Diverged;
       r->message = "non-finite energy or positions at iteration " + std::to_string(r->iterations);
       return;
     }
-    X_good = X;
-    E_acc = E;
-    load_free();
-    const double grad = 2.0 * (m.A_ff() * xf + Cfix - Bf).norm();
-    if (it == 0) ref = std::max(ref, grad);
+    X_good = X;  // the last iterate whose residual was checked
+    res_acc = grad;
+    if (it == 0) {
+      // Floor: a residual this small is round-off (e.g. at the rest actuation, where both the
+      // residual at rest and at the start are ~0 and their ratio would be noise).
+      ref = std::max({ref, grad, 1e-10 * total_weight_ * m.size()});
+    }
     r->gradient_ratio = ref > 0 ? grad / ref : 0.0;
 
     const auto t1 = Clock::now();
@@ -124,6 +136,7 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
       store_free(Gf);
     }
   }
+  X = X_good;  // never return an unchecked (extrapolated) iterate
   r->status = FkStatus::IterationCap;
   r->message = "iteration cap of " + std::to_string(options_.max_iterations) + " reached";
 }

