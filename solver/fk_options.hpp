@@ -8,12 +8,12 @@ namespace softkin {
 struct FkOptions {
   /// Solver name: "lg" (plain local-global, Algorithm 1) or "lg-aa" (Anderson-accelerated).
   std::string solver = "lg-aa";
-  int max_iterations = 3000;
+  int max_iterations = 10000;
   /// Stop when every vertex moves less than tolerance * model size in one iteration ...
   double tolerance = 1e-5;
   /// ... and the energy gradient norm has fallen below gradient_tolerance times its value at the
   /// first iteration (guards against slow creeping on thin, bending-dominated parts).
-  double gradient_tolerance = 1e-3;
+  double gradient_tolerance = 1e-5;
   int anderson_window = 6;
   /// Apply the actuation in this many equal steps (continuation), warm-starting each.
   int continuation_steps = 1;
