@@ -1,7 +1,7 @@
 // Google Benchmark suite for the forward-kinematics solver (local-global + Anderson acceleration).
 //
 // Every benchmark except BM_FullBend sweeps the pneumatic_finger resolution (the `res` argument:
-// cells across the 20 mm width, ~26 res^3 tets) and reports the counters
+// cells across the 20 mm width, ~22.5 res^3 tets for the 18 mm tall finger) and reports the counters
 //   tets, vertices, free      mesh size (elements, vertices, non-fixed vertices)
 //   per_vertex                wall time per vertex (per iteration of the benchmark)
 //   per_tet                   wall time per element (element loops only)
@@ -22,6 +22,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <memory>
 #include <random>
@@ -37,7 +38,7 @@ double Since(Clock::time_point t0) {
 }
 
 constexpr const char* kRobot = "pneumatic_finger";
-/// Resolutions of the sweep: ~5.6k, 13k, 26k, 45k, 71k and 152k tets.
+/// Resolutions of the sweep: 5.4k, 13k, 27k, 47.5k, 76k and 156k tets (finger as of f689150).
 const std::vector<int> kResolutions = {6, 8, 10, 12, 14, 18};
 /// Actuation (chamber volume ratio) of the deformed configuration used by the per-step benchmarks.
 constexpr double kAlpha = 3.0;
@@ -108,13 +109,14 @@ const Fixture& GetFixture(int res) {
   return *cache.emplace(res, std::move(f)).first->second;
 }
 
-void SizeCounters(benchmark::State& state, const Fixture& f, bool per_tet) {
+void SizeCounters(benchmark::State& state, const Fixture& f, bool per_tet, bool per_vertex = true) {
   state.counters["tets"] = f.tets;
   state.counters["vertices"] = f.vertices;
   state.counters["free"] = f.free;
   // Rate counters with kInvert: seconds per vertex / per tet of one benchmark iteration.
-  state.counters["per_vertex"] = benchmark::Counter(
-      f.vertices, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  if (per_vertex)
+    state.counters["per_vertex"] = benchmark::Counter(
+        f.vertices, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
   if (per_tet)
     state.counters["per_tet"] = benchmark::Counter(
         f.tets, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
@@ -148,19 +150,21 @@ double Median(std::vector<double> v) {
 }
 
 /// Baseline of one iteration: the bare global solve (3 RHS) + the bare SVD pass (default threads),
-/// medians of `reps` timed repetitions after one warm-up.
-/// Also times the polar pass (BestRotation), for the stricter ratio against the solver's own
-/// rotation fit.
+/// and, for the stricter ratio against the solver's own rotation fit, the polar pass. `iteration`
+/// (optional) times one sample of the iteration being compared; it is interleaved with the
+/// baseline passes so that load changes on a shared machine hit both sides alike. Medians of
+/// `reps` repetitions after one warm-up.
 struct Baseline {
-  double solve_s = 0, svd_s = 0, polar_s = 0;
+  double solve_s = 0, svd_s = 0, polar_s = 0, iter_s = 0;
   double total() const { return solve_s + svd_s; }
   double total_polar() const { return solve_s + polar_s; }
 };
-Baseline MeasureBaseline(const Fixture& f, int reps = 7) {
-  std::vector<double> ts, tv, tp;
+Baseline MeasureBaseline(const Fixture& f, const std::function<double()>& iteration, int reps = 7) {
+  std::vector<double> ts, tv, tp, ti;
   benchmark::DoNotOptimize(f.model->SolveFree(f.rhs_free));
   benchmark::DoNotOptimize(SvdPass(f.M, 0));
   benchmark::DoNotOptimize(PolarPass(f.M, 0));
+  if (iteration) iteration();
   for (int k = 0; k < reps; ++k) {
     auto t0 = Clock::now();
     Eigen::MatrixX3d Y = f.model->SolveFree(f.rhs_free);
@@ -174,8 +178,18 @@ Baseline MeasureBaseline(const Fixture& f, int reps = 7) {
     s = PolarPass(f.M, 0);
     benchmark::DoNotOptimize(s);
     tp.push_back(Since(t0));
+    if (iteration) ti.push_back(iteration());
   }
-  return {Median(ts), Median(tv), Median(tp)};
+  return {Median(ts), Median(tv), Median(tp), ti.empty() ? 0.0 : Median(ti)};
+}
+
+void BaselineCounters(benchmark::State& state, const Baseline& b) {
+  state.counters["base_solve_ms"] = 1e3 * b.solve_s;
+  state.counters["base_svd_ms"] = 1e3 * b.svd_s;
+  state.counters["base_polar_ms"] = 1e3 * b.polar_s;
+  state.counters["iter_ms"] = 1e3 * b.iter_s;
+  state.counters["ratio_to_baseline"] = b.iter_s / b.total();
+  state.counters["ratio_to_polar_base"] = b.iter_s / b.total_polar();
 }
 
 FkOptions OneIterationOptions(const Model& m, int max_iterations) {
@@ -284,34 +298,31 @@ BENCHMARK(BM_PolarPass)->Apply(ResolutionThreadSweep)->Unit(benchmark::kMillisec
 
 /// One full local-global iteration through the public solver API: LocalGlobalSolver::Solve with
 /// max_iterations = 1 from a warm start (nothing subtracted, so the per-call overhead of Solve is
-/// included). ratio_to_baseline = median iteration time / (bare global solve + bare SVD pass),
-/// the baseline timed in the same process just before the loop.
+/// included). ratio_to_baseline = iteration time / (bare global solve + bare SVD pass), all medians
+/// of 7 interleaved repetitions timed in the same process just before the benchmark loop.
 void BM_Iteration(benchmark::State& state) {
   const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
   LocalGlobalSolver solver(f.model, OneIterationOptions(*f.model, 1));
-  const Baseline base = MeasureBaseline(f);
-  benchmark::DoNotOptimize(solver.Solve(f.c, &f.X).energy);  // warm-up
-  std::vector<double> times;
-  double local_s = 0, global_s = 0;
   int bad = 0;
-  for (auto _ : state) {
+  auto one_iteration = [&]() {
     const auto t0 = Clock::now();
     FkResult r = solver.Solve(f.c, &f.X);
-    times.push_back(Since(t0));
+    const double t = Since(t0);
+    benchmark::DoNotOptimize(r.energy);
+    if (r.iterations != 1) ++bad;
+    return t;
+  };
+  const Baseline base = MeasureBaseline(f, one_iteration);
+  double local_s = 0, global_s = 0;
+  for (auto _ : state) {
+    FkResult r = solver.Solve(f.c, &f.X);
     benchmark::DoNotOptimize(r.energy);
     local_s += r.local_time_s;
     global_s += r.global_time_s;
     if (r.iterations != 1) ++bad;
   }
   SizeCounters(state, f, false);
-  const double it_med = Median(times);
-  state.counters["baseline_ms"] = 1e3 * base.total();
-  state.counters["base_solve_ms"] = 1e3 * base.solve_s;
-  state.counters["base_svd_ms"] = 1e3 * base.svd_s;
-  state.counters["base_polar_ms"] = 1e3 * base.polar_s;
-  state.counters["iter_median_ms"] = 1e3 * it_med;
-  state.counters["ratio_to_baseline"] = it_med / base.total();
-  state.counters["ratio_to_polar_base"] = it_med / base.total_polar();
+  BaselineCounters(state, base);
   // Solver-internal split (the local part includes the reference-residual local step at rest).
   state.counters["local_ms"] =
       benchmark::Counter(1e3 * local_s, benchmark::Counter::kAvgIterations);
@@ -323,16 +334,15 @@ BENCHMARK(BM_Iteration)->Apply(ResolutionSweep)->Unit(benchmark::kMillisecond)->
 
 /// Marginal cost of one iteration inside a Solve: (t(Solve, 1 + K iterations) - t(Solve, 1)) / K,
 /// i.e. BM_Iteration without the per-call setup (reference residual, final energy, copies).
-/// Includes Anderson and any safeguard re-evaluations (aa_rejected counts them).
+/// Includes Anderson and any safeguard re-evaluations (aa_rejected counts them). Same ratio
+/// counters as BM_Iteration.
 void BM_IterationMarginal(benchmark::State& state) {
   constexpr int K = 5;
   const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
   LocalGlobalSolver one(f.model, OneIterationOptions(*f.model, 1));
   LocalGlobalSolver many(f.model, OneIterationOptions(*f.model, 1 + K));
-  const Baseline base = MeasureBaseline(f);
-  std::vector<double> times;
-  int rejected = 0, accepted = 0;
-  for (auto _ : state) {
+  int rejected = 0, accepted = 0, samples = 0;
+  auto marginal = [&]() {
     auto t0 = Clock::now();
     FkResult r1 = one.Solve(f.c, &f.X);
     const double t1 = Since(t0);
@@ -342,17 +352,15 @@ void BM_IterationMarginal(benchmark::State& state) {
     benchmark::DoNotOptimize(r1.energy + rk.energy);
     rejected += rk.aa_rejected;
     accepted += rk.aa_accepted;
-    const double dt = std::max(0.0, (tk - t1) / K);
-    times.push_back(dt);
-    state.SetIterationTime(dt);
-  }
+    ++samples;
+    return std::max(0.0, (tk - t1) / K);
+  };
+  const Baseline base = MeasureBaseline(f, marginal);
+  for (auto _ : state) state.SetIterationTime(marginal());
   SizeCounters(state, f, false);
-  const double it_med = Median(times);
-  state.counters["baseline_ms"] = 1e3 * base.total();
-  state.counters["ratio_to_baseline"] = it_med / base.total();
-  state.counters["ratio_to_polar_base"] = it_med / base.total_polar();
-  state.counters["aa_rejected"] = benchmark::Counter(rejected, benchmark::Counter::kAvgIterations);
-  state.counters["aa_accepted"] = benchmark::Counter(accepted, benchmark::Counter::kAvgIterations);
+  BaselineCounters(state, base);
+  state.counters["aa_rejected"] = double(rejected) / samples;  // per Solve of 1 + K iterations
+  state.counters["aa_accepted"] = double(accepted) / samples;
 }
 BENCHMARK(BM_IterationMarginal)
     ->Apply(ResolutionSweep)
@@ -420,7 +428,7 @@ void BM_FullBend(benchmark::State& state) {
     }
     total += Since(t0);
   }
-  SizeCounters(state, f, false);
+  SizeCounters(state, f, false, false);
   using C = benchmark::Counter;
   state.counters["total_s"] = C(total, C::kAvgIterations);
   state.counters["solver_s"] = C(solver_s, C::kAvgIterations);
