@@ -153,9 +153,10 @@ int RunCli(int argc, char** argv) {
       Scene scene = robot.empty() ? LoadSceneJson(scene_file) : MakeRobot(robot, res);
       FkOptions opt = scene.solver;
       if (!solver_name.empty()) opt.solver = solver_name;
-      if (continuation != 0) opt.continuation_steps = continuation;
-      if (max_iter != 0) opt.max_iterations = max_iter;
-      if (tolerance != 0) opt.tolerance = tolerance;
+      // Options given on the command line override the scene's (a given 0 is validated, not ignored).
+      if (fk->count("--continuation")) opt.continuation_steps = continuation;
+      if (fk->count("--max-iterations")) opt.max_iterations = max_iter;
+      if (fk->count("--tolerance")) opt.tolerance = tolerance;
       std::string why;
       if (!opt.IsValid(&why)) throw std::invalid_argument("option " + why);
       const Eigen::VectorXd c = ParseVector(actuation, "--actuation");

@@ -9,10 +9,10 @@ iteration count of plain local-global (lg) and Anderson-accelerated local-global
 every robot and actuation level, on a log scale. Bars of runs that did not converge are hatched.
 Exit status 2 with a message on stderr if the CSV is missing or malformed.
 """
-import csv
-import json
 import os
 import sys
+
+import figlib
 
 NAME = "aa_ablation"
 COLUMNS = ["robot", "level", "solver", "iterations", "time_s", "energy", "status", "aa_rejected"]
@@ -22,48 +22,18 @@ COLORS = {"lg": "tab:gray", "lg-aa": "tab:blue"}
 
 
 def fail(msg):
-    print(f"{NAME}.py: error: {msg}", file=sys.stderr)
-    sys.exit(2)
+    figlib.fail(NAME, msg)
 
 
 def read_table(path):
-    """Rows of `path`; numeric columns as floats. Fails with the file and line of any bad value."""
-    if not os.path.isfile(path):
-        fail(f"{path} not found (run `softkin run experiments/{NAME}.json` first)")
-    rows = []
-    with open(path, newline="") as f:
-        reader = csv.DictReader(f)
-        header = reader.fieldnames or []
-        missing = [c for c in COLUMNS if c not in header]
-        if missing:
-            fail(f"{path}: header lacks column(s) {', '.join(missing)}; expected {','.join(COLUMNS)}")
-        for row in reader:
-            line = reader.line_num
-            if None in row or any(row.get(c) is None for c in COLUMNS):
-                fail(f"{path}:{line}: expected {len(header)} values")
-            vals = dict(row)
-            for c in NUMERIC:
-                try:
-                    vals[c] = float(row[c])
-                except ValueError:
-                    fail(f"{path}:{line}: column '{c}' is '{row[c]}', expected a number")
-            if vals["solver"] not in SOLVERS:
-                fail(f"{path}:{line}: solver is '{vals['solver']}', expected one of {', '.join(SOLVERS)}")
-            rows.append(vals)
-    if not rows:
-        fail(f"{path}: no data rows")
-    return rows
+    return figlib.read_table(
+        NAME, path, COLUMNS, NUMERIC,
+        check=lambda v: None if v["solver"] in SOLVERS else
+        f"solver is '{v['solver']}', expected one of {', '.join(SOLVERS)}")
 
 
 def read_summary(path):
-    if not os.path.isfile(path):
-        return {}
-    try:
-        with open(path) as f:
-            data = json.load(f)
-    except (OSError, ValueError) as e:
-        fail(f"{path}: not valid JSON ({e})")
-    return data if isinstance(data, dict) else {}
+    return figlib.read_summary(NAME, path)
 
 
 def main(argv):

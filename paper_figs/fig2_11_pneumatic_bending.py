@@ -10,10 +10,10 @@ and, if present, RESULTS_DIR/summary.json. Writes RESULTS_DIR/fig2_11_pneumatic_
   right: bend angle against actuation (volume ratio of the chamber).
 Exit status 2 with a message on stderr if the CSV is missing or malformed.
 """
-import csv
-import json
 import os
 import sys
+
+import figlib
 
 NAME = "fig2_11_pneumatic_bending"
 COLUMNS = ["step", "actuation", "bend_deg", "tip_x", "tip_y", "tip_z", "iterations", "time_s",
@@ -22,48 +22,15 @@ MILESTONES = (90.0, 180.0, 240.0)
 
 
 def fail(msg):
-    print(f"{NAME}.py: error: {msg}", file=sys.stderr)
-    sys.exit(2)
+    figlib.fail(NAME, msg)
 
 
 def read_table(path, columns):
-    """Rows of `path` as dicts of floats; fails with the file and line of any bad value."""
-    if not os.path.isfile(path):
-        fail(f"{path} not found (run `softkin run experiments/{NAME}.json` first)")
-    rows = []
-    with open(path, newline="") as f:
-        reader = csv.DictReader(f)
-        header = reader.fieldnames or []
-        missing = [c for c in columns if c not in header]
-        if missing:
-            fail(f"{path}: header lacks column(s) {', '.join(missing)}; expected {','.join(columns)}")
-        for row in reader:
-            line = reader.line_num
-            if None in row or any(row.get(c) is None for c in columns):
-                fail(f"{path}:{line}: expected {len(header)} values")
-            vals = {}
-            for c in columns:
-                try:
-                    vals[c] = float(row[c])
-                except ValueError:
-                    fail(f"{path}:{line}: column '{c}' is '{row[c]}', expected a number")
-            rows.append(vals)
-    if len(rows) < 2:
-        fail(f"{path}: needs at least 2 data rows, found {len(rows)}")
-    return rows
+    return figlib.read_table(NAME, path, columns, min_rows=2)
 
 
 def read_summary(path):
-    if not os.path.isfile(path):
-        return {}
-    try:
-        with open(path) as f:
-            data = json.load(f)
-    except (OSError, ValueError) as e:
-        fail(f"{path}: not valid JSON ({e})")
-    if not isinstance(data, dict):
-        fail(f"{path}: expected a JSON object")
-    return data
+    return figlib.read_summary(NAME, path)
 
 
 def crossings(rows):

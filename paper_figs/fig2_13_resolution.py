@@ -10,11 +10,11 @@ and, if present, RESULTS_DIR/summary.json. Writes RESULTS_DIR/fig2_13_resolution
   right:  distance of each tip to the tip on the finest mesh (convergence).
 Exit status 2 with a message on stderr if the CSV is missing or malformed.
 """
-import csv
-import json
 import math
 import os
 import sys
+
+import figlib
 
 NAME = "fig2_13_resolution"
 COLUMNS = ["res", "n_vertices", "n_tets", "build_s", "factor_s", "iterations", "solve_s",
@@ -23,48 +23,16 @@ COLUMNS = ["res", "n_vertices", "n_tets", "build_s", "factor_s", "iterations", "
 
 
 def fail(msg):
-    print(f"{NAME}.py: error: {msg}", file=sys.stderr)
-    sys.exit(2)
+    figlib.fail(NAME, msg)
 
 
 def read_table(path, columns):
-    """Rows of `path` as dicts of floats; fails with the file and line of any bad value."""
-    if not os.path.isfile(path):
-        fail(f"{path} not found (run `softkin run experiments/{NAME}.json` first)")
-    rows = []
-    with open(path, newline="") as f:
-        reader = csv.DictReader(f)
-        header = reader.fieldnames or []
-        missing = [c for c in columns if c not in header]
-        if missing:
-            fail(f"{path}: header lacks column(s) {', '.join(missing)}; expected {','.join(columns)}")
-        for row in reader:
-            line = reader.line_num
-            if None in row or any(row.get(c) is None for c in columns):
-                fail(f"{path}:{line}: expected {len(header)} values")
-            vals = {}
-            for c in columns:
-                try:
-                    vals[c] = float(row[c])
-                except ValueError:
-                    fail(f"{path}:{line}: column '{c}' is '{row[c]}', expected a number")
-            if vals["n_tets"] <= 0:
-                fail(f"{path}:{line}: n_tets must be positive, got {row['n_tets']}")
-            rows.append(vals)
-    if not rows:
-        fail(f"{path}: no data rows")
-    return rows
+    return figlib.read_table(NAME, path, columns, check=lambda v: None if v["n_tets"] > 0 else
+                             f"n_tets must be positive, got {v['n_tets']:g}")
 
 
 def read_summary(path):
-    if not os.path.isfile(path):
-        return {}
-    try:
-        with open(path) as f:
-            data = json.load(f)
-    except (OSError, ValueError) as e:
-        fail(f"{path}: not valid JSON ({e})")
-    return data if isinstance(data, dict) else {}
+    return figlib.read_summary(NAME, path)
 
 
 def main(argv):

@@ -54,17 +54,19 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     for (int i = 0; i < nf; ++i) X.row(fv[i]) = Y.row(i);
   };
 
-  // Reference residual: the residual at the rest shape for this actuation.
-  double ref = 0.0;
-  {
+  // Reference residual: the residual at the rest shape for this actuation. It depends on c only,
+  // so it is cached across calls (sweeps and finite differences re-solve the same c often).
+  if (ref_c_.size() != c.size() || ref_c_ != c) {
     const Eigen::MatrixX3d keep = X;
     X = m.rest_positions();
     double E0;
     local(&E0);
     load_free();
-    ref = 2.0 * (m.A_ff() * xf + Cfix - Bf).norm();
+    ref_value_ = 2.0 * (m.A_ff() * xf + Cfix - Bf).norm();
+    ref_c_ = c;
     X = keep;
   }
+  double ref = ref_value_;
 
   if (total_weight_ == 0.0)
     for (const auto& e : m.elements()) total_weight_ += e.wv;

@@ -27,7 +27,9 @@ class LocalGlobalSolver : public FkSolver {
   FkOptions options_;
   std::vector<ElemRows> weighted_;  // per-element w Vol T, reused across iterations
   std::vector<double> ratios_;
-  double total_weight_ = 0.0;  // sum of w_i Vol_i, sets the scale of the residual's round-off floor
+  double total_weight_ = 0.0;
+  Eigen::VectorXd ref_c_;    // actuation of the cached reference residual
+  double ref_value_ = 0.0;   // ||2 (A X_rest - B(X_rest; ref_c_))||  // sum of w_i Vol_i, sets the scale of the residual's round-off floor
 };
 
 }  // namespace softkin

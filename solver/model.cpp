@@ -122,9 +122,7 @@ Model::Model(const Scene& scene) : scene_(scene) {
 }
 
 Eigen::MatrixX3d Model::SolveFree(const Eigen::Ref<const Eigen::MatrixX3d>& rhs) const {
-  Eigen::MatrixXd b = rhs;
-  Eigen::MatrixXd y = chol_.solve(b);
-  return y;
+  return chol_.solve(rhs);
 }
 
 }  // namespace softkin

@@ -1,0 +1,59 @@
+"""Shared input handling for the paper_figs scripts: every error goes to stderr with the file and
+line and what was expected, and the script exits with status 2."""
+import csv
+import json
+import os
+import sys
+
+
+def fail(name, msg):
+    print(f"{name}.py: error: {msg}", file=sys.stderr)
+    sys.exit(2)
+
+
+def read_table(name, path, columns, numeric=None, check=None, min_rows=1):
+    """Rows of the CSV `path` as dicts. `columns` must all be in the header; those in `numeric`
+    (default: all of them) are parsed as floats. `check(vals)` may return an error message for a
+    row. Fails with the file and line of any bad value."""
+    numeric = columns if numeric is None else numeric
+    if not os.path.isfile(path):
+        fail(name, f"{path} not found (run `softkin run experiments/{name}.json` first)")
+    rows = []
+    with open(path, newline="") as f:
+        reader = csv.DictReader(f)
+        header = reader.fieldnames or []
+        missing = [c for c in columns if c not in header]
+        if missing:
+            fail(name, f"{path}: header lacks column(s) {', '.join(missing)}; "
+                       f"expected {','.join(columns)}")
+        for row in reader:
+            line = reader.line_num
+            if None in row or any(row.get(c) is None for c in columns):
+                fail(name, f"{path}:{line}: expected {len(header)} values")
+            vals = dict(row)
+            for c in numeric:
+                try:
+                    vals[c] = float(row[c])
+                except ValueError:
+                    fail(name, f"{path}:{line}: column '{c}' is '{row[c]}', expected a number")
+            why = check(vals) if check else None
+            if why:
+                fail(name, f"{path}:{line}: {why}")
+            rows.append(vals)
+    if len(rows) < min_rows:
+        fail(name, f"{path}: needs at least {min_rows} data row(s), found {len(rows)}")
+    return rows
+
+
+def read_summary(name, path):
+    """summary.json as a dict, {} if absent; fails if it is not a JSON object."""
+    if not os.path.isfile(path):
+        return {}
+    try:
+        with open(path) as f:
+            data = json.load(f)
+    except (OSError, ValueError) as e:
+        fail(name, f"{path}: not valid JSON ({e})")
+    if not isinstance(data, dict):
+        fail(name, f"{path}: expected a JSON object")
+    return data
