@@ -75,9 +75,9 @@ int RunCli(int argc, char** argv) {
 
   // fk
   auto* fk = app.add_subcommand("fk", "Solve forward kinematics for one actuation");
-  std::string robot, scene_file, actuation, solver_name, json_out, vtu_out, obj_out;
+  std::string robot, scene_file, actuation, solver_name, json_out, vtu_out, obj_out, safeguard;
   int res = 0, continuation = 0, max_iter = 0;
-  double tolerance = 0;
+  double tolerance = 0, gradient_tolerance = 0;
   auto* o_robot = fk->add_option("--robot", robot, "Embedded robot name (see `softkin robots`)");
   auto* o_scene = fk->add_option("--scene", scene_file, "Scene JSON file (see `softkin scene --schema`)");
   o_robot->excludes(o_scene);
@@ -87,6 +87,10 @@ int RunCli(int argc, char** argv) {
   fk->add_option("--continuation", continuation, "Apply the actuation in this many steps");
   fk->add_option("--max-iterations", max_iter, "Iteration cap");
   fk->add_option("--tolerance", tolerance, "Per-iteration vertex move tolerance, relative to model size");
+  fk->add_option("--gradient-tolerance", gradient_tolerance,
+                 "Residual tolerance, relative to its reference value");
+  fk->add_option("--aa-safeguard", safeguard,
+                 "Anderson safeguard: hybrid (energy or residual), energy, or none");
   fk->add_option("--json", json_out, "Write the result as JSON to this file");
   fk->add_option("--vtu", vtu_out, "Write the deformed mesh as ParaView .vtu");
   fk->add_option("--obj", obj_out, "Write the deformed surface as .obj");
@@ -157,6 +161,8 @@ int RunCli(int argc, char** argv) {
       if (fk->count("--continuation")) opt.continuation_steps = continuation;
       if (fk->count("--max-iterations")) opt.max_iterations = max_iter;
       if (fk->count("--tolerance")) opt.tolerance = tolerance;
+      if (fk->count("--gradient-tolerance")) opt.gradient_tolerance = gradient_tolerance;
+      if (fk->count("--aa-safeguard")) opt.anderson_safeguard = safeguard;
       std::string why;
       if (!opt.IsValid(&why)) throw std::invalid_argument("option " + why);
       const Eigen::VectorXd c = ParseVector(actuation, "--actuation");

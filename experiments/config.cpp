@@ -143,12 +143,13 @@ void ApplySolverJson(const nlohmann::json& j, const std::string& where, FkOption
     else if (k == "tolerance") { need(v.is_number(), "a number"); o->tolerance = v.get<double>(); }
     else if (k == "gradient_tolerance") { need(v.is_number(), "a number"); o->gradient_tolerance = v.get<double>(); }
     else if (k == "anderson_window") { need(v.is_number_integer(), "an integer"); o->anderson_window = v.get<int>(); }
+    else if (k == "anderson_safeguard") { need(v.is_string(), "one of hybrid, energy, none"); o->anderson_safeguard = v.get<std::string>(); }
     else if (k == "continuation_steps") { need(v.is_number_integer(), "an integer"); o->continuation_steps = v.get<int>(); }
     else if (k == "threads") { need(v.is_number_integer(), "an integer"); o->threads = v.get<int>(); }
     else
       throw std::invalid_argument(where + "." + k + ": unknown key (expected one of solver, "
                                   "max_iterations, tolerance, gradient_tolerance, anderson_window, "
-                                  "continuation_steps, threads)");
+                                  "anderson_safeguard, continuation_steps, threads)");
   }
   std::string why;
   if (!o->IsValid(&why)) throw std::invalid_argument(where + ": " + why);

@@ -14,6 +14,10 @@ bool FkOptions::IsValid(std::string* why) const {
     return bad("gradient_tolerance: expected a number > 0");
   if (anderson_window < 1 || anderson_window > 50)
     return bad("anderson_window: expected an integer in [1, 50]");
+  if (anderson_safeguard != "hybrid" && anderson_safeguard != "energy" &&
+      anderson_safeguard != "none")
+    return bad("anderson_safeguard: expected one of hybrid, energy, none; got '" +
+               anderson_safeguard + "'");
   if (continuation_steps < 1) return bad("continuation_steps: expected an integer >= 1");
   if (threads < 0) return bad("threads: expected an integer >= 0");
   return true;

@@ -13,8 +13,13 @@ struct FkOptions {
   double tolerance = 1e-5;
   /// ... and the energy gradient norm has fallen below gradient_tolerance times its value at the
   /// first iteration (guards against slow creeping on thin, bending-dominated parts).
-  double gradient_tolerance = 1e-5;
+  double gradient_tolerance = 1e-6;
   int anderson_window = 6;
+  /// When an Anderson step is rejected and the plain step taken instead (Sec. "safeguard" in
+  /// local_global.hpp): "hybrid" keeps it if it lowers the energy OR the fixed-point residual
+  /// ||G(x) - x|| relative to the point it extrapolates from; "energy" keeps it only if it does not
+  /// raise the energy (Peng et al. 2018); "none" keeps every finite step.
+  std::string anderson_safeguard = "hybrid";
   /// Apply the actuation in this many equal steps (continuation), warm-starting each.
   int continuation_steps = 1;
   /// OpenMP threads for the local step (0 = library default).

@@ -76,51 +76,64 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     load_free();
     return 2.0 * (m.A_ff() * xf + Cfix - Bf).norm();
   };
-  double res_acc = 0.0;
-  bool accelerated = false;
+  const std::string& guard = options_.anderson_safeguard;
+  // Merits of the iterate an accelerated step was extrapolated from.
+  double base_E = 0.0, base_f = 0.0;
+  bool accelerated = false;  // X is an Anderson (extrapolated) iterate, not yet checked
+  auto reject = [&]() {      // fall back to the plain step G(x_k); the history is kept
+    store_free(Gprev);
+    ++r->aa_rejected;
+    accelerated = false;
+  };
   for (int it = 0; it < options_.max_iterations; ++it) {
     double E;
     local(&E);
-    double grad = residual();
-    // Safeguard on the local-global residual ||2 (A X - B)||. (The energy is not a valid merit
-    // function here: with volume-proportional local ratios or blended targets the fixed point of
-    // Algorithm 1 is not a minimum of E, and plain steps can raise E near it.)
-    if (aa_on && accelerated && !(grad <= res_acc)) {
-      store_free(Gprev);
-      aa.Reset();
-      ++r->aa_rejected;
-      local(&E);
-      grad = residual();
-    } else if (accelerated) {
-      ++r->aa_accepted;
+    const double grad = residual();
+    const bool finite = std::isfinite(E) && X.allFinite() && std::isfinite(grad);
+    if (accelerated && (!finite || (guard == "energy" && !(E <= base_E)))) {
+      reject();
+      ++r->iterations;
+      continue;
     }
-    if (!std::isfinite(E) || !X.allFinite() || !std::isfinite(grad)) {
+    if (!finite) {
       X = X_good;
       r->status = FkStatus::Diverged;
       r->message = "non-finite energy or positions at iteration " + std::to_string(r->iterations);
       return;
     }
-    X_good = X;  // the last iterate whose residual was checked
-    res_acc = grad;
+
+    const auto t1 = Clock::now();
+    Gf = m.SolveFree(Bf - Cfix);
+    r->global_time_s += Seconds(t1, Clock::now());
+    ++r->iterations;
+    if (!Gf.allFinite()) {
+      if (accelerated) {
+        reject();
+        continue;
+      }
+      X = X_good;
+      r->status = FkStatus::Diverged;
+      r->message = "the global step produced non-finite positions";
+      return;
+    }
+    const double fnorm = (Gf - xf).norm();  // fixed-point residual ||G(x) - x||
+    if (accelerated) {
+      if (guard == "hybrid" && !(E <= base_E || fnorm <= base_f)) {
+        reject();
+        continue;
+      }
+      ++r->aa_accepted;
+      accelerated = false;
+    }
+    X_good = X;  // the last iterate whose merit was checked
     if (it == 0) {
       // Floor: a residual this small is round-off (e.g. at the rest actuation, where both the
       // residual at rest and at the start are ~0 and their ratio would be noise).
       ref = std::max({ref, grad, 1e-10 * total_weight_ * m.size()});
     }
     r->gradient_ratio = ref > 0 ? grad / ref : 0.0;
-
-    const auto t1 = Clock::now();
-    Gf = m.SolveFree(Bf - Cfix);
-    r->global_time_s += Seconds(t1, Clock::now());
-    ++r->iterations;
-
     const double move = (Gf - xf).rowwise().norm().maxCoeff() / m.size();
     r->max_move = move;
-    if (!Gf.allFinite()) {
-      r->status = FkStatus::Diverged;
-      r->message = "the global step produced non-finite positions";
-      return;
-    }
     if (move < tol && r->gradient_ratio < gtol) {
       store_free(Gf);
       r->status = FkStatus::Converged;
@@ -131,6 +144,8 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
       const Eigen::VectorXd f = g - Eigen::Map<const Eigen::VectorXd>(xf.data(), 3 * nf);
       const Eigen::VectorXd& xn = aa.Compute(g, f);
       Gprev = Gf;
+      base_E = E;
+      base_f = fnorm;
       accelerated = aa.history() > 0;
       Eigen::Map<const Eigen::MatrixXd> xnm(xn.data(), nf, 3);
       store_free(xnm);

@@ -17,50 +17,49 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // ================================================================================================
 // pneumatic_finger (thesis Fig. 2.11): PneuNet-style bending actuator on a voxel grid.
 //
-// Axes: x = long axis (proximal end x = 0, fixed; distal end x = 100), y = width [0, 20],
-// z = height [0, 18]. The inextensible layer is at the bottom and the chambers in the upper part,
-// so inflation lengthens the top side and the finger curls towards -z (tip down, then back).
-// Nominal geometry (mm), snapped to the grid of cell size h = 20 / res:
-//   base layer z in [0, 1.5]          region 2 "inextensible" (r_omega 1, weight 5)
-//   proximal block x in [0, ~8]       region 0 solid, its x = 0 face is fixed
-//   9 chamber blocks of length ~10 sharing their end walls (no gaps: an isotropically inflating
-//   cavity next to an empty gap only balloons into the gap and pushes the base down, which
-//   bends the finger the wrong way), full width and height;
-//   each block: 2 mm walls (x ends, y sides, top), region 0 "body" (r_omega 1, weight 1),
-//   around a cavity from z = 8 mm to the top wall, filled with region-1 tets: the
-//   pneumatic actuation elements of the single actuator "chamber". The solid body below the
-//   cavities makes the expansion one-sided.
-// Every feature is >= 1 cell at every allowed resolution; at coarse resolutions (res < 8) the
-// number of chambers drops so that the finger stays 100 mm long. The proximal block absorbs the
-// rounding so the total length is exactly 100 mm. At the default res 12 (h = 1.667 mm): base
-// 2 cells (3.33 mm), walls and gaps 1 cell (1.67 mm), blocks 5 cells (8.33 mm; cavity 5 x 16.7 x
-// 15 mm), proximal block 6 cells (10 mm); 45,360 tets, 10,309 vertices.
+// Axes: x = long axis (proximal end x = 0, fixed; distal end x = 120), y = width [0, 20],
+// z = height [0, 15]. The inextensible layer is at the bottom and the chambers above it, so
+// inflation lengthens the upper side and the finger curls towards -z (tip down, then back).
+// Nominal geometry (mm), snapped to the grid of cell size h = 20 / res (every feature >= 1 cell):
+//   base layer z in [0, 1.5]              region 2 "inextensible" (r_omega 1, weight 20)
+//   floor z in [1.5, 3]                    region 0, a thin solid floor under the chambers
+//   proximal block x in [0, >= 8]          region 0, its x = 0 face is fixed
+//   a row of cavities 5 mm long separated by single 1.5 mm walls (the last wall closes the
+//   distal end), with 1.5 mm side walls and roof: region 0 "body" (r_omega 1, weight 1). The
+//   cavities are filled with region-1 tets, the pneumatic actuation elements of the single
+//   actuator "chamber" (volume ratio alpha in [1, 10]).
+// Why this layout: the chamber elements expand isotropically (Eq. 2.8). Thin walls leave the
+// expansion to the chambers; the shared end walls carry no bending; the heavy thin base layer
+// does not lengthen, so the lengthening upper side curls the finger. (Gaps between chambers, as
+// in a moulded PneuNet, give more bend per volume but a far stiffer, slower fixed-point problem;
+// a thick solid lower body acts as a stiff beam and caps the bend near 50 degrees.) Measured at
+// res 12: 262 degrees at alpha = 10 (fig2_11_pneumatic_bending).
+// At the default res 12 (h = 1.667 mm): base, floor, walls 1 cell; cavities 3 cells
+// (5 x 16.7 x 10 mm); 16 chambers; proximal block 7 cells; 46,656 tets, 9,490 vertices.
+// The grid snaps features to whole cells, so the wall thickness changes with res; the
+// resolution study (fig2_13) uses three_chamber, whose geometry does not depend on res.
 // ================================================================================================
 
-constexpr int kFingerMinRes = 4, kFingerMaxRes = 40, kFingerDefaultRes = 12;
-constexpr double kFingerLength = 100.0, kFingerWidth = 20.0, kFingerHeight = 18.0;
-constexpr double kFingerBase = 1.5, kFingerWall = 2.0, kFingerGap = 2.0, kFingerProximal = 8.0;
-constexpr int kFingerBlocks = 9;
-/// Cavities start at this height (mm): the lower part is solid body, so inflation lengthens the top.
-constexpr double kFingerCavityFloor = 8.0;
-/// Weight of the inextensible layer relative to the body (it resists stretching; being one or two
-/// cells thin, it still bends).
-constexpr double kFingerLayerWeight = 5.0;
+constexpr int kFingerMinRes = 5, kFingerMaxRes = 40, kFingerDefaultRes = 12;
+constexpr double kFingerLength = 120.0, kFingerWidth = 20.0, kFingerHeight = 15.0;
+constexpr double kFingerBase = 1.5, kFingerFloor = 1.5, kFingerWall = 1.5, kFingerCavity = 5.0;
+constexpr double kFingerProximal = 8.0;
+/// Weight of the inextensible layer relative to the body: it resists stretching; being one cell
+/// thin it still bends.
+constexpr double kFingerLayerWeight = 20.0;
 constexpr double kFingerBodyROmega = 1.0;
+constexpr double kFingerMaxAlpha = 10.0;
 
 /// The finger's layout in cells.
 struct FingerLayout {
   double h = 1.0;        // cell size, mm
   int nx = 0, ny = 0, nz = 0;
   int base = 0;          // base layer thickness (cells)
-  int top = 0;           // top wall
-  int side = 0;          // side walls (y)
-  int wall = 0;          // end walls of each block (x)
-  int gap = 0;           // empty gap between blocks
-  int blocks = 0;        // number of chamber blocks
-  int block = 0;         // block length
+  int floor = 0;         // solid floor between the base layer and the cavities
+  int wall = 0;          // walls: between cavities (x), sides (y), roof (z)
+  int cavity = 0;        // cavity length (x)
+  int chambers = 0;      // number of cavities
   int proximal = 0;      // proximal solid block length
-  int cavity_floor = 0;  // first cell layer (z) of the cavities
 };
 
 int Cells(double mm, double h) { return std::max(1, static_cast<int>(std::lround(mm / h))); }
@@ -69,36 +68,25 @@ FingerLayout MakeFingerLayout(int res) {
   FingerLayout L;
   L.h = kFingerWidth / res;
   L.ny = res;
-  L.nx = static_cast<int>(std::lround(kFingerLength / L.h));   // = 5 res
-  L.nz = static_cast<int>(std::lround(kFingerHeight / L.h));   // = res
+  L.nx = static_cast<int>(std::lround(kFingerLength / L.h));  // = 6 res
+  L.nz = static_cast<int>(std::lround(kFingerHeight / L.h));
   L.base = Cells(kFingerBase, L.h);
-  L.top = Cells(kFingerWall, L.h);
-  L.side = Cells(kFingerWall, L.h);
+  L.floor = Cells(kFingerFloor, L.h);
   L.wall = Cells(kFingerWall, L.h);
-  L.gap = 0;  // chambers share their walls (see the layout comment)
-  L.cavity_floor = std::max(L.base + 1, static_cast<int>(std::lround(kFingerCavityFloor / L.h)));
-  const int prox_min = Cells(kFingerProximal, L.h);
-  const int min_block = 2 * L.wall + 1;
-  // Nominal block length: 9 (gap, block) pairs fill the 92 mm after the proximal block.
-  const double block_mm =
-      (kFingerLength - kFingerProximal - kFingerBlocks * kFingerGap) / kFingerBlocks;
-  const int avail = L.nx - prox_min;  // cells for gaps and blocks
-  L.blocks = std::min(kFingerBlocks, avail / (min_block + L.gap));
-  L.block = std::max(min_block, Cells(block_mm, L.h));
-  L.block = std::min(L.block, avail / L.blocks - L.gap);
-  L.proximal = L.nx - L.blocks * (L.gap + L.block);
+  L.cavity = Cells(kFingerCavity, L.h);
+  const int pitch = L.wall + L.cavity;
+  L.chambers = (L.nx - Cells(kFingerProximal, L.h) - L.wall) / pitch;
+  L.proximal = L.nx - L.chambers * pitch - L.wall;
   return L;
 }
 
-/// Region of cell (i, j, k): 2 base layer, 0 wall/proximal block, 1 cavity, -1 gap (empty).
+/// Region of cell (i, j, k): 2 base layer, 0 body (floor, walls, proximal block), 1 cavity.
 int FingerCell(const FingerLayout& L, int i, int j, int k) {
   if (k < L.base) return 2;
-  if (i < L.proximal) return 0;
-  const int pitch = L.gap + L.block;
-  const int u = (i - L.proximal) % pitch - L.gap;  // position in the block, < 0 in the gap
-  if (u < 0) return -1;  // gap in front of the block
-  const bool cavity = u >= L.wall && u < L.block - L.wall && j >= L.side && j < L.ny - L.side &&
-                      k < L.nz - L.top && k >= L.cavity_floor;
+  const int u = i - L.proximal;
+  if (u < 0 || u >= L.chambers * (L.wall + L.cavity)) return 0;
+  const bool cavity = u % (L.wall + L.cavity) >= L.wall && j >= L.wall && j < L.ny - L.wall &&
+                      k >= L.base + L.floor && k < L.nz - L.wall;
   return cavity ? 1 : 0;
 }
 
@@ -118,7 +106,7 @@ Scene MakePneumaticFinger(int res) {
   a.regions = {1};
   a.rest = 1.0;
   a.min = 1.0;
-  a.max = 8.0;
+  a.max = kFingerMaxAlpha;
   s.actuators.push_back(a);
 
   const double eps = 1e-6 * L.h;
@@ -210,14 +198,15 @@ const std::vector<RobotEntry>& Registry() {
   static const std::vector<RobotEntry> kRobots = {
       {{"pneumatic_finger",
         "PneuNet-style pneumatic bending finger (thesis Fig. 2.11), voxel tet mesh. x = long axis "
-        "[0, 100] mm (x = 0 fixed), y = width [0, 20], z = height [0, 18]; inextensible base layer "
-        "z in [0, 1.5] (region 2, weight 5), a solid proximal block and 9 chamber blocks sharing 2 mm "
-        "walls (region 0) over a solid lower body; the filled cavities (z >= 8, region 1) form one pneumatic actuator "
-        "'chamber' (volume ratio in [1, 8]). Markers: tip (distal face x = 100), tip_top / "
-        "tip_bottom (top / bottom quarter of the distal face).",
+        "[0, 120] mm (x = 0 fixed), y = width [0, 20], z = height [0, 15]; inextensible base layer "
+        "z in [0, 1.5] (region 2, weight 20), a 1.5 mm floor, a solid proximal block and a row of "
+        "5 mm cavities between single 1.5 mm walls (region 0); the filled cavities (region 1) form "
+        "one pneumatic actuator 'chamber' (volume ratio in [1, 10]; ~260 degrees of bend at 10). "
+        "Markers: tip (distal face x = 120), tip_top / tip_bottom (top / bottom quarter of the "
+        "distal face).",
         kFingerDefaultRes,
-        "cells across the 20 mm width (cell size 20/res mm), integer in [4, 40]; ~26 res^3 tets; "
-        "fewer than 9 chambers below res 8"},
+        "cells across the 20 mm width (cell size 20/res mm), integer in [5, 40]; 27 res^3 tets; "
+        "features snap to whole cells (16 chambers at res 12)"},
        kFingerMinRes, kFingerMaxRes, &MakePneumaticFinger},
       {{"three_chamber",
         "Three-chamber pneumatic actuator (thesis Fig. 2.12, Chapter 5): 48 x 48 x 136 mm cylinder. "

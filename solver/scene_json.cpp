@@ -178,6 +178,10 @@ const std::vector<KeySpec>& KeyTable() {
                     .Def(fk.gradient_tolerance).Above(0.0));
     t.push_back(Key("solver.anderson_window", I, Opt, "History length of Anderson acceleration (lg-aa).")
                     .Def(fk.anderson_window).In(1, 50));
+    t.push_back(Key("solver.anderson_safeguard", S, Opt,
+                    "Keep an Anderson step if it lowers the energy or the fixed-point residual "
+                    "(hybrid), only if it does not raise the energy (energy), or always (none).")
+                    .Def(fk.anderson_safeguard).Choices({"hybrid", "energy", "none"}));
     t.push_back(Key("solver.continuation_steps", I, Opt,
                     "Apply the actuation in this many equal steps, warm-starting each.")
                     .Def(fk.continuation_steps).AtLeast(1));
@@ -819,6 +823,7 @@ Scene SceneParser::Build(const json& root) {
   o.tolerance = Get(solver, "solver", "tolerance").get<double>();
   o.gradient_tolerance = Get(solver, "solver", "gradient_tolerance").get<double>();
   o.anderson_window = AsInt(Get(solver, "solver", "anderson_window"));
+  o.anderson_safeguard = Get(solver, "solver", "anderson_safeguard").get<std::string>();
   o.continuation_steps = AsInt(Get(solver, "solver", "continuation_steps"));
   o.threads = AsInt(Get(solver, "solver", "threads"));
   std::string why;

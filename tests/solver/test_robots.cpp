@@ -469,7 +469,7 @@ TEST(Robots, ListsBothRobotsAndRejectsBadInput) {
     MakeRobot("pneumatic_finger", 2);
     FAIL() << "no exception";
   } catch (const std::invalid_argument& e) {
-    EXPECT_EQ(std::string(e.what()), "pneumatic_finger: --res must be an integer in [4, 40], got 2");
+    EXPECT_EQ(std::string(e.what()), "pneumatic_finger: --res must be an integer in [5, 40], got 2");
   }
   EXPECT_THROW(MakeRobot("pneumatic_finger", 41), std::invalid_argument);
   EXPECT_THROW(MakeRobot("three_chamber", 2), std::invalid_argument);
@@ -530,16 +530,19 @@ TEST(RobotsPneumaticFinger, DefaultSizeRegionsAndMaterials) {
   for (const auto& e : s.mesh.elements) regions.insert(e.region);
   EXPECT_EQ(regions, (std::set<int>{0, 1, 2}));
   EXPECT_GT(CountRegion(s.mesh, 1), n / 10);
-  // Bounding box 100 x 20 x ~18 mm (the height is snapped to the 20/12 mm grid: 11 cells).
+  // Bounding box 120 x 20 x 15 mm (9 cells of 20/12 mm in height).
   const Eigen::RowVector3d lo = s.mesh.vertices.colwise().minCoeff();
   const Eigen::RowVector3d hi = s.mesh.vertices.colwise().maxCoeff();
   EXPECT_LT((lo - Eigen::RowVector3d(0, 0, 0)).norm(), 1e-9);
-  EXPECT_LT((hi - Eigen::RowVector3d(100, 20, 11 * 20.0 / 12)).norm(), 1e-9);
-  // The inextensible layer is at the bottom: its tets lie in z <= ~3 mm (snapped to the grid).
+  EXPECT_LT((hi - Eigen::RowVector3d(120, 20, 15)).norm(), 1e-9);
+  // The inextensible layer is the bottom cell layer; it is heavier than the body.
   for (const auto& e : s.mesh.elements) {
     if (e.region != 2) continue;
-    for (int j = 0; j < 4; ++j) ASSERT_LE(s.mesh.vertices(e.v[j], 2), 4.0);
+    for (int j = 0; j < 4; ++j) ASSERT_LE(s.mesh.vertices(e.v[j], 2), 20.0 / 12 + 1e-9);
   }
+  EXPECT_GT(s.body.at(2).weight, s.body.at(0).weight);
+  EXPECT_EQ(s.actuators[0].min, 1.0);
+  EXPECT_EQ(s.actuators[0].max, 10.0);
 }
 
 TEST(RobotsPneumaticFinger, FixedBaseAndTipMarkers) {
@@ -552,48 +555,48 @@ TEST(RobotsPneumaticFinger, FixedBaseAndTipMarkers) {
   for (const char* name : {"tip", "tip_top", "tip_bottom"}) {
     const int k = s.marker_index(name);
     ASSERT_GE(k, 0) << name;
-    for (int v : s.markers[k].vertices) EXPECT_NEAR(m.vertices(v, 0), 100.0, 1e-9) << name;
+    for (int v : s.markers[k].vertices) EXPECT_NEAR(m.vertices(v, 0), 120.0, 1e-9) << name;
   }
   const Eigen::MatrixX3d P = s.marker_positions(m.vertices);
   const Eigen::Vector3d tip = P.row(s.marker_index("tip")).transpose();
   const Eigen::Vector3d top = P.row(s.marker_index("tip_top")).transpose();
   const Eigen::Vector3d bot = P.row(s.marker_index("tip_bottom")).transpose();
-  EXPECT_NEAR(tip.x(), 100.0, 1e-9);
+  EXPECT_NEAR(tip.x(), 120.0, 1e-9);
   EXPECT_NEAR(tip.y(), 10.0, 1e-9);
   const double height = m.vertices.col(2).maxCoeff();
-  EXPECT_NEAR(height, 18.0, 20.0 / 12);
+  EXPECT_NEAR(height, 15.0, 1e-9);
   EXPECT_NEAR(tip.z(), height / 2, 1e-9);
   EXPECT_NEAR(top.y(), 10.0, 1e-9);
   EXPECT_NEAR(bot.y(), 10.0, 1e-9);
   EXPECT_GE(top.z(), 0.75 * height);
-  EXPECT_LE(bot.z(), 5.0);
+  EXPECT_LE(bot.z(), 0.25 * height);
 }
 
 TEST(RobotsPneumaticFinger, FeaturesSurviveEveryResolution) {
-  // Walls enclose every cavity, shared walls separate the chambers, the base layer exists, the
-  // cavities sit above a solid lower body (one-sided inflation).
-  for (int res : {4, 5, 6, 7, 8, 9, 10, 12, 15, 16, 20}) {
+  // Walls enclose every cavity, single walls separate the chambers, the base layer and the floor
+  // exist under every cavity, and the finger keeps its 120 x 20 x 15 mm size.
+  for (int res : {5, 6, 7, 8, 9, 10, 12, 15, 16, 20}) {
     SCOPED_TRACE(res);
     const Scene s = MakeRobot("pneumatic_finger", res);
     const Mesh& m = s.mesh;
+    const double h = 20.0 / res;
     ExpectWellFormed(m, "finger");
     EXPECT_GT(CountRegion(m, 2), 0);
     EXPECT_EQ(RegionTetsOnBoundary(m, {1}), 0) << "a cavity element lies on the outer surface";
     const int chambers = Components(m, [](const Element& e) { return e.region == 1; });
     const int body_parts = Components(m, [](const Element& e) { return e.region == 0; });
-    EXPECT_EQ(body_parts, 1) << "the walls and the lower body form one connected part";
-    const double height = m.vertices.col(2).maxCoeff();
+    EXPECT_EQ(body_parts, 1) << "the walls, floor and proximal block form one connected part";
     for (const auto& e : m.elements) {
-      if (e.region != 1) continue;
-      for (int j = 0; j < 4; ++j) ASSERT_GE(m.vertices(e.v[j], 2), 0.3 * height);
+      if (e.region != 1) continue;  // cavities sit above the base layer and the floor
+      for (int j = 0; j < 4; ++j) ASSERT_GE(m.vertices(e.v[j], 2), 2 * h - 1e-9);
     }
-    if (res >= 8) {
-      EXPECT_EQ(chambers, 9);
-    }
-    EXPECT_GE(chambers, 3);
+    // Chambers: cavities ~5 mm long between ~1.5 mm walls along ~110 mm.
+    const int pitch = std::max(1, int(std::lround(5.0 / h))) + std::max(1, int(std::lround(1.5 / h)));
+    EXPECT_GE(chambers * pitch * h, 95.0);
+    EXPECT_GE(chambers, 8);
     const Eigen::RowVector3d hi = m.vertices.colwise().maxCoeff();
-    EXPECT_LT((hi.head<2>() - Eigen::RowVector2d(100, 20)).norm(), 1e-9);
-    EXPECT_NEAR(hi(2), 18.0, 0.5 * 20.0 / res + 1e-9);
+    EXPECT_LT((hi.head<2>() - Eigen::RowVector2d(120, 20)).norm(), 1e-9);
+    EXPECT_NEAR(hi(2), 15.0, 0.5 * h + 1e-9);
   }
 }
 
@@ -604,7 +607,7 @@ TEST(RobotsPneumaticFinger, CellCountScalesAsResCubed) {
   EXPECT_NEAR(n24 / n12, 8.0, 8.0 * 0.2);
   // tets / res^3 stays roughly constant.
   for (auto [n, r] : {std::pair<double, int>{n8, 8}, {n12, 12}, {n16, 16}, {n24, 24}})
-    EXPECT_NEAR(n / (r * r * r), 27.5, 5.0) << "res " << r;
+    EXPECT_NEAR(n / (r * r * r), 27.0, 3.0) << "res " << r;
 }
 
 // ---- three_chamber ----

@@ -641,7 +641,7 @@ const std::vector<std::string> kAllKeys = {
     "fixed[].file", "fixed[].base", "markers", "markers[].name", "markers[].vertex",
     "markers[].nearest", "markers[].box", "markers[].box.min", "markers[].box.max", "solver",
     "solver.solver", "solver.max_iterations", "solver.tolerance", "solver.gradient_tolerance",
-    "solver.anderson_window", "solver.continuation_steps", "solver.threads"};
+    "solver.anderson_window", "solver.anderson_safeguard", "solver.continuation_steps", "solver.threads"};
 
 /// Key lines of the schema (after the "Keys:" line, not indented): path -> the rest of the line,
 /// plus the doc line that follows.
