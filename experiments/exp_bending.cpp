@@ -20,6 +20,9 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
   const int steps = cfg.Int("steps", 40);
   const double max_value_cfg = cfg.Number("max_value", 0.0);
   const int vtu_every = cfg.Int("vtu_every", 0);
+  // Secant predictor: start each step from X_k + (X_k - X_{k-1}) (equal actuation steps) instead
+  // of X_k. It is a better first guess along a smooth sweep; the solution is the same.
+  const bool predictor = cfg.Bool("predictor", true);
   const std::vector<double> milestones = cfg.NumberList("milestones_deg", {90, 180, 240});
   const auto t_build0 = std::chrono::steady_clock::now();
   Scene scene = MakeRobot(robot, res);
@@ -52,14 +55,16 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
            1.0, 0, 1});
 
   Eigen::VectorXd c = scene.rest_actuation();
-  Eigen::MatrixX3d X = scene.mesh.vertices;
+  Eigen::MatrixX3d X = scene.mesh.vertices, X_prev = X, guess;
   double cumulative = 0.0, max_bend = 0.0;
   int total_iters = 0, failures = 0;
   std::vector<double> reach(milestones.size(), -1.0);
   for (int s = 1; s <= steps; ++s) {
     c[a] = act.rest + (vmax - act.rest) * double(s) / steps;
-    FkResult r = solver->Solve(c, &X);
+    guess = (predictor && s > 1) ? Eigen::MatrixX3d(2.0 * X - X_prev) : X;
+    FkResult r = solver->Solve(c, &guess);
     if (r.status == FkStatus::InvalidInput) throw std::runtime_error(r.message);
+    X_prev = X;
     X = r.positions;
     cumulative += r.time_s;
     total_iters += r.iterations;
@@ -98,6 +103,8 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
   j["factor_s"] = model->factor_time_s();
   j["non_converged_steps"] = failures;
   j["solver"] = opts.solver;
+  j["anderson_window"] = opts.anderson_window;
+  j["predictor"] = predictor;
   for (size_t q = 0; q < milestones.size(); ++q) {
     char key[32];
     std::snprintf(key, sizeof(key), "t%.0f_s", milestones[q]);

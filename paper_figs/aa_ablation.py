@@ -5,8 +5,10 @@ Usage: aa_ablation.py RESULTS_DIR
 
 Reads RESULTS_DIR/aa_ablation.csv (written by `softkin run experiments/aa_ablation.json`) and, if
 present, RESULTS_DIR/summary.json. Writes RESULTS_DIR/aa_ablation.png: grouped bars of the
-iteration count of plain local-global (lg) and Anderson-accelerated local-global (lg-aa) for
-every robot and actuation level, on a log scale. Bars of runs that did not converge are hatched.
+iteration count of plain local-global (lg) and of each Anderson-accelerated variant
+("lg-aa m=<window> <safeguard>") for every robot and actuation level, on a log scale, with the
+lg / variant iteration ratio above each Anderson bar. Bars of runs that did not converge are
+hatched.
 Exit status 2 with a message on stderr if the CSV is missing or malformed.
 """
 import os
@@ -15,10 +17,11 @@ import sys
 import figlib
 
 NAME = "aa_ablation"
-COLUMNS = ["robot", "level", "solver", "iterations", "time_s", "energy", "status", "aa_rejected"]
-NUMERIC = ["level", "iterations", "time_s", "energy", "aa_rejected"]
-SOLVERS = ("lg", "lg-aa")
-COLORS = {"lg": "tab:gray", "lg-aa": "tab:blue"}
+COLUMNS = ["robot", "level", "variant", "iterations", "time_s", "energy", "status", "aa_accepted",
+           "aa_rejected", "iteration_ratio", "time_ratio"]
+NUMERIC = ["level", "iterations", "time_s", "energy", "aa_accepted", "aa_rejected",
+           "iteration_ratio", "time_ratio"]
+PALETTE = ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown"]
 
 
 def fail(msg):
@@ -28,8 +31,8 @@ def fail(msg):
 def read_table(path):
     return figlib.read_table(
         NAME, path, COLUMNS, NUMERIC,
-        check=lambda v: None if v["solver"] in SOLVERS else
-        f"solver is '{v['solver']}', expected one of {', '.join(SOLVERS)}")
+        check=lambda v: None if v["variant"] == "lg" or v["variant"].startswith("lg-aa m=") else
+        f"variant is '{v['variant']}', expected lg or 'lg-aa m=<window> <safeguard>'")
 
 
 def read_summary(path):
@@ -51,38 +54,40 @@ def main(argv):
     import matplotlib.pyplot as plt
     from matplotlib.patches import Patch
 
-    # Groups (robot, level) in the order they first appear; one bar per solver inside each.
-    groups, table = [], {}
+    # Groups (robot, level) in the order they first appear; one bar per variant inside each.
+    groups, table, variants = [], {}, []
     for r in rows:
         key = (r["robot"], r["level"])
         if key not in table:
             groups.append(key)
             table[key] = {}
-        table[key][r["solver"]] = r
+        table[key][r["variant"]] = r
+        if r["variant"] not in variants:
+            variants.append(r["variant"])
+    if "lg" in variants:  # plain first
+        variants.remove("lg")
+        variants.insert(0, "lg")
+    colors = {v: ("tab:gray" if v == "lg" else PALETTE[(i - 1) % len(PALETTE)])
+              for i, v in enumerate(variants)}
 
-    width = 0.38
-    fig, ax = plt.subplots(figsize=(max(8.0, 1.5 * len(groups) + 2.5), 5.2))
+    width = 0.8 / len(variants)
+    fig, ax = plt.subplots(figsize=(max(8.0, 0.45 * len(groups) * len(variants) + 3.0), 5.4))
     any_failed = False
-    for s_i, solver in enumerate(SOLVERS):
+    for s_i, variant in enumerate(variants):
         for g_i, key in enumerate(groups):
-            r = table[key].get(solver)
+            r = table[key].get(variant)
             if r is None:
                 continue
-            xpos = g_i + (s_i - 0.5) * width
+            xpos = g_i + (s_i - (len(variants) - 1) / 2) * width
             failed = r["status"] != "converged"
             any_failed |= failed
             height = max(r["iterations"], 1.0)  # log axis: show 0 iterations as 1
-            ax.bar(xpos, height, width, color=COLORS[solver], edgecolor="k", linewidth=0.6,
+            ax.bar(xpos, height, width, color=colors[variant], edgecolor="k", linewidth=0.6,
                    hatch="//" if failed else None)
-            ax.text(xpos, height * 1.05, f"{r['iterations']:.0f}", ha="center", va="bottom",
-                    fontsize=8)
-    for g_i, key in enumerate(groups):
-        pair = table[key]
-        if all(s in pair for s in SOLVERS) and pair["lg-aa"]["iterations"] > 0:
-            ratio = pair["lg"]["iterations"] / pair["lg-aa"]["iterations"]
-            ax.annotate(f"\N{MULTIPLICATION SIGN}{ratio:.1f}", xy=(g_i, 0), xycoords=("data", "axes fraction"),
-                        xytext=(0, -30), textcoords="offset points", ha="center", fontsize=8,
-                        color="tab:blue")
+            label = f"{r['iterations']:.0f}"
+            if variant != "lg" and "lg" in table[key]:
+                label += f"\n\N{MULTIPLICATION SIGN}{r['iteration_ratio']:.1f}"
+            ax.text(xpos, height * 1.05, label, ha="center", va="bottom", fontsize=7)
 
     ax.set_yscale("log")
     ax.set_xticks(range(len(groups)))
@@ -93,16 +98,15 @@ def main(argv):
     tallest = max(max(r["iterations"], 1.0) for r in rows)
     lowest = min(max(r["iterations"], 1.0) for r in rows)
     ax.set_ylim(max(0.5, lowest / 2.0), tallest * 10.0)
-    handles = [Patch(facecolor=COLORS[s], edgecolor="k", label=s) for s in SOLVERS]
-    handles[0].set_label("lg (plain local-global)")
-    handles[1].set_label("lg-aa (Anderson accelerated)")
+    handles = [Patch(facecolor=colors[v], edgecolor="k",
+                     label="lg (plain local-global)" if v == "lg" else v) for v in variants]
     if any_failed:
         handles.append(Patch(facecolor="white", edgecolor="k", hatch="//", label="not converged"))
     ax.legend(handles=handles, loc="upper left", fontsize=8)
     quick = " (quick run)" if summary.get("quick") else ""
     ax.set_title("Ablation (not a thesis figure): local-global solver (Alg. 1, Sec. 2.5)\n"
                  f"with and without Anderson acceleration{quick}; "
-                 "below the bars: lg / lg-aa iteration ratio", fontsize=10)
+                 "above the bars: iterations and lg / variant ratio", fontsize=10)
     fig.tight_layout()
     out = os.path.join(results, f"{NAME}.png")
     fig.savefig(out, dpi=130)
