@@ -7,6 +7,7 @@
 #include "solver/robots.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -23,12 +24,16 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
   // Secant predictor: start each step from X_k + (X_k - X_{k-1}) (equal actuation steps) instead
   // of X_k. It is a better first guess along a smooth sweep; the solution is the same.
   const bool predictor = cfg.Bool("predictor", true);
+  // Actuation spacing: "linear" (equal steps) or "geometric" (equal ratios, so smaller steps at
+  // the start, where the bend angle grows fastest with the volume ratio).
+  const std::string spacing = cfg.String("spacing", "linear");
   const std::vector<double> milestones = cfg.NumberList("milestones_deg", {90, 180, 240});
   const auto t_build0 = std::chrono::steady_clock::now();
   Scene scene = MakeRobot(robot, res);
   FkOptions opts = cfg.Solver(scene.solver);
   cfg.CheckNoUnknownKeys();
   if (steps < 1) cfg.Fail("steps", "an integer >= 1");
+  if (spacing != "linear" && spacing != "geometric") cfg.Fail("spacing", "linear or geometric");
   if (vtu_every < 0) cfg.Fail("vtu_every", "an integer >= 0");
   const int a = act_name.empty() ? 0 : scene.actuator_index(act_name);
   if (a < 0) cfg.Fail("actuator", "the name of an actuator of robot '" + robot + "'");
@@ -59,9 +64,18 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
   double cumulative = 0.0, max_bend = 0.0;
   int total_iters = 0, failures = 0;
   std::vector<double> reach(milestones.size(), -1.0);
+  if (spacing == "geometric" && !(act.rest > 0))
+    cfg.Fail("spacing", "linear (geometric spacing needs a positive rest value)");
+  auto value = [&](int s) {
+    const double t = double(s) / steps;
+    return spacing == "geometric" ? act.rest * std::pow(vmax / act.rest, t)
+                                  : act.rest + (vmax - act.rest) * t;
+  };
   for (int s = 1; s <= steps; ++s) {
-    c[a] = act.rest + (vmax - act.rest) * double(s) / steps;
-    guess = (predictor && s > 1) ? Eigen::MatrixX3d(2.0 * X - X_prev) : X;
+    c[a] = value(s);
+    // Secant predictor, scaled by the ratio of this step to the previous one.
+    const double q = s > 1 ? (value(s) - value(s - 1)) / (value(s - 1) - value(s - 2)) : 0.0;
+    guess = (predictor && s > 1) ? Eigen::MatrixX3d(X + q * (X - X_prev)) : X;
     FkResult r = solver->Solve(c, &guess);
     if (r.status == FkStatus::InvalidInput) throw std::runtime_error(r.message);
     X_prev = X;
@@ -105,6 +119,7 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
   j["solver"] = opts.solver;
   j["anderson_window"] = opts.anderson_window;
   j["predictor"] = predictor;
+  j["spacing"] = spacing;
   for (size_t q = 0; q < milestones.size(); ++q) {
     char key[32];
     std::snprintf(key, sizeof(key), "t%.0f_s", milestones[q]);
