@@ -38,7 +38,7 @@ double Since(Clock::time_point t0) {
 }
 
 constexpr const char* kRobot = "pneumatic_finger";
-/// Resolutions of the sweep: 5.8k, 13.8k, 27k, 46.7k, 74k and 157k tets.
+/// Resolutions of the sweep: 6.5k, 13.8k, 28.8k, 46.7k, 77.6k and 163k tets.
 const std::vector<int> kResolutions = {6, 8, 10, 12, 14, 18};
 /// Actuation (chamber volume ratio) of the deformed configuration used by the per-step benchmarks.
 constexpr double kAlpha = 3.0;
