@@ -1,5 +1,6 @@
 #include "solver/energy.hpp"
 
+#include "solver/actuation.hpp"
 #include "solver/rotation.hpp"
 #include "solver/targets.hpp"
 
@@ -55,9 +56,8 @@ double EnergyAndGradient(const Model& model, const Eigen::Ref<const Eigen::Matri
   std::vector<double> ratios;
   ComputeLocalRatios(model, X, c, &ratios);
   grad->setZero(model.num_vertices(), 3);
-  // dE_i/dc_i for pneumatic elements, with c_i = cbrt(alpha_i): needed for the chain rule through
-  // the volume-proportional ratio distribution.
-  std::vector<double> dE_dscale(ne, 0.0);
+  // dE_i/dr_i for actuation elements: needed for the chain rule through the ratio distribution.
+  std::vector<double> dE_dratio(ne, 0.0);
   double E = 0.0;
   for (int i = 0; i < ne; ++i) {
     const ModelElement& e = els[i];
@@ -65,11 +65,11 @@ double EnergyAndGradient(const Model& model, const Eigen::Ref<const Eigen::Matri
     ElemRows D = ElemRows::Zero();
     for (int j = 0; j < k; ++j) D.row(j) = X.row(e.v[j]);
     CenterRows(D, k);
-    const Eigen::Matrix3d R = BestRotation(D.topRows(k).transpose() * e.rest.topRows(k));
-    ElemRows RP = ElemRows::Zero();
-    RP.topRows(k) = e.rest.topRows(k) * R.transpose();
     ElemRows G = ElemRows::Zero();  // dE_i/dD (centred rows)
     if (e.role == ElementRole::Body) {
+      const Eigen::Matrix3d R = BestRotation(D.topRows(k).transpose() * e.rest.topRows(k));
+      ElemRows RP = ElemRows::Zero();
+      RP.topRows(k) = e.rest.topRows(k) * R.transpose();
       // E_i = wv || beta D - Rw R P ||^2, beta = 1 - (1 - Rw) s(Vol(D)).
       const double vd = RowsVolume(D, k);
       double s = 1.0;
@@ -90,39 +90,51 @@ double EnergyAndGradient(const Model& model, const Eigen::Ref<const Eigen::Matri
         G += dE_dbeta * dbeta_dvol * RowsVolumeGradient(D, k);
       }
     } else {
-      const double cs = std::cbrt(ratios[i]);
-      const ElemRows r = D - cs * RP;
+      // E_i = wv || D - P S(r)^T R^T ||^2 with R the best rotation (no derivative needed: R
+      // minimises the term).
+      ElemRows Ps = ElemRows::Zero();
+      Ps.topRows(k) = e.rest.topRows(k) * ActuationShape(e, ratios[i]).transpose();
+      const Eigen::Matrix3d R = BestRotation(D.topRows(k).transpose() * Ps.topRows(k));
+      ElemRows r = D;
+      r.topRows(k) -= Ps.topRows(k) * R.transpose();
       E += e.wv * r.squaredNorm();
       G = 2.0 * e.wv * r;
-      dE_dscale[i] = -2.0 * e.wv * (r.topRows(k).cwiseProduct(RP.topRows(k))).sum();
+      ElemRows dT = ElemRows::Zero();
+      dT.topRows(k) = e.rest.topRows(k) * ActuationShapeDerivative(e, ratios[i]).transpose() *
+                      R.transpose();
+      dE_dratio[i] = -2.0 * e.wv * (r.topRows(k).cwiseProduct(dT.topRows(k))).sum();
     }
     // D = N V: dE/dV = N^T dE/dD = dE/dD centred.
     CenterRows(G, k);
     for (int j = 0; j < k; ++j) grad->row(e.v[j]) += G.row(j);
   }
-  // Chain rule through alpha_i = Vol_i^d * alpha U / (u_i U^d):
-  // dcbrt(alpha_i)/dVol_j = cbrt(alpha_i)/3 * (delta_ij / Vol_i - 1 / U^d).
+  // Chain rule through r_i = kappa m_i / mu_i, kappa = T_a / sum_j m_j:
+  //   dr_i/dm_j = r_i (delta_ij / m_i - 1 / sum m),
+  // so dE/dm_j = g_j r_j / m_j - (sum_i g_i r_i) / sum m, with g_i = dE/dr_i. (A measure at its
+  // floor kMinMeasure * mu_j has a zero gradient.)
   for (int a = 0; a < model.num_actuators(); ++a) {
     const auto& ids = model.actuator_elements(a);
-    double Ud = 0.0, sum_gc = 0.0;
-    std::vector<double> vol(ids.size());
+    double Md = 0.0, sum_gr = 0.0;
+    std::vector<double> meas(ids.size());
+    std::vector<bool> floored(ids.size());
     for (size_t q = 0; q < ids.size(); ++q) {
       const ModelElement& e = els[ids[q]];
       ElemRows P;
       for (int j = 0; j < e.k; ++j) P.row(j) = X.row(e.v[j]);
-      vol[q] = RowsVolume(P, e.k);
-      Ud += std::max(vol[q], 1e-6 * e.rest_volume);
-      sum_gc += dE_dscale[ids[q]] * std::cbrt(ratios[ids[q]]);
+      const double m = ActuationMeasure(e, P);
+      floored[q] = !(m > kMinMeasure * e.measure0);
+      meas[q] = floored[q] ? kMinMeasure * e.measure0 : m;
+      Md += meas[q];
+      sum_gr += dE_dratio[ids[q]] * ratios[ids[q]];
     }
     for (size_t q = 0; q < ids.size(); ++q) {
+      if (floored[q]) continue;
       const ModelElement& e = els[ids[q]];
-      const double cs = std::cbrt(ratios[ids[q]]);
-      double coef = -sum_gc / (3.0 * Ud);
-      if (vol[q] > 1e-6 * e.rest_volume) coef += dE_dscale[ids[q]] * cs / (3.0 * vol[q]);
+      const double coef = dE_dratio[ids[q]] * ratios[ids[q]] / meas[q] - sum_gr / Md;
       ElemRows P;
       for (int j = 0; j < e.k; ++j) P.row(j) = X.row(e.v[j]);
-      const ElemRows gV = RowsVolumeGradient(P, e.k);
-      for (int j = 0; j < e.k; ++j) grad->row(e.v[j]) += coef * gV.row(j);
+      const ElemRows gm = ActuationMeasureGradient(e, P);
+      for (int j = 0; j < e.k; ++j) grad->row(e.v[j]) += coef * gm.row(j);
     }
   }
   return E;

@@ -1,6 +1,10 @@
 #include "solver/model.hpp"
 
+#include "solver/actuation.hpp"
+
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 
 namespace softkin {
@@ -21,15 +25,14 @@ Model::Model(const Scene& scene) : scene_(scene) {
     material[tag] = &mat;
   }
   actuator_elements_.assign(scene_.num_actuators(), {});
-  actuator_rest_volume_.assign(scene_.num_actuators(), 0.0);
+  actuator_rest_measure_.assign(scene_.num_actuators(), 0.0);
+  actuator_offset_.assign(scene_.num_actuators(), 0.0);
   for (int a = 0; a < scene_.num_actuators(); ++a) {
     const Actuator& act = scene_.actuators[a];
-    if (act.type != ActuatorType::Pneumatic)
-      throw std::invalid_argument("actuator '" + act.name + "': " +
-                                  ActuatorTypeToString(act.type) +
-                                  " actuation elements are not supported by this build; "
-                                  "expected type 'pneumatic'");
-    for (int r : act.regions) role[r] = {ElementRole::Pneumatic, a};
+    const ElementRole r = act.type == ActuatorType::Pneumatic ? ElementRole::Pneumatic
+                          : act.type == ActuatorType::Cable   ? ElementRole::Cable
+                                                              : ElementRole::Dea;
+    for (int reg : act.regions) role[reg] = {r, a};
   }
 
   elements_.resize(ne);
@@ -57,8 +60,21 @@ Model::Model(const Scene& scene) : scene_(scene) {
       me.r_omega = 1.0;
       me.wv = scene_.actuators[grp].weight * me.rest_volume;
       actuator_elements_[grp].push_back(i);
-      actuator_rest_volume_[grp] += me.rest_volume;
+      if (r == ElementRole::Pneumatic) {
+        me.measure0 = me.rest_volume;
+      } else if (r == ElementRole::Dea) {
+        me.axis = PrismNormal(me.rest);
+        me.measure0 = ActuationMeasure(me, me.rest);
+      }
+      // Cable elements get their direction and length share below, per cable.
     }
+  }
+  for (int a = 0; a < scene_.num_actuators(); ++a) {
+    if (scene_.actuators[a].type == ActuatorType::Cable) SetUpCable(a);
+    for (int i : actuator_elements_[a]) actuator_rest_measure_[a] += elements_[i].measure0;
+    if (!(actuator_rest_measure_[a] > 0))
+      throw std::invalid_argument("actuator '" + scene_.actuators[a].name +
+                                  "': its elements have zero rest measure");
   }
 
   // Incidence (CSR).
@@ -123,6 +139,107 @@ Model::Model(const Scene& scene) : scene_(scene) {
     throw std::runtime_error("scene '" + scene_.name +
                              "': CHOLMOD could not factor the global matrix; is every part of the "
                              "mesh connected to a fixed vertex?");
+}
+
+namespace {
+
+/// Barycentric point-in-tet test (inclusive, with a small tolerance).
+bool InTet(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+           const Eigen::Vector3d& c, const Eigen::Vector3d& d) {
+  Eigen::Matrix3d T;
+  T << b - a, c - a, d - a;
+  const Eigen::Vector3d l = T.partialPivLu().solve(p - a);
+  const double tol = 1e-9;
+  return l.allFinite() && l.minCoeff() >= -tol && l.sum() <= 1.0 + tol;
+}
+
+bool InElement(const Eigen::Vector3d& p, const Element& e, const Eigen::MatrixX3d& V) {
+  auto x = [&](int j) { return Eigen::Vector3d(V.row(e.v[j]).transpose()); };
+  if (e.k() == 4) return InTet(p, x(0), x(1), x(2), x(3));
+  // The prism's three tets (as in RowsVolume).
+  return InTet(p, x(0), x(1), x(2), x(5)) || InTet(p, x(0), x(1), x(5), x(4)) ||
+         InTet(p, x(0), x(4), x(5), x(3));
+}
+
+}  // namespace
+
+void Model::SetUpCable(int a) {
+  const Actuator& act = scene_.actuators[a];
+  const Mesh& m = scene_.mesh;
+  const auto& path = act.path;
+  const auto& ids = actuator_elements_[a];
+  double L = 0;
+  for (size_t q = 1; q < path.size(); ++q) L += (path[q] - path[q - 1]).norm();
+
+  // Direction: tangent of the path segment nearest to the element's centroid.
+  double total_volume = 0;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  for (int i : ids) {
+    ModelElement& me = elements_[i];
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (int j = 0; j < me.k; ++j) {
+      const Eigen::Vector3d x = m.vertices.row(me.v[j]).transpose();
+      c += x / me.k;
+      lo = lo.cwiseMin(x);
+      hi = hi.cwiseMax(x);
+    }
+    double best = 1e300;
+    for (size_t q = 1; q < path.size(); ++q) {
+      const Eigen::Vector3d s = path[q] - path[q - 1];
+      const double len2 = s.squaredNorm();
+      if (!(len2 > 0)) continue;
+      const double t = std::clamp((c - path[q - 1]).dot(s) / len2, 0.0, 1.0);
+      const double dist = (path[q - 1] + t * s - c).squaredNorm();
+      if (dist < best) {
+        best = dist;
+        me.axis = s.normalized();
+      }
+    }
+    // Q d with Q = P (P^T P)^-1: F d = D^T Q d for the element's best-fit deformation gradient.
+    const Eigen::MatrixXd P = me.rest.topRows(me.k);
+    const Eigen::VectorXd qd = P * (P.transpose() * P).ldlt().solve(me.axis);
+    for (int j = 0; j < me.k; ++j) me.qd[j] = qd[j];
+    total_volume += me.rest_volume;
+  }
+
+  // Length of the path inside the actuation elements (sum l_i): sampled at ~L / 4000 spacing,
+  // each sample tested against the elements whose bounding box holds it.
+  double inside = 0;
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> boxes;
+  boxes.reserve(ids.size());
+  for (int i : ids) {
+    Eigen::Vector3d blo = Eigen::Vector3d::Constant(1e300), bhi = -blo;
+    for (int j = 0; j < elements_[i].k; ++j) {
+      const Eigen::Vector3d x = m.vertices.row(elements_[i].v[j]).transpose();
+      blo = blo.cwiseMin(x);
+      bhi = bhi.cwiseMax(x);
+    }
+    boxes.emplace_back(blo, bhi);
+  }
+  for (size_t q = 1; q < path.size(); ++q) {
+    const Eigen::Vector3d s = path[q] - path[q - 1];
+    const double len = s.norm();
+    const int n = std::max(1, static_cast<int>(std::ceil(4000.0 * len / L)));
+    for (int t = 0; t < n; ++t) {
+      const Eigen::Vector3d p = path[q - 1] + (t + 0.5) / n * s;
+      if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
+      for (size_t b = 0; b < ids.size(); ++b) {
+        if ((p.array() < boxes[b].first.array()).any() ||
+            (p.array() > boxes[b].second.array()).any())
+          continue;
+        if (InElement(p, m.elements[ids[b]], m.vertices)) {
+          inside += len / n;
+          break;
+        }
+      }
+    }
+  }
+  if (!(inside > 0))
+    throw std::invalid_argument("cable '" + act.name +
+                                "': its path does not pass through its actuation elements");
+  // l_i: the inside length shared by volume; L_R: the rest of the path.
+  for (int i : ids) elements_[i].measure0 = inside * elements_[i].rest_volume / total_volume;
+  actuator_offset_[a] = std::max(0.0, L - inside);
 }
 
 Eigen::MatrixX3d Model::SolveFree(const Eigen::Ref<const Eigen::MatrixX3d>& rhs) const {

@@ -26,6 +26,13 @@ struct ModelElement {
   double wv = 0;          ///< w_i * Vol_i, the weight in Eq. 2.10
   double r_omega = 1.0;   ///< shape-blending parameter R_omega (Eq. 2.5), body elements
   ElemRows rest;          ///< N * V_i: centred rest shape (first k rows), mm
+  /// Actuation elements (actuation.hpp): mu_i, the rest value of the constrained measure (volume,
+  /// mm^3; mean triangle area, mm^2; the element's share l_i of the cable length, mm).
+  double measure0 = 0;
+  /// Cable: unit cable direction d at the element; DEA: unit rest normal n. Rest frame.
+  Eigen::Vector3d axis = Eigen::Vector3d::Zero();
+  /// Cable: Q d with Q = P (P^T P)^-1 (P the centred rest rows), so that F d = D^T (Q d).
+  std::array<double, 6> qd{};
 };
 
 class Model {
@@ -48,8 +55,12 @@ class Model {
   const std::vector<ModelElement>& elements() const { return elements_; }
   /// Element indices of actuator a.
   const std::vector<int>& actuator_elements(int a) const { return actuator_elements_[a]; }
-  /// Sum of the rest volumes of actuator a's elements (U, A-related or L-related total), mm^3.
-  double actuator_rest_volume(int a) const { return actuator_rest_volume_[a]; }
+  /// M_a = sum of mu_i over actuator a's elements: U (volume), A (area) or the cable length
+  /// inside actuation elements (actuation.hpp).
+  double actuator_rest_measure(int a) const { return actuator_rest_measure_[a]; }
+  /// L_R of a cable actuator: the length of its path outside its actuation elements (0 for the
+  /// other types). The constraint is c (M + L_R) - L_R = sum_i r_i mu_i.
+  double actuator_offset(int a) const { return actuator_offset_[a]; }
 
   /// Free (non-fixed) vertex ids in order; free_index()[v] is v's row among them, or -1.
   const std::vector<int>& free_vertices() const { return free_vertices_; }
@@ -75,11 +86,13 @@ class Model {
   double factor_time_s() const { return factor_time_s_; }
 
  private:
+  /// Cable actuator a: per-element directions, Q d and length shares; L_R.
+  void SetUpCable(int a);
   Scene scene_;
   double size_ = 0;
   std::vector<ModelElement> elements_;
   std::vector<std::vector<int>> actuator_elements_;
-  std::vector<double> actuator_rest_volume_;
+  std::vector<double> actuator_rest_measure_, actuator_offset_;
   std::vector<int> free_vertices_, free_index_;
   std::vector<int> inc_offset_, inc_;
   Eigen::SparseMatrix<double> A_, A_ff_, A_fc_;

@@ -73,6 +73,16 @@ void Scene::validate() const {
       fail("actuator '" + a.name + "': expected 0 < min <= rest <= max");
     if (!(a.weight > 0.0)) fail("actuator '" + a.name + "': weight must be > 0");
     if (a.regions.empty()) fail("actuator '" + a.name + "' has no regions");
+    if (a.type == ActuatorType::Cable) {
+      if (a.path.size() < 2) fail("cable '" + a.name + "': expected a path of at least 2 points");
+      for (const auto& p : a.path)
+        if (!p.allFinite()) fail("cable '" + a.name + "': path points must be finite");
+      double len = 0;
+      for (size_t q = 1; q < a.path.size(); ++q) len += (a.path[q] - a.path[q - 1]).norm();
+      if (!(len > 0)) fail("cable '" + a.name + "': the path has zero length");
+    } else if (!a.path.empty()) {
+      fail("actuator '" + a.name + "': only cable actuators have a path");
+    }
     for (int r : a.regions) {
       auto it = role.find(r);
       if (it != role.end())
@@ -90,6 +100,13 @@ void Scene::validate() const {
     bool any = false;
     for (int r : a.regions) any = any || used.count(r);
     if (!any) fail("actuator '" + a.name + "' has no elements in the mesh");
+    if (a.type == ActuatorType::Dea) {
+      const std::set<int> regs(a.regions.begin(), a.regions.end());
+      for (int i = 0; i < mesh.num_elements(); ++i)
+        if (regs.count(mesh.elements[i].region) && mesh.elements[i].k() != 6)
+          fail("DEA actuator '" + a.name + "': element " + std::to_string(i) +
+               " is a tet; expected prism elements (Sec. 2.3.3)");
+    }
   }
   if (fixed.empty()) fail("no fixed vertices: the problem would have a rigid-motion null space");
   for (int v : fixed)

@@ -36,6 +36,10 @@ struct Actuator {
   double max = 2.0;   ///< upper bound of the actuation value
   double rest = 1.0;  ///< value at which the actuator is at rest
   double weight = 5.0;  ///< w_i of its elements (Sec. 2.5: 5 vs 1 for body elements)
+  /// Cable only: the cable's path, a polyline of >= 2 points (mm), from its anchored end to where
+  /// it is pulled. Its length is L; the part inside the actuator's elements is sum l_i, the rest
+  /// L_R (Eq. 2.6). Each element's cable direction is the tangent of the nearest path segment.
+  std::vector<Eigen::Vector3d> path;
 };
 
 /// A named tracked point: the mean of the listed vertices' positions.

@@ -33,7 +33,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // The key table
 // ------------------------------------------------------------------------------------------------
 
-enum class Type { Object, ObjectArray, String, Number, Integer, Vec3 };
+enum class Type { Object, ObjectArray, String, Number, Integer, Vec3, Polyline };
 /// Required: must be present. Optional: has a default. Selector: each object of that kind needs
 /// exactly one key of its selector group (e.g. fixed[]: region | box | plane | file).
 enum class Need { Required, Optional, Selector };
@@ -136,6 +136,11 @@ const std::vector<KeySpec>& KeyTable() {
     t.push_back(Key("regions[].weight", N, Opt,
                     "Element weight w_i (Eq. 2.10) of actuation elements (Sec. 2.5 uses 5).")
                     .Def(act.weight).Above(0.0).Roles(kActuatorRoles));
+    t.push_back(Key("regions[].path", Type::Polyline, R,
+                    "cable: the cable's path through the body, from its anchored end to where it "
+                    "is pulled (mm). Elements take the direction of the nearest segment; the path "
+                    "length outside the cable's elements is L_R of Eq. 2.6.")
+                    .Roles({"cable"}));
     t.push_back(Key("fixed", A, R,
                     "Vertices held at their rest positions: the union of the entries' selections."));
     t.push_back(Key("fixed[].region", I, Sel, "Every vertex of the elements with this region tag."));
@@ -251,6 +256,7 @@ std::string TypeText(const KeySpec& k, bool with_article) {
     case Type::Number: return art("a ", "number") + RangeText(k);
     case Type::Integer: return art("an ", "integer") + RangeText(k);
     case Type::Vec3: return art("an ", "array of 3 numbers [x, y, z]");
+    case Type::Polyline: return art("an ", "array of >= 2 points [[x, y, z], ...]");
   }
   return "?";
 }
@@ -315,6 +321,14 @@ bool ValueOk(const KeySpec& k, const json& v) {
       if (!v.is_array() || v.size() != 3) return false;
       for (const auto& e : v)
         if (!e.is_number() || !std::isfinite(e.get<double>())) return false;
+      return true;
+    case Type::Polyline:
+      if (!v.is_array() || v.size() < 2) return false;
+      for (const auto& p : v) {
+        if (!p.is_array() || p.size() != 3) return false;
+        for (const auto& e : p)
+          if (!e.is_number() || !std::isfinite(e.get<double>())) return false;
+      }
       return true;
   }
   return false;
@@ -649,6 +663,17 @@ void SceneParser::ReadRegions(const json& regions, Scene* scene) const {
            "\"; regions sharing an actuator name must have the same role");
     }
     scene->actuators[it->second.index].regions.push_back(tag);
+    if (role == "cable") {
+      std::vector<Eigen::Vector3d> pts;
+      for (const auto& p : r.at("path")) pts.push_back(AsVec(p));
+      auto& a = scene->actuators[it->second.index];
+      if (a.path.empty())
+        a.path = pts;
+      else if (a.path != pts)
+        Fail(path + ".path: cable '" + name +
+             "' already has a different path; regions sharing a cable name must give the same "
+             "path");
+    }
     for (const char* key : {"min", "max", "rest", "weight"}) {
       if (!r.contains(key)) continue;
       const double v = r.at(key).get<double>();

@@ -1,5 +1,6 @@
 #include "solver/targets.hpp"
 
+#include "solver/actuation.hpp"
 #include "solver/rotation.hpp"
 
 #include <algorithm>
@@ -27,29 +28,29 @@ void ComputeLocalRatios(const Model& model, const Eigen::Ref<const Eigen::Matrix
   if (achieved) achieved->assign(model.num_actuators(), 1.0);
   for (int a = 0; a < model.num_actuators(); ++a) {
     const auto& ids = model.actuator_elements(a);
-    const double U = model.actuator_rest_volume(a);
-    double Ud = 0.0;
+    const double M = model.actuator_rest_measure(a), LR = model.actuator_offset(a);
+    double Md = 0.0;
     for (int i : ids) {
       ElemRows D;
       for (int j = 0; j < els[i].k; ++j) D.row(j) = X.row(els[i].v[j]);
       // Inverted or collapsed elements count as (almost) empty.
-      (*ratios)[i] = std::max(RowsVolume(D, els[i].k), 1e-6 * els[i].rest_volume);
-      Ud += (*ratios)[i];
+      (*ratios)[i] = std::max(ActuationMeasure(els[i], D), kMinMeasure * els[i].measure0);
+      Md += (*ratios)[i];
     }
-    if (achieved) (*achieved)[a] = Ud / U;
-    // alpha_i u_i = Vol_i^d * (alpha U / U^d): proportional to the current volume, exact total.
-    const double scale = c[a] * U / Ud;
-    for (int i : ids) (*ratios)[i] = (*ratios)[i] * scale / els[i].rest_volume;
+    if (achieved) (*achieved)[a] = (Md + LR) / (M + LR);
+    // r_i mu_i = m_i * (c (M + L_R) - L_R) / M^d: proportional to the current measure, exact
+    // total. (A cable pulled shorter than its rigid part L_R allows gets tiny positive ratios.)
+    const double scale = std::max(c[a] * (M + LR) - LR, kMinMeasure * M) / Md;
+    for (int i : ids) (*ratios)[i] = (*ratios)[i] * scale / els[i].measure0;
   }
 }
 
 void ElementTarget(const ModelElement& e, const ElemRows& D, double ratio, ElemRows* T) {
   const int k = e.k;
-  // Best rotation from the rest shape to the current shape: max tr(R^T D^T P).
-  const Eigen::Matrix3d M = D.topRows(k).transpose() * e.rest.topRows(k);
-  const Eigen::Matrix3d R = BestRotation(M);
   T->setZero();
   if (e.role == ElementRole::Body) {
+    // Best rotation from the rest shape to the current shape: max tr(R^T D^T P).
+    const Eigen::Matrix3d R = BestRotation(D.topRows(k).transpose() * e.rest.topRows(k));
     T->topRows(k) = e.rest.topRows(k) * R.transpose();  // V^r = R V (rows), Eq. 2.3
     if (e.r_omega < 1.0) {
       const double vd = RowsVolume(D, k);
@@ -58,9 +59,17 @@ void ElementTarget(const ModelElement& e, const ElemRows& D, double ratio, ElemR
       s = std::min(s, 10.0);
       T->topRows(k) = e.r_omega * T->topRows(k) + (1.0 - e.r_omega) * s * D.topRows(k);  // Eq. 2.5
     }
-  } else {
-    // Pneumatic: rest shape scaled by cbrt(alpha_i) about its centre, rotated (Eq. 2.8).
+  } else if (e.role == ElementRole::Pneumatic) {
+    // Rest shape scaled by cbrt(alpha_i) about its centre, rotated (Eq. 2.8). Isotropic scaling
+    // does not change the best rotation.
+    const Eigen::Matrix3d R = BestRotation(D.topRows(k).transpose() * e.rest.topRows(k));
     T->topRows(k) = std::cbrt(ratio) * (e.rest.topRows(k) * R.transpose());
+  } else {
+    // Cable / DEA: reshape the rest shape (actuation.hpp), then rotate it onto the current shape.
+    ElemRows Ps = ElemRows::Zero();
+    Ps.topRows(k) = e.rest.topRows(k) * ActuationShape(e, ratio).transpose();
+    const Eigen::Matrix3d R = BestRotation(D.topRows(k).transpose() * Ps.topRows(k));
+    T->topRows(k) = Ps.topRows(k) * R.transpose();
   }
 }
 

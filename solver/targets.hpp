@@ -5,8 +5,9 @@
 ///    the best rotation from the rest shape to the current one and S scales the current shape back
 ///    to the rest volume. Note: the thesis writes S = diag(r, r, r) with r = Vol(V)/Vol(V^d); a
 ///    uniform scale that restores the volume is the cube root of that ratio, which is what is used.
-///  - Pneumatic elements: the rest shape scaled by cbrt(alpha_i) about its centre (Eq. 2.8), rotated
-///    to the current shape.
+///  - Actuation elements: the rest shape reshaped by the local ratio (actuation.hpp: pneumatic
+///    cbrt(alpha_i) I, Eq. 2.8; cable shrink s_i along the cable, Eq. 2.6; DEA in-plane sqrt(lambda_i)
+///    and thickness 1/lambda_i, Eq. 2.7), then rotated onto the current shape.
 /// The blended target is already aligned with the current shape: D^T T is symmetric positive
 /// semi-definite, so the final rotation R_i of Eq. 2.10 is the identity and is not recomputed.
 #include "solver/model.hpp"
@@ -15,18 +16,22 @@
 
 namespace softkin {
 
-/// Per-element local actuation ratios alpha_i (pneumatic, 1 for body elements) for actuation c at
-/// positions X (#V x 3). Sec. 2.3.3: the ratios are proportional to each element's current volume
-/// ratio rho_i = Vol(V_i^d)/u_i and scaled so that sum_i alpha_i u_i = alpha U exactly (Eq. 2.8).
-/// This is the least-norm correction of the current ratios in the metric sum_i (u_i/rho_i)
-/// (alpha_i - rho_i)^2. `achieved` (optional) receives each actuator's current volume ratio
-/// sum_i Vol(V_i^d) / U.
+/// Measures below this fraction of their rest value count as this fraction (inverted or collapsed
+/// elements), so that ratios stay positive and finite.
+constexpr double kMinMeasure = 1e-6;
+
+/// Per-element local actuation ratios r_i (alpha_i, s_i or lambda_i; 1 for body elements) for
+/// actuation c at positions X (#V x 3). Sec. 2.3.3: the ratios are proportional to each element's
+/// current measure ratio rho_i = m_i(X) / mu_i (actuation.hpp) and scaled so that each actuator's
+/// constraint holds exactly: sum_i r_i mu_i = c (M + L_R) - L_R (Eq. 2.6-2.8; L_R = 0 except for
+/// cables). This is the least-norm correction of the current ratios in the metric
+/// sum_i (mu_i / rho_i) (r_i - rho_i)^2. `achieved` (optional) receives each actuator's current
+/// ratio (sum_i m_i + L_R) / (M + L_R): volume, cable length or area ratio.
 void ComputeLocalRatios(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
                         const Eigen::Ref<const Eigen::VectorXd>& c, std::vector<double>* ratios,
                         std::vector<double>* achieved = nullptr);
 
-/// Target of one element: D = N V^d (centred current rows), ratio = alpha_i (pneumatic, ignored
-/// for body). Writes the centred target T, already rotated to the current frame.
+/// Target of one element: D = N V^d (centred current rows), ratio = r_i (ignored for body). Writes the centred target T, already rotated to the current frame.
 void ElementTarget(const ModelElement& e, const ElemRows& D, double ratio, ElemRows* T);
 
 /// The local step: for every element computes its target (stored as w_i Vol_i * T in `weighted`,

@@ -566,7 +566,7 @@ void CheckLocalRatios(const Model& m, const Eigen::VectorXd& c, const char* what
         kmin = std::min(kmin, kk);
         kmax = std::max(kmax, kk);
       }
-      const double U = m.actuator_rest_volume(a);
+      const double U = m.actuator_rest_measure(a);
       EXPECT_NEAR(sum, c[a] * U, 1e-14 * c[a] * U) << what;
       EXPECT_NEAR(achieved[a], Ud / U, 1e-14) << what;
       EXPECT_LE(kmax - kmin, 1e-13 * kmax) << what << " proportional to current volume";

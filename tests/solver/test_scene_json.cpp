@@ -251,18 +251,32 @@ TEST(SceneJsonTiny, CableAndDeaRolesAndDefaults) {
     "mesh": {"file": "tiny.tet", "labels": "tiny_labels.txt"},
     "regions": [
       {"tag": 0, "role": "body"},
-      {"tag": 1, "role": "cable", "name": "tendon"},
+      {"tag": 1, "role": "cable", "name": "tendon", "path": [[0, 0, 0], [1, 0, 0], [1, 1, 0]]},
       {"tag": 2, "role": "dea", "name": "skin", "max": 1.5}
     ],
     "fixed": [{"box": {"min": [-1, -1, -1], "max": [2, 0, 2]}}]
   })");
+  // The tiny mesh is all tets: a DEA region needs prisms (Sec. 2.3.3).
+  try {
+    LoadFrom(dir.path(), j);
+    ADD_FAILURE() << "a DEA region of tets was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("DEA actuator 'skin': element 2 is a tet; expected prism "
+                                         "elements"),
+              std::string::npos)
+        << e.what();
+  }
+  j["regions"][2] = json::parse(R"({"tag": 2, "role": "pneumatic", "name": "skin", "max": 1.5})");
   const Scene s = LoadFrom(dir.path(), j);
   EXPECT_EQ(s.name, "scene");  // default: the JSON file's stem
   ASSERT_EQ(s.num_actuators(), 2);
   EXPECT_EQ(s.actuators[0].name, "tendon");
   EXPECT_EQ(s.actuators[0].type, ActuatorType::Cable);
   EXPECT_EQ(s.actuators[1].name, "skin");
-  EXPECT_EQ(s.actuators[1].type, ActuatorType::Dea);
+  EXPECT_EQ(s.actuators[1].type, ActuatorType::Pneumatic);
+  ASSERT_EQ(s.actuators[0].path.size(), 3u);
+  EXPECT_EQ(s.actuators[0].path[2], Eigen::Vector3d(1, 1, 0));
+  EXPECT_TRUE(s.actuators[1].path.empty());
   const Actuator def;
   EXPECT_DOUBLE_EQ(s.actuators[0].min, def.min);
   EXPECT_DOUBLE_EQ(s.actuators[0].max, def.max);
@@ -574,8 +588,23 @@ TEST(SceneJsonErrors, ActuatorRegionsMustAgree) {
   ExpectSceneError(j, {"regions[2].max: actuator 'chamber' already has max 3 from regions[1].max, got 4"});
   j = TinyScene();
   j["regions"][2]["role"] = "cable";
+  j["regions"][2]["path"] = json::parse("[[0, 0, 0], [1, 0, 0]]");
   ExpectSceneError(j, {"regions[2].role: actuator 'chamber' is pneumatic in regions[1].role",
                        "got \"cable\""});
+  // A cable's path: at least two finite points, and the same path in every region of the cable.
+  j = TinyScene();
+  j["regions"][1] = json::parse(R"({"tag": 1, "role": "cable", "name": "tendon", "path": [[0, 0, 0]]})");
+  ExpectSceneError(j, {"regions[1].path", "expected an array of >= 2 points [[x, y, z], ...]"});
+  j = TinyScene();
+  j["regions"][1] = json::parse(R"({"tag": 1, "role": "cable", "name": "tendon"})");
+  ExpectSceneError(j, {"regions[1]", "path"});
+  j = TinyScene();
+  j["regions"][1] = json::parse(R"({"tag": 1, "role": "cable", "name": "t", "path": [[0, 0, 0], [1, 0, 0]]})");
+  j["regions"][2] = json::parse(R"({"tag": 2, "role": "cable", "name": "t", "path": [[0, 0, 0], [2, 0, 0]]})");
+  ExpectSceneError(j, {"regions[2].path: cable 't' already has a different path"});
+  j = TinyScene();
+  j["regions"][1]["path"] = json::parse("[[0, 0, 0], [1, 0, 0]]");
+  ExpectSceneError(j, {"regions[1].path"});
   j = TinyScene();
   j["regions"][1]["rest"] = 3.5;
   ExpectSceneError(j, {"regions[1]: actuator 'chamber': expected min <= rest <= max",
@@ -635,7 +664,7 @@ TEST(SceneJsonErrors, MeshReaderErrorPassesThrough) {
 const std::vector<std::string> kAllKeys = {
     "name", "mesh", "mesh.file", "mesh.format", "mesh.labels", "mesh.tag_array", "mesh.scale",
     "regions", "regions[].tag", "regions[].role", "regions[].material", "regions[].r_omega",
-    "regions[].weight", "regions[].name", "regions[].min", "regions[].max", "regions[].rest",
+    "regions[].weight", "regions[].name", "regions[].min", "regions[].max", "regions[].rest", "regions[].path",
     "fixed", "fixed[].region", "fixed[].box", "fixed[].box.min", "fixed[].box.max",
     "fixed[].plane", "fixed[].plane.point", "fixed[].plane.normal", "fixed[].plane.tolerance",
     "fixed[].file", "fixed[].base", "markers", "markers[].name", "markers[].vertex",
