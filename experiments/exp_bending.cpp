@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <iostream>
 
 namespace softkin {
@@ -17,9 +18,13 @@ namespace softkin {
 nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bool verbose) {
   const std::string robot = cfg.String("robot", "pneumatic_finger");
   const int res = cfg.Int("res", 0);
+  // The swept actuators ("actuators": [names], or "actuator": name; default the first one), all
+  // set to the same value, from their common rest value to "end_value" (default: the end of their
+  // range away from rest, e.g. the max volume ratio or the min cable shortening ratio).
   const std::string act_name = cfg.String("actuator", "");
+  const std::vector<std::string> act_names = cfg.StringList("actuators", {});
   const int steps = cfg.Int("steps", 40);
-  const double max_value_cfg = cfg.Number("max_value", 0.0);
+  const double end_value_cfg = cfg.Number("end_value", 0.0);
   const int vtu_every = cfg.Int("vtu_every", 0);
   // Secant predictor: start each step from X_k + (X_k - X_{k-1}) (equal actuation steps) instead
   // of X_k. It is a better first guess along a smooth sweep; the solution is the same.
@@ -27,7 +32,7 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
   // Actuation spacing: "linear" (equal steps) or "geometric" (equal ratios, so smaller steps at
   // the start, where the bend angle grows fastest with the volume ratio).
   const std::string spacing = cfg.String("spacing", "linear");
-  const std::vector<double> milestones = cfg.NumberList("milestones_deg", {90, 180, 240});
+  std::vector<double> milestones = cfg.NumberList("milestones_deg", {});
   const auto t_build0 = std::chrono::steady_clock::now();
   Scene scene = MakeRobot(robot, res);
   FkOptions opts = cfg.Solver(scene.solver);
@@ -35,18 +40,38 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
   if (steps < 1) cfg.Fail("steps", "an integer >= 1");
   if (spacing != "linear" && spacing != "geometric") cfg.Fail("spacing", "linear or geometric");
   if (vtu_every < 0) cfg.Fail("vtu_every", "an integer >= 0");
-  const int a = act_name.empty() ? 0 : scene.actuator_index(act_name);
-  if (a < 0) cfg.Fail("actuator", "the name of an actuator of robot '" + robot + "'");
+  if (!act_name.empty() && !act_names.empty())
+    cfg.Fail("actuators", "either 'actuator' or 'actuators', not both");
+  std::vector<int> swept;
+  for (const std::string& n : act_names.empty() ? std::vector<std::string>{act_name} : act_names) {
+    const int i = n.empty() ? 0 : scene.actuator_index(n);
+    if (i < 0) cfg.Fail(act_names.empty() ? "actuator" : "actuators",
+                        "names of actuators of robot '" + robot + "', got '" + n + "'");
+    swept.push_back(i);
+  }
+  const int a = swept[0];
   const Actuator& act = scene.actuators[a];
-  const double vmax = max_value_cfg > 0 ? max_value_cfg : act.max;
-  if (vmax > act.max || vmax <= act.rest)
-    cfg.Fail("max_value", "a value in (rest, max] of actuator '" + act.name + "'");
+  for (int i : swept)
+    if (scene.actuators[i].rest != act.rest || scene.actuators[i].min != act.min ||
+        scene.actuators[i].max != act.max)
+      cfg.Fail("actuators", "actuators with the same rest value and range");
+  const double vmax = end_value_cfg > 0 ? end_value_cfg
+                      : act.max > act.rest ? act.max : act.min;
+  if (vmax > act.max || vmax < act.min || vmax == act.rest)
+    cfg.Fail("end_value", "a value in [min, max] of actuator '" + act.name + "', not its rest value");
 
   auto model = std::make_shared<const Model>(scene);
   const double build_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t_build0).count();
   auto solver = MakeFkSolver(model, opts);
-  BendAngle bend(scene);
+  // The bend angle needs the tip_top / tip_bottom markers; without them it is not reported.
+  const bool has_bend = scene.marker_index("tip_top") >= 0 && scene.marker_index("tip_bottom") >= 0;
+  std::unique_ptr<BendAngle> bend;
+  if (has_bend) bend = std::make_unique<BendAngle>(scene);
+  if (!has_bend && !milestones.empty())
+    cfg.Fail("milestones_deg", "no milestones: robot '" + robot +
+                                   "' has no tip_top / tip_bottom markers, so no bend angle is measured");
+  if (has_bend && milestones.empty()) milestones = {90, 180, 240};
   const int tip = scene.marker_index("tip");
   if (tip < 0) throw std::invalid_argument("robot '" + robot + "' has no 'tip' marker");
 
@@ -64,6 +89,7 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
   double cumulative = 0.0, max_bend = 0.0;
   int total_iters = 0, failures = 0;
   std::vector<double> reach(milestones.size(), -1.0);
+  nlohmann::json tips = nlohmann::json::array(), step_times = nlohmann::json::array();
   if (spacing == "geometric" && !(act.rest > 0))
     cfg.Fail("spacing", "linear (geometric spacing needs a positive rest value)");
   auto value = [&](int s) {
@@ -72,7 +98,7 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
                                   : act.rest + (vmax - act.rest) * t;
   };
   for (int s = 1; s <= steps; ++s) {
-    c[a] = value(s);
+    for (int i : swept) c[i] = value(s);
     // Secant predictor, scaled by the ratio of this step to the previous one.
     const double q = s > 1 ? (value(s) - value(s - 1)) / (value(s - 1) - value(s - 2)) : 0.0;
     guess = (predictor && s > 1) ? Eigen::MatrixX3d(X + q * (X - X_prev)) : X;
@@ -84,11 +110,13 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
     total_iters += r.iterations;
     const bool ok = r.status == FkStatus::Converged;
     if (!ok) ++failures;
-    const double ang = bend(X);
+    const double ang = has_bend ? (*bend)(X) : 0.0;
     max_bend = std::max(max_bend, ang);
     for (size_t q = 0; q < milestones.size(); ++q)
       if (reach[q] < 0 && ang >= milestones[q]) reach[q] = cumulative;
     const Eigen::MatrixX3d P = scene.marker_positions(X);
+    tips.push_back({P(tip, 0), P(tip, 1), P(tip, 2)});
+    step_times.push_back(r.time_s);
     csv.Row({double(s), c[a], ang, P(tip, 0), P(tip, 1), P(tip, 2), double(r.iterations), r.time_s,
              cumulative, r.energy, r.volume_ratios[a], r.gradient_ratio, ok ? 1.0 : 0.0});
     if (vtu_every > 0 && (s % vtu_every == 0 || s == steps)) {
@@ -97,9 +125,12 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
       WriteVtu(dir + "/" + name, scene.mesh, X);
       frames.emplace_back(c[a], name);
     }
-    if (verbose)
-      std::fprintf(stderr, "  [%d/%d] %s = %.3f  bend %.1f deg  %s\n", s, steps, act.name.c_str(),
-                   c[a], ang, r.BriefReport().c_str());
+    if (verbose) {
+      char bend_txt[40] = "";
+      if (has_bend) std::snprintf(bend_txt, sizeof(bend_txt), "bend %.1f deg  ", ang);
+      std::fprintf(stderr, "  [%d/%d] %s = %.3f  %s%s\n", s, steps, act.name.c_str(), c[a],
+                   bend_txt, r.BriefReport().c_str());
+    }
   }
   if (!frames.empty()) WritePvd(dir + "/frames.pvd", frames);
 
@@ -109,7 +140,10 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
   j["n_elements"] = scene.mesh.num_elements();
   j["n_tets"] = scene.mesh.num_tets();
   j["steps"] = steps;
-  j["max_actuation"] = vmax;
+  j["actuators"] = nlohmann::json::array();
+  for (int i : swept) j["actuators"].push_back(scene.actuators[i].name);
+  j["end_value"] = vmax;
+  j["bend_measured"] = has_bend;
   j["max_bend_deg"] = max_bend;
   j["total_solve_s"] = cumulative;
   j["total_iterations"] = total_iters;
@@ -125,7 +159,10 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
     std::snprintf(key, sizeof(key), "t%.0f_s", milestones[q]);
     j[key] = reach[q] >= 0 ? nlohmann::json(reach[q]) : nlohmann::json(nullptr);
   }
-  j["thesis_table_2_2"] = {{"t90_s", 8.5}, {"t180_s", 15.2}, {"t240_s", 23.2}, {"elements", 45802}};
+  j["tips"] = tips;
+  j["step_times_s"] = step_times;
+  if (robot == "pneumatic_finger")
+    j["thesis_table_2_2"] = {{"t90_s", 8.5}, {"t180_s", 15.2}, {"t240_s", 23.2}, {"elements", 45802}};
   return j;
 }
 

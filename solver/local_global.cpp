@@ -129,7 +129,7 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     if (it == 0) {
       // Floor: a residual this small is round-off (e.g. at the rest actuation, where both the
       // residual at rest and at the start are ~0 and their ratio would be noise).
-      ref = std::max({ref, grad, 1e-10 * total_weight_ * m.size()});
+      ref = std::max({ref, grad, 1e-8 * total_weight_ * m.size()});
     }
     r->gradient_ratio = ref > 0 ? grad / ref : 0.0;
     const double move = (Gf - xf).rowwise().norm().maxCoeff() / m.size();

@@ -104,7 +104,7 @@ TEST(Cli, RunWritesSummaryWithConfigCommitAndMachine) {
   const std::string cfg = dir + "/tiny.json";
   std::ofstream(cfg) << R"({"name": "tiny_bend", "experiment": "pneumatic_bending", "seed": 3,
     "robot": "three_chamber", "res": 3, "actuator": "c1", "steps": 3,
-    "milestones_deg": [5], "max_value": 1.6})";
+    "milestones_deg": [5], "end_value": 1.6})";
   // three_chamber has no tip_top/tip_bottom: the bending experiment must say so.
   CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
   EXPECT_NE(r.code, 0);

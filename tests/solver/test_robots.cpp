@@ -448,11 +448,12 @@ TEST(MeshGenDisk, RejectsBadArguments) {
 // Robots
 // ---------------------------------------------------------------------------------------------
 
-TEST(Robots, ListsBothRobotsAndRejectsBadInput) {
+TEST(Robots, ListsEveryRobotAndRejectsBadInput) {
   const std::vector<RobotInfo> list = ListRobots();
-  ASSERT_EQ(list.size(), 2u);
+  ASSERT_EQ(list.size(), 3u);
   EXPECT_EQ(list[0].name, "pneumatic_finger");
   EXPECT_EQ(list[1].name, "three_chamber");
+  EXPECT_EQ(list[2].name, "cable_finger");
   for (const auto& r : list) {
     EXPECT_GT(r.default_resolution, 0);
     EXPECT_FALSE(r.description.empty());
@@ -463,7 +464,7 @@ TEST(Robots, ListsBothRobotsAndRejectsBadInput) {
     FAIL() << "no exception";
   } catch (const std::invalid_argument& e) {
     EXPECT_EQ(std::string(e.what()),
-              "unknown robot 'x'; known robots: pneumatic_finger, three_chamber");
+              "unknown robot 'x'; known robots: pneumatic_finger, three_chamber, cable_finger");
   }
   try {
     MakeRobot("pneumatic_finger", 2);
@@ -492,10 +493,17 @@ TEST(Robots, EveryRobotIsValidWellFormedAndDeterministic) {
     EXPECT_TRUE(std::adjacent_find(a.fixed.begin(), a.fixed.end()) == a.fixed.end());
     EXPECT_GE(a.marker_index("tip"), 0);
     for (const auto& act : a.actuators) {
-      EXPECT_EQ(act.type, ActuatorType::Pneumatic);
+      // Rest at ratio 1, at the end of the range the actuator starts from: pneumatic chambers
+      // inflate (alpha >= 1), cables shorten (s <= 1).
       EXPECT_EQ(act.rest, 1.0);
-      EXPECT_EQ(act.min, 1.0);
-      EXPECT_GT(act.max, 1.0);
+      EXPECT_LT(act.min, act.max);
+      if (act.type == ActuatorType::Pneumatic) {
+        EXPECT_EQ(act.min, 1.0);
+      } else {
+        EXPECT_EQ(act.type, ActuatorType::Cable);
+        EXPECT_EQ(act.max, 1.0);
+        EXPECT_GE(act.path.size(), 2u);
+      }
     }
   }
 }
