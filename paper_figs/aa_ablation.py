@@ -40,12 +40,7 @@ def read_summary(path):
 
 
 def main(argv):
-    if len(argv) != 2 or argv[1] in ("-h", "--help"):
-        print(__doc__.strip(), file=sys.stderr)
-        sys.exit(0 if len(argv) == 2 else 2)
-    results = argv[1]
-    if not os.path.isdir(results):
-        fail(f"results folder {results} does not exist")
+    results = figlib.results_dir(NAME, argv, __doc__)
     rows = read_table(os.path.join(results, "aa_ablation.csv"))
     summary = read_summary(os.path.join(results, "summary.json"))
 
@@ -107,10 +102,7 @@ def main(argv):
     ax.set_title("Ablation (not a thesis figure): local-global solver (Alg. 1, Sec. 2.5)\n"
                  f"with and without Anderson acceleration{quick}; "
                  "above the bars: iterations and lg / variant ratio", fontsize=10)
-    fig.tight_layout()
-    out = os.path.join(results, f"{NAME}.png")
-    fig.savefig(out, dpi=130)
-    print(f"wrote {out}")
+    figlib.save_figure(fig, results, NAME)
     return 0
 
 

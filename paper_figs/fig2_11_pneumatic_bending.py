@@ -56,12 +56,7 @@ def fmt_s(v):
 
 
 def main(argv):
-    if len(argv) != 2 or argv[1] in ("-h", "--help"):
-        print(__doc__.strip(), file=sys.stderr)
-        sys.exit(0 if len(argv) == 2 else 2)
-    results = argv[1]
-    if not os.path.isdir(results):
-        fail(f"results folder {results} does not exist")
+    results = figlib.results_dir(NAME, argv, __doc__)
     rows = read_table(os.path.join(results, "trajectory.csv"), COLUMNS)
     summary = read_summary(os.path.join(results, "summary.json"))
 
@@ -144,10 +139,7 @@ def main(argv):
     max_bend = max(bend)
     fig.suptitle(f"Thesis Fig. 2.11 / Table 2.2: {robot} under pneumatic actuation{quick}; "
                  f"max bend {max_bend:.0f}\N{DEGREE SIGN}")
-    fig.tight_layout()
-    out = os.path.join(results, f"{NAME}.png")
-    fig.savefig(out, dpi=130)
-    print(f"wrote {out}")
+    figlib.save_figure(fig, results, NAME)
     return 0
 
 

@@ -36,12 +36,7 @@ def read_summary(path):
 
 
 def main(argv):
-    if len(argv) != 2 or argv[1] in ("-h", "--help"):
-        print(__doc__.strip(), file=sys.stderr)
-        sys.exit(0 if len(argv) == 2 else 2)
-    results = argv[1]
-    if not os.path.isdir(results):
-        fail(f"results folder {results} does not exist")
+    results = figlib.results_dir(NAME, argv, __doc__)
     rows = read_table(os.path.join(results, "resolution.csv"), COLUMNS)
     summary = read_summary(os.path.join(results, "summary.json"))
 
@@ -116,10 +111,7 @@ def main(argv):
     quick = " (quick run)" if summary.get("quick") else ""
     fig.suptitle(f"Thesis Fig. 2.13: FK on meshes from coarse to fine"
                  f"{': ' + robot if robot else ''}{quick}")
-    fig.tight_layout()
-    out = os.path.join(results, f"{NAME}.png")
-    fig.savefig(out, dpi=130)
-    print(f"wrote {out}")
+    figlib.save_figure(fig, results, NAME)
     return 0
 
 

@@ -21,12 +21,7 @@ COLUMNS = ["step", "actuation", "bend_deg", "tip_x", "tip_y", "tip_z", "iteratio
 
 
 def main(argv):
-    if len(argv) != 2 or argv[1] in ("-h", "--help"):
-        print(__doc__.strip(), file=sys.stderr)
-        sys.exit(0 if len(argv) == 2 else 2)
-    results = argv[1]
-    if not os.path.isdir(results):
-        figlib.fail(NAME, f"results folder {results} does not exist")
+    results = figlib.results_dir(NAME, argv, __doc__)
     rows = figlib.read_table(NAME, os.path.join(results, "trajectory.csv"), COLUMNS, min_rows=2)
     summary = figlib.read_summary(NAME, os.path.join(results, "summary.json"))
 
@@ -67,10 +62,7 @@ def main(argv):
     extra = f"; total solve {total:.2f} s" if isinstance(total, (int, float)) else ""
     ax2.set_title(f"Tendons {acts} shortened together{extra}", fontsize=10)
     fig.suptitle(f"Thesis Fig. 2.8: cable_finger under cable actuation{quick}")
-    fig.tight_layout()
-    out = os.path.join(results, f"{NAME}.png")
-    fig.savefig(out, dpi=130)
-    print(f"wrote {out}")
+    figlib.save_figure(fig, results, NAME)
     return 0
 
 

@@ -57,3 +57,23 @@ def read_summary(name, path):
     if not isinstance(data, dict):
         fail(name, f"{path}: expected a JSON object")
     return data
+
+
+def save_figure(fig, results, name, dpi=130):
+    """Lays out `fig`, writes it to RESULTS/<name>.png and says so; returns the path."""
+    fig.tight_layout()
+    out = os.path.join(results, f"{name}.png")
+    fig.savefig(out, dpi=dpi)
+    print(f"wrote {out}")
+    return out
+
+
+def results_dir(name, argv, doc):
+    """The RESULTS_DIR argument of a plot script: prints `doc` for -h/--help (exit 0) or a wrong
+    argument count (exit 2); fails if the folder does not exist."""
+    if len(argv) != 2 or argv[1] in ("-h", "--help"):
+        print(doc.strip(), file=sys.stderr)
+        sys.exit(0 if len(argv) == 2 else 2)
+    if not os.path.isdir(argv[1]):
+        fail(name, f"results folder {argv[1]} does not exist")
+    return argv[1]

@@ -90,6 +90,20 @@ int FingerCell(const FingerLayout& L, int i, int j, int k) {
   return cavity ? 1 : 0;
 }
 
+/// Markers of a finger whose distal face is the plane x = xmax: "tip" (the face's centroid),
+/// "tip_top" / "tip_bottom" (its top and bottom quarters in z, used for the bend angle).
+void AddDistalFaceMarkers(double xmax, double zmax, double eps, Scene* s) {
+  const Mesh& m = s->mesh;
+  s->markers.push_back({"tip", VerticesInBox(m, Eigen::Vector3d(xmax - eps, -kInf, -kInf),
+                                             Eigen::Vector3d(xmax + eps, kInf, kInf))});
+  s->markers.push_back(
+      {"tip_top", VerticesInBox(m, Eigen::Vector3d(xmax - eps, -kInf, 0.75 * zmax - eps),
+                                Eigen::Vector3d(xmax + eps, kInf, kInf))});
+  s->markers.push_back(
+      {"tip_bottom", VerticesInBox(m, Eigen::Vector3d(xmax - eps, -kInf, -kInf),
+                                   Eigen::Vector3d(xmax + eps, kInf, 0.25 * zmax + eps))});
+}
+
 Scene MakePneumaticFinger(int res) {
   const FingerLayout L = MakeFingerLayout(res);
   Scene s;
@@ -112,14 +126,7 @@ Scene MakePneumaticFinger(int res) {
   const double eps = 1e-6 * L.h;
   const double xmax = L.nx * L.h, zmax = L.nz * L.h;
   s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
-  s.markers.push_back({"tip", VerticesInBox(s.mesh, Eigen::Vector3d(xmax - eps, -kInf, -kInf),
-                                            Eigen::Vector3d(xmax + eps, kInf, kInf))});
-  s.markers.push_back(
-      {"tip_top", VerticesInBox(s.mesh, Eigen::Vector3d(xmax - eps, -kInf, 0.75 * zmax - eps),
-                                Eigen::Vector3d(xmax + eps, kInf, kInf))});
-  s.markers.push_back(
-      {"tip_bottom", VerticesInBox(s.mesh, Eigen::Vector3d(xmax - eps, -kInf, -kInf),
-                                   Eigen::Vector3d(xmax + eps, kInf, 0.25 * zmax + eps))});
+  AddDistalFaceMarkers(xmax, zmax, eps, &s);
   s.validate();
   return s;
 }
@@ -256,14 +263,7 @@ Scene MakeCableFinger(int res) {
   }
   const double eps = 1e-6 * h, xmax = nx * h;
   s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
-  s.markers.push_back({"tip", VerticesInBox(s.mesh, Eigen::Vector3d(xmax - eps, -kInf, -kInf),
-                                            Eigen::Vector3d(xmax + eps, kInf, kInf))});
-  s.markers.push_back(
-      {"tip_top", VerticesInBox(s.mesh, Eigen::Vector3d(xmax - eps, -kInf, 0.75 * zmax - eps),
-                                Eigen::Vector3d(xmax + eps, kInf, kInf))});
-  s.markers.push_back(
-      {"tip_bottom", VerticesInBox(s.mesh, Eigen::Vector3d(xmax - eps, -kInf, -kInf),
-                                   Eigen::Vector3d(xmax + eps, kInf, 0.25 * zmax + eps))});
+  AddDistalFaceMarkers(xmax, zmax, eps, &s);
   s.validate();
   return s;
 }

@@ -19,30 +19,8 @@ namespace {
 
 using test::MatrixNear;
 
-Actuator Cable(const std::string& name, std::vector<int> regions, std::vector<Eigen::Vector3d> path,
-               double min = 0.3, double max = 1.0) {
-  Actuator a;
-  a.name = name;
-  a.type = ActuatorType::Cable;
-  a.regions = std::move(regions);
-  a.path = std::move(path);
-  a.min = min;
-  a.max = max;
-  a.rest = 1.0;
-  return a;
-}
-
-Actuator Dea(const std::string& name, std::vector<int> regions, double min = 0.5,
-             double max = 2.0) {
-  Actuator a;
-  a.name = name;
-  a.type = ActuatorType::Dea;
-  a.regions = std::move(regions);
-  a.min = min;
-  a.max = max;
-  a.rest = 1.0;
-  return a;
-}
+using test::Cable;
+using test::Dea;
 
 /// A 10 x 2 x 2 bar of unit cubes along x; cells with i >= body_cells are the cable's elements,
 /// the rest rigid body. The cable runs along the bar's axis from x = 0 to x = 10.

@@ -39,6 +39,33 @@ inline Actuator Pneumatic(const std::string& name, std::vector<int> regions, dou
   return a;
 }
 
+/// A cable actuator on `regions` along `path`, shortening ratio in [min, max], rest 1.
+inline Actuator Cable(const std::string& name, std::vector<int> regions, std::vector<Eigen::Vector3d> path,
+               double min = 0.3, double max = 1.0) {
+  Actuator a;
+  a.name = name;
+  a.type = ActuatorType::Cable;
+  a.regions = std::move(regions);
+  a.path = std::move(path);
+  a.min = min;
+  a.max = max;
+  a.rest = 1.0;
+  return a;
+}
+
+/// A DEA actuator on `regions` (prism elements), area ratio in [min, max], rest 1.
+inline Actuator Dea(const std::string& name, std::vector<int> regions, double min = 0.5,
+             double max = 2.0) {
+  Actuator a;
+  a.name = name;
+  a.type = ActuatorType::Dea;
+  a.regions = std::move(regions);
+  a.min = min;
+  a.max = max;
+  a.rest = 1.0;
+  return a;
+}
+
 /// Fills in the common parts of a test scene: x = 0 face fixed, markers "tip" (the x = xmax face)
 /// and "all" (every vertex), then validates.
 inline void FinishScene(Scene* s) {
