@@ -21,6 +21,7 @@ const Entry kExperiments[] = {
     {"pneumatic_bending", &RunPneumaticBending},
     {"resolution_sweep", &RunResolutionSweep},
     {"aa_ablation", &RunAaAblation},
+    {"actuation_paths", &RunActuationPaths},
 };
 }  // namespace
 

@@ -35,5 +35,6 @@ nlohmann::json RunExperiment(const std::string& config_path, const RunOptions& o
 nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunResolutionSweep(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunAaAblation(const Config& cfg, const std::string& dir, bool verbose);
+nlohmann::json RunActuationPaths(const Config& cfg, const std::string& dir, bool verbose);
 
 }  // namespace softkin

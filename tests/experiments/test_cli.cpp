@@ -110,6 +110,28 @@ TEST(Cli, RunWritesSummaryWithConfigCommitAndMachine) {
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.out.find("tip_top"), std::string::npos) << r.out;
 
+  // actuation_paths (Fig. 2.12): a group naming an unknown actuator is rejected with the key.
+  std::ofstream(cfg) << R"({"name": "tiny_paths", "experiment": "actuation_paths", "seed": 3,
+    "robot": "three_chamber", "res": 3, "paths": ["c1", "c1+c9"], "steps": 2})";
+  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("paths"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("c1+c9"), std::string::npos) << r.out;
+  std::ofstream(cfg) << R"({"name": "tiny_paths", "experiment": "actuation_paths", "seed": 3,
+    "robot": "three_chamber", "res": 3, "paths": ["c1", "c1+c2+c3"], "steps": 2, "end_value": 1.5})";
+  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  {
+    std::ifstream pf(dir + "/tiny_paths/summary.json");
+    const auto pj = nlohmann::json::parse(pf);
+    ASSERT_EQ(pj["paths"].size(), 2u);
+    EXPECT_EQ(pj["non_converged_steps"], 0);
+    // Equal inflation of all three chambers keeps the tip on the axis (x = z = 0).
+    const auto& tip = pj["paths"][1]["tips"][1];
+    EXPECT_NEAR(tip[0].get<double>(), 0.0, 1e-6);
+    EXPECT_NEAR(tip[2].get<double>(), 0.0, 1e-6);
+  }
+
   std::ofstream(cfg) << R"({"name": "tiny_aa", "experiment": "aa_ablation", "seed": 3,
     "robots": ["three_chamber"], "resolutions": [3], "levels": [0.5]})";
   r = Cli("run " + cfg + " --no-plot --results " + dir);
