@@ -50,10 +50,14 @@ nlohmann::json RunAaAblation(const Config& cfg, const std::string& dir, bool ver
     Scene scene = MakeRobot(robots[ri], res.empty() ? 0 : res[ri]);
     auto model = std::make_shared<const Model>(scene);
     for (double level : levels) {
-      // All actuators driven to the same fraction of their range.
+      // All actuators driven the same fraction of the way from rest to the far end of their range
+      // (the max volume ratio of a chamber, the min length ratio of a cable).
       Eigen::VectorXd c = scene.rest_actuation();
-      for (int a = 0; a < c.size(); ++a)
-        c[a] = scene.actuators[a].rest + level * (scene.actuators[a].max - scene.actuators[a].rest);
+      for (int a = 0; a < c.size(); ++a) {
+        const Actuator& act = scene.actuators[a];
+        const double far = act.max > act.rest ? act.max : act.min;
+        c[a] = act.rest + level * (far - act.rest);
+      }
       nlohmann::json row{{"robot", robots[ri]}, {"level", level}};
       double lg_iters = 0, lg_time = 0;
       bool lg_capped = false;
