@@ -35,7 +35,10 @@ nlohmann::json RunAaAblation(const Config& cfg, const std::string& dir, bool ver
       v.opts.anderson_window = m;
       v.opts.anderson_safeguard = g;
       std::string why;
-      if (!v.opts.IsValid(&why)) cfg.Fail(m < 1 || m > 50 ? "windows" : "safeguards", why);
+      if (!v.opts.IsValid(&why)) {
+        if (m < 1 || m > 50) cfg.Fail("windows", "Anderson windows, integers in [1, 50]");
+        cfg.Fail("safeguards", "safeguard names, each one of hybrid, energy, none");
+      }
       variants.push_back(v);
     }
   if (!res.empty() && res.size() != robots.size())

@@ -45,8 +45,12 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
   std::vector<int> swept;
   for (const std::string& n : act_names.empty() ? std::vector<std::string>{act_name} : act_names) {
     const int i = n.empty() ? 0 : scene.actuator_index(n);
-    if (i < 0) cfg.Fail(act_names.empty() ? "actuator" : "actuators",
-                        "names of actuators of robot '" + robot + "', got '" + n + "'");
+    if (i < 0) {
+      std::string known;
+      for (const auto& act : scene.actuators) known += (known.empty() ? "" : ", ") + act.name;
+      cfg.Fail(act_names.empty() ? "actuator" : "actuators",
+               "names of actuators of robot '" + robot + "' (" + known + ")");
+    }
     swept.push_back(i);
   }
   const int a = swept[0];
