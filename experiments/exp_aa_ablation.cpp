@@ -58,8 +58,7 @@ nlohmann::json RunAaAblation(const Config& cfg, const std::string& dir, bool ver
       Eigen::VectorXd c = scene.rest_actuation();
       for (int a = 0; a < c.size(); ++a) {
         const Actuator& act = scene.actuators[a];
-        const double far = act.max > act.rest ? act.max : act.min;
-        c[a] = act.rest + level * (far - act.rest);
+        c[a] = act.rest + level * (act.FarEnd() - act.rest);
       }
       nlohmann::json row{{"robot", robots[ri]}, {"level", level}};
       double lg_iters = 0, lg_time = 0;

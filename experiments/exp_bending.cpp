@@ -59,8 +59,7 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
     if (scene.actuators[i].rest != act.rest || scene.actuators[i].min != act.min ||
         scene.actuators[i].max != act.max)
       cfg.Fail("actuators", "actuators with the same rest value and range");
-  const double vmax = end_value_cfg > 0 ? end_value_cfg
-                      : act.max > act.rest ? act.max : act.min;
+  const double vmax = end_value_cfg > 0 ? end_value_cfg : act.FarEnd();
   if (vmax > act.max || vmax < act.min || vmax == act.rest)
     cfg.Fail("end_value", "a value in [min, max] of actuator '" + act.name + "', not its rest value");
 

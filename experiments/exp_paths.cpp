@@ -38,8 +38,7 @@ nlohmann::json RunActuationPaths(const Config& cfg, const std::string& dir, bool
     if (g.empty()) cfg.Fail("paths", "non-empty actuator groups");
     for (int a : g) {
       const Actuator& act = scene.actuators[a];
-      const double v = end_value > 0 ? end_value : (act.max > act.rest ? act.max : act.min);
-      if (v < act.min || v > act.max)
+      if (end_value > 0 && (end_value < act.min || end_value > act.max))
         cfg.Fail("end_value", "a value inside the range of actuator '" + act.name + "'");
     }
     groups.push_back(g);
@@ -54,8 +53,12 @@ nlohmann::json RunActuationPaths(const Config& cfg, const std::string& dir, bool
   int failures = 0;
   double total_s = 0;
   for (size_t p = 0; p < groups.size(); ++p) {
+    // Each actuator of the group goes from its rest value to end_value (default: its far end).
+    auto end_of = [&](int a) {
+      return end_value > 0 ? end_value : scene.actuators[a].FarEnd();
+    };
     const Actuator& first = scene.actuators[groups[p][0]];
-    const double v_end = end_value > 0 ? end_value : (first.max > first.rest ? first.max : first.min);
+    const double v_end = end_of(groups[p][0]);
     csv.RowStrings({paths[p], "0", std::to_string(first.rest), std::to_string(rest_tips(tip, 0)),
                     std::to_string(rest_tips(tip, 1)), std::to_string(rest_tips(tip, 2)), "0", "0",
                     "1"});
@@ -67,7 +70,7 @@ nlohmann::json RunActuationPaths(const Config& cfg, const std::string& dir, bool
     for (int s = 1; s <= steps; ++s) {
       for (int a : groups[p]) {
         const Actuator& act = scene.actuators[a];
-        c[a] = act.rest + (v_end - act.rest) * double(s) / steps;
+        c[a] = act.rest + (end_of(a) - act.rest) * double(s) / steps;
       }
       guess = s > 1 ? Eigen::MatrixX3d(2.0 * X - X_prev) : X;  // secant predictor
       const FkResult r = solver->Solve(c, &guess);

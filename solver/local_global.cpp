@@ -38,7 +38,8 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     Xc.row(q) = m.rest_positions().row(m.fixed_vertices()[q]);
   const Eigen::MatrixX3d Cfix = m.A_fc() * Xc;
 
-  Eigen::MatrixX3d B(m.num_vertices(), 3), Bf(nf, 3), xf(nf, 3), Gf(nf, 3), Gprev(nf, 3);
+  Eigen::MatrixX3d B(m.num_vertices(), 3), Bf(nf, 3), xf(nf, 3), Gf(nf, 3), Gprev(nf, 3),
+      step(nf, 3);
   auto local = [&](double* E) {
     const auto t0 = Clock::now();
     ComputeLocalRatios(m, X, c, &ratios_);
@@ -116,7 +117,8 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
       r->message = "the global step produced non-finite positions";
       return;
     }
-    const double fnorm = (Gf - xf).norm();  // fixed-point residual ||G(x) - x||
+    step = Gf - xf;
+    const double fnorm = step.norm();  // fixed-point residual ||G(x) - x||
     if (accelerated) {
       if (guard == "hybrid" && !(E <= base_E || fnorm <= base_f)) {
         reject();
@@ -132,7 +134,7 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
       ref = std::max({ref, grad, 1e-8 * total_weight_ * m.size()});
     }
     r->gradient_ratio = ref > 0 ? grad / ref : 0.0;
-    const double move = (Gf - xf).rowwise().norm().maxCoeff() / m.size();
+    const double move = step.rowwise().norm().maxCoeff() / m.size();
     r->max_move = move;
     if (move < tol && r->gradient_ratio < gtol) {
       store_free(Gf);
@@ -140,8 +142,7 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
       return;
     }
     if (aa_on) {
-      Eigen::Map<const Eigen::VectorXd> g(Gf.data(), 3 * nf);
-      const Eigen::VectorXd f = g - Eigen::Map<const Eigen::VectorXd>(xf.data(), 3 * nf);
+      Eigen::Map<const Eigen::VectorXd> g(Gf.data(), 3 * nf), f(step.data(), 3 * nf);
       const Eigen::VectorXd& xn = aa.Compute(g, f);
       Gprev = Gf;
       base_E = E;

@@ -172,17 +172,24 @@ void Model::SetUpCable(int a) {
   for (size_t q = 1; q < path.size(); ++q) L += (path[q] - path[q - 1]).norm();
 
   // Direction: tangent of the path segment nearest to the element's centroid.
+  // Bounding boxes of the elements (for the path sampling below) and of the whole cable region.
   double total_volume = 0;
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> boxes;
+  boxes.reserve(ids.size());
   for (int i : ids) {
     ModelElement& me = elements_[i];
     Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    Eigen::Vector3d blo = Eigen::Vector3d::Constant(1e300), bhi = -blo;
     for (int j = 0; j < me.k; ++j) {
       const Eigen::Vector3d x = m.vertices.row(me.v[j]).transpose();
       c += x / me.k;
-      lo = lo.cwiseMin(x);
-      hi = hi.cwiseMax(x);
+      blo = blo.cwiseMin(x);
+      bhi = bhi.cwiseMax(x);
     }
+    boxes.emplace_back(blo, bhi);
+    lo = lo.cwiseMin(blo);
+    hi = hi.cwiseMax(bhi);
     double best = 1e300;
     for (size_t q = 1; q < path.size(); ++q) {
       const Eigen::Vector3d s = path[q] - path[q - 1];
@@ -205,17 +212,6 @@ void Model::SetUpCable(int a) {
   // Length of the path inside the actuation elements (sum l_i): sampled at ~L / 4000 spacing,
   // each sample tested against the elements whose bounding box holds it.
   double inside = 0;
-  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> boxes;
-  boxes.reserve(ids.size());
-  for (int i : ids) {
-    Eigen::Vector3d blo = Eigen::Vector3d::Constant(1e300), bhi = -blo;
-    for (int j = 0; j < elements_[i].k; ++j) {
-      const Eigen::Vector3d x = m.vertices.row(elements_[i].v[j]).transpose();
-      blo = blo.cwiseMin(x);
-      bhi = bhi.cwiseMax(x);
-    }
-    boxes.emplace_back(blo, bhi);
-  }
   for (size_t q = 1; q < path.size(); ++q) {
     const Eigen::Vector3d s = path[q] - path[q - 1];
     const double len = s.norm();

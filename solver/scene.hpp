@@ -40,6 +40,10 @@ struct Actuator {
   /// it is pulled. Its length is L; the part inside the actuator's elements is sum l_i, the rest
   /// L_R (Eq. 2.6). Each element's cable direction is the tangent of the nearest path segment.
   std::vector<Eigen::Vector3d> path;
+
+  /// The end of the range away from rest: max for an inflating chamber (rest = min), min for a
+  /// shortening cable (rest = max).
+  double FarEnd() const { return max > rest ? max : min; }
 };
 
 /// A named tracked point: the mean of the listed vertices' positions.
