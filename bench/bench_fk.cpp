@@ -51,7 +51,7 @@ struct Fixture {
   std::shared_ptr<const Model> model;
   Eigen::VectorXd c;             ///< actuation of the deformed configuration
   Eigen::MatrixX3d X;            ///< deformed positions (#V x 3), a partly converged lg-aa solve
-  Eigen::MatrixX3d rhs_free;     ///< B_f - A_fc X_c at X: the right-hand side of the global step
+  Eigen::VectorXd rhs_free;      ///< B_f - A_fc X_c at X: the right-hand side of the global step
   std::vector<Eigen::Matrix3d> M;  ///< per-element cross-covariance D^T P at X
   int tets = 0, vertices = 0, free = 0;
 };
@@ -86,12 +86,11 @@ const Fixture& GetFixture(int res) {
   ComputeLocalRatios(m, f->X, f->c, &ratios);
   LocalStep(m, f->X, ratios, &weighted);
   AssembleRhs(m, weighted, &B);
-  const auto& fixed = m.fixed_vertices();
-  Eigen::MatrixX3d Xc(fixed.size(), 3);
-  for (size_t q = 0; q < fixed.size(); ++q) Xc.row(q) = m.rest_positions().row(fixed[q]);
-  const Eigen::MatrixX3d Cfix = m.A_fc() * Xc;
-  f->rhs_free.resize(m.num_free(), 3);
-  for (int i = 0; i < m.num_free(); ++i) f->rhs_free.row(i) = B.row(m.free_vertices()[i]);
+  Eigen::MatrixX3d Xc = Eigen::MatrixX3d::Zero(m.num_vertices(), 3);
+  m.ApplyConstraints(f->c, &Xc);
+  Eigen::VectorXd Cfix;
+  m.GatherFree(m.A() * Xc, &Cfix);
+  m.GatherFree(B, &f->rhs_free);
   f->rhs_free -= Cfix;
 
   // Cross-covariances M_i = D_i^T P_i (current centred rows vs rest centred rows), as in the
@@ -167,7 +166,7 @@ Baseline MeasureBaseline(const Fixture& f, const std::function<double()>& iterat
   if (iteration) iteration();
   for (int k = 0; k < reps; ++k) {
     auto t0 = Clock::now();
-    Eigen::MatrixX3d Y = f.model->SolveFree(f.rhs_free);
+    Eigen::VectorXd Y = f.model->SolveFree(f.rhs_free);
     benchmark::DoNotOptimize(Y.data());
     ts.push_back(Since(t0));
     t0 = Clock::now();
@@ -270,7 +269,7 @@ BENCHMARK(BM_AssembleRhs)->Apply(ResolutionSweep)->Unit(benchmark::kMicrosecond)
 void BM_GlobalSolve(benchmark::State& state) {
   const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
   for (auto _ : state) {
-    Eigen::MatrixX3d Y = f.model->SolveFree(f.rhs_free);
+    Eigen::VectorXd Y = f.model->SolveFree(f.rhs_free);
     benchmark::DoNotOptimize(Y.data());
   }
   SizeCounters(state, f, false);

@@ -112,8 +112,8 @@ double EnergyAndGradient(const Model& model, const Eigen::Ref<const Eigen::Matri
   //   dr_i/dm_j = r_i (delta_ij / m_i - 1 / sum m),
   // so dE/dm_j = g_j r_j / m_j - (sum_i g_i r_i) / sum m, with g_i = dE/dr_i. (A measure at its
   // floor kMinMeasure * mu_j has a zero gradient.)
-  for (int a = 0; a < model.num_actuators(); ++a) {
-    const auto& ids = model.actuator_elements(a);
+  for (int g = 0; g < model.num_groups(); ++g) {
+    const auto& ids = model.group_elements(g);
     double Md = 0.0, sum_gr = 0.0;
     std::vector<double> meas(ids.size());
     std::vector<bool> floored(ids.size());

@@ -26,33 +26,39 @@ LocalGlobalSolver::LocalGlobalSolver(std::shared_ptr<const Model> model, const F
 void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* Xp, FkResult* r) {
   const Model& m = *model_;
   Eigen::MatrixX3d& X = *Xp;
-  const auto& fv = m.free_vertices();
-  const int nf = m.num_free();
+  const int nf = m.num_free_dofs();
   const int nt = options_.threads;
   const bool aa_on = options_.solver == "lg-aa";
   const double tol = options_.tolerance;
   const double gtol = options_.gradient_tolerance;
 
-  Eigen::MatrixX3d Xc(m.fixed_vertices().size(), 3);
-  for (size_t q = 0; q < m.fixed_vertices().size(); ++q)
-    Xc.row(q) = m.rest_positions().row(m.fixed_vertices()[q]);
-  const Eigen::MatrixX3d Cfix = m.A_fc() * Xc;
+  // Prescribed coordinates for this actuation (motion actuators move theirs with c), and their
+  // contribution A_fc x_c to the global system: A X restricted to the free rows, with every free
+  // coordinate zero.
+  m.ApplyConstraints(c, &X);
+  Eigen::VectorXd Cfix;
+  {
+    Eigen::MatrixX3d Xc = Eigen::MatrixX3d::Zero(m.num_vertices(), 3);
+    m.ApplyConstraints(c, &Xc);
+    m.GatherFree(m.A() * Xc, &Cfix);
+  }
 
-  Eigen::MatrixX3d B(m.num_vertices(), 3), Bf(nf, 3), xf(nf, 3), Gf(nf, 3), Gprev(nf, 3),
-      step(nf, 3);
+  Eigen::MatrixX3d B(m.num_vertices(), 3), Mv(m.num_vertices(), 3);
+  Eigen::VectorXd Bf(nf), xf(nf), Gf(nf), Gprev(nf), step(nf), AX(nf);
   auto local = [&](double* E) {
     const auto t0 = Clock::now();
     ComputeLocalRatios(m, X, c, &ratios_);
     *E = LocalStep(m, X, ratios_, &weighted_, nt);
     AssembleRhs(m, weighted_, &B, nt);
-    for (int i = 0; i < nf; ++i) Bf.row(i) = B.row(fv[i]);
+    m.GatherFree(B, &Bf);
     r->local_time_s += Seconds(t0, Clock::now());
   };
-  auto load_free = [&]() {
-    for (int i = 0; i < nf; ++i) xf.row(i) = X.row(fv[i]);
-  };
-  auto store_free = [&](const Eigen::MatrixX3d& Y) {
-    for (int i = 0; i < nf; ++i) X.row(fv[i]) = Y.row(i);
+  auto load_free = [&]() { m.GatherFree(X, &xf); };
+  auto store_free = [&](const Eigen::VectorXd& y) { m.ScatterFree(y, &X); };
+  // ||A_ff x_f + A_fc x_c - B_f||: the energy gradient over the free coordinates (up to 2).
+  auto residual_norm = [&]() {
+    m.GatherFree(m.A() * X, &AX);
+    return 2.0 * (AX - Bf).norm();
   };
 
   // Reference residual: the residual at the rest shape for this actuation. It depends on c only,
@@ -60,10 +66,10 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
   if (ref_c_.size() != c.size() || ref_c_ != c) {
     const Eigen::MatrixX3d keep = X;
     X = m.rest_positions();
+    m.ApplyConstraints(c, &X);
     double E0;
     local(&E0);
-    load_free();
-    ref_value_ = 2.0 * (m.A_ff() * xf + Cfix - Bf).norm();
+    ref_value_ = residual_norm();
     ref_c_ = c;
     X = keep;
   }
@@ -71,11 +77,11 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
 
   if (total_weight_ == 0.0)
     for (const auto& e : m.elements()) total_weight_ += e.wv;
-  Anderson aa(3 * nf, options_.anderson_window);
+  Anderson aa(nf, options_.anderson_window);
   Eigen::MatrixX3d X_good = X;
   auto residual = [&]() {
     load_free();
-    return 2.0 * (m.A_ff() * xf + Cfix - Bf).norm();
+    return residual_norm();
   };
   const std::string& guard = options_.anderson_safeguard;
   // Merits of the iterate an accelerated step was extrapolated from.
@@ -134,7 +140,9 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
       ref = std::max({ref, grad, 1e-8 * total_weight_ * m.size()});
     }
     r->gradient_ratio = ref > 0 ? grad / ref : 0.0;
-    const double move = step.rowwise().norm().maxCoeff() / m.size();
+    Mv.setZero();
+    m.ScatterFree(step, &Mv);
+    const double move = Mv.rowwise().norm().maxCoeff() / m.size();
     r->max_move = move;
     if (move < tol && r->gradient_ratio < gtol) {
       store_free(Gf);
@@ -142,14 +150,12 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
       return;
     }
     if (aa_on) {
-      Eigen::Map<const Eigen::VectorXd> g(Gf.data(), 3 * nf), f(step.data(), 3 * nf);
-      const Eigen::VectorXd& xn = aa.Compute(g, f);
+      const Eigen::VectorXd& xn = aa.Compute(Gf, step);
       Gprev = Gf;
       base_E = E;
       base_f = fnorm;
       accelerated = aa.history() > 0;
-      Eigen::Map<const Eigen::MatrixXd> xnm(xn.data(), nf, 3);
-      store_free(xnm);
+      store_free(xn);
     } else {
       store_free(Gf);
     }
@@ -177,7 +183,7 @@ FkResult LocalGlobalSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
       if (!warm_start->allFinite())
         throw std::invalid_argument("warm start: positions must be finite");
       r.positions = *warm_start;
-      for (int v : m.fixed_vertices()) r.positions.row(v) = m.rest_positions().row(v);
+      m.ApplyConstraints(c, &r.positions);
     }
   } catch (const std::invalid_argument& e) {
     r.status = FkStatus::InvalidInput;

@@ -24,15 +24,20 @@ Model::Model(const Scene& scene) : scene_(scene) {
     role[tag] = {ElementRole::Body, -1};
     material[tag] = &mat;
   }
-  actuator_elements_.assign(scene_.num_actuators(), {});
-  actuator_rest_measure_.assign(scene_.num_actuators(), 0.0);
-  actuator_offset_.assign(scene_.num_actuators(), 0.0);
+  first_group_.assign(scene_.num_actuators(), -1);
   for (int a = 0; a < scene_.num_actuators(); ++a) {
     const Actuator& act = scene_.actuators[a];
+    if (act.is_motion()) continue;
     const ElementRole r = act.type == ActuatorType::Pneumatic ? ElementRole::Pneumatic
                           : act.type == ActuatorType::Cable   ? ElementRole::Cable
                                                               : ElementRole::Dea;
-    for (int reg : act.regions) role[reg] = {r, a};
+    first_group_[a] = num_groups();
+    groups_.push_back(Group{a, act.is_signed() ? 1 : 0, {}, 0.0, 0.0});
+    for (int reg : act.regions) role[reg] = {r, num_groups() - 1};
+    if (act.is_signed()) {
+      groups_.push_back(Group{a, -1, {}, 0.0, 0.0});
+      for (int reg : act.negative_regions) role[reg] = {r, num_groups() - 1};
+    }
   }
 
   elements_.resize(ne);
@@ -58,8 +63,8 @@ Model::Model(const Scene& scene) : scene_(scene) {
       me.wv = mat.weight * me.rest_volume;
     } else {
       me.r_omega = 1.0;
-      me.wv = scene_.actuators[grp].weight * me.rest_volume;
-      actuator_elements_[grp].push_back(i);
+      me.wv = scene_.actuators[groups_[grp].actuator].weight * me.rest_volume;
+      groups_[grp].elements.push_back(i);
       if (r == ElementRole::Pneumatic) {
         me.measure0 = me.rest_volume;
       } else if (r == ElementRole::Dea) {
@@ -69,11 +74,12 @@ Model::Model(const Scene& scene) : scene_(scene) {
       // Cable elements get their direction and length share below, per cable.
     }
   }
-  for (int a = 0; a < scene_.num_actuators(); ++a) {
-    if (scene_.actuators[a].type == ActuatorType::Cable) SetUpCable(a);
-    for (int i : actuator_elements_[a]) actuator_rest_measure_[a] += elements_[i].measure0;
-    if (!(actuator_rest_measure_[a] > 0))
-      throw std::invalid_argument("actuator '" + scene_.actuators[a].name +
+  for (int g = 0; g < num_groups(); ++g) {
+    const Actuator& act = scene_.actuators[groups_[g].actuator];
+    if (act.type == ActuatorType::Cable) SetUpCable(g);
+    for (int i : groups_[g].elements) groups_[g].rest_measure += elements_[i].measure0;
+    if (!(groups_[g].rest_measure > 0))
+      throw std::invalid_argument("actuator '" + act.name +
                                   "': its elements have zero rest measure");
   }
 
@@ -102,43 +108,141 @@ Model::Model(const Scene& scene) : scene_(scene) {
   A_.setFromTriplets(trip.begin(), trip.end());
   A_.makeCompressed();
 
-  free_index_.assign(nv, -1);
-  std::vector<int> fixed_index(nv, -1);
-  for (size_t c = 0; c < scene_.fixed.size(); ++c) fixed_index[scene_.fixed[c]] = static_cast<int>(c);
-  for (int v = 0; v < nv; ++v)
-    if (fixed_index[v] < 0) {
-      free_index_[v] = static_cast<int>(free_vertices_.size());
-      free_vertices_.push_back(v);
-    }
-  std::vector<Eigen::Triplet<double>> tff, tfc;
-  for (int col = 0; col < A_.outerSize(); ++col)
-    for (Eigen::SparseMatrix<double>::InnerIterator it(A_, col); it; ++it) {
-      const int fr = free_index_[it.row()];
-      if (fr < 0) continue;
-      if (free_index_[col] >= 0) {
-        tff.emplace_back(fr, free_index_[col], it.value());
-      } else {
-        tfc.emplace_back(fr, fixed_index[col], it.value());
+  SetUpConstraints();
+}
+
+void Model::SetUpConstraints() {
+  const int nv = num_vertices();
+  // Per axis: which coordinates are prescribed.
+  std::array<std::vector<char>, 3> held;
+  for (int d = 0; d < 3; ++d) {
+    held[d].assign(nv, 0);
+    for (int v : scene_.fixed) held[d][v] = 1;
+    for (int v : scene_.fixed_axis[d]) held[d][v] = 1;
+    for (const auto& a : scene_.actuators)
+      if (a.is_motion())
+        for (int v : a.vertices) held[d][v] = 1;
+  }
+  fully_held_.clear();
+  num_fully_free_ = 0;
+  for (int v = 0; v < nv; ++v) {
+    if (held[0][v] && held[1][v] && held[2][v]) fully_held_.push_back(v);
+    if (!held[0][v] && !held[1][v] && !held[2][v]) ++num_fully_free_;
+  }
+  free_offset_[0] = 0;
+  for (int d = 0; d < 3; ++d) {
+    free_[d].clear();
+    free_index_[d].assign(nv, -1);
+    for (int v = 0; v < nv; ++v)
+      if (!held[d][v]) {
+        free_index_[d][v] = static_cast<int>(free_[d].size());
+        free_[d].push_back(v);
       }
-    }
-  A_ff_.resize(num_free(), num_free());
-  A_ff_.setFromTriplets(tff.begin(), tff.end());
-  A_ff_.makeCompressed();
-  A_fc_.resize(num_free(), static_cast<int>(scene_.fixed.size()));
-  A_fc_.setFromTriplets(tfc.begin(), tfc.end());
-  A_fc_.makeCompressed();
+    free_offset_[d + 1] = free_offset_[d] + static_cast<int>(free_[d].size());
+  }
 
   const auto t0 = std::chrono::steady_clock::now();
-  // Simplicial LL^T: for these sparse 3D meshes its 3-RHS solve is faster than the supernodal one
-  // (3.4 vs 5.3 ms at 47k tets, bench_fk BM_GlobalSolve) and it calls no BLAS, whose own threads
-  // would compete with the OpenMP local step on a small machine.
-  chol_.setMode(Eigen::CholmodSimplicialLLt);
-  chol_.compute(A_ff_);
+  factors_.clear();
+  for (int d = 0; d < 3; ++d) {
+    // Axes with the same free set share one factorisation (the usual case: only whole vertices
+    // are fixed).
+    int same = -1;
+    for (int e = 0; e < d && same < 0; ++e)
+      if (held[e] == held[d]) same = factor_of_axis_[e];
+    if (same >= 0) {
+      factor_of_axis_[d] = same;
+      continue;
+    }
+    const int nf = static_cast<int>(free_[d].size());
+    if (nf == 0)
+      throw std::invalid_argument("scene '" + scene_.name + "': every " + std::string(1, "xyz"[d]) +
+                                  " coordinate is prescribed; nothing to solve for");
+    std::vector<Eigen::Triplet<double>> tff;
+    for (int col = 0; col < A_.outerSize(); ++col) {
+      const int fc = free_index_[d][col];
+      if (fc < 0) continue;
+      for (Eigen::SparseMatrix<double>::InnerIterator it(A_, col); it; ++it) {
+        const int fr = free_index_[d][it.row()];
+        if (fr >= 0) tff.emplace_back(fr, fc, it.value());
+      }
+    }
+    Factor f;
+    f.A_ff = std::make_unique<Eigen::SparseMatrix<double>>(nf, nf);
+    f.A_ff->setFromTriplets(tff.begin(), tff.end());
+    f.A_ff->makeCompressed();
+    f.chol = std::make_unique<Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower>>();
+    // Simplicial LL^T: for these sparse 3D meshes its 3-RHS solve is faster than the supernodal
+    // one (3.4 vs 5.3 ms at 47k tets, bench_fk BM_GlobalSolve) and it calls no BLAS, whose own
+    // threads would compete with the OpenMP local step on a small machine.
+    f.chol->setMode(Eigen::CholmodSimplicialLLt);
+    f.chol->compute(*f.A_ff);
+    if (f.chol->info() != Eigen::Success)
+      throw std::runtime_error(
+          "scene '" + scene_.name + "': CHOLMOD could not factor the global matrix of axis " +
+          std::string(1, "xyz"[d]) +
+          "; is every part of the mesh held in that coordinate (fixed, held or moved vertices)?");
+    factor_of_axis_[d] = static_cast<int>(factors_.size());
+    factors_.push_back(std::move(f));
+  }
   factor_time_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (chol_.info() != Eigen::Success)
-    throw std::runtime_error("scene '" + scene_.name +
-                             "': CHOLMOD could not factor the global matrix; is every part of the "
-                             "mesh connected to a fixed vertex?");
+}
+
+double Model::GroupRatio(int g, const Eigen::Ref<const Eigen::VectorXd>& c) const {
+  const Group& gr = groups_[g];
+  return scene_.actuators[gr.actuator].SideRatio(gr.side, c[gr.actuator]);
+}
+
+double Model::ActuatorValue(int a, const std::vector<double>& group_ratios,
+                            const Eigen::Ref<const Eigen::VectorXd>& c) const {
+  const Actuator& act = scene_.actuators[a];
+  if (act.is_motion()) return c[a];
+  const int g = first_group_[a];
+  if (!act.is_signed()) return group_ratios[g];
+  // v = (rho_+ - 1) / gain - (rho_- - 1) / gain: exact when only one side is driven.
+  return (group_ratios[g] - group_ratios[g + 1]) / act.gain;
+}
+
+namespace {
+const std::vector<int> kNoElements;
+}
+
+const std::vector<int>& Model::actuator_elements(int a) const {
+  return first_group_[a] < 0 ? kNoElements : groups_[first_group_[a]].elements;
+}
+double Model::actuator_rest_measure(int a) const {
+  return first_group_[a] < 0 ? 0.0 : groups_[first_group_[a]].rest_measure;
+}
+double Model::actuator_offset(int a) const {
+  return first_group_[a] < 0 ? 0.0 : groups_[first_group_[a]].offset;
+}
+
+void Model::GatherFree(const Eigen::Ref<const Eigen::MatrixX3d>& X, Eigen::VectorXd* x) const {
+  x->resize(num_free_dofs());
+  for (int d = 0; d < 3; ++d) {
+    const auto& fv = free_[d];
+    double* out = x->data() + free_offset_[d];
+    for (size_t i = 0; i < fv.size(); ++i) out[i] = X(fv[i], d);
+  }
+}
+
+void Model::ScatterFree(const Eigen::VectorXd& x, Eigen::MatrixX3d* X) const {
+  for (int d = 0; d < 3; ++d) {
+    const auto& fv = free_[d];
+    const double* in = x.data() + free_offset_[d];
+    for (size_t i = 0; i < fv.size(); ++i) (*X)(fv[i], d) = in[i];
+  }
+}
+
+void Model::ApplyConstraints(const Eigen::Ref<const Eigen::VectorXd>& c, Eigen::MatrixX3d* X) const {
+  const Eigen::MatrixX3d& R = rest_positions();
+  for (int v : scene_.fixed) X->row(v) = R.row(v);
+  for (int d = 0; d < 3; ++d)
+    for (int v : scene_.fixed_axis[d]) (*X)(v, d) = R(v, d);
+  for (int a = 0; a < scene_.num_actuators(); ++a) {
+    const Actuator& act = scene_.actuators[a];
+    if (!act.is_motion()) continue;
+    for (int v : act.vertices) X->row(v) = act.Move(R.row(v).transpose(), c[a]).transpose();
+  }
 }
 
 namespace {
@@ -163,11 +267,11 @@ bool InElement(const Eigen::Vector3d& p, const Element& e, const Eigen::MatrixX3
 
 }  // namespace
 
-void Model::SetUpCable(int a) {
-  const Actuator& act = scene_.actuators[a];
+void Model::SetUpCable(int g) {
+  const Actuator& act = scene_.actuators[groups_[g].actuator];
   const Mesh& m = scene_.mesh;
   const auto& path = act.path;
-  const auto& ids = actuator_elements_[a];
+  const auto& ids = groups_[g].elements;
   double L = 0;
   for (size_t q = 1; q < path.size(); ++q) L += (path[q] - path[q - 1]).norm();
 
@@ -235,11 +339,25 @@ void Model::SetUpCable(int a) {
                                 "': its path does not pass through its actuation elements");
   // l_i: the inside length shared by volume; L_R: the rest of the path.
   for (int i : ids) elements_[i].measure0 = inside * elements_[i].rest_volume / total_volume;
-  actuator_offset_[a] = std::max(0.0, L - inside);
+  groups_[g].offset = std::max(0.0, L - inside);
 }
 
-Eigen::MatrixX3d Model::SolveFree(const Eigen::Ref<const Eigen::MatrixX3d>& rhs) const {
-  return chol_.solve(rhs);
+Eigen::VectorXd Model::SolveFree(const Eigen::VectorXd& rhs) const {
+  Eigen::VectorXd y(num_free_dofs());
+  if (factor_of_axis_[0] == factor_of_axis_[1] && factor_of_axis_[1] == factor_of_axis_[2]) {
+    // One factor: solve the three axes as one 3-column right-hand side.
+    const int nf = static_cast<int>(free_[0].size());
+    Eigen::Map<const Eigen::MatrixXd> B(rhs.data(), nf, 3);
+    Eigen::Map<Eigen::MatrixXd> Y(y.data(), nf, 3);
+    Y = factors_[factor_of_axis_[0]].chol->solve(B);
+    return y;
+  }
+  for (int d = 0; d < 3; ++d) {
+    const int n = free_offset_[d + 1] - free_offset_[d];
+    y.segment(free_offset_[d], n) =
+        factors_[factor_of_axis_[d]].chol->solve(rhs.segment(free_offset_[d], n));
+  }
+  return y;
 }
 
 }  // namespace softkin

@@ -9,6 +9,7 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/Sparse>
 
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -21,7 +22,7 @@ struct ModelElement {
   std::array<int, 6> v{};
   int k = 4;
   ElementRole role = ElementRole::Body;
-  int group = -1;         ///< actuator index for actuation elements, -1 for body elements
+  int group = -1;         ///< actuation group (Model::group_elements) of actuation elements, -1 for body elements
   double rest_volume = 0; ///< Vol_i, mm^3 (> 0)
   double wv = 0;          ///< w_i * Vol_i, the weight in Eq. 2.10
   double r_omega = 1.0;   ///< shape-blending parameter R_omega (Eq. 2.5), body elements
@@ -47,24 +48,58 @@ class Model {
   const Mesh& mesh() const { return scene_.mesh; }
   const Eigen::MatrixX3d& rest_positions() const { return scene_.mesh.vertices; }
   int num_vertices() const { return scene_.mesh.num_vertices(); }
-  int num_free() const { return static_cast<int>(free_vertices_.size()); }
   int num_actuators() const { return scene_.num_actuators(); }
   /// Bounding-box diagonal of the rest mesh, mm (the "model size" for tolerances).
   double size() const { return size_; }
 
   const std::vector<ModelElement>& elements() const { return elements_; }
-  /// Element indices of actuator a.
-  const std::vector<int>& actuator_elements(int a) const { return actuator_elements_[a]; }
-  /// M_a = sum of mu_i over actuator a's elements: U (volume), A (area) or the cable length
-  /// inside actuation elements (actuation.hpp).
-  double actuator_rest_measure(int a) const { return actuator_rest_measure_[a]; }
-  /// L_R of a cable actuator: the length of its path outside its actuation elements (0 for the
-  /// other types). The constraint is c (M + L_R) - L_R = sum_i r_i mu_i.
-  double actuator_offset(int a) const { return actuator_offset_[a]; }
 
-  /// Free (non-fixed) vertex ids in order; free_index()[v] is v's row among them, or -1.
-  const std::vector<int>& free_vertices() const { return free_vertices_; }
-  const std::vector<int>& free_index() const { return free_index_; }
+  // ---- Actuation groups ----
+  // A group is the set of actuation elements that share one constraint (Eq. 2.6-2.8): one per
+  // element actuator, two for a signed pneumatic actuator (its positive and negative sides).
+  // Motion actuators have no group.
+  int num_groups() const { return static_cast<int>(groups_.size()); }
+  const std::vector<int>& group_elements(int g) const { return groups_[g].elements; }
+  int group_actuator(int g) const { return groups_[g].actuator; }
+  /// 0: unsigned actuator; +1 / -1: positive / negative side of a signed one.
+  int group_side(int g) const { return groups_[g].side; }
+  /// M_g = sum of mu_i over the group's elements: U (volume), A (area) or the cable length inside
+  /// actuation elements (actuation.hpp).
+  double group_rest_measure(int g) const { return groups_[g].rest_measure; }
+  /// L_R of a cable group: its path length outside its actuation elements (0 for the other types).
+  /// The constraint is rho (M + L_R) - L_R = sum_i r_i mu_i, rho = GroupRatio(g, c).
+  double group_offset(int g) const { return groups_[g].offset; }
+  /// The group's target ratio rho for actuation vector c (Actuator::SideRatio).
+  double GroupRatio(int g, const Eigen::Ref<const Eigen::VectorXd>& c) const;
+  /// Actuator a's value implied by per-group achieved ratios (the inverse of GroupRatio; a motion
+  /// actuator's value is prescribed exactly, so it is c[a]).
+  double ActuatorValue(int a, const std::vector<double>& group_ratios,
+                       const Eigen::Ref<const Eigen::VectorXd>& c) const;
+  /// Shorthands for the first (positive or only) group of an element actuator a.
+  const std::vector<int>& actuator_elements(int a) const;
+  double actuator_rest_measure(int a) const;
+  double actuator_offset(int a) const;
+
+  // ---- Constraints and the free degrees of freedom ----
+  // Coordinate d of vertex v is either prescribed (v fixed, held on axis d, or moved by a motion
+  // actuator) or free. The free coordinates, axis by axis (all free x, then y, then z, each in
+  // vertex order), form the unknown vector x of the global step.
+  /// Number of free coordinates.
+  int num_free_dofs() const { return free_offset_[3]; }
+  /// Free vertex ids of axis d in order; free_index(d)[v] is v's position among them, or -1.
+  const std::vector<int>& free_vertices(int d = 0) const { return free_[d]; }
+  const std::vector<int>& free_index(int d = 0) const { return free_index_[d]; }
+  /// Number of vertices with every coordinate free.
+  int num_free() const { return num_fully_free_; }
+  /// Vertices with every coordinate prescribed (fixed or moved), sorted.
+  const std::vector<int>& fixed_vertices() const { return fully_held_; }
+  /// x = the free coordinates of X (#V x 3).
+  void GatherFree(const Eigen::Ref<const Eigen::MatrixX3d>& X, Eigen::VectorXd* x) const;
+  /// Writes the free coordinates x into X, leaving the prescribed ones untouched.
+  void ScatterFree(const Eigen::VectorXd& x, Eigen::MatrixX3d* X) const;
+  /// Sets X's prescribed coordinates for actuation c: rest values for fixed and held ones, the
+  /// moved rest positions for motion actuators' vertices. Free coordinates are untouched.
+  void ApplyConstraints(const Eigen::Ref<const Eigen::VectorXd>& c, Eigen::MatrixX3d* X) const;
 
   /// Incidence in CSR form: for vertex v, entries [incidence_offset()[v], incidence_offset()[v+1])
   /// of incidence() encode element e and local slot j as e * 6 + j.
@@ -72,31 +107,44 @@ class Model {
   const std::vector<int>& incidence() const { return inc_; }
 
   /// Full #V x #V matrix A = sum_i w_i Vol_i S_i^T N_i S_i (the Hessian of Eq. 2.10 / 2 with
-  /// frozen targets), and its free-free and free-fixed blocks.
+  /// frozen targets; the same for x, y and z), and its free-free block of axis d.
   const Eigen::SparseMatrix<double>& A() const { return A_; }
-  const Eigen::SparseMatrix<double>& A_ff() const { return A_ff_; }
-  const Eigen::SparseMatrix<double>& A_fc() const { return A_fc_; }
-  /// Fixed vertex ids in the column order of A_fc.
-  const std::vector<int>& fixed_vertices() const { return scene_.fixed; }
+  const Eigen::SparseMatrix<double>& A_ff(int d = 0) const { return *factors_[factor_of_axis_[d]].A_ff; }
+  /// Number of distinct factorisations (1 when every axis has the same free vertices).
+  int num_factors() const { return static_cast<int>(factors_.size()); }
 
-  /// Solves A_ff Y = rhs for #free x 3 right-hand sides with the prefactored CHOLMOD factor.
-  /// Not safe to call concurrently on one Model.
-  Eigen::MatrixX3d SolveFree(const Eigen::Ref<const Eigen::MatrixX3d>& rhs) const;
+  /// Solves A_ff y = rhs axis by axis with the prefactored CHOLMOD factors; rhs and the result
+  /// are in the free-coordinate layout (GatherFree). Not safe to call concurrently on one Model.
+  Eigen::VectorXd SolveFree(const Eigen::VectorXd& rhs) const;
   /// Time spent in symbolic + numeric factorisation, s.
   double factor_time_s() const { return factor_time_s_; }
 
  private:
-  /// Cable actuator a: per-element directions, Q d and length shares; L_R.
-  void SetUpCable(int a);
+  struct Group {
+    int actuator = -1, side = 0;
+    std::vector<int> elements;
+    double rest_measure = 0, offset = 0;
+  };
+  struct Factor {
+    std::unique_ptr<Eigen::SparseMatrix<double>> A_ff;
+    std::unique_ptr<Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower>> chol;
+  };
+  /// Cable group g: per-element directions, Q d and length shares; L_R.
+  void SetUpCable(int g);
+  void SetUpConstraints();
   Scene scene_;
   double size_ = 0;
   std::vector<ModelElement> elements_;
-  std::vector<std::vector<int>> actuator_elements_;
-  std::vector<double> actuator_rest_measure_, actuator_offset_;
-  std::vector<int> free_vertices_, free_index_;
+  std::vector<Group> groups_;
+  std::vector<int> first_group_;  ///< per actuator: its first group, -1 for motion actuators
+  std::array<std::vector<int>, 3> free_, free_index_;
+  std::array<int, 4> free_offset_{};
+  std::vector<int> fully_held_;
+  int num_fully_free_ = 0;
   std::vector<int> inc_offset_, inc_;
-  Eigen::SparseMatrix<double> A_, A_ff_, A_fc_;
-  mutable Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> chol_;
+  Eigen::SparseMatrix<double> A_;
+  std::vector<Factor> factors_;
+  std::array<int, 3> factor_of_axis_{};
   double factor_time_s_ = 0;
 };
 

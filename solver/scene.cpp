@@ -1,6 +1,9 @@
 #include "solver/scene.hpp"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
+#include <cmath>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -12,6 +15,8 @@ const char* ActuatorTypeToString(ActuatorType t) {
     case ActuatorType::Pneumatic: return "pneumatic";
     case ActuatorType::Cable: return "cable";
     case ActuatorType::Dea: return "dea";
+    case ActuatorType::Displacement: return "displacement";
+    case ActuatorType::Twist: return "twist";
   }
   return "unknown";
 }
@@ -20,6 +25,27 @@ bool ActuatorTypeFromString(const std::string& s, ActuatorType* t) {
   if (s == "pneumatic") { *t = ActuatorType::Pneumatic; return true; }
   if (s == "cable") { *t = ActuatorType::Cable; return true; }
   if (s == "dea") { *t = ActuatorType::Dea; return true; }
+  if (s == "displacement") { *t = ActuatorType::Displacement; return true; }
+  if (s == "twist") { *t = ActuatorType::Twist; return true; }
+  return false;
+}
+
+Eigen::Vector3d Actuator::Move(const Eigen::Vector3d& p, double v) const {
+  const Eigen::Vector3d u = axis.normalized();
+  if (type == ActuatorType::Displacement) return p + v * u;
+  if (type == ActuatorType::Twist) {
+    const double a = v * std::acos(-1.0) / 180.0;
+    return centre + Eigen::AngleAxisd(a, u) * (p - centre);
+  }
+  return p;
+}
+
+bool Scene::is_constrained(int v, int d) const {
+  if (std::binary_search(fixed.begin(), fixed.end(), v)) return true;
+  if (std::binary_search(fixed_axis[d].begin(), fixed_axis[d].end(), v)) return true;
+  for (const auto& a : actuators)
+    if (a.is_motion() && std::find(a.vertices.begin(), a.vertices.end(), v) != a.vertices.end())
+      return true;
   return false;
 }
 
@@ -66,13 +92,44 @@ void Scene::validate() const {
       fail("body region " + std::to_string(tag) + ": weight must be > 0");
   }
   std::set<std::string> names;
+  std::set<int> moved;
   for (const auto& a : actuators) {
     if (a.name.empty()) fail("an actuator has an empty name");
     if (!names.insert(a.name).second) fail("actuator name '" + a.name + "' is used twice");
-    if (!(a.min <= a.rest && a.rest <= a.max) || !(a.min > 0.0))
-      fail("actuator '" + a.name + "': expected 0 < min <= rest <= max");
-    if (!(a.weight > 0.0)) fail("actuator '" + a.name + "': weight must be > 0");
-    if (a.regions.empty()) fail("actuator '" + a.name + "' has no regions");
+    const std::string what = std::string(ActuatorTypeToString(a.type)) + " actuator '" + a.name + "'";
+    if (!(a.min <= a.rest && a.rest <= a.max))
+      fail(what + ": expected min <= rest <= max, got " + std::to_string(a.min) + ", " +
+           std::to_string(a.rest) + ", " + std::to_string(a.max));
+    if (!(a.weight > 0.0)) fail(what + ": weight must be > 0");
+    if (!a.path.empty() && a.type != ActuatorType::Cable)
+      fail(what + ": only cable actuators have a path");
+    if (a.is_signed() && a.type != ActuatorType::Pneumatic)
+      fail(what + ": only pneumatic actuators can be signed (have negative_regions)");
+    if (!a.vertices.empty() && !a.is_motion())
+      fail(what + ": only displacement and twist actuators move vertices");
+    if (a.is_motion()) {
+      if (!a.regions.empty()) fail(what + ": a motion actuator has no regions");
+      if (a.vertices.empty()) fail(what + ": expected at least one moved vertex");
+      for (int v : a.vertices) {
+        if (v < 0 || v >= mesh.num_vertices())
+          fail(what + ": moved vertex " + std::to_string(v) + " is out of range");
+        if (!moved.insert(v).second)
+          fail(what + ": vertex " + std::to_string(v) + " is moved by two actuators");
+      }
+      if (!(a.axis.allFinite() && a.axis.norm() > 0)) fail(what + ": expected a non-zero axis");
+      if (!a.centre.allFinite()) fail(what + ": the centre must be finite");
+      if (!(std::isfinite(a.min) && std::isfinite(a.max)))
+        fail(what + ": expected a finite range");
+      continue;
+    }
+    if (a.is_signed()) {
+      if (!(a.min <= 0.0 && a.max >= 0.0 && a.rest == 0.0))
+        fail(what + ": a signed actuator has rest 0 and min <= 0 <= max");
+      if (!(a.gain > 0.0 && std::isfinite(a.gain))) fail(what + ": gain must be > 0");
+    } else if (!(a.min > 0.0)) {
+      fail(what + ": expected 0 < min <= rest <= max (the value is a ratio)");
+    }
+    if (a.regions.empty()) fail(what + " has no regions");
     if (a.type == ActuatorType::Cable) {
       if (a.path.size() < 2) fail("cable '" + a.name + "': expected a path of at least 2 points");
       for (const auto& p : a.path)
@@ -80,10 +137,10 @@ void Scene::validate() const {
       double len = 0;
       for (size_t q = 1; q < a.path.size(); ++q) len += (a.path[q] - a.path[q - 1]).norm();
       if (!(len > 0)) fail("cable '" + a.name + "': the path has zero length");
-    } else if (!a.path.empty()) {
-      fail("actuator '" + a.name + "': only cable actuators have a path");
     }
-    for (int r : a.regions) {
+    std::vector<int> all = a.regions;
+    all.insert(all.end(), a.negative_regions.begin(), a.negative_regions.end());
+    for (int r : all) {
       auto it = role.find(r);
       if (it != role.end())
         fail("region " + std::to_string(r) + " is both " + it->second + " and actuator '" +
@@ -97,9 +154,15 @@ void Scene::validate() const {
     if (!role.count(r))
       fail("region " + std::to_string(r) + " has elements but no role (body or actuator)");
   for (const auto& a : actuators) {
-    bool any = false;
-    for (int r : a.regions) any = any || used.count(r);
-    if (!any) fail("actuator '" + a.name + "' has no elements in the mesh");
+    if (a.is_motion()) continue;
+    for (const auto* regs : {&a.regions, &a.negative_regions}) {
+      if (regs->empty()) continue;
+      bool any = false;
+      for (int r : *regs) any = any || used.count(r);
+      if (!any)
+        fail("actuator '" + a.name + "' has no elements in the mesh" +
+             (regs == &a.negative_regions ? " on its negative side" : ""));
+    }
     if (a.type == ActuatorType::Dea) {
       const std::set<int> regs(a.regions.begin(), a.regions.end());
       for (int i = 0; i < mesh.num_elements(); ++i)
@@ -108,10 +171,17 @@ void Scene::validate() const {
                " is a tet; expected prism elements (Sec. 2.3.3)");
     }
   }
-  if (fixed.empty()) fail("no fixed vertices: the problem would have a rigid-motion null space");
+  if (fixed.empty() && moved.empty())
+    fail("no fixed or moved vertices: the problem would have a rigid-motion null space");
   for (int v : fixed)
     if (v < 0 || v >= mesh.num_vertices())
       fail("fixed vertex " + std::to_string(v) + " is out of range");
+  for (int d = 0; d < 3; ++d)
+    for (int v : fixed_axis[d])
+      if (v < 0 || v >= mesh.num_vertices())
+        fail("vertex " + std::to_string(v) + " held on axis " + "xyz"[d] + " is out of range");
+  for (int v : fixed)
+    if (moved.count(v)) fail("vertex " + std::to_string(v) + " is both fixed and moved");
   std::set<std::string> mnames;
   for (const auto& m : markers) {
     if (!mnames.insert(m.name).second) fail("marker name '" + m.name + "' is used twice");

@@ -6,6 +6,8 @@
 #include "solver/fk_options.hpp"
 #include "solver/mesh.hpp"
 
+#include <algorithm>
+#include <array>
 #include <map>
 #include <string>
 #include <vector>
@@ -20,14 +22,23 @@ struct Material {
   double weight = 1.0;
 };
 
-enum class ActuatorType { Pneumatic, Cable, Dea };
+/// Element actuators (pneumatic, cable, DEA) drive actuation elements. Motion actuators
+/// (displacement, twist) prescribe a rigid motion of a vertex set instead: a boundary condition
+/// swept like an actuation value (the tensile and twisting tests of Fig. 2.6).
+enum class ActuatorType { Pneumatic, Cable, Dea, Displacement, Twist };
 const char* ActuatorTypeToString(ActuatorType t);
-/// Parses "pneumatic" / "cable" / "dea"; returns false if unknown.
+/// Parses "pneumatic" / "cable" / "dea" / "displacement" / "twist"; returns false if unknown.
 bool ActuatorTypeFromString(const std::string& s, ActuatorType* t);
 
-/// An actuator: its elements are all elements whose region tag is in `regions`.
-/// Pneumatic: value = total volume ratio alpha (rest 1). Cable: shortening ratio s (rest 1).
-/// DEA: area ratio lambda (rest 1).
+/// An actuator: its elements are all elements whose region tag is in `regions` (or in
+/// `negative_regions`, for a signed pneumatic actuator).
+/// Pneumatic: value = total volume ratio alpha (rest 1). Signed pneumatic (non-empty
+/// `negative_regions`, thesis Sec. 5.3.1): value v (rest 0), v > 0 drives the chambers in `regions`
+/// to volume ratio 1 + gain v, v < 0 those in `negative_regions` to 1 + gain |v|; the other side
+/// stays at ratio 1. Cable: shortening ratio s (rest 1). DEA: area ratio lambda (rest 1).
+/// Displacement: translation (mm) of `vertices` along `axis`. Twist: rotation (degrees, right-hand
+/// rule) of `vertices` about the line through `centre` along `axis`. Motion actuators have no
+/// regions; their vertices are held (every coordinate) at the moved positions.
 struct Actuator {
   std::string name;
   ActuatorType type = ActuatorType::Pneumatic;
@@ -40,6 +51,27 @@ struct Actuator {
   /// it is pulled. Its length is L; the part inside the actuator's elements is sum l_i, the rest
   /// L_R (Eq. 2.6). Each element's cable direction is the tangent of the nearest path segment.
   std::vector<Eigen::Vector3d> path;
+  /// Signed pneumatic only: the opposite side's chamber regions, and the volume ratio per unit of
+  /// |value| (e.g. per bar when the value is a pressure).
+  std::vector<int> negative_regions;
+  double gain = 1.0;
+  /// Motion actuators only: the moved vertices, the unit direction / rotation axis, the centre.
+  std::vector<int> vertices;
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitX();
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+
+  bool is_signed() const { return !negative_regions.empty(); }
+  bool is_motion() const {
+    return type == ActuatorType::Displacement || type == ActuatorType::Twist;
+  }
+  /// Target ratio of the elements of one side for value v: side 0 = an unsigned actuator (v
+  /// itself), +1 / -1 = the positive / negative side of a signed pneumatic actuator.
+  double SideRatio(int side, double v) const {
+    if (side == 0) return v;
+    return 1.0 + gain * std::max(0.0, side * v);
+  }
+  /// Position of rest point p under the prescribed motion for value v (motion actuators).
+  Eigen::Vector3d Move(const Eigen::Vector3d& p, double v) const;
 
   /// The end of the range away from rest: max for an inflating chamber (rest = min), min for a
   /// shortening cable (rest = max).
@@ -58,6 +90,10 @@ struct Scene {
   std::map<int, Material> body;      ///< region tag -> body material
   std::vector<Actuator> actuators;   ///< in actuation-vector order
   std::vector<int> fixed;            ///< sorted, unique vertex indices held at rest positions
+  /// Vertices with only some coordinates held at their rest values: fixed_axis[d] lists (sorted,
+  /// unique) the vertices whose coordinate d is held, e.g. fixed_axis[2] for vertices sliding on a
+  /// plane z = const. Vertices in `fixed` need not be repeated here.
+  std::array<std::vector<int>, 3> fixed_axis;
   std::vector<Marker> markers;
   FkOptions solver;                  ///< default solver options for this scene
 
@@ -69,6 +105,9 @@ struct Scene {
   Eigen::VectorXd rest_actuation() const;
   /// Marker positions (#markers x 3) for vertex positions X.
   Eigen::MatrixX3d marker_positions(const Eigen::Ref<const Eigen::MatrixX3d>& X) const;
+  /// Whether vertex v's coordinate d is prescribed (fixed, held on axis d, or moved by a motion
+  /// actuator). Linear in the constraint lists; for setup code, not inner loops.
+  bool is_constrained(int v, int d) const;
   /// Throws std::invalid_argument with a clear message if the scene is inconsistent: a region with
   /// no role or two roles, an actuator without elements, empty fixed set, marker vertex out of
   /// range, bad ranges or materials.

@@ -25,10 +25,11 @@ void ComputeLocalRatios(const Model& model, const Eigen::Ref<const Eigen::Matrix
                         std::vector<double>* achieved) {
   const auto& els = model.elements();
   ratios->assign(els.size(), 1.0);
-  if (achieved) achieved->assign(model.num_actuators(), 1.0);
-  for (int a = 0; a < model.num_actuators(); ++a) {
-    const auto& ids = model.actuator_elements(a);
-    const double M = model.actuator_rest_measure(a), LR = model.actuator_offset(a);
+  std::vector<double> group_achieved(model.num_groups(), 1.0);
+  for (int g = 0; g < model.num_groups(); ++g) {
+    const auto& ids = model.group_elements(g);
+    const double M = model.group_rest_measure(g), LR = model.group_offset(g);
+    const double rho = model.GroupRatio(g, c);
     double Md = 0.0;
     for (int i : ids) {
       ElemRows D;
@@ -37,11 +38,16 @@ void ComputeLocalRatios(const Model& model, const Eigen::Ref<const Eigen::Matrix
       (*ratios)[i] = std::max(ActuationMeasure(els[i], D), kMinMeasure * els[i].measure0);
       Md += (*ratios)[i];
     }
-    if (achieved) (*achieved)[a] = (Md + LR) / (M + LR);
+    group_achieved[g] = (Md + LR) / (M + LR);
     // r_i mu_i = m_i * (c (M + L_R) - L_R) / M^d: proportional to the current measure, exact
     // total. (A cable pulled shorter than its rigid part L_R allows gets tiny positive ratios.)
-    const double scale = std::max(c[a] * (M + LR) - LR, kMinMeasure * M) / Md;
+    const double scale = std::max(rho * (M + LR) - LR, kMinMeasure * M) / Md;
     for (int i : ids) (*ratios)[i] = (*ratios)[i] * scale / els[i].measure0;
+  }
+  if (achieved) {
+    achieved->resize(model.num_actuators());
+    for (int a = 0; a < model.num_actuators(); ++a)
+      (*achieved)[a] = model.ActuatorValue(a, group_achieved, c);
   }
 }
 

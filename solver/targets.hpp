@@ -23,10 +23,12 @@ constexpr double kMinMeasure = 1e-6;
 /// Per-element local actuation ratios r_i (alpha_i, s_i or lambda_i; 1 for body elements) for
 /// actuation c at positions X (#V x 3). Sec. 2.3.3: the ratios are proportional to each element's
 /// current measure ratio rho_i = m_i(X) / mu_i (actuation.hpp) and scaled so that each actuator's
-/// constraint holds exactly: sum_i r_i mu_i = c (M + L_R) - L_R (Eq. 2.6-2.8; L_R = 0 except for
-/// cables). This is the least-norm correction of the current ratios in the metric
-/// sum_i (mu_i / rho_i) (r_i - rho_i)^2. `achieved` (optional) receives each actuator's current
-/// ratio (sum_i m_i + L_R) / (M + L_R): volume, cable length or area ratio.
+/// group's constraint holds exactly: sum_i r_i mu_i = rho (M + L_R) - L_R (Eq. 2.6-2.8; L_R = 0
+/// except for cables; rho = Model::GroupRatio, i.e. c[a] for an unsigned actuator). This is the
+/// least-norm correction of the current ratios in the metric sum_i (mu_i / rho_i) (r_i - rho_i)^2.
+/// `achieved` (optional) receives each actuator's current value: the ratio
+/// (sum_i m_i + L_R) / (M + L_R) (volume, cable length or area ratio), the signed value implied by
+/// both sides' volume ratios for a signed actuator, c[a] for a motion actuator.
 void ComputeLocalRatios(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
                         const Eigen::Ref<const Eigen::VectorXd>& c, std::vector<double>* ratios,
                         std::vector<double>* achieved = nullptr);
