@@ -51,7 +51,10 @@ nlohmann::json RobotsJson() {
                       {"range", {a.min, a.max}}, {"rest", a.rest}});
     nlohmann::json markers = nlohmann::json::array();
     for (const auto& m : s.markers) markers.push_back(m.name);
-    out.push_back({{"name", info.name}, {"description", info.description},
+    nlohmann::json params = nlohmann::json::array();
+    for (const auto& p : info.params)
+      params.push_back({{"name", p.name}, {"default", p.def}, {"range", {p.lo, p.hi}}, {"doc", p.doc}});
+    out.push_back({{"name", info.name}, {"description", info.description}, {"params", params},
                    {"default_resolution", info.default_resolution},
                    {"resolution", info.resolution_doc}, {"actuators", acts}, {"markers", markers},
                    {"n_vertices", s.mesh.num_vertices()}, {"n_tets", s.mesh.num_tets()},
@@ -82,6 +85,10 @@ int RunCli(int argc, char** argv) {
   auto* o_scene = fk->add_option("--scene", scene_file, "Scene JSON file (see `softkin scene --schema`)");
   o_robot->excludes(o_scene);
   fk->add_option("--res", res, "Robot resolution (default: the robot's own)")->needs(o_robot);
+  std::vector<std::string> robot_params;
+  fk->add_option("--param", robot_params,
+                 "Robot design parameter NAME=VALUE (repeatable; see `softkin robots`)")
+      ->needs(o_robot);
   fk->add_option("--actuation", actuation, "Actuation values v1,v2,... in actuator order")->required();
   fk->add_option("--solver", solver_name, "FK solver: lg (plain local-global) or lg-aa (Anderson)");
   fk->add_option("--continuation", continuation, "Apply the actuation in this many steps");
@@ -125,14 +132,20 @@ int RunCli(int argc, char** argv) {
         std::cout << j.dump(2) << "\n";
       } else {
         for (const auto& r : j) {
-          std::cout << r["name"].get<std::string>() << ": " << r["n_tets"] << " tets, "
-                    << r["n_vertices"] << " vertices (default res " << r["default_resolution"]
+          std::cout << r["name"].get<std::string>() << ": ";
+          if (r["n_tets"].get<int>() > 0) std::cout << r["n_tets"] << " tets, ";
+          if (r["n_prisms"].get<int>() > 0) std::cout << r["n_prisms"] << " prisms, ";
+          std::cout << r["n_vertices"] << " vertices (default res " << r["default_resolution"]
                     << ")\n  " << r["description"].get<std::string>() << "\n  actuators:";
           for (const auto& a : r["actuators"])
             std::cout << " " << a["name"].get<std::string>() << " (" << a["type"].get<std::string>()
                       << ", [" << a["range"][0] << ", " << a["range"][1] << "])";
           std::cout << "\n  markers:";
           for (const auto& m : r["markers"]) std::cout << " " << m.get<std::string>();
+          for (const auto& p : r["params"])
+            std::cout << "\n  param " << p["name"].get<std::string>() << " = " << p["default"]
+                      << " in [" << p["range"][0] << ", " << p["range"][1]
+                      << "]: " << p["doc"].get<std::string>();
           std::cout << "\n";
         }
       }
@@ -154,7 +167,19 @@ int RunCli(int argc, char** argv) {
       if (robot.empty() == scene_file.empty())
         throw std::invalid_argument("fk: give exactly one of --robot NAME or --scene FILE");
       if (res < 0) throw std::invalid_argument("--res: expected a positive integer");
-      Scene scene = robot.empty() ? LoadSceneJson(scene_file) : MakeRobot(robot, res);
+      RobotParams params;
+      for (const auto& text : robot_params) {
+        const auto eq = text.find('=');
+        char* end = nullptr;
+        const std::string value = eq == std::string::npos ? "" : text.substr(eq + 1);
+        const double v = value.empty() ? 0.0 : std::strtod(value.c_str(), &end);
+        if (eq == std::string::npos || eq == 0 || value.empty() || end != value.c_str() + value.size() ||
+            !std::isfinite(v))
+          throw std::invalid_argument("--param: expected NAME=VALUE with a finite number, got '" +
+                                      text + "'");
+        params[text.substr(0, eq)] = v;
+      }
+      Scene scene = robot.empty() ? LoadSceneJson(scene_file) : MakeRobot(robot, res, params);
       FkOptions opt = scene.solver;
       if (!solver_name.empty()) opt.solver = solver_name;
       // Options given on the command line override the scene's (a given 0 is validated, not ignored).

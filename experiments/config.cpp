@@ -116,6 +116,19 @@ std::vector<double> Config::NumberList(const std::string& key, const std::vector
   return out;
 }
 
+std::map<std::string, double> Config::NumberMap(const std::string& key) const {
+  used_.insert(key);
+  std::map<std::string, double> out;
+  if (!j_.contains(key)) return out;
+  const auto& v = j_[key];
+  if (!v.is_object()) Fail(key, "an object of numbers, e.g. {\"name\": 1.5}");
+  for (const auto& [k, x] : v.items()) {
+    if (!x.is_number()) Fail(key, "a number for every entry (entry '" + k + "' is not)");
+    out[k] = x.get<double>();
+  }
+  return out;
+}
+
 std::vector<std::string> Config::StringList(const std::string& key,
                                             const std::vector<std::string>& def) const {
   used_.insert(key);

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <map>
 #include <set>
 #include <string>
 #include <vector>
@@ -36,6 +37,8 @@ class Config {
   std::vector<double> NumberList(const std::string& key, const std::vector<double>& def) const;
   std::vector<std::string> StringList(const std::string& key,
                                       const std::vector<std::string>& def) const;
+  /// An object of numbers, e.g. "robot_params": {"interface": 0.3}.
+  std::map<std::string, double> NumberMap(const std::string& key) const;
   /// Solver options from the "solver" object on top of `base`.
   FkOptions Solver(const FkOptions& base) const;
   /// Throws if the config has keys that no getter asked for.

@@ -34,7 +34,7 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
   const std::string spacing = cfg.String("spacing", "linear");
   std::vector<double> milestones = cfg.NumberList("milestones_deg", {});
   const auto t_build0 = std::chrono::steady_clock::now();
-  Scene scene = MakeRobot(robot, res);
+  Scene scene = ConfigRobot(cfg, robot, res);
   FkOptions opts = cfg.Solver(scene.solver);
   cfg.CheckNoUnknownKeys();
   if (steps < 1) cfg.Fail("steps", "an integer >= 1");

@@ -17,7 +17,7 @@ nlohmann::json RunActuationPaths(const Config& cfg, const std::string& dir, bool
   const std::vector<std::string> paths = cfg.StringList("paths", {});
   const int steps = cfg.Int("steps", 8);
   const double end_value = cfg.Number("end_value", 0.0);
-  Scene scene = MakeRobot(robot, res);
+  Scene scene = ConfigRobot(cfg, robot, res);
   FkOptions opts = cfg.Solver(scene.solver);
   cfg.CheckNoUnknownKeys();
   if (paths.empty()) cfg.Fail("paths", "a non-empty array of \"a+b+...\" actuator groups");

@@ -25,7 +25,7 @@ nlohmann::json RunResolutionSweep(const Config& cfg, const std::string& dir, boo
   nlohmann::json rows = nlohmann::json::array();
   for (int res : resolutions) {
     const auto t0 = std::chrono::steady_clock::now();
-    Scene scene = MakeRobot(robot, res);
+    Scene scene = ConfigRobot(cfg, robot, res);
     auto model = std::make_shared<const Model>(scene);
     const double build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     Eigen::VectorXd c = scene.rest_actuation();

@@ -1,5 +1,7 @@
 #include "experiments/runner.hpp"
 
+#include "solver/robots.hpp"
+
 #include "experiments/results.hpp"
 
 #include <chrono>
@@ -29,6 +31,16 @@ std::vector<std::string> ExperimentTypes() {
   std::vector<std::string> v;
   for (const auto& e : kExperiments) v.push_back(e.type);
   return v;
+}
+
+Scene ConfigRobot(const Config& cfg, const std::string& robot, int res) {
+  const auto params = cfg.NumberMap("robot_params");
+  try {
+    return MakeRobot(robot, res, params);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(cfg.path() + ": robot '" + robot + "' (keys robot, res, " +
+                                "robot_params): " + e.what());
+  }
 }
 
 ExperimentFn FindExperiment(const std::string& type) {

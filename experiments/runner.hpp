@@ -4,6 +4,7 @@
 /// results/<name>/{summary.json, config.json, run.json, *.csv} and, unless disabled, runs the
 /// matching paper_figs/<name>.py to make the PNG.
 #include "experiments/config.hpp"
+#include "solver/scene.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -30,6 +31,10 @@ ExperimentFn FindExperiment(const std::string& type);
 /// Runs one config; returns the summary written. Throws std::invalid_argument for bad configs and
 /// std::runtime_error if a step fails (finished CSV rows are kept).
 nlohmann::json RunExperiment(const std::string& config_path, const RunOptions& options);
+
+/// The config's robot at resolution `res` with its "robot_params" object (design parameters);
+/// errors from the robot generator are reported with the config's path and key.
+Scene ConfigRobot(const Config& cfg, const std::string& robot, int res);
 
 // Experiments (each in its own file).
 nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bool verbose);

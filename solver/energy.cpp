@@ -89,6 +89,8 @@ double EnergyAndGradient(const Model& model, const Eigen::Ref<const Eigen::Matri
         const double dbeta_dvol = (1.0 - e.r_omega) * s / (3.0 * vd);
         G += dE_dbeta * dbeta_dvol * RowsVolumeGradient(D, k);
       }
+    } else if (ratios[i] == kVented) {
+      continue;  // vented chamber: no energy, no force
     } else {
       // E_i = wv || D - P S(r)^T R^T ||^2 with R the best rotation (no derivative needed: R
       // minimises the term).
@@ -114,6 +116,7 @@ double EnergyAndGradient(const Model& model, const Eigen::Ref<const Eigen::Matri
   // floor kMinMeasure * mu_j has a zero gradient.)
   for (int g = 0; g < model.num_groups(); ++g) {
     const auto& ids = model.group_elements(g);
+    if (!ids.empty() && ratios[ids[0]] == kVented) continue;
     double Md = 0.0, sum_gr = 0.0;
     std::vector<double> meas(ids.size());
     std::vector<bool> floored(ids.size());

@@ -144,7 +144,10 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     m.ScatterFree(step, &Mv);
     const double move = Mv.rowwise().norm().maxCoeff() / m.size();
     r->max_move = move;
-    if (move < tol && r->gradient_ratio < gtol) {
+    // A residual at round-off level (e.g. at the rest actuation, where the reference is itself
+    // round-off) counts as converged whatever the ratio.
+    const bool roundoff = grad <= 1e-12 * total_weight_ * m.size();
+    if (move < tol && (r->gradient_ratio < gtol || roundoff)) {
       store_free(Gf);
       r->status = FkStatus::Converged;
       return;

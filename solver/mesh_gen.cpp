@@ -269,4 +269,78 @@ Mesh ExtrudedDiskTetMesh(const DiskExtrusion& p, const DiskRegionFn& region) {
   return mesh;
 }
 
+Mesh PrismGridMesh(const Eigen::Vector3d& origin, double hx, double hy, const Eigen::Vector2i& cells,
+                   const std::vector<double>& z, const PrismClassifier& classify) {
+  if (!(hx > 0.0 && hy > 0.0) || !std::isfinite(hx) || !std::isfinite(hy))
+    throw std::invalid_argument("PrismGridMesh: cell sizes must be > 0");
+  if (cells.minCoeff() < 1) throw std::invalid_argument("PrismGridMesh: every cell count must be >= 1");
+  if (z.size() < 2) throw std::invalid_argument("PrismGridMesh: expected at least 2 z levels");
+  for (size_t l = 1; l < z.size(); ++l)
+    if (!(z[l] > z[l - 1])) throw std::invalid_argument("PrismGridMesh: z levels must increase");
+  if (!classify) throw std::invalid_argument("PrismGridMesh: no cell classifier given");
+  const std::int64_t nx = cells[0], ny = cells[1], nl = static_cast<std::int64_t>(z.size()) - 1;
+  const std::int64_t vx = nx + 1, vy = ny + 1;
+  if (vx * vy * (nl + 1) > std::int64_t(1) << 30)
+    throw std::invalid_argument("PrismGridMesh: grid too large");
+  auto vid = [&](std::int64_t i, std::int64_t j, std::int64_t l) { return i + vx * (j + vy * l); };
+  std::vector<int> tag(static_cast<size_t>(nx * ny * nl), -1);
+  std::vector<char> used(static_cast<size_t>(vx * vy * (nl + 1)), 0);
+  for (std::int64_t l = 0; l < nl; ++l)
+    for (std::int64_t j = 0; j < ny; ++j)
+      for (std::int64_t i = 0; i < nx; ++i) {
+        const Eigen::Vector3d centre = origin + Eigen::Vector3d((i + 0.5) * hx, (j + 0.5) * hy,
+                                                                0.5 * (z[l] + z[l + 1]));
+        const int t = classify(centre, Eigen::Vector3i(int(i), int(j), int(l)));
+        if (t < 0) continue;
+        tag[i + nx * (j + ny * l)] = t;
+        for (int c = 0; c < 8; ++c)
+          used[vid(i + (c & 1), j + ((c >> 1) & 1), l + ((c >> 2) & 1))] = 1;
+      }
+  std::vector<int> newid(used.size(), -1);
+  int nv = 0;
+  for (size_t g = 0; g < used.size(); ++g)
+    if (used[g]) newid[g] = nv++;
+  Mesh mesh;
+  mesh.vertices.resize(nv, 3);
+  for (std::int64_t l = 0; l <= nl; ++l)
+    for (std::int64_t j = 0; j < vy; ++j)
+      for (std::int64_t i = 0; i < vx; ++i)
+        if (const int id = newid[vid(i, j, l)]; id >= 0)
+          mesh.vertices.row(id) =
+              (origin + Eigen::Vector3d(double(i) * hx, double(j) * hy, z[l])).transpose();
+  for (std::int64_t l = 0; l < nl; ++l)
+    for (std::int64_t j = 0; j < ny; ++j)
+      for (std::int64_t i = 0; i < nx; ++i) {
+        const int t = tag[i + nx * (j + ny * l)];
+        if (t < 0) continue;
+        auto v = [&](int di, int dj, int dl) { return newid[vid(i + di, j + dj, l + dl)]; };
+        // Corners: a = (0,0), b = (1,0), c = (1,1), d = (0,1); both triangles counter-clockwise.
+        int tri[2][2][3];  // [triangle][corner][di, dj, unused]
+        if (((i + j) & 1) == 0) {
+          const int t0[3][2] = {{0, 0}, {1, 0}, {1, 1}}, t1[3][2] = {{0, 0}, {1, 1}, {0, 1}};
+          for (int q = 0; q < 3; ++q) {
+            tri[0][0][q] = t0[q][0]; tri[0][1][q] = t0[q][1];
+            tri[1][0][q] = t1[q][0]; tri[1][1][q] = t1[q][1];
+          }
+        } else {
+          const int t0[3][2] = {{0, 0}, {1, 0}, {0, 1}}, t1[3][2] = {{1, 0}, {1, 1}, {0, 1}};
+          for (int q = 0; q < 3; ++q) {
+            tri[0][0][q] = t0[q][0]; tri[0][1][q] = t0[q][1];
+            tri[1][0][q] = t1[q][0]; tri[1][1][q] = t1[q][1];
+          }
+        }
+        for (int s = 0; s < 2; ++s) {
+          Element e;
+          e.type = ElementType::Prism;
+          for (int q = 0; q < 3; ++q) {
+            e.v[q] = v(tri[s][0][q], tri[s][1][q], 0);
+            e.v[q + 3] = v(tri[s][0][q], tri[s][1][q], 1);
+          }
+          e.region = t;
+          mesh.elements.push_back(e);
+        }
+      }
+  return mesh;
+}
+
 }  // namespace softkin

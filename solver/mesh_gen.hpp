@@ -43,6 +43,26 @@ Mesh VoxelTetMesh(const Eigen::Vector3d& origin, double h, const Eigen::Vector3i
                   const VoxelClassifier& classify);
 
 // ------------------------------------------------------------------------------------------------
+// Prism grid (thin shells and membranes)
+// ------------------------------------------------------------------------------------------------
+
+/// Classifies one prism cell: its centre (mm) and index (i, j, layer). Returns the region tag of
+/// the cell's two prisms (>= 0), or a negative value to leave it empty.
+using PrismClassifier =
+    std::function<int(const Eigen::Vector3d& centre, const Eigen::Vector3i& cell)>;
+
+/// A grid of cx x cy rectangular cells of size hx x hy (mm) in the x-y plane, from `origin`,
+/// extruded between the increasing z levels `z` (layer l spans z[l] .. z[l+1]; z.size() >= 2).
+/// Each kept cell is split into two triangles and extruded into two prisms (bottom triangle
+/// v[0..2] counter-clockwise seen from +z, top copy v[3..5]: positively oriented). The diagonal
+/// alternates with the parity of i + j (from (i, j) to (i+1, j+1) when even, else the other one),
+/// so the triangulation is symmetric under reflection about any grid line. Unused grid vertices
+/// are removed; vertices are numbered in grid order (x fastest, then y, then level).
+/// Throws std::invalid_argument on bad sizes or non-increasing levels.
+Mesh PrismGridMesh(const Eigen::Vector3d& origin, double hx, double hy, const Eigen::Vector2i& cells,
+                   const std::vector<double>& z, const PrismClassifier& classify);
+
+// ------------------------------------------------------------------------------------------------
 // Concentric-ring disk and its extrusion
 // ------------------------------------------------------------------------------------------------
 

@@ -141,6 +141,34 @@ void Model::SetUpConstraints() {
     free_offset_[d + 1] = free_offset_[d] + static_cast<int>(free_[d].size());
   }
 
+  // Per axis, the global matrix is a weighted graph Laplacian of the mesh (the same for x, y, z):
+  // singular exactly when a connected part of the mesh has no prescribed coordinate on that axis
+  // (CHOLMOD may not notice a singular Laplacian in floating point). Check it up front.
+  {
+    std::vector<int> parent(nv);
+    for (int v = 0; v < nv; ++v) parent[v] = v;
+    auto find = [&](int v) {
+      while (parent[v] != v) v = parent[v] = parent[parent[v]];
+      return v;
+    };
+    for (const auto& me : elements_)
+      for (int j = 1; j < me.k; ++j) parent[find(me.v[j])] = find(me.v[0]);
+    for (int d = 0; d < 3; ++d) {
+      std::vector<char> anchored(nv, 0);
+      for (int v = 0; v < nv; ++v)
+        if (held[d][v]) anchored[find(v)] = 1;
+      for (int v = 0; v < nv; ++v) {
+        const int root = find(v);
+        if (!anchored[root] && !inc_offset_.empty() && inc_offset_[v + 1] > inc_offset_[v])
+          throw std::invalid_argument(
+              "scene '" + scene_.name + "': vertex " + std::to_string(v) +
+              " lies in a connected part of the mesh with nothing fixed, moved or held on axis " +
+              std::string(1, "xyz"[d]) + "; that part could drift freely along " +
+              std::string(1, "xyz"[d]) + " (a rigid-motion null space)");
+      }
+    }
+  }
+
   const auto t0 = std::chrono::steady_clock::now();
   factors_.clear();
   for (int d = 0; d < 3; ++d) {
@@ -198,8 +226,10 @@ double Model::ActuatorValue(int a, const std::vector<double>& group_ratios,
   if (act.is_motion()) return c[a];
   const int g = first_group_[a];
   if (!act.is_signed()) return group_ratios[g];
-  // v = (rho_+ - 1) / gain - (rho_- - 1) / gain: exact when only one side is driven.
-  return (group_ratios[g] - group_ratios[g + 1]) / act.gain;
+  // The active side's volume ratio 1 + gain |v|, inverted; the other side is vented.
+  if (c[a] > 0.0) return (group_ratios[g] - 1.0) / act.gain;
+  if (c[a] < 0.0) return -(group_ratios[g + 1] - 1.0) / act.gain;
+  return 0.0;
 }
 
 namespace {
@@ -238,10 +268,19 @@ void Model::ApplyConstraints(const Eigen::Ref<const Eigen::VectorXd>& c, Eigen::
   for (int v : scene_.fixed) X->row(v) = R.row(v);
   for (int d = 0; d < 3; ++d)
     for (int v : scene_.fixed_axis[d]) (*X)(v, d) = R(v, d);
+  // Motion actuators compose in actuator order: each moves the position left by the previous ones
+  // (e.g. a twist listed before a displacement: rotate about the rest axis, then translate).
+  bool first = true;
   for (int a = 0; a < scene_.num_actuators(); ++a) {
     const Actuator& act = scene_.actuators[a];
     if (!act.is_motion()) continue;
-    for (int v : act.vertices) X->row(v) = act.Move(R.row(v).transpose(), c[a]).transpose();
+    if (first) {
+      for (int b = a; b < scene_.num_actuators(); ++b)
+        if (scene_.actuators[b].is_motion())
+          for (int v : scene_.actuators[b].vertices) X->row(v) = R.row(v);
+      first = false;
+    }
+    for (int v : act.vertices) X->row(v) = act.Move(X->row(v).transpose(), c[a]).transpose();
   }
 }
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -13,6 +14,12 @@ namespace softkin {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+
+std::string FormatNumber(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
 
 // ================================================================================================
 // pneumatic_finger (thesis Fig. 2.11): PneuNet-style bending actuator on a voxel grid.
@@ -268,11 +275,408 @@ Scene MakeCableFinger(int res) {
   return s;
 }
 
+// ================================================================================================
+// Chamber rows shared by the multi-segment robots: along x, a solid proximal part, then cavities
+// of `cavity` cells between walls of `wall` cells, the last wall closing the segment.
+// ================================================================================================
+
+struct ChamberRow {
+  int x0 = 0, x1 = 0;        // the segment's cells [x0, x1)
+  int wall = 1, cavity = 1;  // cells
+  int first = 0;             // first cavity wall cell (after the solid proximal part)
+  int chambers = 0;
+};
+
+ChamberRow MakeChamberRow(int x0, int x1, int wall, int cavity, int min_solid) {
+  ChamberRow r{x0, x1, wall, cavity, 0, 0};
+  const int pitch = wall + cavity;
+  r.chambers = std::max(0, (x1 - x0 - min_solid - wall) / pitch);
+  r.first = x1 - r.chambers * pitch - wall;
+  return r;
+}
+
+/// Whether cell column i lies in a cavity of the row.
+bool InCavity(const ChamberRow& r, int i) {
+  const int u = i - r.first;
+  if (u < 0 || u >= r.chambers * (r.wall + r.cavity)) return false;
+  return u % (r.wall + r.cavity) >= r.wall;
+}
+
+Actuator PneumaticActuator(const std::string& name, std::vector<int> regions, double max) {
+  Actuator a;
+  a.name = name;
+  a.type = ActuatorType::Pneumatic;
+  a.regions = std::move(regions);
+  a.rest = a.min = 1.0;
+  a.max = max;
+  return a;
+}
+
+std::vector<int> VerticesInXRange(const Mesh& m, double x0, double x1, double zmax_incl) {
+  return VerticesInBox(m, Eigen::Vector3d(x0, -kInf, -kInf), Eigen::Vector3d(x1, kInf, zmax_incl));
+}
+
+// ================================================================================================
+// finger_manipulator (thesis Sec. 5.3.1, Fig. 5.3b): three finger sections joined rigidly, each
+// with two opposite rows of chambers; one signed actuation value per section.
+//
+// Axes: x = long axis (x = 0 fixed), y = width [0, 20], z = thickness [0, 12]; the motion is planar
+// in x-y. Layout (mm, snapped to cells of h = 20 / res): a 6 mm base block; then three 40 mm
+// sections, the first two followed by a 6 mm connector (region 8, weight 20: rigid joints); a
+// 3 mm tip cap. In each section, a central spine along x (region 7, inextensible, weight 20; the
+// cells between the two cavity rows) and two rows of 4 mm cavities between 1.5 mm walls, one on
+// the +y side (region 1 + 2 s), one on the -y side (region 2 + 2 s), 1.5 mm side walls, floor and
+// roof (region 0). Section s is the signed pneumatic actuator "s<s+1>": value v in [-3, 3]
+// (the thesis's pressure in bar, its sign picking the side); v > 0 drives the +y chambers to
+// volume ratio 1 + gain v and bends the section towards -y, v < 0 the -y chambers and bends it
+// towards +y. gain = 2 (volume ratio 7 at |v| = 3) gives about 120 degrees per section (the
+// thesis's figure). The mesh is mirror-symmetric about y = 10 (res is even), so v and -v give
+// mirror images. Markers: tip (distal face x = L), j1, j2 (the connectors' distal faces: the
+// ends of sections 1 and 2).
+// ================================================================================================
+
+constexpr int kManipMinRes = 4, kManipMaxRes = 24, kManipDefaultRes = 8;
+constexpr double kManipWidth = 20.0, kManipThick = 12.0, kManipBase = 6.0, kManipSection = 40.0,
+                 kManipJoint = 6.0, kManipCap = 3.0, kManipWall = 1.5, kManipCavity = 4.0,
+                 kManipSpine = 3.0, kManipGain = 2.0, kManipRange = 3.0;
+
+Scene MakeFingerManipulator(int res, const RobotParams& P) {
+  if (res % 2 != 0)
+    throw std::invalid_argument("finger_manipulator: --res must be even (mirror symmetry about "
+                                "the mid-plane y = 10), got " + std::to_string(res));
+  const double h = kManipWidth / res;
+  const int ny = res, nz = static_cast<int>(std::lround(kManipThick / h));
+  const int wall = Cells(kManipWall, h), cav = Cells(kManipCavity, h);
+  const int side_cav = std::max(1, (ny - 2 * wall - Cells(kManipSpine, h)) / 2);
+  const int base = Cells(kManipBase, h), sec = Cells(kManipSection, h), joint = Cells(kManipJoint, h),
+            cap = Cells(kManipCap, h);
+  const int nx = base + 3 * sec + 2 * joint + cap;
+  if (nz < 2 * wall + 1 || ny < 2 * wall + 2 * side_cav + 1)
+    throw std::invalid_argument("finger_manipulator: res " + std::to_string(res) + " too coarse");
+  std::vector<ChamberRow> rows;
+  std::vector<std::pair<int, int>> joints;
+  int x = base;
+  for (int q = 0; q < 3; ++q) {
+    rows.push_back(MakeChamberRow(x, x + sec, wall, cav, wall));
+    x += sec;
+    if (q < 2) {
+      joints.emplace_back(x, x + joint);
+      x += joint;
+    }
+  }
+  auto cell = [&](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
+    const int i = c[0], j = c[1], k = c[2];
+    for (const auto& jt : joints)
+      if (i >= jt.first && i < jt.second) return 8;
+    for (int q = 0; q < 3; ++q) {
+      const ChamberRow& r = rows[q];
+      if (i < r.x0 || i >= r.x1) continue;
+      const bool zin = k >= wall && k < nz - wall;
+      if (InCavity(r, i) && zin) {
+        if (j >= wall && j < wall + side_cav) return 2 + 2 * q;           // -y side
+        if (j >= ny - wall - side_cav && j < ny - wall) return 1 + 2 * q;  // +y side
+      }
+      if (j >= wall + side_cav && j < ny - wall - side_cav && i >= r.first) return 7;  // spine
+      return 0;
+    }
+    return 0;
+  };
+  Scene s;
+  s.name = "finger_manipulator";
+  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz), cell);
+  s.body[0] = Material{"body", 1.0, 1.0};
+  s.body[7] = Material{"spine", 1.0, P.at("spine_weight")};
+  s.body[8] = Material{"joint", 1.0, 20.0};
+  const double gain = P.at("gain");
+  for (int q = 0; q < 3; ++q) {
+    Actuator a;
+    a.name = "s" + std::to_string(q + 1);
+    a.type = ActuatorType::Pneumatic;
+    a.regions = {1 + 2 * q};
+    a.negative_regions = {2 + 2 * q};
+    a.gain = gain;
+    a.rest = 0.0;
+    a.min = -kManipRange;
+    a.max = kManipRange;
+    s.actuators.push_back(a);
+  }
+  const double eps = 1e-6 * h, xmax = nx * h;
+  s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
+  s.markers.push_back({"tip", VerticesOnPlane(s.mesh, Eigen::Vector3d(xmax, 0, 0),
+                                              Eigen::Vector3d::UnitX(), eps)});
+  for (int q = 0; q < 2; ++q)
+    s.markers.push_back({"j" + std::to_string(q + 1),
+                         VerticesOnPlane(s.mesh, Eigen::Vector3d(joints[q].second * h, 0, 0),
+                                         Eigen::Vector3d::UnitX(), eps)});
+  s.validate();
+  return s;
+}
+
+// ================================================================================================
+// multi_segment_gripper (thesis Fig. 4.7): three pneumatic bending segments in a row on a common
+// inextensible layer; the third segment is the gripper that wraps an object.
+//
+// Axes: x = long axis (x = 0 fixed), y = width [0, 20], z = height [0, 15]; planar motion in x-z
+// (the segments curl towards -z, as pneumatic_finger). Layout (mm, cells of h = 20 / res): an
+// 8 mm base block, three 50 mm segments separated by 5 mm connectors (region 5, weight 20); the
+// inextensible layer z in [0, 1.5] over the whole length (region 4, weight 20); in segment k, a row
+// of 5 mm cavities between 1.5 mm walls over a 1.5 mm floor, with 1.5 mm side walls and roof
+// (region 0); its filled cavities are the pneumatic actuator "c<k>" (region k, volume ratio in
+// [1, 8]). Markers: tip (distal face), tip_top / tip_bottom, P0 (the distal face of the second
+// segment's connector: where the gripper segment starts), grip_layer (the vertices of the third
+// segment's inextensible layer, the surface that closes on the object).
+// ================================================================================================
+
+constexpr int kGripMinRes = 4, kGripMaxRes = 24, kGripDefaultRes = 8;
+constexpr double kGripWidth = 20.0, kGripHeight = 15.0, kGripBase = 8.0, kGripSegment = 50.0,
+                 kGripJoint = 5.0, kGripLayer = 1.5, kGripWall = 1.5, kGripCavity = 5.0,
+                 kGripMaxAlpha = 8.0;
+
+Scene MakeMultiSegmentGripper(int res, const RobotParams&) {
+  const double h = kGripWidth / res;
+  const int ny = res, nz = static_cast<int>(std::lround(kGripHeight / h));
+  const int wall = Cells(kGripWall, h), cav = Cells(kGripCavity, h), layer = Cells(kGripLayer, h);
+  const int base = Cells(kGripBase, h), seg = Cells(kGripSegment, h), joint = Cells(kGripJoint, h);
+  const int nx = base + 3 * seg + 2 * joint;
+  if (nz < layer + 2 * wall + 1)
+    throw std::invalid_argument("multi_segment_gripper: res " + std::to_string(res) + " too coarse");
+  std::vector<ChamberRow> rows;
+  std::vector<std::pair<int, int>> joints;
+  int x = base;
+  for (int k = 0; k < 3; ++k) {
+    rows.push_back(MakeChamberRow(x, x + seg, wall, cav, wall));
+    x += seg;
+    if (k < 2) {
+      joints.emplace_back(x, x + joint);
+      x += joint;
+    }
+  }
+  auto cell = [&](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
+    const int i = c[0], j = c[1], kz = c[2];
+    if (kz < layer) return 4;
+    for (const auto& jt : joints)
+      if (i >= jt.first && i < jt.second) return 5;
+    for (int k = 0; k < 3; ++k) {
+      const ChamberRow& r = rows[k];
+      if (i < r.x0 || i >= r.x1) continue;
+      if (InCavity(r, i) && j >= wall && j < ny - wall && kz >= layer + wall && kz < nz - wall)
+        return k + 1;
+      return 0;
+    }
+    return 0;
+  };
+  Scene s;
+  s.name = "multi_segment_gripper";
+  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz), cell);
+  s.body[0] = Material{"body", 1.0, 1.0};
+  s.body[4] = Material{"inextensible", 1.0, 20.0};
+  s.body[5] = Material{"connector", 1.0, 20.0};
+  for (int k = 0; k < 3; ++k)
+    s.actuators.push_back(PneumaticActuator("c" + std::to_string(k + 1), {k + 1}, kGripMaxAlpha));
+  const double eps = 1e-6 * h, xmax = nx * h, zmax = nz * h;
+  s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
+  AddDistalFaceMarkers(xmax, zmax, eps, &s);
+  s.markers.push_back({"P0", VerticesOnPlane(s.mesh, Eigen::Vector3d(joints[1].second * h, 0, 0),
+                                             Eigen::Vector3d::UnitX(), eps)});
+  s.markers.push_back({"grip_layer", VerticesInXRange(s.mesh, rows[2].x0 * h - eps,
+                                                      rows[2].x1 * h + eps, layer * h + eps)});
+  s.validate();
+  return s;
+}
+
+// ================================================================================================
+// dea_crawler (thesis Fig. 2.10, after [83]): a thin strip of prism elements, a DEA membrane under a
+// bendable frame, with a leg under each end.
+//
+// Axes: x = long axis [0, 60], y = width [0, 20], z = up. Prism layers (mm): legs z in [0, 5] under
+// x in [0, 5] and [55, 60] (region 3, weight 20: rigid); the membrane layer z in [5, 5.5], whose
+// part x in [10, 50] is the DEA actuator "dea" (region 1) and the rest passive elastomer
+// (region 2); the frame layer z in [5.5, 6.5] over the whole strip (region 0, R_omega 1).
+// The mesh is the flat, pre-stretched state of fabrication (area ratio 1). Releasing the stretch
+// gives the robot's rest state, lambda_init = 0.7: the membrane shrinks, the bilayer arches up and
+// the legs are pulled together. A voltage relaxes the membrane (lambda towards 1), flattening the
+// arch and spreading the legs. Range lambda in [0.7, 1], rest 0.7.
+// Supports: the legs stay on the x-y plane (thesis): the bottom of the rear leg (x in [0, 5]) is
+// pinned (the stance foot), the bottom of the front leg has only z held (it slides on the
+// ground). Markers: tip (front face x = 60), rear_foot / front_foot (centroids of the leg
+// bottoms), apex (the frame's top surface at x = 30). The leg spacing is front_foot - rear_foot.
+// Resolution: prisms per 20 mm of width (in-plane cell 20 / res mm).
+// ================================================================================================
+
+constexpr int kCrawlMinRes = 4, kCrawlMaxRes = 40, kCrawlDefaultRes = 8;
+constexpr double kCrawlLength = 60.0, kCrawlWidth = 20.0, kCrawlLeg = 5.0, kCrawlLegHeight = 5.0,
+                 kCrawlMembrane = 0.5, kCrawlFrame = 1.0, kCrawlDea0 = 10.0, kCrawlDea1 = 50.0,
+                 kCrawlInit = 0.7;
+
+Scene MakeDeaCrawler(int res, const RobotParams& P) {
+  const double h = kCrawlWidth / res;
+  const int nx = static_cast<int>(std::lround(kCrawlLength / h)), ny = res;
+  // Layers: legs split into cells of about h, then the membrane and the frame.
+  const int leg_layers = std::max(1, static_cast<int>(std::lround(kCrawlLegHeight / h)));
+  std::vector<double> z;
+  for (int l = 0; l <= leg_layers; ++l) z.push_back(kCrawlLegHeight * l / leg_layers);
+  z.push_back(kCrawlLegHeight + kCrawlMembrane);
+  z.push_back(kCrawlLegHeight + kCrawlMembrane + P.at("frame_thickness"));
+  auto cell = [&](const Eigen::Vector3d& ctr, const Eigen::Vector3i& c) {
+    const double xc = ctr.x();
+    if (c[2] < leg_layers) return (xc < kCrawlLeg || xc > kCrawlLength - kCrawlLeg) ? 3 : -1;
+    if (c[2] == leg_layers) return (xc > kCrawlDea0 && xc < kCrawlDea1) ? 1 : 2;
+    return 0;
+  };
+  Scene s;
+  s.name = "dea_crawler";
+  s.mesh = PrismGridMesh(Eigen::Vector3d::Zero(), h, h, Eigen::Vector2i(nx, ny), z, cell);
+  s.body[0] = Material{"frame", 1.0, P.at("frame_weight")};
+  s.body[2] = Material{"elastomer", 1.0, 1.0};
+  s.body[3] = Material{"leg", 1.0, 20.0};
+  Actuator a;
+  a.name = "dea";
+  a.type = ActuatorType::Dea;
+  a.regions = {1};
+  a.min = a.rest = kCrawlInit;
+  a.max = 1.0;
+  s.actuators.push_back(a);
+  const double eps = 1e-6 * h, xmax = nx * h;
+  const std::vector<int> rear = VerticesInBox(s.mesh, Eigen::Vector3d(-kInf, -kInf, -eps),
+                                              Eigen::Vector3d(kCrawlLeg + eps, kInf, eps));
+  const std::vector<int> front = VerticesInBox(s.mesh, Eigen::Vector3d(xmax - kCrawlLeg - eps, -kInf, -eps),
+                                               Eigen::Vector3d(kInf, kInf, eps));
+  s.fixed = rear;
+  s.fixed_axis[2] = front;
+  s.markers.push_back({"tip", VerticesOnPlane(s.mesh, Eigen::Vector3d(xmax, 0, 0),
+                                              Eigen::Vector3d::UnitX(), eps)});
+  s.markers.push_back({"rear_foot", rear});
+  s.markers.push_back({"front_foot", front});
+  const double ztop = z.back();
+  const int mid = NearestVertex(s.mesh, Eigen::Vector3d(0.5 * xmax, 0, ztop));
+  const double xmid = s.mesh.vertices(mid, 0);
+  s.markers.push_back({"apex", VerticesInBox(s.mesh, Eigen::Vector3d(xmid - eps, -kInf, ztop - eps),
+                                             Eigen::Vector3d(xmid + eps, kInf, kInf))});
+  s.validate();
+  return s;
+}
+
+// ================================================================================================
+// bimaterial_bar (thesis Fig. 2.6): the two-material specimen of the elongation and twisting
+// tests used to calibrate R_omega.
+//
+// Axes: x = long axis [0, 80], cross-section y, z in [0, 12] x [0, 12]. Material A (region 0) for
+// x < interface * 80, material B (region 1) beyond; the x = 0 face is fixed. The x = 80 face is
+// moved by two motion actuators, composed in this order: "twist" (degrees about the bar's axis
+// y = z = 6, range [-180, 180]) and "stretch" (mm along +x, range [0, 40]). Each material's
+// R_omega and weight are parameters. Markers: tip (end face), interface (the cells' face nearest
+// the interface plane), a_mid / b_mid (the cross-sections midway through each material).
+// Resolution: cells across the 12 mm side (cell 12 / res mm); the interface snaps to a cell face.
+// ================================================================================================
+
+constexpr int kBarMinRes = 2, kBarMaxRes = 24, kBarDefaultRes = 4;
+constexpr double kBarLength = 80.0, kBarSide = 12.0;
+
+Scene MakeBimaterialBar(int res, const RobotParams& P) {
+  const double h = kBarSide / res;
+  const int nx = static_cast<int>(std::lround(kBarLength / h));
+  const int ni = std::clamp(static_cast<int>(std::lround(P.at("interface") * nx)), 1, nx - 1);
+  auto cell = [&](const Eigen::Vector3d&, const Eigen::Vector3i& c) { return c[0] < ni ? 0 : 1; };
+  Scene s;
+  s.name = "bimaterial_bar";
+  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, res, res), cell);
+  s.body[0] = Material{"A", P.at("r_omega_a"), P.at("weight_a")};
+  s.body[1] = Material{"B", P.at("r_omega_b"), P.at("weight_b")};
+  const double eps = 1e-6 * h, xmax = nx * h;
+  const std::vector<int> end =
+      VerticesOnPlane(s.mesh, Eigen::Vector3d(xmax, 0, 0), Eigen::Vector3d::UnitX(), eps);
+  Actuator tw;
+  tw.name = "twist";
+  tw.type = ActuatorType::Twist;
+  tw.vertices = end;
+  tw.axis = Eigen::Vector3d::UnitX();
+  tw.centre = Eigen::Vector3d(0, 0.5 * kBarSide, 0.5 * kBarSide);
+  tw.rest = 0.0;
+  tw.min = -180.0;
+  tw.max = 180.0;
+  Actuator st = tw;
+  st.name = "stretch";
+  st.type = ActuatorType::Displacement;
+  st.min = 0.0;
+  st.max = 40.0;
+  s.actuators = {tw, st};
+  s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
+  auto plane = [&](int i) {
+    return VerticesOnPlane(s.mesh, Eigen::Vector3d(i * h, 0, 0), Eigen::Vector3d::UnitX(), eps);
+  };
+  s.markers.push_back({"tip", end});
+  s.markers.push_back({"interface", plane(ni)});
+  s.markers.push_back({"a_mid", plane(ni / 2)});
+  s.markers.push_back({"b_mid", plane((ni + nx) / 2)});
+  s.validate();
+  return s;
+}
+
+// ================================================================================================
+// cable_gripper (thesis Fig. 2.9): a cable-driven gripper finger whose body alternates two
+// materials, links and joints; the two material distributions of Fig. 2.9 are two choices of
+// their parameters (uniform vs stiff links with soft joints: experiments/fig2_9_multimaterial).
+//
+// Axes: x = long axis [0, 100] (x = 0 fixed), y = width [0, 20], z = height [0, 20]; planar motion
+// in x-z. The cable channel is the top strip z in [16, 20] for x >= 10 (region 1, the actuation
+// elements of cable "cable", shortening ratio in [0.5, 1]); its path runs along x at the strip's
+// mid-height from x = 10 to the tip, so L_R = 0. Below it, the body alternates 10 mm links
+// (region 0) and 5 mm joints (region 2), starting with a 10 mm link at the fixed end. Parameters:
+// each material's weight and R_omega. Markers (Fig. 2.9's three boundary markers): m1, m2, m3 on
+// the bottom face (z = 0, mid-width) at x = 40, 70 and 100; tip (distal face).
+// ================================================================================================
+
+constexpr int kCgMinRes = 4, kCgMaxRes = 24, kCgDefaultRes = 8;
+constexpr double kCgLength = 100.0, kCgWidth = 20.0, kCgHeight = 20.0, kCgChannel = 16.0,
+                 kCgStart = 10.0, kCgLink = 10.0, kCgJoint = 5.0;
+
+Scene MakeCableGripper(int res, const RobotParams& P) {
+  const double h = kCgWidth / res;
+  const int nx = static_cast<int>(std::lround(kCgLength / h)), nz = static_cast<int>(std::lround(kCgHeight / h));
+  auto cell = [&](const Eigen::Vector3d& c, const Eigen::Vector3i&) {
+    if (c.z() > kCgChannel && c.x() > kCgStart) return 1;
+    const double u = std::fmod(c.x(), kCgLink + kCgJoint);
+    return u < kCgLink ? 0 : 2;
+  };
+  Scene s;
+  s.name = "cable_gripper";
+  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, res, nz), cell);
+  s.body[0] = Material{"link", P.at("link_r_omega"), P.at("link_weight")};
+  s.body[2] = Material{"joint", P.at("joint_r_omega"), P.at("joint_weight")};
+  // The channel cells actually present (snapped): the path spans them at their mid-height.
+  const double zlo = std::ceil(kCgChannel / h - 0.5) * h, zmax = nz * h, xmax = nx * h;
+  const double x0 = std::ceil(kCgStart / h - 0.5) * h;
+  Actuator a;
+  a.name = "cable";
+  a.type = ActuatorType::Cable;
+  a.regions = {1};
+  a.rest = a.max = 1.0;
+  a.min = 0.5;
+  a.path = {Eigen::Vector3d(x0, 0.5 * kCgWidth, 0.5 * (zlo + zmax)),
+            Eigen::Vector3d(xmax, 0.5 * kCgWidth, 0.5 * (zlo + zmax))};
+  s.actuators.push_back(a);
+  const double eps = 1e-6 * h;
+  s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
+  s.markers.push_back({"tip", VerticesOnPlane(s.mesh, Eigen::Vector3d(xmax, 0, 0),
+                                              Eigen::Vector3d::UnitX(), eps)});
+  for (int q = 0; q < 3; ++q) {
+    const double xm = std::min(xmax, 40.0 + 30.0 * q);
+    s.markers.push_back({"m" + std::to_string(q + 1),
+                         {NearestVertex(s.mesh, Eigen::Vector3d(xm, 0.5 * kCgWidth, 0.0))}});
+  }
+  s.validate();
+  return s;
+}
+
 struct RobotEntry {
   RobotInfo info;
   int min_res, max_res;
-  Scene (*make)(int);
+  Scene (*make)(int, const RobotParams&);
 };
+
+Scene MakePneumaticFingerP(int res, const RobotParams&) { return MakePneumaticFinger(res); }
+Scene MakeThreeChamberP(int res, const RobotParams&) { return MakeThreeChamber(res); }
+Scene MakeCableFingerP(int res, const RobotParams&) { return MakeCableFinger(res); }
 
 const std::vector<RobotEntry>& Registry() {
   static const std::vector<RobotEntry> kRobots = {
@@ -286,8 +690,8 @@ const std::vector<RobotEntry>& Registry() {
         "distal face).",
         kFingerDefaultRes,
         "cells across the 20 mm width (cell size 20/res mm), integer in [5, 40]; 27 res^3 tets; "
-        "features snap to whole cells (16 chambers at res 12)"},
-       kFingerMinRes, kFingerMaxRes, &MakePneumaticFinger},
+        "features snap to whole cells (16 chambers at res 12)", {}},
+       kFingerMinRes, kFingerMaxRes, &MakePneumaticFingerP},
       {{"three_chamber",
         "Three-chamber pneumatic actuator (thesis Fig. 2.12, Chapter 5): 48 x 48 x 136 mm cylinder. "
         "y = long axis (y = 0 fixed, tip face y = 136); angles phi = atan2(z, x) in the x-z plane. "
@@ -297,8 +701,8 @@ const std::vector<RobotEntry>& Registry() {
         "(top face y = 136).",
         kThreeDefaultRes,
         "number of concentric rings of the cross-section disk (radial spacing 24/res mm; layers "
-        "along y of about the same size), integer in [3, 16]; ~102 res^3 tets"},
-       kThreeMinRes, kThreeMaxRes, &MakeThreeChamber},
+        "along y of about the same size), integer in [3, 16]; ~102 res^3 tets", {}},
+       kThreeMinRes, kThreeMaxRes, &MakeThreeChamberP},
       {{"cable_finger",
         "Cable-driven finger (thesis Fig. 2.8, Fig. 4.1): 120 x 25 x 25 mm, four teeth on a 5 mm "
         "base; x = long axis (x = 0 fixed), z = height, planar motion in x-z. Three knuckles (gaps "
@@ -306,8 +710,64 @@ const std::vector<RobotEntry>& Registry() {
         "elements of its own tendon t1, t2, t3 (cable, shortening ratio in [0.5, 1]; regions 1-3; "
         "each tendon's path runs along x through its bridge). Markers: tip (face x = 120), tip_top / "
         "tip_bottom (top / bottom quarter of that face).",
-        kCableDefaultRes, "cells across the 25 mm width (cell size 25/res mm), integer in [5, 30]"},
-       kCableMinRes, kCableMaxRes, &MakeCableFinger},
+        kCableDefaultRes, "cells across the 25 mm width (cell size 25/res mm), integer in [5, 30]", {}},
+       kCableMinRes, kCableMaxRes, &MakeCableFingerP},
+      {{"finger_manipulator",
+        "Planar finger manipulator (thesis Sec. 5.3.1): three 40 mm finger sections joined by rigid "
+        "6 mm connectors; x = long axis (x = 0 fixed), y = width [0, 20], z = thickness [0, 12]; "
+        "planar motion in x-y. Each section has a row of chambers on each side of a central "
+        "inextensible spine; its signed pneumatic actuator s1, s2, s3 takes a value in [-3, 3]: "
+        "v > 0 inflates the +y chambers to volume ratio 1 + gain v (bending towards -y), v < 0 the "
+        "-y chambers. Redundant: m = 3, n = 2. Markers: tip, j1, j2 (ends of sections 1 and 2).",
+        kManipDefaultRes,
+        "cells across the 20 mm width (cell size 20/res mm), even integer in [4, 24]",
+        {{"gain", kManipGain, 0.1, 10.0,
+          "volume ratio per unit of actuation: a chamber side reaches 1 + gain |v|"},
+         {"spine_weight", 20.0, 0.01, 100.0, "element weight of the central spine"}}},
+       kManipMinRes, kManipMaxRes, &MakeFingerManipulator},
+      {{"multi_segment_gripper",
+        "Three-segment pneumatic manipulator-gripper (thesis Fig. 4.7): three 50 mm bending "
+        "segments on a common inextensible layer (z in [0, 1.5], weight 20) joined by 5 mm "
+        "connectors; x = long axis (x = 0 fixed), y = width [0, 20], z = height [0, 15]; planar "
+        "motion in x-z. Pneumatic actuators c1, c2, c3 (volume ratio in [1, 8]). Markers: tip, "
+        "tip_top, tip_bottom, P0 (end of the second segment), grip_layer (the third segment's "
+        "inextensible layer).",
+        kGripDefaultRes, "cells across the 20 mm width (cell size 20/res mm), integer in [4, 24]", {}},
+       kGripMinRes, kGripMaxRes, &MakeMultiSegmentGripper},
+      {{"dea_crawler",
+        "DEA crawling robot (thesis Fig. 2.10): a 60 x 20 mm strip of prism elements, a 0.5 mm DEA "
+        "membrane (actuator 'dea', area ratio in [0.7, 1], rest 0.7 = the released pre-stretch "
+        "lambda_init) under a bendable frame, with a 5 mm leg under each end. The mesh is the flat "
+        "pre-stretched state. The rear foot is pinned, the front foot slides on the x-y plane (z "
+        "held). Markers: tip, rear_foot, front_foot, apex (top of the frame at mid-length).",
+        kCrawlDefaultRes, "prisms across the 20 mm width (in-plane cell 20/res mm), integer in [4, 40]",
+        {{"frame_thickness", kCrawlFrame, 0.2, 5.0, "thickness of the frame layer, mm"},
+         {"frame_weight", 1.0, 0.01, 100.0, "element weight of the frame (membrane: 1, DEA: 5)"}}},
+       kCrawlMinRes, kCrawlMaxRes, &MakeDeaCrawler},
+      {{"bimaterial_bar",
+        "Two-material specimen of the elongation and twisting tests (thesis Fig. 2.6): an "
+        "80 x 12 x 12 mm bar, material A (region 0) up to the interface and B (region 1) beyond; "
+        "x = 0 fixed; the x = 80 face is driven by the motion actuators 'twist' (degrees about the "
+        "bar's axis, [-180, 180]) and 'stretch' (mm along +x, [0, 40]). Markers: tip, interface, "
+        "a_mid, b_mid.",
+        kBarDefaultRes, "cells across the 12 mm side (cell size 12/res mm), integer in [2, 24]",
+        {{"interface", 0.5, 0.05, 0.95, "interface position as a fraction of the length (snapped to a cell face)"},
+         {"r_omega_a", 1.0, 0.0, 1.0, "R_omega of material A"},
+         {"r_omega_b", 1.0, 0.0, 1.0, "R_omega of material B"},
+         {"weight_a", 1.0, 1e-3, 1e3, "element weight of material A"},
+         {"weight_b", 1.0, 1e-3, 1e3, "element weight of material B"}}},
+       kBarMinRes, kBarMaxRes, &MakeBimaterialBar},
+      {{"cable_gripper",
+        "Cable-driven gripper finger of two materials (thesis Fig. 2.9): 100 x 20 x 20 mm, x = long "
+        "axis (x = 0 fixed), planar motion in x-z; a cable channel along the top (z >= 16, cable "
+        "'cable', shortening ratio in [0.5, 1]) over a body of alternating 10 mm links (region 0) "
+        "and 5 mm joints (region 2). Markers: tip, m1, m2, m3 (bottom face at x = 40, 70, 100).",
+        kCgDefaultRes, "cells across the 20 mm width (cell size 20/res mm), integer in [4, 24]",
+        {{"link_weight", 1.0, 1e-3, 1e3, "element weight of the links"},
+         {"joint_weight", 1.0, 1e-3, 1e3, "element weight of the joints"},
+         {"link_r_omega", 1.0, 0.0, 1.0, "R_omega of the links"},
+         {"joint_r_omega", 1.0, 0.0, 1.0, "R_omega of the joints"}}},
+       kCgMinRes, kCgMaxRes, &MakeCableGripper},
   };
   return kRobots;
 }
@@ -320,7 +780,7 @@ std::vector<RobotInfo> ListRobots() {
   return out;
 }
 
-Scene MakeRobot(const std::string& name, int res) {
+Scene MakeRobot(const std::string& name, int res, const RobotParams& params) {
   for (const auto& r : Registry()) {
     if (r.info.name != name) continue;
     if (res <= 0) res = r.info.default_resolution;
@@ -328,7 +788,24 @@ Scene MakeRobot(const std::string& name, int res) {
       throw std::invalid_argument(name + ": --res must be an integer in [" +
                                   std::to_string(r.min_res) + ", " + std::to_string(r.max_res) +
                                   "], got " + std::to_string(res));
-    return r.make(res);
+    RobotParams full;
+    for (const auto& p : r.info.params) full[p.name] = p.def;
+    for (const auto& [key, value] : params) {
+      auto it = std::find_if(r.info.params.begin(), r.info.params.end(),
+                             [&](const RobotParam& p) { return p.name == key; });
+      if (it == r.info.params.end()) {
+        std::string known;
+        for (const auto& p : r.info.params) known += (known.empty() ? "" : ", ") + p.name;
+        throw std::invalid_argument(name + ": unknown parameter '" + key + "'; its parameters: " +
+                                    (known.empty() ? std::string("none") : known));
+      }
+      if (!(value >= it->lo && value <= it->hi))
+        throw std::invalid_argument(name + ": parameter '" + key + "' must be in [" +
+                                    FormatNumber(it->lo) + ", " + FormatNumber(it->hi) +
+                                    "], got " + FormatNumber(value));
+      full[key] = value;
+    }
+    return r.make(res, full);
   }
   std::string known;
   for (const auto& r : Registry()) known += (known.empty() ? "" : ", ") + r.info.name;

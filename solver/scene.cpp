@@ -110,11 +110,13 @@ void Scene::validate() const {
     if (a.is_motion()) {
       if (!a.regions.empty()) fail(what + ": a motion actuator has no regions");
       if (a.vertices.empty()) fail(what + ": expected at least one moved vertex");
+      std::set<int> own;
       for (int v : a.vertices) {
         if (v < 0 || v >= mesh.num_vertices())
           fail(what + ": moved vertex " + std::to_string(v) + " is out of range");
-        if (!moved.insert(v).second)
-          fail(what + ": vertex " + std::to_string(v) + " is moved by two actuators");
+        if (!own.insert(v).second)
+          fail(what + ": vertex " + std::to_string(v) + " is listed twice");
+        moved.insert(v);
       }
       if (!(a.axis.allFinite() && a.axis.norm() > 0)) fail(what + ": expected a non-zero axis");
       if (!a.centre.allFinite()) fail(what + ": the centre must be finite");
@@ -171,8 +173,20 @@ void Scene::validate() const {
                " is a tet; expected prism elements (Sec. 2.3.3)");
     }
   }
-  if (fixed.empty() && moved.empty())
-    fail("no fixed or moved vertices: the problem would have a rigid-motion null space");
+  auto sorted_unique = [](const std::vector<int>& v) {
+    for (size_t q = 1; q < v.size(); ++q)
+      if (!(v[q - 1] < v[q])) return false;
+    return true;
+  };
+  if (!sorted_unique(fixed)) fail("the fixed vertex list must be sorted and without repeats");
+  for (int d = 0; d < 3; ++d) {
+    if (!sorted_unique(fixed_axis[d]))
+      fail(std::string("the list of vertices held on axis ") + "xyz"[d] +
+           " must be sorted and without repeats");
+    if (fixed.empty() && moved.empty() && fixed_axis[d].empty())
+      fail(std::string("no vertex is fixed, moved or held on axis ") + "xyz"[d] +
+           ": the problem would have a rigid-motion null space");
+  }
   for (int v : fixed)
     if (v < 0 || v >= mesh.num_vertices())
       fail("fixed vertex " + std::to_string(v) + " is out of range");

@@ -35,10 +35,12 @@ bool ActuatorTypeFromString(const std::string& s, ActuatorType* t);
 /// Pneumatic: value = total volume ratio alpha (rest 1). Signed pneumatic (non-empty
 /// `negative_regions`, thesis Sec. 5.3.1): value v (rest 0), v > 0 drives the chambers in `regions`
 /// to volume ratio 1 + gain v, v < 0 those in `negative_regions` to 1 + gain |v|; the other side
-/// stays at ratio 1. Cable: shortening ratio s (rest 1). DEA: area ratio lambda (rest 1).
+/// is vented (its elements follow the deformation with no energy: targets.hpp, kVented). Cable: shortening ratio s (rest 1). DEA: area ratio lambda (rest 1).
 /// Displacement: translation (mm) of `vertices` along `axis`. Twist: rotation (degrees, right-hand
 /// rule) of `vertices` about the line through `centre` along `axis`. Motion actuators have no
-/// regions; their vertices are held (every coordinate) at the moved positions.
+/// regions; their vertices are held (every coordinate) at the moved positions. A vertex moved by
+/// several motion actuators gets their motions composed in actuator order (each applied to the
+/// position left by the previous ones; a twist's centre and axis are fixed in space).
 struct Actuator {
   std::string name;
   ActuatorType type = ActuatorType::Pneumatic;

@@ -30,6 +30,8 @@ void ComputeLocalRatios(const Model& model, const Eigen::Ref<const Eigen::Matrix
     const auto& ids = model.group_elements(g);
     const double M = model.group_rest_measure(g), LR = model.group_offset(g);
     const double rho = model.GroupRatio(g, c);
+    const int side = model.group_side(g);
+    const bool vented = side != 0 && !(side * c[model.group_actuator(g)] > 0.0);
     double Md = 0.0;
     for (int i : ids) {
       ElemRows D;
@@ -39,6 +41,10 @@ void ComputeLocalRatios(const Model& model, const Eigen::Ref<const Eigen::Matrix
       Md += (*ratios)[i];
     }
     group_achieved[g] = (Md + LR) / (M + LR);
+    if (vented) {
+      for (int i : ids) (*ratios)[i] = kVented;
+      continue;
+    }
     // r_i mu_i = m_i * (c (M + L_R) - L_R) / M^d: proportional to the current measure, exact
     // total. (A cable pulled shorter than its rigid part L_R allows gets tiny positive ratios.)
     const double scale = std::max(rho * (M + LR) - LR, kMinMeasure * M) / Md;
@@ -53,6 +59,10 @@ void ComputeLocalRatios(const Model& model, const Eigen::Ref<const Eigen::Matrix
 
 void ElementTarget(const ModelElement& e, const ElemRows& D, double ratio, ElemRows* T) {
   const int k = e.k;
+  if (ratio == kVented && e.role != ElementRole::Body) {
+    *T = D;  // vented chamber: empty space
+    return;
+  }
   T->setZero();
   if (e.role == ElementRole::Body) {
     // Best rotation from the rest shape to the current shape: max tr(R^T D^T P).

@@ -20,6 +20,12 @@ namespace softkin {
 /// elements), so that ratios stay positive and finite.
 constexpr double kMinMeasure = 1e-6;
 
+/// Ratio that marks the elements of a vented chamber: the inactive side of a signed pneumatic
+/// actuator, whose air escapes (thesis Sec. 5.3.1: only one side of a section is pressurised at a
+/// time). Such an element's target is its own current shape, so it adds no energy and no force:
+/// the cavity is empty space, free to change volume.
+constexpr double kVented = -1.0;
+
 /// Per-element local actuation ratios r_i (alpha_i, s_i or lambda_i; 1 for body elements) for
 /// actuation c at positions X (#V x 3). Sec. 2.3.3: the ratios are proportional to each element's
 /// current measure ratio rho_i = m_i(X) / mu_i (actuation.hpp) and scaled so that each actuator's
@@ -28,7 +34,8 @@ constexpr double kMinMeasure = 1e-6;
 /// least-norm correction of the current ratios in the metric sum_i (mu_i / rho_i) (r_i - rho_i)^2.
 /// `achieved` (optional) receives each actuator's current value: the ratio
 /// (sum_i m_i + L_R) / (M + L_R) (volume, cable length or area ratio), the signed value implied by
-/// both sides' volume ratios for a signed actuator, c[a] for a motion actuator.
+/// active side's volume ratio for a signed actuator (0 at value 0), c[a] for a motion actuator.
+/// The inactive side of a signed actuator is vented: its elements get ratio kVented.
 void ComputeLocalRatios(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
                         const Eigen::Ref<const Eigen::VectorXd>& c, std::vector<double>* ratios,
                         std::vector<double>* achieved = nullptr);
