@@ -116,6 +116,11 @@ std::vector<double> Config::NumberList(const std::string& key, const std::vector
   return out;
 }
 
+nlohmann::json Config::Raw(const std::string& key) const {
+  used_.insert(key);
+  return j_.contains(key) ? j_.at(key) : nlohmann::json();
+}
+
 std::map<std::string, double> Config::NumberMap(const std::string& key) const {
   used_.insert(key);
   std::map<std::string, double> out;

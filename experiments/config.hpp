@@ -37,6 +37,9 @@ class Config {
   std::vector<double> NumberList(const std::string& key, const std::vector<double>& def) const;
   std::vector<std::string> StringList(const std::string& key,
                                       const std::vector<std::string>& def) const;
+  /// The raw JSON value of `key` (null if missing), for structured keys the experiment checks
+  /// itself (reporting errors through Fail).
+  nlohmann::json Raw(const std::string& key) const;
   /// An object of numbers, e.g. "robot_params": {"interface": 0.3}.
   std::map<std::string, double> NumberMap(const std::string& key) const;
   /// Solver options from the "solver" object on top of `base`.

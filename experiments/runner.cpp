@@ -22,6 +22,7 @@ struct Entry {
 const Entry kExperiments[] = {
     {"pneumatic_bending", &RunPneumaticBending},
     {"resolution_sweep", &RunResolutionSweep},
+    {"marker_sweep", &RunMarkerSweep},
     {"aa_ablation", &RunAaAblation},
     {"actuation_paths", &RunActuationPaths},
 };

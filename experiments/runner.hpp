@@ -41,5 +41,6 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
 nlohmann::json RunResolutionSweep(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunAaAblation(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunActuationPaths(const Config& cfg, const std::string& dir, bool verbose);
+nlohmann::json RunMarkerSweep(const Config& cfg, const std::string& dir, bool verbose);
 
 }  // namespace softkin

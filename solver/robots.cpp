@@ -335,7 +335,7 @@ std::vector<int> VerticesInXRange(const Mesh& m, double x0, double x1, double zm
 // ends of sections 1 and 2).
 // ================================================================================================
 
-constexpr int kManipMinRes = 4, kManipMaxRes = 24, kManipDefaultRes = 8;
+constexpr int kManipMinRes = 6, kManipMaxRes = 24, kManipDefaultRes = 8;
 constexpr double kManipWidth = 20.0, kManipThick = 12.0, kManipBase = 6.0, kManipSection = 40.0,
                  kManipJoint = 6.0, kManipCap = 3.0, kManipWall = 1.5, kManipCavity = 4.0,
                  kManipSpine = 3.0, kManipGain = 2.0, kManipRange = 3.0;
@@ -427,7 +427,7 @@ Scene MakeFingerManipulator(int res, const RobotParams& P) {
 // segment's inextensible layer, the surface that closes on the object).
 // ================================================================================================
 
-constexpr int kGripMinRes = 4, kGripMaxRes = 24, kGripDefaultRes = 8;
+constexpr int kGripMinRes = 6, kGripMaxRes = 24, kGripDefaultRes = 8;
 constexpr double kGripWidth = 20.0, kGripHeight = 15.0, kGripBase = 8.0, kGripSegment = 50.0,
                  kGripJoint = 5.0, kGripLayer = 1.5, kGripWall = 1.5, kGripCavity = 5.0,
                  kGripMaxAlpha = 8.0;
@@ -720,7 +720,7 @@ const std::vector<RobotEntry>& Registry() {
         "v > 0 inflates the +y chambers to volume ratio 1 + gain v (bending towards -y), v < 0 the "
         "-y chambers. Redundant: m = 3, n = 2. Markers: tip, j1, j2 (ends of sections 1 and 2).",
         kManipDefaultRes,
-        "cells across the 20 mm width (cell size 20/res mm), even integer in [4, 24]",
+        "cells across the 20 mm width (cell size 20/res mm), even integer in [6, 24]",
         {{"gain", kManipGain, 0.1, 10.0,
           "volume ratio per unit of actuation: a chamber side reaches 1 + gain |v|"},
          {"spine_weight", 20.0, 0.01, 100.0, "element weight of the central spine"}}},
@@ -732,7 +732,7 @@ const std::vector<RobotEntry>& Registry() {
         "motion in x-z. Pneumatic actuators c1, c2, c3 (volume ratio in [1, 8]). Markers: tip, "
         "tip_top, tip_bottom, P0 (end of the second segment), grip_layer (the third segment's "
         "inextensible layer).",
-        kGripDefaultRes, "cells across the 20 mm width (cell size 20/res mm), integer in [4, 24]", {}},
+        kGripDefaultRes, "cells across the 20 mm width (cell size 20/res mm), integer in [6, 24]", {}},
        kGripMinRes, kGripMaxRes, &MakeMultiSegmentGripper},
       {{"dea_crawler",
         "DEA crawling robot (thesis Fig. 2.10): a 60 x 20 mm strip of prism elements, a 0.5 mm DEA "

@@ -450,10 +450,11 @@ TEST(MeshGenDisk, RejectsBadArguments) {
 
 TEST(Robots, ListsEveryRobotAndRejectsBadInput) {
   const std::vector<RobotInfo> list = ListRobots();
-  ASSERT_EQ(list.size(), 3u);
-  EXPECT_EQ(list[0].name, "pneumatic_finger");
-  EXPECT_EQ(list[1].name, "three_chamber");
-  EXPECT_EQ(list[2].name, "cable_finger");
+  const std::vector<std::string> names = {"pneumatic_finger", "three_chamber", "cable_finger",
+                                          "finger_manipulator", "multi_segment_gripper",
+                                          "dea_crawler", "bimaterial_bar", "cable_gripper"};
+  ASSERT_EQ(list.size(), names.size());
+  for (size_t i = 0; i < names.size(); ++i) EXPECT_EQ(list[i].name, names[i]);
   for (const auto& r : list) {
     EXPECT_GT(r.default_resolution, 0);
     EXPECT_FALSE(r.description.empty());
@@ -464,7 +465,8 @@ TEST(Robots, ListsEveryRobotAndRejectsBadInput) {
     FAIL() << "no exception";
   } catch (const std::invalid_argument& e) {
     EXPECT_EQ(std::string(e.what()),
-              "unknown robot 'x'; known robots: pneumatic_finger, three_chamber, cable_finger");
+              "unknown robot 'x'; known robots: pneumatic_finger, three_chamber, cable_finger, "
+              "finger_manipulator, multi_segment_gripper, dea_crawler, bimaterial_bar, cable_gripper");
   }
   try {
     MakeRobot("pneumatic_finger", 2);
@@ -484,7 +486,13 @@ TEST(Robots, EveryRobotIsValidWellFormedAndDeterministic) {
     const Scene b = MakeRobot(info.name, info.default_resolution);
     EXPECT_NO_THROW(a.validate());
     EXPECT_EQ(a.name, info.name);
-    ExpectWellFormed(a.mesh, info.name);
+    if (a.mesh.num_prisms() == 0) {
+      ExpectWellFormed(a.mesh, info.name);
+    } else {
+      // Prism meshes (PrismGridMesh, tested in test_constraints.cpp): oriented, no unused vertex.
+      for (const auto& e : a.mesh.elements) EXPECT_GT(SignedVolume(e, a.mesh.vertices), 0.0);
+      EXPECT_EQ(UnusedVertices(a.mesh), 0);
+    }
     EXPECT_TRUE(SameMesh(a.mesh, b.mesh)) << "two builds differ";
     EXPECT_EQ(a.fixed, b.fixed);
     ASSERT_EQ(a.markers.size(), b.markers.size());
@@ -493,16 +501,27 @@ TEST(Robots, EveryRobotIsValidWellFormedAndDeterministic) {
     EXPECT_TRUE(std::adjacent_find(a.fixed.begin(), a.fixed.end()) == a.fixed.end());
     EXPECT_GE(a.marker_index("tip"), 0);
     for (const auto& act : a.actuators) {
-      // Rest at ratio 1, at the end of the range the actuator starts from: pneumatic chambers
-      // inflate (alpha >= 1), cables shorten (s <= 1).
-      EXPECT_EQ(act.rest, 1.0);
+      SCOPED_TRACE(act.name);
       EXPECT_LT(act.min, act.max);
-      if (act.type == ActuatorType::Pneumatic) {
+      EXPECT_GE(act.rest, act.min);
+      EXPECT_LE(act.rest, act.max);
+      if (act.is_motion() || act.is_signed()) {
+        // Motion: rest = no motion; signed pneumatic: rest 0 = both sides vented.
+        EXPECT_EQ(act.rest, 0.0);
+      } else if (act.type == ActuatorType::Pneumatic) {
+        // Chambers inflate from ratio 1.
+        EXPECT_EQ(act.rest, 1.0);
         EXPECT_EQ(act.min, 1.0);
-      } else {
-        EXPECT_EQ(act.type, ActuatorType::Cable);
+      } else if (act.type == ActuatorType::Cable) {
+        // Cables shorten from ratio 1.
+        EXPECT_EQ(act.rest, 1.0);
         EXPECT_EQ(act.max, 1.0);
         EXPECT_GE(act.path.size(), 2u);
+      } else {
+        // DEA: the crawler rests at its released pre-stretch lambda_init < 1 (the mesh is the
+        // stretched state, ratio 1).
+        EXPECT_EQ(act.type, ActuatorType::Dea);
+        EXPECT_LE(act.rest, 1.0);
       }
     }
   }
