@@ -46,8 +46,14 @@ TEST(Cli, RobotsJsonListsActuatorsAndMarkers) {
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_GE(j.size(), 2u);
   for (const auto& robot : j) {
-    EXPECT_GT(robot["n_tets"].get<int>(), 1000);
+    // Default meshes: thousands of tets, or a thin shell of prisms (dea_crawler).
+    EXPECT_GT(robot["n_tets"].get<int>() + robot["n_prisms"].get<int>(), 500) << robot["name"];
     EXPECT_FALSE(robot["actuators"].empty());
+    EXPECT_TRUE(robot["params"].is_array()) << robot["name"];
+    for (const auto& p : robot["params"]) {
+      EXPECT_LE(p["range"][0].get<double>(), p["default"].get<double>()) << p["name"];
+      EXPECT_LE(p["default"].get<double>(), p["range"][1].get<double>()) << p["name"];
+    }
     bool has_tip = false;
     for (const auto& m : robot["markers"]) has_tip = has_tip || m == "tip";
     EXPECT_TRUE(has_tip) << robot["name"];
