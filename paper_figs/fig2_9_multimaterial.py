@@ -21,9 +21,6 @@ import sys
 import figlib
 
 NAME = "fig2_9_multimaterial"
-COLUMNS = ["variant", "step", "value", "marker", "x", "y", "z", "iterations", "time_s",
-           "converged"]
-NUMERIC = ["step", "value", "x", "y", "z", "iterations", "time_s", "converged"]
 MARKERS = ["m1", "m2", "m3"]  # required, plotted in this order
 TIP = "tip"                   # optional, dashed
 COMPARE = "m3"                # overlaid across the variants in the last panel
@@ -35,20 +32,7 @@ def fail(msg):
 
 
 def read_table(path):
-    seen = set()
-
-    def check(v):
-        if v["step"] < 0 or v["step"] != int(v["step"]):
-            return f"step is {v['step']:g}, expected a non-negative integer"
-        if v["converged"] not in (0.0, 1.0):
-            return f"converged is {v['converged']:g}, expected 0 or 1"
-        key = (v["variant"], int(v["step"]), v["marker"])
-        if key in seen:
-            return f"second row for variant {key[0]}, step {key[1]}, marker {key[2]}"
-        seen.add(key)
-        return None
-
-    return figlib.read_table(NAME, path, COLUMNS, NUMERIC, check=check, min_rows=2)
+    return figlib.read_marker_table(NAME, path)
 
 
 def read_summary(path):

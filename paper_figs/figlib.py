@@ -77,3 +77,27 @@ def results_dir(name, argv, doc):
     if not os.path.isdir(argv[1]):
         fail(name, f"results folder {argv[1]} does not exist")
     return argv[1]
+
+
+MARKER_COLUMNS = ["variant", "step", "value", "marker", "x", "y", "z", "iterations", "time_s",
+                  "converged"]
+MARKER_NUMERIC = ["step", "value", "x", "y", "z", "iterations", "time_s", "converged"]
+
+
+def read_marker_table(name, path):
+    """Reads the markers.csv of a marker_sweep experiment (one row per variant x step x marker):
+    steps must be non-negative integers, converged 0 or 1, and (variant, step, marker) unique."""
+    seen = set()
+
+    def check(v):
+        if v["step"] < 0 or v["step"] != int(v["step"]):
+            return f"step is {v['step']:g}, expected a non-negative integer"
+        if v["converged"] not in (0.0, 1.0):
+            return f"converged is {v['converged']:g}, expected 0 or 1"
+        key = (v["variant"], int(v["step"]), v["marker"])
+        if key in seen:
+            return f"second row for variant {key[0]}, step {key[1]}, marker {key[2]}"
+        seen.add(key)
+        return None
+
+    return read_table(name, path, MARKER_COLUMNS, MARKER_NUMERIC, check=check, min_rows=2)
