@@ -270,16 +270,12 @@ void Model::ApplyConstraints(const Eigen::Ref<const Eigen::VectorXd>& c, Eigen::
     for (int v : scene_.fixed_axis[d]) (*X)(v, d) = R(v, d);
   // Motion actuators compose in actuator order: each moves the position left by the previous ones
   // (e.g. a twist listed before a displacement: rotate about the rest axis, then translate).
-  bool first = true;
+  for (const auto& act : scene_.actuators)
+    if (act.is_motion())
+      for (int v : act.vertices) X->row(v) = R.row(v);
   for (int a = 0; a < scene_.num_actuators(); ++a) {
     const Actuator& act = scene_.actuators[a];
     if (!act.is_motion()) continue;
-    if (first) {
-      for (int b = a; b < scene_.num_actuators(); ++b)
-        if (scene_.actuators[b].is_motion())
-          for (int v : scene_.actuators[b].vertices) X->row(v) = R.row(v);
-      first = false;
-    }
     for (int v : act.vertices) X->row(v) = act.Move(X->row(v).transpose(), c[a]).transpose();
   }
 }

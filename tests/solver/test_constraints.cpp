@@ -77,18 +77,27 @@ std::array<long long, 3> Key(const Eigen::RowVector3d& p) {
   return {std::llround(p.x() * 1024.0), std::llround(p.y() * 1024.0), std::llround(p.z() * 1024.0)};
 }
 
-/// For every vertex of `m`, the vertex whose rest position is its image under `map`, or -1.
+/// For every vertex of `from`, the vertex of `to` whose rest position is its image under `map`,
+/// or -1.
 template <class F>
-std::vector<int> Partner(const Mesh& m, const F& map) {
+std::vector<int> Partner(const Mesh& from, const Mesh& to, const F& map) {
   std::map<std::array<long long, 3>, int> at;
-  for (int v = 0; v < m.num_vertices(); ++v) at[Key(m.vertices.row(v))] = v;
-  std::vector<int> out(m.num_vertices(), -1);
-  for (int v = 0; v < m.num_vertices(); ++v) {
-    const Eigen::RowVector3d p = m.vertices.row(v);
+  for (int v = 0; v < to.num_vertices(); ++v) at[Key(to.vertices.row(v))] = v;
+  std::vector<int> out(from.num_vertices(), -1);
+  for (int v = 0; v < from.num_vertices(); ++v) {
+    const Eigen::RowVector3d p = from.vertices.row(v);
     auto it = at.find(Key(map(p)));
     if (it != at.end()) out[v] = it->second;
   }
   return out;
+}
+template <class F>
+std::vector<int> Partner(const Mesh& m, const F& map) {
+  return Partner(m, m, map);
+}
+/// For every vertex of `sub`, the vertex of `full` at the same rest position, or -1.
+std::vector<int> SamePosition(const Mesh& sub, const Mesh& full) {
+  return Partner(sub, full, [](const Eigen::RowVector3d& p) { return p; });
 }
 
 /// Partner of each vertex under the reflection of coordinate d about the plane x_d = centre.
@@ -645,14 +654,13 @@ TEST(Constraints, SymmetryPlaneHalfModelMatchesFullModel) {
   ASSERT_EQ(rf.status, FkStatus::Converged) << rf.BriefReport();
   ASSERT_EQ(rh.status, FkStatus::Converged) << rh.BriefReport();
   // Match half-model vertices to the full model's by rest position.
-  std::map<std::array<long long, 3>, int> at;
-  for (int v = 0; v < full.mesh.num_vertices(); ++v) at[Key(full.mesh.vertices.row(v))] = v;
+  const std::vector<int> same = SamePosition(half.mesh, full.mesh);
   double worst = 0, tip_drop = 0;
   for (int v = 0; v < half.mesh.num_vertices(); ++v) {
-    const auto it = at.find(Key(half.mesh.vertices.row(v)));
-    ASSERT_NE(it, at.end());
-    worst = std::max(worst, (rh.positions.row(v) - rf.positions.row(it->second)).norm());
-    tip_drop = std::max(tip_drop, std::abs(rf.positions(it->second, 2) - full.mesh.vertices(it->second, 2)));
+    const int w = same[v];
+    ASSERT_GE(w, 0);
+    worst = std::max(worst, (rh.positions.row(v) - rf.positions.row(w)).norm());
+    tip_drop = std::max(tip_drop, std::abs(rf.positions(w, 2) - full.mesh.vertices(w, 2)));
   }
   const double sym = MirrorDefect(rf.positions, MirrorPartner(full.mesh, 1, 4.0), 1, 4.0);
   std::printf("  tip drop %.3f mm; |half - full| %.3g mm, full-model asymmetry %.3g mm "
@@ -1121,13 +1129,11 @@ TEST(Signed, InactiveSideIsVentedLikeEmptySpace) {
   const FkResult rc = SolveTight(std::make_shared<const Model>(cut), Vec1(1.0 + gain * v));
   ASSERT_EQ(rs.status, FkStatus::Converged) << rs.BriefReport();
   ASSERT_EQ(rc.status, FkStatus::Converged) << rc.BriefReport();
-  std::map<std::array<long long, 3>, int> at;
-  for (int q = 0; q < s.mesh.num_vertices(); ++q) at[Key(s.mesh.vertices.row(q))] = q;
+  const std::vector<int> same = SamePosition(cut.mesh, s.mesh);
   double worst = 0, moved = 0;
   for (int q = 0; q < cut.mesh.num_vertices(); ++q) {
-    const auto it = at.find(Key(cut.mesh.vertices.row(q)));
-    ASSERT_NE(it, at.end());
-    worst = std::max(worst, (rc.positions.row(q) - rs.positions.row(it->second)).norm());
+    ASSERT_GE(same[q], 0);
+    worst = std::max(worst, (rc.positions.row(q) - rs.positions.row(same[q])).norm());
     moved = std::max(moved, (rc.positions.row(q) - cut.mesh.vertices.row(q)).norm());
   }
   const double vented = RegionVolumeRatio(s.mesh, rs.positions, 2);
