@@ -9,12 +9,14 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <set>
@@ -76,6 +78,8 @@ KeySpec Key(std::string path, Type type, Need need, std::string doc) {
 
 const std::vector<std::string> kActuatorRoles = {"pneumatic", "cable", "dea"};
 
+std::string Num(double v);
+
 const std::vector<KeySpec>& KeyTable() {
   static const std::vector<KeySpec> table = [] {
     const Material mat;
@@ -127,12 +131,23 @@ const std::vector<KeySpec>& KeyTable() {
                     .Roles(kActuatorRoles));
     t.push_back(Key("regions[].min", N, Opt,
                     "Lower bound of the actuation value (pneumatic: volume ratio; cable: shortening "
-                    "ratio; dea: area ratio).")
-                    .Def(act.min).Above(0.0).Roles(kActuatorRoles));
-    t.push_back(Key("regions[].max", N, Opt, "Upper bound of the actuation value.")
-                    .Def(act.max).Above(0.0).Roles(kActuatorRoles));
-    t.push_back(Key("regions[].rest", N, Opt, "Actuation value at which the actuator is at rest.")
-                    .Def(act.rest).Above(0.0).Roles(kActuatorRoles));
+                    "ratio; dea: area ratio; all > 0). Signed pneumatic: required, <= 0.")
+                    .Def(act.min).DefText(Num(act.min) + " (signed: required)").Roles(kActuatorRoles));
+    t.push_back(Key("regions[].max", N, Opt,
+                    "Upper bound of the actuation value. Signed pneumatic: required, >= 0.")
+                    .Def(act.max).DefText(Num(act.max) + " (signed: required)").Roles(kActuatorRoles));
+    t.push_back(Key("regions[].rest", N, Opt,
+                    "Actuation value at which the actuator is at rest (signed pneumatic: 0).")
+                    .Def(act.rest).DefText(Num(act.rest) + " (signed: 0)").Roles(kActuatorRoles));
+    t.push_back(Key("regions[].side", S, Opt,
+                    "pneumatic: which chamber set of the actuator this region belongs to. An "
+                    "actuator with a negative region is signed (Sec. 5.3.1): value v > 0 inflates "
+                    "its positive regions to volume ratio 1 + gain v, v < 0 its negative ones to "
+                    "1 + gain |v|; the other side is vented.")
+                    .Def("positive").Choices({"positive", "negative"}).Roles({"pneumatic"}));
+    t.push_back(Key("regions[].gain", N, Opt,
+                    "Signed pneumatic only: volume ratio per unit of |value| (e.g. per bar).")
+                    .Def(act.gain).Above(0.0).Roles({"pneumatic"}));
     t.push_back(Key("regions[].weight", N, Opt,
                     "Element weight w_i (Eq. 2.10) of actuation elements (Sec. 2.5 uses 5).")
                     .Def(act.weight).Above(0.0).Roles(kActuatorRoles));
@@ -157,6 +172,41 @@ const std::vector<KeySpec>& KeyTable() {
                     "relative to the JSON's folder."));
     t.push_back(Key("fixed[].base", I, Opt, "Index base of `file`: 0 or 1.")
                     .Def(0).In(0, 1).With("file"));
+    t.push_back(Key("fixed[].axes", S, Opt,
+                    "Coordinates held: any of x, y, z once each (e.g. \"z\" for vertices that "
+                    "slide on a plane z = const, or a symmetry plane's normal axis).")
+                    .Def("xyz"));
+    t.push_back(Key("motions", A, Opt,
+                    "Motion actuators: a prescribed rigid motion of a vertex set, swept like an "
+                    "actuation value (the tensile and twisting tests of Fig. 2.6). They follow the "
+                    "region actuators in the actuation vector, in this order; rest 0. The moved "
+                    "vertices are held at the moved positions; a vertex moved by several motions "
+                    "gets them composed in order.")
+                    .Def(json::array()).DefText("[]"));
+    t.push_back(Key("motions[].name", S, R, "Actuator name, unique among all actuators."));
+    t.push_back(Key("motions[].type", S, R,
+                    "displacement: translation (mm) along `axis`; twist: rotation (degrees, "
+                    "right-hand rule) about the line through `centre` along `axis`.")
+                    .Choices({"displacement", "twist"}));
+    t.push_back(Key("motions[].region", I, Sel, "Move every vertex of the elements with this region tag."));
+    t.push_back(Key("motions[].box", O, Sel, "Move every vertex inside an axis-aligned box."));
+    t.push_back(Key("motions[].box.min", V, R, "Lower corner [x, y, z]."));
+    t.push_back(Key("motions[].box.max", V, R, "Upper corner [x, y, z]."));
+    t.push_back(Key("motions[].plane", O, Sel, "Move every vertex within `tolerance` of a plane."));
+    t.push_back(Key("motions[].plane.point", V, R, "A point on the plane [x, y, z]."));
+    t.push_back(Key("motions[].plane.normal", V, R, "Plane normal [x, y, z] (non-zero; normalised)."));
+    t.push_back(Key("motions[].plane.tolerance", N, Opt, "Largest distance from the plane.")
+                    .Def(1e-6).AtLeast(0.0));
+    t.push_back(Key("motions[].file", S, Sel,
+                    "Move the vertices listed in a text file (whitespace-separated indices, # comments)."));
+    t.push_back(Key("motions[].base", I, Opt, "Index base of `file`: 0 or 1.")
+                    .Def(0).In(0, 1).With("file"));
+    t.push_back(Key("motions[].axis", V, R,
+                    "Direction of the translation, or the rotation axis (non-zero; normalised)."));
+    t.push_back(Key("motions[].centre", V, Opt, "A point on the rotation axis.")
+                    .Def(json::array({0.0, 0.0, 0.0})).Roles({"twist"}));
+    t.push_back(Key("motions[].min", N, R, "Lower bound of the value (mm or degrees), <= 0."));
+    t.push_back(Key("motions[].max", N, R, "Upper bound of the value (mm or degrees), >= 0."));
     t.push_back(Key("markers", A, Opt,
                     "Named tracked points; each is the mean position of its selected vertices.")
                     .Def(json::array()));
@@ -492,8 +542,11 @@ class SceneParser {
             roles.insert(roles.end(), s.roles.begin(), s.roles.end());
           }
         if (known && !any_role)
-          Fail(Join(path, key) + ": not allowed for role '" + role + "' (only for role " +
-               ListText(roles) + "; expected one of: " + ListText(allowed) + ")");
+        {
+          const std::string word = pattern == "motions[]" ? "type" : "role";
+          Fail(Join(path, key) + ": not allowed for " + word + " '" + role + "' (only for " + word +
+               " " + ListText(roles) + "; expected one of: " + ListText(allowed) + ")");
+        }
         std::string hint;
         for (const auto& a : allowed)
           if (EditDistance(key, a) <= 2) {
@@ -531,8 +584,14 @@ class SceneParser {
 
   void ReadMeshSection(const json& m, Scene* scene) const;
   void ReadRegions(const json& regions, Scene* scene) const;
-  std::vector<int> ReadFixed(const json& fixed, const Mesh& mesh) const;
-  std::vector<int> ReadIndexFile(const json& entry, const std::string& path, const Mesh& mesh) const;
+  void ReadFixed(const json& fixed, Scene* scene) const;
+  void ReadMotions(const json& motions, Scene* scene) const;
+  /// The vertices chosen by the selector key (region | box | plane | file) of an object at
+  /// `pattern` ("fixed[]" or "motions[]"), already checked by CheckObject.
+  std::vector<int> ReadSelection(const json& entry, const std::string& pattern,
+                                 const std::string& path, const Mesh& mesh) const;
+  std::vector<int> ReadIndexFile(const json& entry, const std::string& pattern,
+                                 const std::string& path, const Mesh& mesh) const;
   std::vector<Marker> ReadMarkers(const json& markers, const Mesh& mesh) const;
   void ReadBox(const json& box, const std::string& pattern, const std::string& path,
                Eigen::Vector3d* lo, Eigen::Vector3d* hi) const;
@@ -617,6 +676,7 @@ void SceneParser::ReadRegions(const json& regions, Scene* scene) const {
   struct ActInfo {
     int index;
     std::string role, role_path;
+    std::string negative_path;  ///< the first region with side "negative" (signed actuator)
     std::map<std::string, Given> given;
   };
   std::map<std::string, ActInfo> acts;
@@ -656,13 +716,20 @@ void SceneParser::ReadRegions(const json& regions, Scene* scene) const {
       if (!ActuatorTypeFromString(role, &a.type))
         throw std::logic_error("scene_json: role '" + role + "' is not an actuator type");
       scene->actuators.push_back(a);
-      it = acts.emplace(name, ActInfo{scene->num_actuators() - 1, role, path + ".role", {}}).first;
+      it = acts.emplace(name, ActInfo{scene->num_actuators() - 1, role, path + ".role", "", {}}).first;
     } else if (it->second.role != role) {
       Fail(path + ".role: actuator '" + name + "' is " + it->second.role + " in " +
            it->second.role_path + ", got \"" + role +
            "\"; regions sharing an actuator name must have the same role");
     }
-    scene->actuators[it->second.index].regions.push_back(tag);
+    const bool negative =
+        role == "pneumatic" && Get(r, "regions[]", "side", role).get<std::string>() == "negative";
+    if (negative) {
+      scene->actuators[it->second.index].negative_regions.push_back(tag);
+      if (it->second.negative_path.empty()) it->second.negative_path = path + ".side";
+    } else {
+      scene->actuators[it->second.index].regions.push_back(tag);
+    }
     if (role == "cable") {
       std::vector<Eigen::Vector3d> pts;
       for (const auto& p : r.at("path")) pts.push_back(AsVec(p));
@@ -674,7 +741,7 @@ void SceneParser::ReadRegions(const json& regions, Scene* scene) const {
              "' already has a different path; regions sharing a cable name must give the same "
              "path");
     }
-    for (const char* key : {"min", "max", "rest", "weight"}) {
+    for (const char* key : {"min", "max", "rest", "weight", "gain"}) {
       if (!r.contains(key)) continue;
       const double v = r.at(key).get<double>();
       const std::string kp = path + "." + key;
@@ -694,16 +761,44 @@ void SceneParser::ReadRegions(const json& regions, Scene* scene) const {
       auto g = info.given.find(key);
       return g != info.given.end() ? g->second.value : Spec("regions[]", key, info.role)->def.get<double>();
     };
+    const std::string entry = info.role_path.substr(0, info.role_path.size() - 5);
+    auto where = [&](const char* key) {
+      auto g = info.given.find(key);
+      return g != info.given.end() ? g->second.path : std::string("default");
+    };
+    a.weight = value("weight");
+    if (info.role == "pneumatic") a.gain = value("gain");
+    if (!info.negative_path.empty()) {
+      // Signed pneumatic actuator: rest 0, an explicit range around it.
+      for (const char* key : {"min", "max"})
+        if (!info.given.count(key))
+          Fail(entry + ": signed actuator '" + name + "' (negative side from " + info.negative_path +
+               ") needs '" + key + "'; expected min <= 0 <= max");
+      a.min = value("min");
+      a.max = value("max");
+      a.rest = info.given.count("rest") ? value("rest") : 0.0;
+      if (a.rest != 0.0)
+        Fail(where("rest") + ": signed actuator '" + name + "': expected rest 0, got " + Num(a.rest));
+      if (!(a.min <= 0.0))
+        Fail(where("min") + ": signed actuator '" + name + "': expected min <= 0, got " + Num(a.min));
+      if (!(a.max >= 0.0))
+        Fail(where("max") + ": signed actuator '" + name + "': expected max >= 0, got " + Num(a.max));
+      if (a.regions.empty())
+        Fail(entry + ": signed actuator '" + name +
+             "' has only negative-side regions; expected at least one region with side \"positive\"");
+      continue;
+    }
+    if (info.given.count("gain"))
+      Fail(where("gain") + ": actuator '" + name +
+           "' is not signed (no region with side \"negative\"); gain applies to signed actuators only");
     a.min = value("min");
     a.max = value("max");
     a.rest = value("rest");
-    a.weight = value("weight");
+    for (const char* key : {"min", "max", "rest"})
+      if (!(value(key) > 0.0))
+        Fail(where(key) + ": actuator '" + name + "': expected a ratio > 0, got " + Num(value(key)));
     if (!(a.min <= a.rest && a.rest <= a.max)) {
-      auto where = [&](const char* key) {
-        auto g = info.given.find(key);
-        return g != info.given.end() ? g->second.path : std::string("default");
-      };
-      Fail(info.role_path.substr(0, info.role_path.size() - 5) + ": actuator '" + name +
+      Fail(entry + ": actuator '" + name +
            "': expected min <= rest <= max, got min " + Num(a.min) + " (" + where("min") +
            "), rest " + Num(a.rest) + " (" + where("rest") + "), max " + Num(a.max) + " (" +
            where("max") + ")");
@@ -721,10 +816,10 @@ void SceneParser::ReadBox(const json& box, const std::string& pattern, const std
          VecText(*hi));
 }
 
-std::vector<int> SceneParser::ReadIndexFile(const json& entry, const std::string& path,
-                                            const Mesh& mesh) const {
+std::vector<int> SceneParser::ReadIndexFile(const json& entry, const std::string& pattern,
+                                            const std::string& path, const Mesh& mesh) const {
   const std::string name = entry.at("file").get<std::string>();
-  const int base = AsInt(Get(entry, "fixed[]", "base"));
+  const int base = AsInt(Get(entry, pattern, "base"));
   const fs::path file = Resolve(name);
   std::ifstream in(file);
   if (!in) Fail(path + ".file: cannot open '" + file.string() + "' (from \"" + name + "\")");
@@ -756,43 +851,124 @@ std::vector<int> SceneParser::ReadIndexFile(const json& entry, const std::string
   return out;
 }
 
-std::vector<int> SceneParser::ReadFixed(const json& fixed, const Mesh& mesh) const {
+std::vector<int> SceneParser::ReadSelection(const json& f, const std::string& pattern,
+                                            const std::string& path, const Mesh& mesh) const {
+  std::vector<int> sel;
+  if (f.contains("region")) {
+    const int tag = AsInt(f.at("region"));
+    sel = VerticesOfRegions(mesh, {tag});
+    if (sel.empty())
+      Fail(path + ".region: no element of the mesh has region tag " + std::to_string(tag) +
+           " (the mesh's tags: " + IntListText(mesh.regions()) + ")");
+  } else if (f.contains("box")) {
+    Eigen::Vector3d lo, hi;
+    ReadBox(f.at("box"), pattern + ".box", path + ".box", &lo, &hi);
+    sel = VerticesInBox(mesh, lo, hi);
+    if (sel.empty()) Fail(path + ".box selects no vertex (" + BoundsText(mesh) + ")");
+  } else if (f.contains("plane")) {
+    const json& p = f.at("plane");
+    CheckObject(p, pattern + ".plane", path + ".plane");
+    const Eigen::Vector3d point = AsVec(p.at("point")), normal = AsVec(p.at("normal"));
+    if (!(normal.norm() > 0.0))
+      Fail(path + ".plane.normal: expected a non-zero vector, got " + VecText(normal));
+    const double tol = Get(p, pattern + ".plane", "tolerance").get<double>();
+    sel = VerticesOnPlane(mesh, point, normal, tol);
+    if (sel.empty())
+      Fail(path + ".plane selects no vertex (tolerance " + Num(tol) + "; " + BoundsText(mesh) + ")");
+  } else {
+    sel = ReadIndexFile(f, pattern, path, mesh);
+  }
+  std::sort(sel.begin(), sel.end());
+  sel.erase(std::unique(sel.begin(), sel.end()), sel.end());
+  return sel;
+}
+
+void SceneParser::ReadFixed(const json& fixed, Scene* scene) const {
   if (fixed.empty()) Fail("fixed: expected at least one selection, got []");
   std::vector<int> all;
+  std::array<std::vector<int>, 3> axis;
   for (size_t i = 0; i < fixed.size(); ++i) {
     const std::string path = "fixed[" + std::to_string(i) + "]";
     const json& f = fixed[i];
     CheckObject(f, "fixed[]", path);
-    std::vector<int> sel;
-    if (f.contains("region")) {
-      const int tag = AsInt(f.at("region"));
-      sel = VerticesOfRegions(mesh, {tag});
-      if (sel.empty())
-        Fail(path + ".region: no element of the mesh has region tag " + std::to_string(tag) +
-             " (the mesh's tags: " + IntListText(mesh.regions()) + ")");
-    } else if (f.contains("box")) {
-      Eigen::Vector3d lo, hi;
-      ReadBox(f.at("box"), "fixed[].box", path + ".box", &lo, &hi);
-      sel = VerticesInBox(mesh, lo, hi);
-      if (sel.empty()) Fail(path + ".box selects no vertex (" + BoundsText(mesh) + ")");
-    } else if (f.contains("plane")) {
-      const json& p = f.at("plane");
-      CheckObject(p, "fixed[].plane", path + ".plane");
-      const Eigen::Vector3d point = AsVec(p.at("point")), normal = AsVec(p.at("normal"));
-      if (!(normal.norm() > 0.0))
-        Fail(path + ".plane.normal: expected a non-zero vector, got " + VecText(normal));
-      const double tol = Get(p, "fixed[].plane", "tolerance").get<double>();
-      sel = VerticesOnPlane(mesh, point, normal, tol);
-      if (sel.empty())
-        Fail(path + ".plane selects no vertex (tolerance " + Num(tol) + "; " + BoundsText(mesh) + ")");
-    } else {
-      sel = ReadIndexFile(f, path, mesh);
+    const std::string axes = Get(f, "fixed[]", "axes").get<std::string>();
+    std::array<bool, 3> held = {false, false, false};
+    for (char c : axes) {
+      const int d = c == 'x' ? 0 : c == 'y' ? 1 : c == 'z' ? 2 : -1;
+      if (d < 0 || held[d])
+        Fail(path + ".axes: expected some of the letters x, y, z, each at most once (e.g. \"xyz\", "
+             "\"z\"), got \"" + axes + "\"");
+      held[d] = true;
     }
-    all.insert(all.end(), sel.begin(), sel.end());
+    if (axes.empty())
+      Fail(path + ".axes: expected some of the letters x, y, z, each at most once, got \"\"");
+    const std::vector<int> sel = ReadSelection(f, "fixed[]", path, scene->mesh);
+    if (held[0] && held[1] && held[2]) {
+      all.insert(all.end(), sel.begin(), sel.end());
+    } else {
+      for (int d = 0; d < 3; ++d)
+        if (held[d]) axis[d].insert(axis[d].end(), sel.begin(), sel.end());
+    }
   }
-  std::sort(all.begin(), all.end());
-  all.erase(std::unique(all.begin(), all.end()), all.end());
-  return all;
+  auto sort_unique = [](std::vector<int>* v) {
+    std::sort(v->begin(), v->end());
+    v->erase(std::unique(v->begin(), v->end()), v->end());
+  };
+  sort_unique(&all);
+  scene->fixed = all;
+  for (int d = 0; d < 3; ++d) {
+    sort_unique(&axis[d]);
+    // A fully fixed vertex needs no per-axis entry.
+    std::vector<int> only;
+    std::set_difference(axis[d].begin(), axis[d].end(), all.begin(), all.end(),
+                        std::back_inserter(only));
+    scene->fixed_axis[d] = only;
+  }
+}
+
+void SceneParser::ReadMotions(const json& motions, Scene* scene) const {
+  std::map<std::string, std::string> name_path;
+  for (size_t i = 0; i < motions.size(); ++i) {
+    const std::string path = "motions[" + std::to_string(i) + "]";
+    const json& m = motions[i];
+    if (!m.is_object()) Fail(path + ": expected an object, got " + Got(m));
+    CheckKey(m, "motions[]", path, "type");
+    const std::string type = m.at("type").get<std::string>();
+    CheckObject(m, "motions[]", path, type);
+    Actuator a;
+    a.name = m.at("name").get<std::string>();
+    if (a.name.empty()) Fail(path + ".name: expected a non-empty actuator name, got \"\"");
+    if (scene->actuator_index(a.name) >= 0)
+      Fail(path + ".name: actuator '" + a.name + "' is already defined" +
+           (name_path.count(a.name) ? " by " + name_path[a.name] : std::string(" in regions")) +
+           "; expected unique actuator names");
+    name_path[a.name] = path;
+    if (!ActuatorTypeFromString(type, &a.type))
+      throw std::logic_error("scene_json: motion type '" + type + "' is not an actuator type");
+    a.vertices = ReadSelection(m, "motions[]", path, scene->mesh);
+    a.axis = AsVec(m.at("axis"));
+    if (!(a.axis.norm() > 0.0))
+      Fail(path + ".axis: expected a non-zero vector, got " + VecText(a.axis));
+    a.axis.normalize();
+    if (a.type == ActuatorType::Twist) a.centre = AsVec(Get(m, "motions[]", "centre", type));
+    a.min = m.at("min").get<double>();
+    a.max = m.at("max").get<double>();
+    a.rest = 0.0;
+    if (!(a.min <= 0.0)) Fail(path + ".min: expected a number <= 0 (rest is 0), got " + Num(a.min));
+    if (!(a.max >= 0.0)) Fail(path + ".max: expected a number >= 0 (rest is 0), got " + Num(a.max));
+    for (int v : a.vertices)
+      if (std::binary_search(scene->fixed.begin(), scene->fixed.end(), v))
+        Fail(path + ": vertex " + std::to_string(v) + " (at " +
+             VecText(scene->mesh.vertices.row(v).transpose()) +
+             ") is also in `fixed`; expected moved vertices not to be fixed");
+    for (int d = 0; d < 3; ++d)
+      for (int v : a.vertices)
+        if (std::binary_search(scene->fixed_axis[d].begin(), scene->fixed_axis[d].end(), v))
+          Fail(path + ": vertex " + std::to_string(v) + " (at " +
+               VecText(scene->mesh.vertices.row(v).transpose()) + ") is also held on axis " +
+               "xyz"[d] + " by `fixed`; expected moved vertices not to be held");
+    scene->actuators.push_back(std::move(a));
+  }
 }
 
 std::vector<Marker> SceneParser::ReadMarkers(const json& markers, const Mesh& mesh) const {
@@ -837,7 +1013,8 @@ Scene SceneParser::Build(const json& root) {
 
   ReadMeshSection(root.at("mesh"), &scene);
   ReadRegions(root.at("regions"), &scene);
-  scene.fixed = ReadFixed(root.at("fixed"), scene.mesh);
+  ReadFixed(root.at("fixed"), &scene);
+  ReadMotions(Get(root, "", "motions"), &scene);
   scene.markers = ReadMarkers(Get(root, "", "markers"), scene.mesh);
 
   const json solver = Get(root, "", "solver");
@@ -898,7 +1075,9 @@ std::string SceneSchema() {
       case Need::Selector: def = "selector"; break;
       case Need::Optional: def = "default " + (k.def_text.empty() ? k.def.dump() : k.def_text); break;
     }
-    if (!k.roles.empty()) def += " [role " + ListText(k.roles) + "]";
+    if (!k.roles.empty())
+      def += std::string(k.path.rfind("motions", 0) == 0 ? " [type " : " [role ") +
+             ListText(k.roles) + "]";
     if (!k.with.empty()) def += " [only with " + k.with + "]";
     std::string line = k.path;
     line.resize(std::max<size_t>(line.size() + 2, 28), ' ');

@@ -611,6 +611,165 @@ TEST(SceneJsonErrors, ActuatorRegionsMustAgree) {
                        "rest 3.5 (regions[1].rest)", "max 3 (regions[1].max)"});
 }
 
+/// The tiny scene with a signed chamber pair, a per-axis hold and two motion actuators.
+/// After scaling: 0 (0,0,0) 1 (2,0,0) 2 (0,0,2) 3 (0,2,0) 4 (2,2,0) 5 (0,2,2).
+json SignedMotionScene() {
+  return json::parse(R"({
+    "mesh": {"file": "tiny.tet", "labels": "tiny_labels.txt", "scale": 2},
+    "regions": [
+      {"tag": 0, "role": "body"},
+      {"tag": 1, "role": "pneumatic", "name": "s", "min": -2, "max": 3, "gain": 1.5},
+      {"tag": 2, "role": "pneumatic", "name": "s", "side": "negative"}
+    ],
+    "fixed": [
+      {"plane": {"point": [0, 0, 0], "normal": [0, 1, 0]}},
+      {"file": "fixed.txt", "base": 1, "axes": "zx"}
+    ],
+    "motions": [
+      {"name": "lift", "type": "displacement", "box": {"min": [1.5, 1.9, -1], "max": [3, 2.1, 1]},
+       "axis": [0, 0, 2], "min": -1, "max": 1},
+      {"name": "turn", "type": "twist", "box": {"min": [-1, 1.9, -1], "max": [0.5, 2.1, 0.5]},
+       "axis": [0, 1, 0], "centre": [1, 0, 1], "min": -90, "max": 90}
+    ]
+  })");
+}
+
+TEST(SceneJsonTiny, SignedActuatorAxesAndMotions) {
+  TempDir dir;
+  WriteTinyMesh(dir.path());
+  const Scene s = LoadFrom(dir.path(), SignedMotionScene());
+  ASSERT_EQ(s.num_actuators(), 3);
+  const Actuator& a = s.actuators[0];
+  EXPECT_EQ(a.name, "s");
+  EXPECT_TRUE(a.is_signed());
+  EXPECT_EQ(a.regions, std::vector<int>{1});
+  EXPECT_EQ(a.negative_regions, std::vector<int>{2});
+  EXPECT_DOUBLE_EQ(a.gain, 1.5);
+  EXPECT_DOUBLE_EQ(a.min, -2);
+  EXPECT_DOUBLE_EQ(a.max, 3);
+  EXPECT_DOUBLE_EQ(a.rest, 0);
+  EXPECT_DOUBLE_EQ(a.SideRatio(-1, -2), 4.0);  // 1 + 1.5 * 2
+  EXPECT_DOUBLE_EQ(a.SideRatio(+1, -2), 1.0);
+  // Motions follow the region actuators, in file order; the axis is normalised.
+  EXPECT_EQ(s.actuators[1].name, "lift");
+  EXPECT_EQ(s.actuators[1].type, ActuatorType::Displacement);
+  EXPECT_EQ(s.actuators[1].vertices, std::vector<int>{4});
+  EXPECT_EQ(s.actuators[1].axis, Eigen::Vector3d(0, 0, 1));
+  EXPECT_DOUBLE_EQ(s.actuators[1].rest, 0);
+  EXPECT_EQ(s.actuators[2].type, ActuatorType::Twist);
+  EXPECT_EQ(s.actuators[2].vertices, std::vector<int>{3});
+  EXPECT_EQ(s.actuators[2].centre, Eigen::Vector3d(1, 0, 1));
+  EXPECT_DOUBLE_EQ(s.actuators[2].min, -90);
+  // Vertex 3 (0,2,0) turned 90 degrees about the y line through (1,0,1): (0,2,2).
+  EXPECT_LT((s.actuators[2].Move(s.mesh.vertices.row(3).transpose(), 90) - Eigen::Vector3d(0, 2, 2)).norm(),
+            1e-12);
+  EXPECT_EQ(s.rest_actuation(), Eigen::Vector3d(0, 0, 0));
+  EXPECT_EQ(s.fixed, (std::vector<int>{0, 1, 2}));
+  EXPECT_EQ(s.fixed_axis[0], std::vector<int>{5});
+  EXPECT_TRUE(s.fixed_axis[1].empty());
+  EXPECT_EQ(s.fixed_axis[2], std::vector<int>{5});
+  EXPECT_TRUE(s.is_constrained(5, 2));
+  EXPECT_FALSE(s.is_constrained(5, 1));
+  EXPECT_TRUE(s.is_constrained(4, 1));  // moved
+  // A per-axis hold on a fully fixed vertex adds nothing.
+  json j = SignedMotionScene();
+  j["fixed"][1] = json::parse(R"({"plane": {"point": [0, 0, 0], "normal": [0, 1, 0]}, "axes": "y"})");
+  const Scene t = LoadFrom(dir.path(), j);
+  for (int d = 0; d < 3; ++d) EXPECT_TRUE(t.fixed_axis[d].empty());
+}
+
+TEST(SceneJsonErrors, SignedActuatorBadValues) {
+  json j = SignedMotionScene();
+  j["regions"][1].erase("min");
+  ExpectSceneError(j, {"regions[1]: signed actuator 's' (negative side from regions[2].side) needs 'min'",
+                       "expected min <= 0 <= max"});
+  j = SignedMotionScene();
+  j["regions"][2]["rest"] = 1;
+  ExpectSceneError(j, {"regions[2].rest: signed actuator 's': expected rest 0, got 1"});
+  j = SignedMotionScene();
+  j["regions"][1]["min"] = 0.5;
+  ExpectSceneError(j, {"regions[1].min: signed actuator 's': expected min <= 0, got 0.5"});
+  j = SignedMotionScene();
+  j["regions"][1]["max"] = -0.5;
+  ExpectSceneError(j, {"regions[1].max: signed actuator 's': expected max >= 0, got -0.5"});
+  j = SignedMotionScene();
+  j["regions"][1]["side"] = "negative";
+  ExpectSceneError(j, {"regions[1]: signed actuator 's' has only negative-side regions"});
+  j = SignedMotionScene();
+  j["regions"][2]["side"] = "left";
+  ExpectSceneError(j, {"regions[2].side: expected one of: positive, negative", "\"left\""});
+  j = SignedMotionScene();
+  j["regions"][1]["gain"] = 0;
+  ExpectSceneError(j, {"regions[1].gain: expected a number > 0, got 0"});
+  j = SignedMotionScene();
+  j["regions"][2]["gain"] = 2;
+  ExpectSceneError(j, {"regions[2].gain: actuator 's' already has gain 1.5 from regions[1].gain, got 2"});
+  j = SignedMotionScene();
+  j["regions"][0]["side"] = "negative";
+  ExpectSceneError(j, {"regions[0].side: not allowed for role 'body'"});
+  // Unsigned actuators: gain has no meaning, and the values are ratios.
+  j = TinyScene();
+  j["regions"][1]["gain"] = 2;
+  ExpectSceneError(j, {"regions[1].gain: actuator 'chamber' is not signed"});
+  j = TinyScene();
+  j["regions"][1]["min"] = 0;
+  ExpectSceneError(j, {"regions[1].min: actuator 'chamber': expected a ratio > 0, got 0"});
+  j = TinyScene();
+  j["regions"][1]["min"] = -1;
+  ExpectSceneError(j, {"regions[1].min: actuator 'chamber': expected a ratio > 0, got -1"});
+}
+
+TEST(SceneJsonErrors, FixedAxesBadValues) {
+  for (const char* bad : {"xx", "w", "", "X", "x y"}) {
+    json j = SignedMotionScene();
+    j["fixed"][1]["axes"] = bad;
+    ExpectSceneError(j, {"fixed[1].axes: expected some of the letters x, y, z"});
+  }
+  json j = SignedMotionScene();
+  j["fixed"][1]["axes"] = 3;
+  ExpectSceneError(j, {"fixed[1].axes: expected a string, got 3"});
+}
+
+TEST(SceneJsonErrors, MotionBadValues) {
+  auto with = [](const std::string& key, const json& v) {
+    json j = SignedMotionScene();
+    j["motions"][1][key] = v;
+    return j;
+  };
+  auto without = [](const std::string& key) {
+    json j = SignedMotionScene();
+    j["motions"][1].erase(key);
+    return j;
+  };
+  ExpectSceneError(without("axis"), {"motions[1]: missing required key 'axis'"});
+  ExpectSceneError(without("min"), {"motions[1]: missing required key 'min'"});
+  ExpectSceneError(without("type"), {"motions[1]: missing required key 'type'"});
+  ExpectSceneError(without("box"), {"motions[1]: expected exactly one of: region, box, plane, file, got none"});
+  ExpectSceneError(with("region", 0), {"motions[1]: expected exactly one of", "got both"});
+  ExpectSceneError(with("type", "spin"), {"motions[1].type: expected one of: displacement, twist"});
+  ExpectSceneError(with("axis", json::parse("[0, 0, 0]")), {"motions[1].axis: expected a non-zero vector"});
+  ExpectSceneError(with("axis", json::parse("[0, 1]")), {"motions[1].axis: expected"});
+  ExpectSceneError(with("min", 5), {"motions[1].min: expected a number <= 0 (rest is 0), got 5"});
+  ExpectSceneError(with("max", -5), {"motions[1].max: expected a number >= 0 (rest is 0), got -5"});
+  ExpectSceneError(with("name", "s"), {"motions[1].name: actuator 's' is already defined in regions"});
+  ExpectSceneError(with("name", "lift"), {"motions[1].name: actuator 'lift' is already defined by motions[0]"});
+  ExpectSceneError(with("box", json::parse(R"({"min": [9, 9, 9], "max": [10, 10, 10]})")),
+                   {"motions[1].box selects no vertex"});
+  ExpectSceneError(with("box", json::parse(R"({"min": [-1, -1, -1], "max": [0.5, 0.5, 0.5]})")),
+                   {"motions[1]: vertex 0", "is also in `fixed`"});
+  ExpectSceneError(with("box", json::parse(R"({"min": [-1, 1.9, 1.9], "max": [0.5, 2.1, 2.1]})")),
+                   {"motions[1]: vertex 5", "is also held on axis x by `fixed`"});
+  json j = SignedMotionScene();
+  j["motions"][0]["centre"] = json::parse("[0, 0, 0]");
+  ExpectSceneError(j, {"motions[0].centre: not allowed for type 'displacement'"});
+  j = SignedMotionScene();
+  j["motions"][0]["speed"] = 1;
+  ExpectSceneError(j, {"motions[0]: unknown key 'speed'"});
+  j = SignedMotionScene();
+  j["motions"] = json::parse("{}");
+  ExpectSceneError(j, {"motions: expected"});
+}
+
 TEST(SceneJsonErrors, RegionTags) {
   json j = TinyScene();
   j["regions"][2]["tag"] = 9;
@@ -665,6 +824,10 @@ const std::vector<std::string> kAllKeys = {
     "name", "mesh", "mesh.file", "mesh.format", "mesh.labels", "mesh.tag_array", "mesh.scale",
     "regions", "regions[].tag", "regions[].role", "regions[].material", "regions[].r_omega",
     "regions[].weight", "regions[].name", "regions[].min", "regions[].max", "regions[].rest", "regions[].path",
+    "regions[].side", "regions[].gain", "fixed[].axes", "motions", "motions[].name", "motions[].type",
+    "motions[].region", "motions[].box", "motions[].box.min", "motions[].box.max", "motions[].plane",
+    "motions[].plane.point", "motions[].plane.normal", "motions[].plane.tolerance", "motions[].file",
+    "motions[].base", "motions[].axis", "motions[].centre", "motions[].min", "motions[].max",
     "fixed", "fixed[].region", "fixed[].box", "fixed[].box.min", "fixed[].box.max",
     "fixed[].plane", "fixed[].plane.point", "fixed[].plane.normal", "fixed[].plane.tolerance",
     "fixed[].file", "fixed[].base", "markers", "markers[].name", "markers[].vertex",
