@@ -329,8 +329,13 @@ std::vector<int> VerticesInXRange(const Mesh& m, double x0, double x1, double zm
 // roof (region 0). Section s is the signed pneumatic actuator "s<s+1>": value v in [-3, 3]
 // (the thesis's pressure in bar, its sign picking the side); v > 0 drives the +y chambers to
 // volume ratio 1 + gain v and bends the section towards -y, v < 0 the -y chambers and bends it
-// towards +y. gain = 2 (volume ratio 7 at |v| = 3) gives about 120 degrees per section (the
-// thesis's figure). The mesh is mirror-symmetric about y = 10 (res is even), so v and -v give
+// towards +y. The thesis's sections bend up to 120 degrees; this geometric model reaches less.
+// At the defaults (gain 4, chamber weight 20) section 1 turns at v = 3 by 43 / 73 / 95 degrees
+// at res 6 / 8 / 12: walls snap to whole cells (3.3 / 2.5 / 1.7 mm for the 1.5 mm design), and
+// thinner walls let the chambers grow more (at res 8 they reach volume ratio 9.8 of the 13
+// asked: the actuation elements are soft constraints, Eq. 2.10, held back by the rigid walls,
+// floor and roof). With the thesis's weight 5 and gain 2 it is 38 degrees at res 8. A
+// PneuNet-style variant with gaps between the chamber boxes did not bend more (50). The mesh is mirror-symmetric about y = 10 (res is even), so v and -v give
 // mirror images. Markers: tip (distal face x = L), j1, j2 (the connectors' distal faces: the
 // ends of sections 1 and 2).
 // ================================================================================================
@@ -338,7 +343,8 @@ std::vector<int> VerticesInXRange(const Mesh& m, double x0, double x1, double zm
 constexpr int kManipMinRes = 6, kManipMaxRes = 24, kManipDefaultRes = 8;
 constexpr double kManipWidth = 20.0, kManipThick = 12.0, kManipBase = 6.0, kManipSection = 40.0,
                  kManipJoint = 6.0, kManipCap = 3.0, kManipWall = 1.5, kManipCavity = 4.0,
-                 kManipSpine = 3.0, kManipGain = 2.0, kManipRange = 3.0;
+                 kManipSpine = 3.0, kManipGain = 4.0, kManipRange = 3.0,
+                 kManipChamberWeight = 20.0;
 
 Scene MakeFingerManipulator(int res, const RobotParams& P) {
   if (res % 2 != 0)
@@ -384,7 +390,7 @@ Scene MakeFingerManipulator(int res, const RobotParams& P) {
   Scene s;
   s.name = "finger_manipulator";
   s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz), cell);
-  s.body[0] = Material{"body", 1.0, 1.0};
+  s.body[0] = Material{"body", P.at("body_r_omega"), 1.0};
   s.body[7] = Material{"spine", 1.0, P.at("spine_weight")};
   s.body[8] = Material{"joint", 1.0, 20.0};
   const double gain = P.at("gain");
@@ -395,6 +401,7 @@ Scene MakeFingerManipulator(int res, const RobotParams& P) {
     a.regions = {1 + 2 * q};
     a.negative_regions = {2 + 2 * q};
     a.gain = gain;
+    a.weight = P.at("chamber_weight");
     a.rest = 0.0;
     a.min = -kManipRange;
     a.max = kManipRange;
@@ -723,7 +730,10 @@ const std::vector<RobotEntry>& Registry() {
         "cells across the 20 mm width (cell size 20/res mm), even integer in [6, 24]",
         {{"gain", kManipGain, 0.1, 10.0,
           "volume ratio per unit of actuation: a chamber side reaches 1 + gain |v|"},
-         {"spine_weight", 20.0, 0.01, 100.0, "element weight of the central spine"}}},
+         {"spine_weight", 20.0, 0.01, 100.0, "element weight of the central spine"},
+         {"chamber_weight", kManipChamberWeight, 0.01, 100.0,
+          "element weight of the chambers' actuation elements"},
+         {"body_r_omega", 1.0, 0.0, 1.0, "R_omega of the body material (walls, floor, roof)"}}},
        kManipMinRes, kManipMaxRes, &MakeFingerManipulator},
       {{"multi_segment_gripper",
         "Three-segment pneumatic manipulator-gripper (thesis Fig. 4.7): three 50 mm bending "
