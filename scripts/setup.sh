@@ -46,6 +46,7 @@ PACKAGES=(
   coinor-libipopt-dev
   libnlopt-cxx-dev
   libcgal-dev
+  pkg-config
 )
 
 log() { echo "[setup] $*"; }

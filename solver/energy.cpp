@@ -49,16 +49,20 @@ double FrozenTargetGradient(const Model& model, const Eigen::Ref<const Eigen::Ma
   return E;
 }
 
-double EnergyAndGradient(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
-                         const Eigen::Ref<const Eigen::VectorXd>& c, Eigen::MatrixX3d* grad) {
+namespace {
+
+/// E and its gradient for the given per-element ratios; `chain` adds the dependence of the ratios
+/// on the chamber measures (EnergyAndGradient), without it the ratios are constants.
+double EnergyAndGradientImpl(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                             const std::vector<double>& ratios, bool chain, Eigen::MatrixX3d* grad) {
   const auto& els = model.elements();
   const int ne = static_cast<int>(els.size());
-  std::vector<double> ratios;
-  ComputeLocalRatios(model, X, c, &ratios);
   grad->setZero(model.num_vertices(), 3);
   // dE_i/dr_i for actuation elements: needed for the chain rule through the ratio distribution.
   std::vector<double> dE_dratio(ne, 0.0);
+  std::vector<ElemRows> Gs(ne, ElemRows::Zero());  // per-element dE_i/dV (centred rows)
   double E = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : E)
   for (int i = 0; i < ne; ++i) {
     const ModelElement& e = els[i];
     const int k = e.k;
@@ -108,8 +112,11 @@ double EnergyAndGradient(const Model& model, const Eigen::Ref<const Eigen::Matri
     }
     // D = N V: dE/dV = N^T dE/dD = dE/dD centred.
     CenterRows(G, k);
-    for (int j = 0; j < k; ++j) grad->row(e.v[j]) += G.row(j);
+    Gs[i] = G;
   }
+  for (int i = 0; i < ne; ++i)
+    for (int j = 0; j < els[i].k; ++j) grad->row(els[i].v[j]) += Gs[i].row(j);
+  if (!chain) return E;
   // Chain rule through r_i = kappa m_i / mu_i, kappa = T_a / sum_j m_j:
   //   dr_i/dm_j = r_i (delta_ij / m_i - 1 / sum m),
   // so dE/dm_j = g_j r_j / m_j - (sum_i g_i r_i) / sum m, with g_i = dE/dr_i. (A measure at its
@@ -141,6 +148,22 @@ double EnergyAndGradient(const Model& model, const Eigen::Ref<const Eigen::Matri
     }
   }
   return E;
+}
+
+}  // namespace
+
+double EnergyAndGradient(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                         const Eigen::Ref<const Eigen::VectorXd>& c, Eigen::MatrixX3d* grad) {
+  std::vector<double> ratios;
+  ComputeLocalRatios(model, X, c, &ratios);
+  return EnergyAndGradientImpl(model, X, ratios, true, grad);
+}
+
+double FixedRatioEnergyAndGradient(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                                   const std::vector<double>& ratios, Eigen::MatrixX3d* grad) {
+  if (ratios.size() != model.elements().size())
+    throw std::invalid_argument("FixedRatioEnergyAndGradient: expected one ratio per element");
+  return EnergyAndGradientImpl(model, X, ratios, false, grad);
 }
 
 }  // namespace softkin

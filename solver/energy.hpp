@@ -25,6 +25,13 @@ double Energy(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
 double EnergyAndGradient(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
                          const Eigen::Ref<const Eigen::VectorXd>& c, Eigen::MatrixX3d* grad);
 
+/// E and its exact gradient with the per-element actuation ratios held at `ratios` (one per
+/// element, as ComputeLocalRatios returns them; kVented elements add nothing). This is the energy
+/// the Ceres and Ipopt solvers minimise between two ratio updates (nlp_solvers.hpp). Body terms
+/// are exact, blending (R_omega < 1) included.
+double FixedRatioEnergyAndGradient(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                                   const std::vector<double>& ratios, Eigen::MatrixX3d* grad);
+
 /// The local-global residual 2 (A X - B(X)) (#V x 3): the gradient with the targets T_i frozen at
 /// X. Local-global iterations drive it to zero. It equals the exact gradient when every body has
 /// R_omega = 1 and the actuation ratios are held fixed; otherwise the two differ (the fixed point

@@ -6,7 +6,8 @@
 namespace softkin {
 
 struct FkOptions {
-  /// Solver name: "lg" (plain local-global, Algorithm 1) or "lg-aa" (Anderson-accelerated).
+  /// Solver name: "lg" (plain local-global, Algorithm 1), "lg-aa" (Anderson-accelerated), or one
+  /// of the general-purpose optimisers of nlp_solvers.hpp: "ceres", "ipopt-lbfgs", "ipopt-newton".
   std::string solver = "lg-aa";
   int max_iterations = 10000;
   /// Stop when every vertex moves less than tolerance * model size in one iteration ...

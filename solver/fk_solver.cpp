@@ -1,6 +1,7 @@
 #include "solver/fk_solver.hpp"
 
 #include "solver/local_global.hpp"
+#include "solver/nlp_solvers.hpp"
 
 #include <cstdio>
 #include <stdexcept>
@@ -37,13 +38,17 @@ std::string FkResult::BriefReport() const {
   return s;
 }
 
-std::vector<std::string> FkSolverNames() { return {"lg", "lg-aa"}; }
+std::vector<std::string> FkSolverNames() {
+  return {"lg", "lg-aa", "ceres", "ipopt-lbfgs", "ipopt-newton"};
+}
 
 std::unique_ptr<FkSolver> MakeFkSolver(std::shared_ptr<const Model> model, const FkOptions& options) {
   std::string why;
   if (!options.IsValid(&why)) throw std::invalid_argument("solver options: " + why);
   if (options.solver == "lg" || options.solver == "lg-aa")
     return std::make_unique<LocalGlobalSolver>(std::move(model), options);
+  if (options.solver == "ceres" || options.solver == "ipopt-lbfgs" || options.solver == "ipopt-newton")
+    return MakeNlpSolver(std::move(model), options);
   throw std::invalid_argument("unknown FK solver '" + options.solver + "'");
 }
 

@@ -220,8 +220,10 @@ const std::vector<KeySpec>& KeyTable() {
     t.push_back(Key("solver", O, Opt, "Default forward-kinematics solver options of this scene.")
                     .Def(json::object()));
     t.push_back(Key("solver.solver", S, Opt,
-                    "lg: plain local-global (Algorithm 1); lg-aa: Anderson-accelerated local-global.")
-                    .Def(fk.solver).Choices({"lg", "lg-aa"}));
+                    "lg: plain local-global (Algorithm 1); lg-aa: Anderson-accelerated local-global; "
+                    "ceres, ipopt-lbfgs, ipopt-newton: the same energy minimised by Ceres or Ipopt "
+                    "(docs/solvers.md).")
+                    .Def(fk.solver).Choices({"lg", "lg-aa", "ceres", "ipopt-lbfgs", "ipopt-newton"}));
     t.push_back(Key("solver.max_iterations", I, Opt, "Iteration limit (per continuation step).")
                     .Def(fk.max_iterations).AtLeast(1));
     t.push_back(Key("solver.tolerance", N, Opt,

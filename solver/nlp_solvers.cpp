@@ -1,0 +1,496 @@
+#include "solver/nlp_solvers.hpp"
+
+#include "solver/actuation.hpp"
+#include "solver/energy.hpp"
+#include "solver/rotation.hpp"
+#include "solver/targets.hpp"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <IpIpoptApplication.hpp>
+#include <IpTNLP.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <stdexcept>
+
+namespace softkin {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Seconds(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+
+// ------------------------------------------------------------------------------------------------
+// The ratio-update loop shared by the optimiser-based solvers
+// ------------------------------------------------------------------------------------------------
+
+/// Outcome of one minimisation with frozen ratios.
+struct InnerResult {
+  bool ok = true;  ///< false: the optimiser failed (message says why)
+  int iterations = 0;
+  std::string message;
+};
+
+class RatioUpdateSolver : public FkSolver {
+ public:
+  RatioUpdateSolver(std::shared_ptr<const Model> model, const FkOptions& options)
+      : FkSolver(std::move(model)), options_(options) {
+    for (const auto& e : model_->elements()) total_weight_ += e.wv;
+  }
+  std::string name() const override { return options_.solver; }
+
+  FkResult Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
+                 const Eigen::MatrixX3d* warm_start) override {
+    const Model& m = *model_;
+    const auto t0 = Clock::now();
+    FkResult r;
+    r.solver = name();
+    r.actuation = c;
+    r.positions = m.rest_positions();
+    try {
+      CheckActuation(m, c);
+      CheckSupported();
+      if (warm_start) {
+        if (warm_start->rows() != m.num_vertices())
+          throw std::invalid_argument("warm start: expected " + std::to_string(m.num_vertices()) +
+                                      " x 3 positions, got " + std::to_string(warm_start->rows()) +
+                                      " rows");
+        if (!warm_start->allFinite()) throw std::invalid_argument("warm start: positions must be finite");
+        r.positions = *warm_start;
+      }
+    } catch (const std::invalid_argument& e) {
+      r.status = FkStatus::InvalidInput;
+      r.message = e.what();
+      r.time_s = Seconds(t0, Clock::now());
+      return r;
+    }
+    const Eigen::VectorXd rest = m.scene().rest_actuation();
+    const int K = warm_start ? 1 : options_.continuation_steps;
+    int updates = 0;
+    for (int s = 1; s <= K; ++s) {
+      const Eigen::VectorXd cs =
+          K == 1 ? Eigen::VectorXd(c) : Eigen::VectorXd(rest + (c - rest) * (double(s) / K));
+      updates += SolveStage(cs, &r);
+      if (r.status != FkStatus::Converged) break;
+    }
+    std::vector<double> ratios;
+    ComputeLocalRatios(m, r.positions, c, &ratios, &r.volume_ratios);
+    Eigen::MatrixX3d g;
+    r.energy = FixedRatioEnergyAndGradient(m, r.positions, ratios, &g);
+    const std::string upd = std::to_string(updates) + " ratio update" + (updates == 1 ? "" : "s");
+    r.message = r.message.empty() ? upd : upd + "; " + r.message;
+    r.time_s = Seconds(t0, Clock::now());
+    return r;
+  }
+
+ protected:
+  /// Throws std::invalid_argument if the scene uses something this solver cannot express.
+  virtual void CheckSupported() const {}
+  /// Minimises E with `ratios` frozen, from X (prescribed coordinates already set), until the
+  /// 2-norm of the gradient over the free coordinates is below grad_tol or max_iterations.
+  virtual InnerResult Minimize(const std::vector<double>& ratios, double grad_tol, int max_iterations,
+                               Eigen::MatrixX3d* X) = 0;
+
+  /// Gradient norm over the free coordinates of E with ratios frozen at their values at X.
+  double FreeGradientNorm(const Eigen::VectorXd& c, const Eigen::MatrixX3d& X,
+                          std::vector<double>* ratios, double* E) const {
+    ComputeLocalRatios(*model_, X, c, ratios);
+    Eigen::MatrixX3d G;
+    *E = FixedRatioEnergyAndGradient(*model_, X, *ratios, &G);
+    Eigen::VectorXd g;
+    model_->GatherFree(G, &g);
+    return g.norm();
+  }
+
+  FkOptions options_;
+  double total_weight_ = 0;
+
+ private:
+  /// One continuation stage; returns the number of ratio updates.
+  int SolveStage(const Eigen::VectorXd& c, FkResult* r) {
+    const Model& m = *model_;
+    Eigen::MatrixX3d& X = r->positions;
+    m.ApplyConstraints(c, &X);
+    std::vector<double> ratios;
+    double E = 0;
+    // Reference: the gradient at the rest shape for this actuation (as the local-global solver).
+    Eigen::MatrixX3d Xr = m.rest_positions();
+    m.ApplyConstraints(c, &Xr);
+    double ref = FreeGradientNorm(c, Xr, &ratios, &E);
+    const double floor = 1e-12 * total_weight_ * m.size();
+    int updates = 0;
+    double move = std::numeric_limits<double>::infinity();
+    for (;;) {
+      const double grad = FreeGradientNorm(c, X, &ratios, &E);
+      if (!std::isfinite(grad) || !std::isfinite(E)) {
+        r->status = FkStatus::Diverged;
+        r->message = "non-finite energy or gradient after " + std::to_string(updates) + " ratio updates";
+        return updates;
+      }
+      if (updates == 0) ref = std::max({ref, grad, 1e-8 * total_weight_ * m.size()});
+      r->gradient_ratio = ref > 0 ? grad / ref : 0.0;
+      r->max_move = std::isfinite(move) ? move : 0.0;
+      if (updates > 0 && move < options_.tolerance &&
+          (r->gradient_ratio < options_.gradient_tolerance || grad <= floor)) {
+        r->status = FkStatus::Converged;
+        return updates;
+      }
+      const int left = options_.max_iterations - r->iterations;
+      if (left <= 0) {
+        r->status = FkStatus::IterationCap;
+        r->message = "iteration cap of " + std::to_string(options_.max_iterations) + " reached";
+        return updates;
+      }
+      const Eigen::MatrixX3d before = X;
+      // The inner solve goes well below the outer threshold, so that the ratio update, not the
+      // inner tolerance, decides when to stop.
+      const InnerResult in = Minimize(ratios, 0.1 * options_.gradient_tolerance * ref, left, &X);
+      r->iterations += in.iterations;
+      ++updates;
+      if (!in.ok || !X.allFinite()) {
+        if (!X.allFinite()) X = before;
+        r->status = FkStatus::Diverged;
+        r->message = in.message.empty() ? "the optimiser returned non-finite positions" : in.message;
+        return updates;
+      }
+      move = (X - before).rowwise().norm().maxCoeff() / m.size();
+    }
+  }
+};
+
+// ------------------------------------------------------------------------------------------------
+// Ceres
+// ------------------------------------------------------------------------------------------------
+
+/// sqrt(w Vol) (N V - R P~) for an element with K vertices: P~ the shaped, centred rest rows.
+template <int K>
+struct ElementResidual {
+  Eigen::Matrix<double, K, 3> P;
+  double sw = 1.0;
+
+  template <typename T>
+  bool Eval(const T* aa, const T* const* v, T* res) const {
+    T mean[3] = {T(0), T(0), T(0)};
+    for (int j = 0; j < K; ++j)
+      for (int d = 0; d < 3; ++d) mean[d] += v[j][d];
+    for (int d = 0; d < 3; ++d) mean[d] /= T(K);
+    for (int j = 0; j < K; ++j) {
+      const T p[3] = {T(P(j, 0)), T(P(j, 1)), T(P(j, 2))};
+      T q[3];
+      ceres::AngleAxisRotatePoint(aa, p, q);
+      for (int d = 0; d < 3; ++d) res[3 * j + d] = T(sw) * (v[j][d] - mean[d] - q[d]);
+    }
+    return true;
+  }
+};
+
+struct TetResidual : ElementResidual<4> {
+  template <typename T>
+  bool operator()(const T* aa, const T* v0, const T* v1, const T* v2, const T* v3, T* res) const {
+    const T* v[4] = {v0, v1, v2, v3};
+    return Eval(aa, v, res);
+  }
+};
+
+struct PrismResidual : ElementResidual<6> {
+  template <typename T>
+  bool operator()(const T* aa, const T* v0, const T* v1, const T* v2, const T* v3, const T* v4,
+                  const T* v5, T* res) const {
+    const T* v[6] = {v0, v1, v2, v3, v4, v5};
+    return Eval(aa, v, res);
+  }
+};
+
+class CeresFkSolver : public RatioUpdateSolver {
+ public:
+  using RatioUpdateSolver::RatioUpdateSolver;
+
+ protected:
+  void CheckSupported() const override {
+    for (const auto& [tag, mat] : model_->scene().body)
+      if (mat.r_omega < 1.0)
+        throw std::invalid_argument("ceres: body region " + std::to_string(tag) + " has r_omega " +
+                                    std::to_string(mat.r_omega) +
+                                    "; the Ceres problem supports r_omega = 1 only (use ipopt-* or lg)");
+  }
+
+  InnerResult Minimize(const std::vector<double>& ratios, double grad_tol, int max_iterations,
+                       Eigen::MatrixX3d* Xp) override {
+    const Model& m = *model_;
+    const Scene& scene = m.scene();
+    Eigen::MatrixX3d& X = *Xp;
+    const int nv = m.num_vertices();
+    std::vector<double> pos(3 * static_cast<size_t>(nv));
+    for (int v = 0; v < nv; ++v)
+      for (int d = 0; d < 3; ++d) pos[3 * v + d] = X(v, d);
+    const auto& els = m.elements();
+    std::vector<double> rot(3 * els.size(), 0.0);
+
+    ceres::Problem::Options po;
+    po.manifold_ownership = ceres::TAKE_OWNERSHIP;
+    ceres::Problem problem(po);
+    for (int v = 0; v < nv; ++v) problem.AddParameterBlock(&pos[3 * v], 3);
+    for (size_t i = 0; i < els.size(); ++i) {
+      const ModelElement& e = els[i];
+      if (e.role != ElementRole::Body && ratios[i] == kVented) continue;  // no energy
+      ElemRows Pt = ElemRows::Zero();
+      Pt.topRows(e.k) = e.rest.topRows(e.k);
+      if (e.role != ElementRole::Body)
+        Pt.topRows(e.k) = e.rest.topRows(e.k) * ActuationShape(e, ratios[i]).transpose();
+      ElemRows D = ElemRows::Zero();
+      for (int j = 0; j < e.k; ++j) D.row(j) = X.row(e.v[j]);
+      CenterRows(D, e.k);
+      const Eigen::Matrix3d R = BestRotation(D.topRows(e.k).transpose() * Pt.topRows(e.k));
+      ceres::RotationMatrixToAngleAxis(R.data(), &rot[3 * i]);
+      double* aa = &rot[3 * i];
+      auto vp = [&](int j) { return &pos[3 * e.v[j]]; };
+      if (e.k == 4) {
+        auto* f = new TetResidual;
+        f->P = Pt.topRows<4>();
+        f->sw = std::sqrt(e.wv);
+        problem.AddResidualBlock(new ceres::AutoDiffCostFunction<TetResidual, 12, 3, 3, 3, 3, 3>(f),
+                                 nullptr, aa, vp(0), vp(1), vp(2), vp(3));
+      } else {
+        auto* f = new PrismResidual;
+        f->P = Pt.topRows<6>();
+        f->sw = std::sqrt(e.wv);
+        problem.AddResidualBlock(
+            new ceres::AutoDiffCostFunction<PrismResidual, 18, 3, 3, 3, 3, 3, 3, 3>(f), nullptr, aa,
+            vp(0), vp(1), vp(2), vp(3), vp(4), vp(5));
+      }
+    }
+    // Prescribed coordinates: fixed and moved vertices constant, per-axis holds via a manifold.
+    for (int v = 0; v < nv; ++v) {
+      std::vector<int> held;
+      for (int d = 0; d < 3; ++d)
+        if (m.free_index(d)[v] < 0) held.push_back(d);
+      if (held.size() == 3)
+        problem.SetParameterBlockConstant(&pos[3 * v]);
+      else if (!held.empty())
+        problem.SetManifold(&pos[3 * v], new ceres::SubsetManifold(3, held));
+    }
+    (void)scene;
+
+    ceres::Solver::Options so;
+    so.minimizer_type = ceres::TRUST_REGION;
+    so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+    so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    so.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
+    so.max_num_iterations = max_iterations;
+    so.num_threads = options_.threads > 0 ? options_.threads : 2;
+    // Ceres minimises (1/2) sum ||r||^2 = E / 2 and tests the max-norm of its gradient; a
+    // max-norm below t / sqrt(n) keeps the 2-norm below t.
+    so.gradient_tolerance = 0.5 * grad_tol / std::sqrt(std::max(1, m.num_free_dofs()));
+    so.function_tolerance = 1e-16;
+    so.parameter_tolerance = 1e-16;
+    so.logging_type = ceres::SILENT;
+    ceres::Solver::Summary summary;
+    ceres::Solve(so, &problem, &summary);
+
+    InnerResult out;
+    out.iterations = static_cast<int>(summary.iterations.size()) - 1;
+    if (summary.termination_type == ceres::FAILURE || summary.termination_type == ceres::USER_FAILURE) {
+      out.ok = false;
+      out.message = "ceres: " + summary.message;
+      return out;
+    }
+    for (int v = 0; v < nv; ++v)
+      for (int d = 0; d < 3; ++d) X(v, d) = pos[3 * v + d];
+    return out;
+  }
+};
+
+// ------------------------------------------------------------------------------------------------
+// Ipopt
+// ------------------------------------------------------------------------------------------------
+
+class FkTnlp : public Ipopt::TNLP {
+ public:
+  FkTnlp(const Model& m, const std::vector<double>& ratios, Eigen::MatrixX3d* X, bool gn_hessian)
+      : m_(m), ratios_(ratios), X_(X), gn_(gn_hessian) {
+    m.GatherFree(*X, &x0_);
+    int off = 0;
+    for (int d = 0; d < 3; ++d) {
+      offset_[d] = off;
+      off += static_cast<int>(m.free_vertices(d).size());
+    }
+  }
+  int iterations = 0;
+  bool finished_ok = false;
+  std::string status_text;
+
+  bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& mc, Ipopt::Index& nnz_jac, Ipopt::Index& nnz_h,
+                    IndexStyleEnum& style) override {
+    n = m_.num_free_dofs();
+    mc = 0;
+    nnz_jac = 0;
+    nnz_h = 0;
+    if (gn_)
+      for (int d = 0; d < 3; ++d) nnz_h += LowerNonZeros(m_.A_ff(d));
+    style = C_STYLE;
+    return true;
+  }
+  bool get_bounds_info(Ipopt::Index n, Ipopt::Number* xl, Ipopt::Number* xu, Ipopt::Index,
+                       Ipopt::Number*, Ipopt::Number*) override {
+    for (Ipopt::Index i = 0; i < n; ++i) {
+      xl[i] = -2e19;  // Ipopt's "no bound" (nlp_lower_bound_inf = -1e19)
+      xu[i] = 2e19;
+    }
+    return true;
+  }
+  bool get_starting_point(Ipopt::Index n, bool init_x, Ipopt::Number* x, bool, Ipopt::Number*,
+                          Ipopt::Number*, Ipopt::Index, bool, Ipopt::Number*) override {
+    if (init_x) std::copy(x0_.data(), x0_.data() + n, x);
+    return true;
+  }
+  bool eval_f(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Number& f) override {
+    Eval(n, x);
+    f = E_;
+    return std::isfinite(E_);
+  }
+  bool eval_grad_f(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Number* g) override {
+    Eval(n, x);
+    std::copy(g_.data(), g_.data() + n, g);
+    return g_.allFinite();
+  }
+  bool eval_g(Ipopt::Index, const Ipopt::Number*, bool, Ipopt::Index, Ipopt::Number*) override {
+    return true;
+  }
+  bool eval_jac_g(Ipopt::Index, const Ipopt::Number*, bool, Ipopt::Index, Ipopt::Index,
+                  Ipopt::Index*, Ipopt::Index*, Ipopt::Number*) override {
+    return true;
+  }
+  bool eval_h(Ipopt::Index, const Ipopt::Number*, bool, Ipopt::Number obj_factor, Ipopt::Index,
+              const Ipopt::Number*, bool, Ipopt::Index, Ipopt::Index* rows, Ipopt::Index* cols,
+              Ipopt::Number* values) override {
+    // Gauss-Newton Hessian 2 A_ff per axis (lower triangle), constant in x.
+    Ipopt::Index q = 0;
+    for (int d = 0; d < 3; ++d) {
+      const auto& A = m_.A_ff(d);
+      for (int col = 0; col < A.outerSize(); ++col)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(A, col); it; ++it) {
+          if (it.row() < col) continue;
+          if (values) {
+            values[q] = 2.0 * obj_factor * it.value();
+          } else {
+            rows[q] = offset_[d] + static_cast<Ipopt::Index>(it.row());
+            cols[q] = offset_[d] + col;
+          }
+          ++q;
+        }
+    }
+    return true;
+  }
+  bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number,
+                             Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number,
+                             Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Index,
+                             const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
+    iterations = iter;
+    return true;
+  }
+  void finalize_solution(Ipopt::SolverReturn status, Ipopt::Index n, const Ipopt::Number* x,
+                         const Ipopt::Number*, const Ipopt::Number*, Ipopt::Index,
+                         const Ipopt::Number*, const Ipopt::Number*, Ipopt::Number,
+                         const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
+    Eigen::VectorXd xs = Eigen::Map<const Eigen::VectorXd>(x, n);
+    finished_ok = status == Ipopt::SUCCESS || status == Ipopt::STOP_AT_ACCEPTABLE_POINT ||
+                  status == Ipopt::MAXITER_EXCEEDED || status == Ipopt::STOP_AT_TINY_STEP;
+    status_text = "ipopt return code " + std::to_string(static_cast<int>(status));
+    if (xs.allFinite()) m_.ScatterFree(xs, X_);
+  }
+
+ private:
+  static int LowerNonZeros(const Eigen::SparseMatrix<double>& A) {
+    int n = 0;
+    for (int col = 0; col < A.outerSize(); ++col)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(A, col); it; ++it)
+        if (it.row() >= col) ++n;
+    return n;
+  }
+  void Eval(Ipopt::Index n, const Ipopt::Number* x) {
+    const Eigen::Map<const Eigen::VectorXd> xv(x, n);
+    if (have_ && xv == last_) return;
+    last_ = xv;
+    have_ = true;
+    work_ = *X_;
+    m_.ScatterFree(last_, &work_);
+    Eigen::MatrixX3d G;
+    E_ = FixedRatioEnergyAndGradient(m_, work_, ratios_, &G);
+    m_.GatherFree(G, &g_);
+  }
+  const Model& m_;
+  const std::vector<double>& ratios_;
+  Eigen::MatrixX3d* X_;
+  bool gn_;
+  Eigen::VectorXd x0_, last_, g_;
+  Eigen::MatrixX3d work_;
+  bool have_ = false;
+  double E_ = 0;
+  int offset_[3] = {0, 0, 0};
+};
+
+class IpoptFkSolver : public RatioUpdateSolver {
+ public:
+  IpoptFkSolver(std::shared_ptr<const Model> model, const FkOptions& options, bool newton)
+      : RatioUpdateSolver(std::move(model), options), newton_(newton) {}
+
+ protected:
+  InnerResult Minimize(const std::vector<double>& ratios, double grad_tol, int max_iterations,
+                       Eigen::MatrixX3d* X) override {
+    Ipopt::SmartPtr<FkTnlp> nlp = new FkTnlp(*model_, ratios, X, newton_);
+    Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
+    auto& o = *app->Options();
+    // SOFTKIN_IPOPT_PRINT_LEVEL (0-12) shows Ipopt's own iteration log, for diagnosis.
+    const char* pl = std::getenv("SOFTKIN_IPOPT_PRINT_LEVEL");
+    o.SetIntegerValue("print_level", pl ? std::clamp(std::atoi(pl), 0, 12) : 0);
+    o.SetStringValue("sb", "yes");
+    o.SetStringValue("hessian_approximation", newton_ ? "exact" : "limited-memory");
+    o.SetStringValue("nlp_scaling_method", "none");
+    o.SetIntegerValue("max_iter", max_iterations);
+    // Unconstrained: the NLP error is the max-norm of the gradient; <= grad_tol keeps the 2-norm
+    // target of the ratio-update loop up to a factor sqrt(n), so aim the max-norm lower.
+    const double tol = grad_tol / std::sqrt(std::max(1, model_->num_free_dofs()));
+    o.SetNumericValue("tol", tol);
+    o.SetNumericValue("dual_inf_tol", tol);
+    o.SetIntegerValue("acceptable_iter", 0);
+    if (newton_) o.SetStringValue("hessian_constant", "yes");
+    InnerResult out;
+    if (app->Initialize() != Ipopt::Solve_Succeeded) {
+      out.ok = false;
+      out.message = "ipopt: initialisation failed";
+      return out;
+    }
+    const Ipopt::ApplicationReturnStatus st = app->OptimizeTNLP(nlp);
+    out.iterations = nlp->iterations;
+    if (!nlp->finished_ok) {
+      out.ok = false;
+      out.message = "ipopt stopped: " + nlp->status_text + " (application status " +
+                    std::to_string(static_cast<int>(st)) + ")";
+    }
+    return out;
+  }
+
+ private:
+  bool newton_;
+};
+
+}  // namespace
+
+bool HasCeresSolver() { return true; }
+bool HasIpoptSolver() { return true; }
+
+std::unique_ptr<FkSolver> MakeNlpSolver(std::shared_ptr<const Model> model, const FkOptions& options) {
+  if (options.solver == "ceres") return std::make_unique<CeresFkSolver>(std::move(model), options);
+  if (options.solver == "ipopt-lbfgs")
+    return std::make_unique<IpoptFkSolver>(std::move(model), options, false);
+  if (options.solver == "ipopt-newton")
+    return std::make_unique<IpoptFkSolver>(std::move(model), options, true);
+  throw std::invalid_argument("MakeNlpSolver: unknown solver '" + options.solver + "'");
+}
+
+}  // namespace softkin
