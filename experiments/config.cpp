@@ -156,7 +156,7 @@ void ApplySolverJson(const nlohmann::json& j, const std::string& where, FkOption
     auto need = [&](bool ok, const char* what) {
       if (!ok) throw std::invalid_argument(where + "." + k + ": expected " + what + ", got " + Dump(v));
     };
-    if (k == "solver") { need(v.is_string(), "a solver name (lg, lg-aa)"); o->solver = v.get<std::string>(); }
+    if (k == "solver") { need(v.is_string(), "a solver name (lg, lg-aa, ceres, ipopt-lbfgs, ipopt-newton)"); o->solver = v.get<std::string>(); }
     else if (k == "max_iterations") { need(v.is_number_integer(), "an integer"); o->max_iterations = v.get<int>(); }
     else if (k == "tolerance") { need(v.is_number(), "a number"); o->tolerance = v.get<double>(); }
     else if (k == "gradient_tolerance") { need(v.is_number(), "a number"); o->gradient_tolerance = v.get<double>(); }
@@ -164,10 +164,11 @@ void ApplySolverJson(const nlohmann::json& j, const std::string& where, FkOption
     else if (k == "anderson_safeguard") { need(v.is_string(), "one of hybrid, energy, none"); o->anderson_safeguard = v.get<std::string>(); }
     else if (k == "continuation_steps") { need(v.is_number_integer(), "an integer"); o->continuation_steps = v.get<int>(); }
     else if (k == "threads") { need(v.is_number_integer(), "an integer"); o->threads = v.get<int>(); }
+    else if (k == "time_limit_s") { need(v.is_number(), "a number of seconds"); o->time_limit_s = v.get<double>(); }
     else
       throw std::invalid_argument(where + "." + k + ": unknown key (expected one of solver, "
                                   "max_iterations, tolerance, gradient_tolerance, anderson_window, "
-                                  "anderson_safeguard, continuation_steps, threads)");
+                                  "anderson_safeguard, continuation_steps, threads, time_limit_s)");
   }
   std::string why;
   if (!o->IsValid(&why)) throw std::invalid_argument(where + ": " + why);

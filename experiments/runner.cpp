@@ -23,6 +23,7 @@ const Entry kExperiments[] = {
     {"pneumatic_bending", &RunPneumaticBending},
     {"resolution_sweep", &RunResolutionSweep},
     {"marker_sweep", &RunMarkerSweep},
+    {"solver_comparison", &RunSolverComparison},
     {"aa_ablation", &RunAaAblation},
     {"actuation_paths", &RunActuationPaths},
 };

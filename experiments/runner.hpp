@@ -42,5 +42,6 @@ nlohmann::json RunResolutionSweep(const Config& cfg, const std::string& dir, boo
 nlohmann::json RunAaAblation(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunActuationPaths(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunMarkerSweep(const Config& cfg, const std::string& dir, bool verbose);
+nlohmann::json RunSolverComparison(const Config& cfg, const std::string& dir, bool verbose);
 
 }  // namespace softkin

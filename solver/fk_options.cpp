@@ -22,6 +22,8 @@ bool FkOptions::IsValid(std::string* why) const {
                anderson_safeguard + "'");
   if (continuation_steps < 1) return bad("continuation_steps: expected an integer >= 1");
   if (threads < 0) return bad("threads: expected an integer >= 0");
+  if (!(time_limit_s >= 0.0) || !std::isfinite(time_limit_s))
+    return bad("time_limit_s: expected a number >= 0 (0: no limit)");
   return true;
 }
 

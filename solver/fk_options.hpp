@@ -28,6 +28,9 @@ struct FkOptions {
   int continuation_steps = 1;
   /// OpenMP threads for the local step (0 = library default).
   int threads = 0;
+  /// Wall-clock limit of one Solve() call in seconds (0 = none); when it runs out the solver
+  /// returns status time_limit with its last checked iterate. For comparisons that must end.
+  double time_limit_s = 0.0;
 
   bool IsValid(std::string* why) const;
 };

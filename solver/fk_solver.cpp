@@ -14,13 +14,14 @@ const char* FkStatusToString(FkStatus s) {
     case FkStatus::IterationCap: return "iteration_cap";
     case FkStatus::Diverged: return "diverged";
     case FkStatus::InvalidInput: return "invalid_input";
+    case FkStatus::TimeLimit: return "time_limit";
   }
   return "unknown";
 }
 
 bool FkStatusFromString(const std::string& s, FkStatus* out) {
   for (FkStatus v : {FkStatus::Converged, FkStatus::IterationCap, FkStatus::Diverged,
-                     FkStatus::InvalidInput})
+                     FkStatus::InvalidInput, FkStatus::TimeLimit})
     if (s == FkStatusToString(v)) {
       *out = v;
       return true;

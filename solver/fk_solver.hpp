@@ -12,7 +12,8 @@
 
 namespace softkin {
 
-enum class FkStatus { Converged, IterationCap, Diverged, InvalidInput };
+/// TimeLimit: FkOptions::time_limit_s ran out (the positions are the last checked iterate).
+enum class FkStatus { Converged, IterationCap, Diverged, InvalidInput, TimeLimit };
 const char* FkStatusToString(FkStatus s);
 bool FkStatusFromString(const std::string& s, FkStatus* out);
 

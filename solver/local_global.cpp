@@ -5,6 +5,7 @@
 #include "solver/targets.hpp"
 
 #include <chrono>
+#include <optional>
 #include <cmath>
 #include <stdexcept>
 
@@ -93,6 +94,12 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     accelerated = false;
   };
   for (int it = 0; it < options_.max_iterations; ++it) {
+    if (deadline_ && Clock::now() > *deadline_) {
+      X = X_good;
+      r->status = FkStatus::TimeLimit;
+      r->message = "time limit of " + std::to_string(options_.time_limit_s) + " s reached";
+      return;
+    }
     double E;
     local(&E);
     const double grad = residual();
@@ -196,12 +203,18 @@ FkResult LocalGlobalSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
   }
   const Eigen::VectorXd rest = m.scene().rest_actuation();
   const int K = warm_start ? 1 : options_.continuation_steps;  // a warm start is already close
+  std::optional<Clock::time_point> deadline;
+  if (options_.time_limit_s > 0)
+    deadline = t0 + std::chrono::duration_cast<Clock::duration>(
+                        std::chrono::duration<double>(options_.time_limit_s));
+  deadline_ = deadline ? &*deadline : nullptr;
   for (int s = 1; s <= K; ++s) {
     const Eigen::VectorXd cs = (K == 1) ? Eigen::VectorXd(c)
                                         : Eigen::VectorXd(rest + (c - rest) * (double(s) / K));
     SolveStage(cs, &r.positions, &r);
-    if (r.status == FkStatus::Diverged) break;
+    if (r.status == FkStatus::Diverged || r.status == FkStatus::TimeLimit) break;
   }
+  deadline_ = nullptr;
   ComputeLocalRatios(m, r.positions, c, &ratios_, &r.volume_ratios);
   r.energy = LocalStep(m, r.positions, ratios_, &weighted_, options_.threads);
   r.time_s = Seconds(t0, Clock::now());

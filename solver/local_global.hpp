@@ -22,6 +22,8 @@
 ///    value at the warm start and at the rest shape for the same actuation).
 #include "solver/fk_solver.hpp"
 
+#include <chrono>
+
 namespace softkin {
 
 class LocalGlobalSolver : public FkSolver {
@@ -39,6 +41,7 @@ class LocalGlobalSolver : public FkSolver {
   std::vector<ElemRows> weighted_;  // per-element w Vol T, reused across iterations
   std::vector<double> ratios_;
   double total_weight_ = 0.0;  // sum of w_i Vol_i: the scale of the residual's round-off floor
+  const std::chrono::steady_clock::time_point* deadline_ = nullptr;  // during Solve(), or none
   Eigen::VectorXd ref_c_;    // actuation of the cached reference residual
   double ref_value_ = 0.0;   // ||2 (A X_rest - B(X_rest; ref_c_))||
 };

@@ -71,6 +71,10 @@ class RatioUpdateSolver : public FkSolver {
     }
     const Eigen::VectorXd rest = m.scene().rest_actuation();
     const int K = warm_start ? 1 : options_.continuation_steps;
+    has_deadline_ = options_.time_limit_s > 0;
+    if (has_deadline_)
+      deadline_ = t0 + std::chrono::duration_cast<Clock::duration>(
+                           std::chrono::duration<double>(options_.time_limit_s));
     int updates = 0;
     for (int s = 1; s <= K; ++s) {
       const Eigen::VectorXd cs =
@@ -107,8 +111,15 @@ class RatioUpdateSolver : public FkSolver {
     return g.norm();
   }
 
+  /// Seconds left before the time limit (a large number without one).
+  double SecondsLeft() const {
+    return has_deadline_ ? Seconds(Clock::now(), deadline_) : 1e30;
+  }
+
   FkOptions options_;
   double total_weight_ = 0;
+  bool has_deadline_ = false;
+  Clock::time_point deadline_;
 
  private:
   /// One continuation stage; returns the number of ratio updates.
@@ -138,6 +149,11 @@ class RatioUpdateSolver : public FkSolver {
       if (updates > 0 && move < options_.tolerance &&
           (r->gradient_ratio < options_.gradient_tolerance || grad <= floor)) {
         r->status = FkStatus::Converged;
+        return updates;
+      }
+      if (SecondsLeft() <= 0) {
+        r->status = FkStatus::TimeLimit;
+        r->message = "time limit of " + std::to_string(options_.time_limit_s) + " s reached";
         return updates;
       }
       const int left = options_.max_iterations - r->iterations;
@@ -289,6 +305,7 @@ class CeresFkSolver : public RatioUpdateSolver {
     so.function_tolerance = 1e-16;
     so.parameter_tolerance = 1e-16;
     so.logging_type = ceres::SILENT;
+    so.max_solver_time_in_seconds = std::max(1e-3, std::min(1e9, SecondsLeft()));
     ceres::Solver::Summary summary;
     ceres::Solve(so, &problem, &summary);
 
@@ -311,8 +328,11 @@ class CeresFkSolver : public RatioUpdateSolver {
 
 class FkTnlp : public Ipopt::TNLP {
  public:
-  FkTnlp(const Model& m, const std::vector<double>& ratios, Eigen::MatrixX3d* X, bool gn_hessian)
-      : m_(m), ratios_(ratios), X_(X), gn_(gn_hessian) {
+  FkTnlp(const Model& m, const std::vector<double>& ratios, Eigen::MatrixX3d* X, bool gn_hessian,
+         double seconds_left)
+      : m_(m), ratios_(ratios), X_(X), gn_(gn_hessian),
+        deadline_(Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                     std::chrono::duration<double>(std::min(seconds_left, 1e9)))) {
     m.GatherFree(*X, &x0_);
     int off = 0;
     for (int d = 0; d < 3; ++d) {
@@ -391,7 +411,7 @@ class FkTnlp : public Ipopt::TNLP {
                              Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Index,
                              const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
     iterations = iter;
-    return true;
+    return Clock::now() < deadline_;  // false stops Ipopt (USER_REQUESTED_STOP) at the time limit
   }
   void finalize_solution(Ipopt::SolverReturn status, Ipopt::Index n, const Ipopt::Number* x,
                          const Ipopt::Number*, const Ipopt::Number*, Ipopt::Index,
@@ -399,7 +419,8 @@ class FkTnlp : public Ipopt::TNLP {
                          const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
     Eigen::VectorXd xs = Eigen::Map<const Eigen::VectorXd>(x, n);
     finished_ok = status == Ipopt::SUCCESS || status == Ipopt::STOP_AT_ACCEPTABLE_POINT ||
-                  status == Ipopt::MAXITER_EXCEEDED || status == Ipopt::STOP_AT_TINY_STEP;
+                  status == Ipopt::MAXITER_EXCEEDED || status == Ipopt::STOP_AT_TINY_STEP ||
+                  status == Ipopt::USER_REQUESTED_STOP;
     status_text = "ipopt return code " + std::to_string(static_cast<int>(status));
     if (xs.allFinite()) m_.ScatterFree(xs, X_);
   }
@@ -432,6 +453,7 @@ class FkTnlp : public Ipopt::TNLP {
   bool have_ = false;
   double E_ = 0;
   int offset_[3] = {0, 0, 0};
+  Clock::time_point deadline_;
 };
 
 class IpoptFkSolver : public RatioUpdateSolver {
@@ -442,7 +464,7 @@ class IpoptFkSolver : public RatioUpdateSolver {
  protected:
   InnerResult Minimize(const std::vector<double>& ratios, double grad_tol, int max_iterations,
                        Eigen::MatrixX3d* X) override {
-    Ipopt::SmartPtr<FkTnlp> nlp = new FkTnlp(*model_, ratios, X, newton_);
+    Ipopt::SmartPtr<FkTnlp> nlp = new FkTnlp(*model_, ratios, X, newton_, SecondsLeft());
     Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
     auto& o = *app->Options();
     // SOFTKIN_IPOPT_PRINT_LEVEL (0-12) shows Ipopt's own iteration log, for diagnosis.
