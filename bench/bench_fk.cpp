@@ -506,6 +506,49 @@ BENCHMARK(BM_RobotSolve)
     ->Unit(benchmark::kSecond)
     ->UseRealTime();
 
+/// The FK methods of table2_2 on one cold solve each, on a small mesh (three_chamber res 3, 2754
+/// tets, actuation (2, 1, 1)) and a medium one (pneumatic_finger res 5, 3600 tets, volume ratio
+/// 2.5), same stopping rule, 120 s wall-clock limit per solve. Counters: iterations, solve_s,
+/// ms_per_iter, converged (1/0), energy, and time_vs_lg_aa (this method's time over lg-aa's on
+/// the same case, measured in the same run).
+void BM_SolverCompare(benchmark::State& state) {
+  static const std::vector<std::string> kSolvers = {"lg-aa", "lg", "ceres", "ipopt-lbfgs",
+                                                    "ipopt-newton"};
+  static std::map<int, double> lg_aa_time;  // per case, from the lg-aa run (registered first)
+  const std::string name = kSolvers[state.range(1)];
+  const int which = static_cast<int>(state.range(0));
+  auto model = std::make_shared<const Model>(which == 0 ? MakeRobot("three_chamber", 3)
+                                                        : MakeRobot("pneumatic_finger", 5));
+  Eigen::VectorXd c = model->scene().rest_actuation();
+  c[0] = which == 0 ? 2.0 : 2.5;
+  FkOptions opts = model->scene().solver;
+  opts.solver = name;
+  opts.time_limit_s = 120;
+  opts.max_iterations = 100000;
+  FkResult r;
+  for (auto _ : state) {
+    auto solver = MakeFkSolver(model, opts);
+    r = solver->Solve(c);
+  }
+  if (name == "lg-aa") lg_aa_time[which] = r.time_s;
+  state.SetLabel(std::string(which == 0 ? "three_chamber res 3" : "pneumatic_finger res 5") +
+                 ", " + name + " (" + FkStatusToString(r.status) + ")");
+  state.counters["elements"] = model->mesh().num_elements();
+  state.counters["iterations"] = r.iterations;
+  state.counters["solve_s"] = r.time_s;
+  state.counters["ms_per_iter"] = r.iterations > 0 ? 1e3 * r.time_s / r.iterations : 0.0;
+  state.counters["converged"] = r.status == FkStatus::Converged ? 1 : 0;
+  state.counters["energy"] = r.energy;
+  if (lg_aa_time.count(which) && lg_aa_time[which] > 0)
+    state.counters["time_vs_lg_aa"] = r.time_s / lg_aa_time[which];
+}
+BENCHMARK(BM_SolverCompare)
+    ->ArgsProduct({{0, 1}, {0, 1, 2, 3, 4}})
+    ->ArgNames({"mesh", "solver"})
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond)
+    ->UseRealTime();
+
 }  // namespace
 }  // namespace softkin
 

@@ -158,7 +158,9 @@ TEST(RobotGrid, MultiSegmentGripperCurlsInPlane) {
                       [&](const Eigen::VectorXd& c, const FkResult& r) {
                         const Eigen::Vector3d p = Marker(s, r.positions, "tip");
                         EXPECT_NEAR(p.y(), tip0.y(), 1e-4 * size) << c.transpose();
-                        if (c.maxCoeff() > 1.0) EXPECT_LT(p.z(), tip0.z() - 1.0) << c.transpose();
+                        if (c.maxCoeff() > 1.0) {
+                          EXPECT_LT(p.z(), tip0.z() - 1.0) << c.transpose();
+                        }
                       }),
             0);
   // The grip layer belongs to the third segment, beyond P0.
@@ -233,8 +235,12 @@ TEST(RobotBimaterialBar, InterfaceFollowsTheParameterAndTheSofterSideStretchesMo
       const double strain_a = (xi - xi0) / xi0, strain_b = (L + 16.0 - xi - (L - xi0)) / (L - xi0);
       // A uniform bar stretches uniformly; B four times heavier stretches about four times less
       // (a series of two springs whose stiffness ratio is the weight ratio).
-      if (wb == 1.0) EXPECT_NEAR(strain_a / strain_b, 1.0, 0.02);
-      if (wb == 4.0) EXPECT_NEAR(strain_a / strain_b, 4.0, 0.4);
+      if (wb == 1.0) {
+        EXPECT_NEAR(strain_a / strain_b, 1.0, 0.02);
+      }
+      if (wb == 4.0) {
+        EXPECT_NEAR(strain_a / strain_b, 4.0, 0.4);
+      }
     }
   }
 }
