@@ -21,7 +21,6 @@ namespace {
 
 /// Methods named in the issue that this build does not run yet, with the reason.
 const std::map<std::string, std::string> kNotRun = {
-    {"ipopt-hard", "not implemented yet: hard volume constraints (Eq. 3.2) on the body energy"},
     {"calculix-linear", "not implemented yet: CalculiX .inp export and ccx run"},
     {"calculix-nonlinear", "not implemented yet: CalculiX .inp export and ccx run"},
     {"sofa", "SOFA is not available on this machine (no Debian package); no row is filled in"},

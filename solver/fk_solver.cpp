@@ -40,7 +40,7 @@ std::string FkResult::BriefReport() const {
 }
 
 std::vector<std::string> FkSolverNames() {
-  return {"lg", "lg-aa", "ceres", "ipopt-lbfgs", "ipopt-newton"};
+  return {"lg", "lg-aa", "ceres", "ipopt-lbfgs", "ipopt-newton", "ipopt-hard"};
 }
 
 std::unique_ptr<FkSolver> MakeFkSolver(std::shared_ptr<const Model> model, const FkOptions& options) {
@@ -48,7 +48,8 @@ std::unique_ptr<FkSolver> MakeFkSolver(std::shared_ptr<const Model> model, const
   if (!options.IsValid(&why)) throw std::invalid_argument("solver options: " + why);
   if (options.solver == "lg" || options.solver == "lg-aa")
     return std::make_unique<LocalGlobalSolver>(std::move(model), options);
-  if (options.solver == "ceres" || options.solver == "ipopt-lbfgs" || options.solver == "ipopt-newton")
+  if (options.solver == "ceres" || options.solver == "ipopt-lbfgs" ||
+      options.solver == "ipopt-newton" || options.solver == "ipopt-hard")
     return MakeNlpSolver(std::move(model), options);
   throw std::invalid_argument("unknown FK solver '" + options.solver + "'");
 }

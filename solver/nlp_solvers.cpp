@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
 
@@ -501,6 +502,288 @@ class IpoptFkSolver : public RatioUpdateSolver {
   bool newton_;
 };
 
+// ------------------------------------------------------------------------------------------------
+// Ipopt with hard actuation constraints ("the straightforward method" of Sec. 2.3.3)
+// ------------------------------------------------------------------------------------------------
+
+/// min sum over body elements w Vol ||N V^d - R N V||^2 subject to, for every active actuation
+/// group g, sum_i m_i(x) = rho_g (M_g + L_R) - L_R (chamber volume, Eq. 3.2; cable length; DEA
+/// area). The actuation elements carry no energy: their region only defines the measured
+/// quantity. L-BFGS Hessian (the constraints' Hessians are not formed).
+class HardTnlp : public Ipopt::TNLP {
+ public:
+  HardTnlp(const Model& m, const std::vector<double>& body_ratios, const std::vector<int>& groups,
+           const std::vector<double>& targets, Eigen::MatrixX3d* X, double seconds_left)
+      : m_(m), ratios_(body_ratios), groups_(groups), targets_(targets), X_(X),
+        deadline_(Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                     std::chrono::duration<double>(std::min(seconds_left, 1e9)))) {
+    m.GatherFree(*X, &x0_);
+    int off = 0;
+    for (int d = 0; d < 3; ++d) {
+      offset_[d] = off;
+      off += static_cast<int>(m.free_vertices(d).size());
+    }
+    // Jacobian sparsity: the free coordinates of each group's vertices.
+    for (int g : groups_) {
+      std::vector<int> cols;
+      for (int i : m.group_elements(g)) {
+        const ModelElement& e = m.elements()[i];
+        for (int j = 0; j < e.k; ++j)
+          for (int d = 0; d < 3; ++d) {
+            const int f = m.free_index(d)[e.v[j]];
+            if (f >= 0) cols.push_back(offset_[d] + f);
+          }
+      }
+      std::sort(cols.begin(), cols.end());
+      cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
+      jac_cols_.push_back(std::move(cols));
+    }
+  }
+  int iterations = 0;
+  Ipopt::SolverReturn status = Ipopt::INTERNAL_ERROR;
+  bool timed_out = false;
+  double max_violation = 0;
+
+  bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& mc, Ipopt::Index& nnz_jac, Ipopt::Index& nnz_h,
+                    IndexStyleEnum& style) override {
+    n = m_.num_free_dofs();
+    mc = static_cast<Ipopt::Index>(groups_.size());
+    nnz_jac = 0;
+    for (const auto& c : jac_cols_) nnz_jac += static_cast<Ipopt::Index>(c.size());
+    nnz_h = 0;
+    style = C_STYLE;
+    return true;
+  }
+  bool get_bounds_info(Ipopt::Index n, Ipopt::Number* xl, Ipopt::Number* xu, Ipopt::Index mc,
+                       Ipopt::Number* gl, Ipopt::Number* gu) override {
+    for (Ipopt::Index i = 0; i < n; ++i) {
+      xl[i] = -2e19;
+      xu[i] = 2e19;
+    }
+    for (Ipopt::Index q = 0; q < mc; ++q) gl[q] = gu[q] = 0.0;
+    return true;
+  }
+  bool get_starting_point(Ipopt::Index n, bool init_x, Ipopt::Number* x, bool, Ipopt::Number*,
+                          Ipopt::Number*, Ipopt::Index, bool, Ipopt::Number*) override {
+    if (init_x) std::copy(x0_.data(), x0_.data() + n, x);
+    return true;
+  }
+  bool eval_f(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Number& f) override {
+    Eval(n, x);
+    f = E_;
+    return std::isfinite(E_);
+  }
+  bool eval_grad_f(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Number* g) override {
+    Eval(n, x);
+    std::copy(g_.data(), g_.data() + n, g);
+    return g_.allFinite();
+  }
+  bool eval_g(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Index mc, Ipopt::Number* g) override {
+    Eval(n, x);
+    for (Ipopt::Index q = 0; q < mc; ++q) g[q] = measure_[q] - targets_[q];
+    return true;
+  }
+  bool eval_jac_g(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Index, Ipopt::Index,
+                  Ipopt::Index* rows, Ipopt::Index* cols, Ipopt::Number* values) override {
+    Ipopt::Index k = 0;
+    if (!values) {
+      for (size_t q = 0; q < jac_cols_.size(); ++q)
+        for (int c : jac_cols_[q]) {
+          rows[k] = static_cast<Ipopt::Index>(q);
+          cols[k++] = c;
+        }
+      return true;
+    }
+    Eval(n, x);
+    for (size_t q = 0; q < jac_cols_.size(); ++q)
+      for (int c : jac_cols_[q]) values[k++] = jac_[q][c];
+    return true;
+  }
+  bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number,
+                             Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number,
+                             Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Index,
+                             const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
+    iterations = iter;
+    timed_out = Clock::now() >= deadline_;
+    return !timed_out;
+  }
+  void finalize_solution(Ipopt::SolverReturn st, Ipopt::Index n, const Ipopt::Number* x,
+                         const Ipopt::Number*, const Ipopt::Number*, Ipopt::Index mc,
+                         const Ipopt::Number* g, const Ipopt::Number*, Ipopt::Number,
+                         const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
+    status = st;
+    const Eigen::Map<const Eigen::VectorXd> xs(x, n);
+    if (xs.allFinite()) m_.ScatterFree(Eigen::VectorXd(xs), X_);
+    max_violation = 0;
+    for (Ipopt::Index q = 0; q < mc; ++q)
+      max_violation = std::max(max_violation, std::abs(g[q]) / std::max(1e-300, std::abs(targets_[q])));
+  }
+
+ private:
+  void Eval(Ipopt::Index n, const Ipopt::Number* x) {
+    const Eigen::Map<const Eigen::VectorXd> xv(x, n);
+    if (have_ && xv == last_) return;
+    last_ = xv;
+    have_ = true;
+    work_ = *X_;
+    m_.ScatterFree(last_, &work_);
+    Eigen::MatrixX3d G;
+    E_ = FixedRatioEnergyAndGradient(m_, work_, ratios_, &G);
+    m_.GatherFree(G, &g_);
+    measure_.assign(groups_.size(), 0.0);
+    jac_.assign(groups_.size(), {});
+    for (size_t q = 0; q < groups_.size(); ++q) {
+      Eigen::MatrixX3d Gm = Eigen::MatrixX3d::Zero(m_.num_vertices(), 3);
+      for (int i : m_.group_elements(groups_[q])) {
+        const ModelElement& e = m_.elements()[i];
+        ElemRows P = ElemRows::Zero();
+        for (int j = 0; j < e.k; ++j) P.row(j) = work_.row(e.v[j]);
+        measure_[q] += ActuationMeasure(e, P);
+        const ElemRows gm = ActuationMeasureGradient(e, P);
+        for (int j = 0; j < e.k; ++j) Gm.row(e.v[j]) += gm.row(j);
+      }
+      Eigen::VectorXd gf;
+      m_.GatherFree(Gm, &gf);
+      jac_[q] = gf;
+    }
+  }
+  const Model& m_;
+  const std::vector<double>& ratios_;
+  const std::vector<int>& groups_;
+  const std::vector<double>& targets_;
+  Eigen::MatrixX3d* X_;
+  Clock::time_point deadline_;
+  Eigen::VectorXd x0_, last_, g_;
+  Eigen::MatrixX3d work_;
+  std::vector<double> measure_;
+  std::vector<Eigen::VectorXd> jac_;
+  std::vector<std::vector<int>> jac_cols_;
+  bool have_ = false;
+  double E_ = 0;
+  int offset_[3] = {0, 0, 0};
+};
+
+class IpoptHardSolver : public FkSolver {
+ public:
+  IpoptHardSolver(std::shared_ptr<const Model> model, const FkOptions& options)
+      : FkSolver(std::move(model)), options_(options) {}
+  std::string name() const override { return options_.solver; }
+
+  FkResult Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
+                 const Eigen::MatrixX3d* warm_start) override {
+    const Model& m = *model_;
+    const auto t0 = Clock::now();
+    FkResult r;
+    r.solver = name();
+    r.actuation = c;
+    r.positions = m.rest_positions();
+    try {
+      CheckActuation(m, c);
+      if (warm_start) {
+        if (warm_start->rows() != m.num_vertices())
+          throw std::invalid_argument("warm start: expected " + std::to_string(m.num_vertices()) +
+                                      " x 3 positions, got " + std::to_string(warm_start->rows()) +
+                                      " rows");
+        if (!warm_start->allFinite()) throw std::invalid_argument("warm start: positions must be finite");
+        r.positions = *warm_start;
+      }
+    } catch (const std::invalid_argument& e) {
+      r.status = FkStatus::InvalidInput;
+      r.message = e.what();
+      r.time_s = Seconds(t0, Clock::now());
+      return r;
+    }
+    Eigen::MatrixX3d& X = r.positions;
+    m.ApplyConstraints(c, &X);
+    // Active groups (the inactive side of a signed actuator is vented: no constraint) and their
+    // targets; every actuation element is left out of the energy (ratio kVented).
+    std::vector<double> ratios;
+    ComputeLocalRatios(m, X, c, &ratios);
+    std::vector<int> groups;
+    std::vector<double> targets;
+    for (int g = 0; g < m.num_groups(); ++g) {
+      const auto& ids = m.group_elements(g);
+      if (ids.empty() || ratios[ids[0]] == kVented) continue;
+      groups.push_back(g);
+      targets.push_back(m.GroupRatio(g, c) * (m.group_rest_measure(g) + m.group_offset(g)) -
+                        m.group_offset(g));
+    }
+    std::vector<double> body_ratios(m.elements().size(), 1.0);
+    for (size_t i = 0; i < m.elements().size(); ++i)
+      if (m.elements()[i].role != ElementRole::Body) body_ratios[i] = kVented;
+    // Reference gradient as for the other solvers (Eq. 2.10 at the rest shape for c).
+    Eigen::MatrixX3d Xr = m.rest_positions(), G;
+    m.ApplyConstraints(c, &Xr);
+    std::vector<double> rr;
+    ComputeLocalRatios(m, Xr, c, &rr);
+    FixedRatioEnergyAndGradient(m, Xr, rr, &G);
+    Eigen::VectorXd g0;
+    m.GatherFree(G, &g0);
+    const double ref = std::max(g0.norm(), 1e-12);
+
+    const double left = options_.time_limit_s > 0 ? options_.time_limit_s : 1e30;
+    Ipopt::SmartPtr<HardTnlp> nlp = new HardTnlp(m, body_ratios, groups, targets, &X, left);
+    Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
+    auto& o = *app->Options();
+    const char* pl = std::getenv("SOFTKIN_IPOPT_PRINT_LEVEL");
+    o.SetIntegerValue("print_level", pl ? std::clamp(std::atoi(pl), 0, 12) : 0);
+    o.SetStringValue("sb", "yes");
+    o.SetStringValue("hessian_approximation", "limited-memory");
+    o.SetStringValue("nlp_scaling_method", "none");
+    o.SetIntegerValue("max_iter", options_.max_iterations);
+    const double tol = options_.gradient_tolerance * ref / std::sqrt(std::max(1, m.num_free_dofs()));
+    o.SetNumericValue("tol", tol);
+    o.SetNumericValue("dual_inf_tol", tol);
+    double tscale = 0;
+    for (double t : targets) tscale = std::max(tscale, std::abs(t));
+    o.SetNumericValue("constr_viol_tol", 1e-8 * std::max(1.0, tscale));
+    o.SetIntegerValue("acceptable_iter", 0);
+    if (app->Initialize() != Ipopt::Solve_Succeeded) {
+      r.status = FkStatus::Diverged;
+      r.message = "ipopt: initialisation failed";
+    } else {
+      app->OptimizeTNLP(nlp);
+      r.iterations = nlp->iterations;
+      switch (nlp->status) {
+        case Ipopt::SUCCESS: r.status = FkStatus::Converged; break;
+        case Ipopt::MAXITER_EXCEEDED:
+          r.status = FkStatus::IterationCap;
+          r.message = "iteration cap of " + std::to_string(options_.max_iterations) + " reached";
+          break;
+        case Ipopt::USER_REQUESTED_STOP:
+          r.status = nlp->timed_out ? FkStatus::TimeLimit : FkStatus::Diverged;
+          r.message = "time limit of " + std::to_string(options_.time_limit_s) + " s reached";
+          break;
+        default:
+          r.status = FkStatus::Diverged;
+          r.message = "ipopt return code " + std::to_string(static_cast<int>(nlp->status));
+      }
+      if (!X.allFinite()) {
+        X = m.rest_positions();
+        m.ApplyConstraints(c, &X);
+        r.status = FkStatus::Diverged;
+        r.message = "ipopt returned non-finite positions";
+      }
+      char buf[96];
+      std::snprintf(buf, sizeof(buf), "largest relative constraint violation %.2e",
+                    nlp->max_violation);
+      r.message = r.message.empty() ? buf : r.message + "; " + buf;
+    }
+    // Report the Eq. 2.10 energy (with the local ratios at the result), as the other solvers do.
+    ComputeLocalRatios(m, X, c, &ratios, &r.volume_ratios);
+    Eigen::MatrixX3d Gx;
+    r.energy = FixedRatioEnergyAndGradient(m, X, ratios, &Gx);
+    Eigen::VectorXd gx;
+    m.GatherFree(Gx, &gx);
+    r.gradient_ratio = gx.norm() / ref;
+    r.time_s = Seconds(t0, Clock::now());
+    return r;
+  }
+
+ private:
+  FkOptions options_;
+};
+
 }  // namespace
 
 bool HasCeresSolver() { return true; }
@@ -512,6 +795,7 @@ std::unique_ptr<FkSolver> MakeNlpSolver(std::shared_ptr<const Model> model, cons
     return std::make_unique<IpoptFkSolver>(std::move(model), options, false);
   if (options.solver == "ipopt-newton")
     return std::make_unique<IpoptFkSolver>(std::move(model), options, true);
+  if (options.solver == "ipopt-hard") return std::make_unique<IpoptHardSolver>(std::move(model), options);
   throw std::invalid_argument("MakeNlpSolver: unknown solver '" + options.solver + "'");
 }
 

@@ -14,6 +14,14 @@
 ///    the rotations and targets frozen) as a Gauss-Newton Hessian: constant, sparse, positive
 ///    definite on the free coordinates. It is not the exact Hessian: it drops how the best-fit
 ///    rotations turn with x.
+///  - "ipopt-hard": the "straightforward method" Sec. 2.3.3 warns about. Only the body energy,
+///    and each active actuation group's measure held exactly by an equality constraint:
+///    sum_i Vol_i(x) = alpha U (Eq. 3.2; the chamber volume, its cavity being meshed), the cable
+///    length L_R + sum_i l_i |F_i d| = s L, the DEA area sum_i a_i = lambda A. The actuation
+///    elements carry no energy, so vertices inside a meshed cavity are free (their positions do
+///    not change the body energy nor the cavity volume; they stay where they start). L-BFGS
+///    Hessian. Its energy is reported as Eq. 2.10 at the result, for comparison; it does not
+///    minimise that energy.
 ///
 /// Actuation ratios. The local step distributes an actuator's ratio over its elements in
 /// proportion to their current measures (Sec. 2.3.3), so the targets depend on x through all
@@ -44,7 +52,7 @@ namespace softkin {
 bool HasCeresSolver();
 bool HasIpoptSolver();
 
-/// Builds "ceres", "ipopt-lbfgs" or "ipopt-newton" (options.solver). Throws std::invalid_argument
+/// Builds "ceres", "ipopt-lbfgs", "ipopt-newton" or "ipopt-hard" (options.solver). Throws std::invalid_argument
 /// for any other name.
 std::unique_ptr<FkSolver> MakeNlpSolver(std::shared_ptr<const Model> model, const FkOptions& options);
 

@@ -21,6 +21,7 @@ namespace softkin {
 namespace {
 
 const std::vector<std::string> kNlpSolvers = {"ceres", "ipopt-lbfgs", "ipopt-newton"};
+const std::vector<std::string> kAllNlpSolvers = {"ceres", "ipopt-lbfgs", "ipopt-newton", "ipopt-hard"};
 
 /// A 5 x 3 x 3 bar of 2 mm cells with a 3-cell chamber inside (region 1), x = 0 fixed.
 Scene ChamberBar(double r_omega = 1.0) {
@@ -152,10 +153,33 @@ TEST(NlpSolvers, IpoptMinimisesBlendedBodiesCeresRejectsThem) {
   EXPECT_LT(g.norm(), 1e-6 * g0.norm());
 }
 
+TEST(NlpSolvers, HardConstraintsHitTheVolumeExactly) {
+  // ipopt-hard: body energy only, the chamber volume held by an equality constraint. The volume
+  // ratio is met to the constraint tolerance (1e-8 relative), while the actuation elements of
+  // lg-aa are a soft constraint that the body holds back; both bend the bar the same way.
+  const Scene s = ChamberBar();
+  const Eigen::VectorXd c = Eigen::VectorXd::Constant(1, 1.5);
+  const FkResult hard = SolveWith(s, c, "ipopt-hard", 1e-6);
+  const FkResult soft = SolveWith(s, c, "lg-aa", 1e-8);
+  ASSERT_EQ(hard.status, FkStatus::Converged) << hard.BriefReport();
+  ASSERT_EQ(soft.status, FkStatus::Converged) << soft.BriefReport();
+  std::printf("  volume ratio: ipopt-hard %.9f, lg-aa %.6f (asked 1.5); %s\n", hard.volume_ratios[0],
+              soft.volume_ratios[0], hard.BriefReport().c_str());
+  EXPECT_NEAR(hard.volume_ratios[0], 1.5, 1e-6);
+  EXPECT_LT(soft.volume_ratios[0], 1.5);
+  EXPECT_GT(soft.volume_ratios[0], 1.0);
+  const int tip = s.marker_index("tip");
+  const Eigen::Vector3d t0 = s.marker_positions(s.mesh.vertices).row(tip).transpose();
+  const Eigen::Vector3d dh = s.marker_positions(hard.positions).row(tip).transpose() - t0;
+  const Eigen::Vector3d ds = s.marker_positions(soft.positions).row(tip).transpose() - t0;
+  EXPECT_GT(dh.dot(ds), 0.5 * dh.norm() * ds.norm());
+  EXPECT_TRUE(hard.positions.allFinite());
+}
+
 TEST(NlpSolvers, BadInputGivesInvalidInputNotAThrow) {
   const Scene s = ChamberBar();
   auto model = std::make_shared<const Model>(s);
-  for (const auto& name : kNlpSolvers) {
+  for (const auto& name : kAllNlpSolvers) {
     FkOptions o;
     o.solver = name;
     auto solver = MakeFkSolver(model, o);
@@ -171,7 +195,7 @@ TEST(NlpSolvers, BadInputGivesInvalidInputNotAThrow) {
   o.solver = "ipopt";
   std::string why;
   EXPECT_FALSE(o.IsValid(&why));
-  EXPECT_NE(why.find("ceres, ipopt-lbfgs, ipopt-newton"), std::string::npos) << why;
+  EXPECT_NE(why.find("ceres, ipopt-lbfgs, ipopt-newton, ipopt-hard"), std::string::npos) << why;
 }
 
 }  // namespace
