@@ -92,7 +92,7 @@ int RunCli(int argc, char** argv) {
   fk->add_option("--actuation", actuation, "Actuation values v1,v2,... in actuator order")->required();
   fk->add_option("--solver", solver_name,
                  "FK solver: lg (plain local-global), lg-aa (Anderson), ceres, ipopt-lbfgs, "
-                 "ipopt-newton or ipopt-hard (docs/solvers.md)");
+                 "ipopt-newton, ipopt-hard, calculix-linear or calculix-nonlinear (docs/solvers.md)");
   fk->add_option("--continuation", continuation, "Apply the actuation in this many steps");
   fk->add_option("--max-iterations", max_iter, "Iteration cap");
   fk->add_option("--tolerance", tolerance, "Per-iteration vertex move tolerance, relative to model size");

@@ -156,7 +156,7 @@ void ApplySolverJson(const nlohmann::json& j, const std::string& where, FkOption
     auto need = [&](bool ok, const char* what) {
       if (!ok) throw std::invalid_argument(where + "." + k + ": expected " + what + ", got " + Dump(v));
     };
-    if (k == "solver") { need(v.is_string(), "a solver name (lg, lg-aa, ceres, ipopt-lbfgs, ipopt-newton, ipopt-hard)"); o->solver = v.get<std::string>(); }
+    if (k == "solver") { need(v.is_string(), "a solver name (see softkin fk --help)"); o->solver = v.get<std::string>(); }
     else if (k == "max_iterations") { need(v.is_number_integer(), "an integer"); o->max_iterations = v.get<int>(); }
     else if (k == "tolerance") { need(v.is_number(), "a number"); o->tolerance = v.get<double>(); }
     else if (k == "gradient_tolerance") { need(v.is_number(), "a number"); o->gradient_tolerance = v.get<double>(); }

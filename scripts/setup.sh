@@ -47,6 +47,7 @@ PACKAGES=(
   libnlopt-cxx-dev
   libcgal-dev
   pkg-config
+  calculix-ccx
 )
 
 log() { echo "[setup] $*"; }

@@ -7,8 +7,10 @@ namespace softkin {
 bool FkOptions::IsValid(std::string* why) const {
   auto bad = [&](const std::string& m) { if (why) *why = m; return false; };
   if (solver != "lg" && solver != "lg-aa" && solver != "ceres" && solver != "ipopt-lbfgs" &&
-      solver != "ipopt-newton" && solver != "ipopt-hard")
-    return bad("solver: expected one of lg, lg-aa, ceres, ipopt-lbfgs, ipopt-newton, ipopt-hard; got '" +
+      solver != "ipopt-newton" && solver != "ipopt-hard" && solver != "calculix-linear" &&
+      solver != "calculix-nonlinear")
+    return bad("solver: expected one of lg, lg-aa, ceres, ipopt-lbfgs, ipopt-newton, ipopt-hard, "
+               "calculix-linear, calculix-nonlinear; got '" +
                solver + "'");
   if (max_iterations < 1) return bad("max_iterations: expected an integer >= 1");
   if (!(tolerance > 0.0) || !std::isfinite(tolerance)) return bad("tolerance: expected a number > 0");

@@ -1,5 +1,6 @@
 #include "solver/fk_solver.hpp"
 
+#include "solver/calculix.hpp"
 #include "solver/local_global.hpp"
 #include "solver/nlp_solvers.hpp"
 
@@ -40,7 +41,8 @@ std::string FkResult::BriefReport() const {
 }
 
 std::vector<std::string> FkSolverNames() {
-  return {"lg", "lg-aa", "ceres", "ipopt-lbfgs", "ipopt-newton", "ipopt-hard"};
+  return {"lg",         "lg-aa",           "ceres",           "ipopt-lbfgs",
+          "ipopt-newton", "ipopt-hard", "calculix-linear", "calculix-nonlinear"};
 }
 
 std::unique_ptr<FkSolver> MakeFkSolver(std::shared_ptr<const Model> model, const FkOptions& options) {
@@ -51,6 +53,11 @@ std::unique_ptr<FkSolver> MakeFkSolver(std::shared_ptr<const Model> model, const
   if (options.solver == "ceres" || options.solver == "ipopt-lbfgs" ||
       options.solver == "ipopt-newton" || options.solver == "ipopt-hard")
     return MakeNlpSolver(std::move(model), options);
+  if (options.solver == "calculix-linear" || options.solver == "calculix-nonlinear") {
+    CalculixOptions co;
+    co.law = options.solver == "calculix-linear" ? "linear" : "neo-hooke";
+    return std::make_unique<CalculixSolver>(std::move(model), options, co);
+  }
   throw std::invalid_argument("unknown FK solver '" + options.solver + "'");
 }
 

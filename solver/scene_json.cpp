@@ -222,9 +222,11 @@ const std::vector<KeySpec>& KeyTable() {
     t.push_back(Key("solver.solver", S, Opt,
                     "lg: plain local-global (Algorithm 1); lg-aa: Anderson-accelerated local-global; "
                     "ceres, ipopt-lbfgs, ipopt-newton: the same energy minimised by Ceres or Ipopt; "
-                    "ipopt-hard: body energy with hard actuation constraints (docs/solvers.md).")
+                    "ipopt-hard: body energy with hard actuation constraints; calculix-linear, "
+                    "calculix-nonlinear: FEM baselines by CalculiX (docs/solvers.md).")
                     .Def(fk.solver)
-                    .Choices({"lg", "lg-aa", "ceres", "ipopt-lbfgs", "ipopt-newton", "ipopt-hard"}));
+                    .Choices({"lg", "lg-aa", "ceres", "ipopt-lbfgs", "ipopt-newton", "ipopt-hard",
+                              "calculix-linear", "calculix-nonlinear"}));
     t.push_back(Key("solver.max_iterations", I, Opt, "Iteration limit (per continuation step).")
                     .Def(fk.max_iterations).AtLeast(1));
     t.push_back(Key("solver.tolerance", N, Opt,

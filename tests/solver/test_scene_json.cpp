@@ -788,7 +788,7 @@ TEST(SceneJsonErrors, ValidateMessagePassesThrough) {
 TEST(SceneJsonErrors, SolverOptions) {
   json j = TinyScene();
   j["solver"]["solver"] = "newton";
-  ExpectSceneError(j, {"solver.solver: expected one of: lg, lg-aa, ceres, ipopt-lbfgs, ipopt-newton, ipopt-hard, got \"newton\""});
+  ExpectSceneError(j, {"solver.solver: expected one of: lg, lg-aa, ceres, ipopt-lbfgs, ipopt-newton, ipopt-hard, calculix-linear, calculix-nonlinear, got \"newton\""});
   j = TinyScene();
   j["solver"]["anderson_window"] = 0;
   ExpectSceneError(j, {"solver.anderson_window: expected an integer in [1, 50], got 0"});
