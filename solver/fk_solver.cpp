@@ -1,6 +1,7 @@
 #include "solver/fk_solver.hpp"
 
 #include "solver/calculix.hpp"
+#include "solver/energy.hpp"
 #include "solver/local_global.hpp"
 #include "solver/nlp_solvers.hpp"
 
@@ -38,6 +39,22 @@ std::string FkResult::BriefReport() const {
   std::string s = buf;
   if (!message.empty()) s += " (" + message + ")";
   return s;
+}
+
+std::string SolveInputError(const Model& m, const Eigen::Ref<const Eigen::VectorXd>& c,
+                            const Eigen::MatrixX3d* warm_start) {
+  try {
+    CheckActuation(m, c);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  if (warm_start) {
+    if (warm_start->rows() != m.num_vertices())
+      return "warm start: expected " + std::to_string(m.num_vertices()) + " x 3 positions, got " +
+             std::to_string(warm_start->rows()) + " rows";
+    if (!warm_start->allFinite()) return "warm start: positions must be finite";
+  }
+  return "";
 }
 
 std::vector<std::string> FkSolverNames() {

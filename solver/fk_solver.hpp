@@ -50,6 +50,11 @@ class FkSolver {
   std::shared_ptr<const Model> model_;
 };
 
+/// Checks an actuation vector (CheckActuation) and an optional warm start (#V x 3, finite) for
+/// `model`; returns "" or the reason. Every solver's Solve() reports it as invalid_input.
+std::string SolveInputError(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& c,
+                            const Eigen::MatrixX3d* warm_start);
+
 /// Names accepted by MakeFkSolver.
 std::vector<std::string> FkSolverNames();
 /// Builds the solver named options.solver; throws std::invalid_argument for an unknown name or

@@ -183,23 +183,15 @@ FkResult LocalGlobalSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
   r.solver = name();
   r.actuation = c;
   r.positions = m.rest_positions();
-  try {
-    CheckActuation(m, c);
-    if (warm_start) {
-      if (warm_start->rows() != m.num_vertices())
-        throw std::invalid_argument("warm start: expected " + std::to_string(m.num_vertices()) +
-                                    " x 3 positions, got " + std::to_string(warm_start->rows()) +
-                                    " rows");
-      if (!warm_start->allFinite())
-        throw std::invalid_argument("warm start: positions must be finite");
-      r.positions = *warm_start;
-      m.ApplyConstraints(c, &r.positions);
-    }
-  } catch (const std::invalid_argument& e) {
+  if (std::string why = SolveInputError(m, c, warm_start); !why.empty()) {
     r.status = FkStatus::InvalidInput;
-    r.message = e.what();
+    r.message = why;
     r.time_s = Seconds(t0, Clock::now());
     return r;
+  }
+  if (warm_start) {
+    r.positions = *warm_start;
+    m.ApplyConstraints(c, &r.positions);
   }
   const Eigen::VectorXd rest = m.scene().rest_actuation();
   const int K = warm_start ? 1 : options_.continuation_steps;  // a warm start is already close

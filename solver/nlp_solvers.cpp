@@ -53,23 +53,15 @@ class RatioUpdateSolver : public FkSolver {
     r.solver = name();
     r.actuation = c;
     r.positions = m.rest_positions();
-    try {
-      CheckActuation(m, c);
-      CheckSupported();
-      if (warm_start) {
-        if (warm_start->rows() != m.num_vertices())
-          throw std::invalid_argument("warm start: expected " + std::to_string(m.num_vertices()) +
-                                      " x 3 positions, got " + std::to_string(warm_start->rows()) +
-                                      " rows");
-        if (!warm_start->allFinite()) throw std::invalid_argument("warm start: positions must be finite");
-        r.positions = *warm_start;
-      }
-    } catch (const std::invalid_argument& e) {
+    std::string why = SolveInputError(m, c, warm_start);
+    if (why.empty()) why = Unsupported();
+    if (!why.empty()) {
       r.status = FkStatus::InvalidInput;
-      r.message = e.what();
+      r.message = why;
       r.time_s = Seconds(t0, Clock::now());
       return r;
     }
+    if (warm_start) r.positions = *warm_start;
     const Eigen::VectorXd rest = m.scene().rest_actuation();
     const int K = warm_start ? 1 : options_.continuation_steps;
     has_deadline_ = options_.time_limit_s > 0;
@@ -94,8 +86,8 @@ class RatioUpdateSolver : public FkSolver {
   }
 
  protected:
-  /// Throws std::invalid_argument if the scene uses something this solver cannot express.
-  virtual void CheckSupported() const {}
+  /// "" or why the scene uses something this solver cannot express.
+  virtual std::string Unsupported() const { return ""; }
   /// Minimises E with `ratios` frozen, from X (prescribed coordinates already set), until the
   /// 2-norm of the gradient over the free coordinates is below grad_tol or max_iterations.
   virtual InnerResult Minimize(const std::vector<double>& ratios, double grad_tol, int max_iterations,
@@ -228,12 +220,13 @@ class CeresFkSolver : public RatioUpdateSolver {
   using RatioUpdateSolver::RatioUpdateSolver;
 
  protected:
-  void CheckSupported() const override {
+  std::string Unsupported() const override {
     for (const auto& [tag, mat] : model_->scene().body)
       if (mat.r_omega < 1.0)
-        throw std::invalid_argument("ceres: body region " + std::to_string(tag) + " has r_omega " +
-                                    std::to_string(mat.r_omega) +
-                                    "; the Ceres problem supports r_omega = 1 only (use ipopt-* or lg)");
+        return "ceres: body region " + std::to_string(tag) + " has r_omega " +
+               std::to_string(mat.r_omega) +
+               "; the Ceres problem supports r_omega = 1 only (use ipopt-* or lg)";
+    return "";
   }
 
   InnerResult Minimize(const std::vector<double>& ratios, double grad_tol, int max_iterations,
@@ -327,11 +320,15 @@ class CeresFkSolver : public RatioUpdateSolver {
 // Ipopt
 // ------------------------------------------------------------------------------------------------
 
-class FkTnlp : public Ipopt::TNLP {
+/// What the Ipopt problems share: the free vertex coordinates as unbounded variables, the energy
+/// with per-element ratios `ratios` (FixedRatioEnergyAndGradient) and its gradient cached per x,
+/// equality constraints g(x) = 0 (if any), the iteration count, a wall-clock deadline, and the
+/// final point written back to X.
+class VertexTnlp : public Ipopt::TNLP {
  public:
-  FkTnlp(const Model& m, const std::vector<double>& ratios, Eigen::MatrixX3d* X, bool gn_hessian,
-         double seconds_left)
-      : m_(m), ratios_(ratios), X_(X), gn_(gn_hessian),
+  VertexTnlp(const Model& m, const std::vector<double>& ratios, Eigen::MatrixX3d* X,
+             double seconds_left)
+      : m_(m), ratios_(ratios), X_(X),
         deadline_(Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                      std::chrono::duration<double>(std::min(seconds_left, 1e9)))) {
     m.GatherFree(*X, &x0_);
@@ -342,26 +339,16 @@ class FkTnlp : public Ipopt::TNLP {
     }
   }
   int iterations = 0;
-  bool finished_ok = false;
-  std::string status_text;
+  bool timed_out = false;
+  Ipopt::SolverReturn status = Ipopt::INTERNAL_ERROR;
 
-  bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& mc, Ipopt::Index& nnz_jac, Ipopt::Index& nnz_h,
-                    IndexStyleEnum& style) override {
-    n = m_.num_free_dofs();
-    mc = 0;
-    nnz_jac = 0;
-    nnz_h = 0;
-    if (gn_)
-      for (int d = 0; d < 3; ++d) nnz_h += LowerNonZeros(m_.A_ff(d));
-    style = C_STYLE;
-    return true;
-  }
-  bool get_bounds_info(Ipopt::Index n, Ipopt::Number* xl, Ipopt::Number* xu, Ipopt::Index,
-                       Ipopt::Number*, Ipopt::Number*) override {
+  bool get_bounds_info(Ipopt::Index n, Ipopt::Number* xl, Ipopt::Number* xu, Ipopt::Index mc,
+                       Ipopt::Number* gl, Ipopt::Number* gu) override {
     for (Ipopt::Index i = 0; i < n; ++i) {
       xl[i] = -2e19;  // Ipopt's "no bound" (nlp_lower_bound_inf = -1e19)
       xu[i] = 2e19;
     }
+    for (Ipopt::Index q = 0; q < mc; ++q) gl[q] = gu[q] = 0.0;
     return true;
   }
   bool get_starting_point(Ipopt::Index n, bool init_x, Ipopt::Number* x, bool, Ipopt::Number*,
@@ -378,6 +365,71 @@ class FkTnlp : public Ipopt::TNLP {
     Eval(n, x);
     std::copy(g_.data(), g_.data() + n, g);
     return g_.allFinite();
+  }
+  bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number,
+                             Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number,
+                             Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Index,
+                             const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
+    iterations = iter;
+    timed_out = Clock::now() >= deadline_;
+    return !timed_out;  // false stops Ipopt (USER_REQUESTED_STOP)
+  }
+  void finalize_solution(Ipopt::SolverReturn st, Ipopt::Index n, const Ipopt::Number* x,
+                         const Ipopt::Number*, const Ipopt::Number*, Ipopt::Index mc,
+                         const Ipopt::Number* g, const Ipopt::Number*, Ipopt::Number,
+                         const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
+    status = st;
+    const Eigen::Map<const Eigen::VectorXd> xs(x, n);
+    if (xs.allFinite()) m_.ScatterFree(Eigen::VectorXd(xs), X_);
+    OnFinal(mc, g);
+  }
+
+ protected:
+  /// Extra work per new x (after the energy and gradient), and at the end (final g values).
+  virtual void OnEval(const Eigen::MatrixX3d&) {}
+  virtual void OnFinal(Ipopt::Index, const Ipopt::Number*) {}
+
+  void Eval(Ipopt::Index n, const Ipopt::Number* x) {
+    const Eigen::Map<const Eigen::VectorXd> xv(x, n);
+    if (have_ && xv == last_) return;
+    last_ = xv;
+    have_ = true;
+    work_ = *X_;
+    m_.ScatterFree(last_, &work_);
+    Eigen::MatrixX3d G;
+    E_ = FixedRatioEnergyAndGradient(m_, work_, ratios_, &G);
+    m_.GatherFree(G, &g_);
+    OnEval(work_);
+  }
+
+  const Model& m_;
+  const std::vector<double>& ratios_;
+  Eigen::MatrixX3d* X_;
+  Clock::time_point deadline_;
+  Eigen::VectorXd x0_, last_, g_;
+  Eigen::MatrixX3d work_;
+  bool have_ = false;
+  double E_ = 0;
+  int offset_[3] = {0, 0, 0};
+};
+
+/// The unconstrained problem of ipopt-lbfgs / ipopt-newton (Gauss-Newton Hessian 2 A_ff).
+class FkTnlp : public VertexTnlp {
+ public:
+  FkTnlp(const Model& m, const std::vector<double>& ratios, Eigen::MatrixX3d* X, bool gn_hessian,
+         double seconds_left)
+      : VertexTnlp(m, ratios, X, seconds_left), gn_(gn_hessian) {}
+
+  bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& mc, Ipopt::Index& nnz_jac, Ipopt::Index& nnz_h,
+                    IndexStyleEnum& style) override {
+    n = m_.num_free_dofs();
+    mc = 0;
+    nnz_jac = 0;
+    nnz_h = 0;
+    if (gn_)
+      for (int d = 0; d < 3; ++d) nnz_h += LowerNonZeros(m_.A_ff(d));
+    style = C_STYLE;
+    return true;
   }
   bool eval_g(Ipopt::Index, const Ipopt::Number*, bool, Ipopt::Index, Ipopt::Number*) override {
     return true;
@@ -407,24 +459,6 @@ class FkTnlp : public Ipopt::TNLP {
     }
     return true;
   }
-  bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number,
-                             Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number,
-                             Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Index,
-                             const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
-    iterations = iter;
-    return Clock::now() < deadline_;  // false stops Ipopt (USER_REQUESTED_STOP) at the time limit
-  }
-  void finalize_solution(Ipopt::SolverReturn status, Ipopt::Index n, const Ipopt::Number* x,
-                         const Ipopt::Number*, const Ipopt::Number*, Ipopt::Index,
-                         const Ipopt::Number*, const Ipopt::Number*, Ipopt::Number,
-                         const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
-    Eigen::VectorXd xs = Eigen::Map<const Eigen::VectorXd>(x, n);
-    finished_ok = status == Ipopt::SUCCESS || status == Ipopt::STOP_AT_ACCEPTABLE_POINT ||
-                  status == Ipopt::MAXITER_EXCEEDED || status == Ipopt::STOP_AT_TINY_STEP ||
-                  status == Ipopt::USER_REQUESTED_STOP;
-    status_text = "ipopt return code " + std::to_string(static_cast<int>(status));
-    if (xs.allFinite()) m_.ScatterFree(xs, X_);
-  }
 
  private:
   static int LowerNonZeros(const Eigen::SparseMatrix<double>& A) {
@@ -434,28 +468,22 @@ class FkTnlp : public Ipopt::TNLP {
         if (it.row() >= col) ++n;
     return n;
   }
-  void Eval(Ipopt::Index n, const Ipopt::Number* x) {
-    const Eigen::Map<const Eigen::VectorXd> xv(x, n);
-    if (have_ && xv == last_) return;
-    last_ = xv;
-    have_ = true;
-    work_ = *X_;
-    m_.ScatterFree(last_, &work_);
-    Eigen::MatrixX3d G;
-    E_ = FixedRatioEnergyAndGradient(m_, work_, ratios_, &G);
-    m_.GatherFree(G, &g_);
-  }
-  const Model& m_;
-  const std::vector<double>& ratios_;
-  Eigen::MatrixX3d* X_;
   bool gn_;
-  Eigen::VectorXd x0_, last_, g_;
-  Eigen::MatrixX3d work_;
-  bool have_ = false;
-  double E_ = 0;
-  int offset_[3] = {0, 0, 0};
-  Clock::time_point deadline_;
 };
+
+/// Ipopt options shared by the solvers: quiet unless SOFTKIN_IPOPT_PRINT_LEVEL (0-12) asks for
+/// Ipopt's own log; no automatic scaling; the max-norm tolerance `tol` on the KKT error; no
+/// "acceptable" early stop.
+void ConfigureIpopt(Ipopt::OptionsList& o, int max_iterations, double tol) {
+  const char* pl = std::getenv("SOFTKIN_IPOPT_PRINT_LEVEL");
+  o.SetIntegerValue("print_level", pl ? std::clamp(std::atoi(pl), 0, 12) : 0);
+  o.SetStringValue("sb", "yes");
+  o.SetStringValue("nlp_scaling_method", "none");
+  o.SetIntegerValue("max_iter", max_iterations);
+  o.SetNumericValue("tol", tol);
+  o.SetNumericValue("dual_inf_tol", tol);
+  o.SetIntegerValue("acceptable_iter", 0);
+}
 
 class IpoptFkSolver : public RatioUpdateSolver {
  public:
@@ -468,19 +496,10 @@ class IpoptFkSolver : public RatioUpdateSolver {
     Ipopt::SmartPtr<FkTnlp> nlp = new FkTnlp(*model_, ratios, X, newton_, SecondsLeft());
     Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
     auto& o = *app->Options();
-    // SOFTKIN_IPOPT_PRINT_LEVEL (0-12) shows Ipopt's own iteration log, for diagnosis.
-    const char* pl = std::getenv("SOFTKIN_IPOPT_PRINT_LEVEL");
-    o.SetIntegerValue("print_level", pl ? std::clamp(std::atoi(pl), 0, 12) : 0);
-    o.SetStringValue("sb", "yes");
+    // Unconstrained: the NLP error is the max-norm of the gradient; a max-norm below
+    // grad_tol / sqrt(n) keeps the 2-norm target of the ratio-update loop.
+    ConfigureIpopt(o, max_iterations, grad_tol / std::sqrt(std::max(1, model_->num_free_dofs())));
     o.SetStringValue("hessian_approximation", newton_ ? "exact" : "limited-memory");
-    o.SetStringValue("nlp_scaling_method", "none");
-    o.SetIntegerValue("max_iter", max_iterations);
-    // Unconstrained: the NLP error is the max-norm of the gradient; <= grad_tol keeps the 2-norm
-    // target of the ratio-update loop up to a factor sqrt(n), so aim the max-norm lower.
-    const double tol = grad_tol / std::sqrt(std::max(1, model_->num_free_dofs()));
-    o.SetNumericValue("tol", tol);
-    o.SetNumericValue("dual_inf_tol", tol);
-    o.SetIntegerValue("acceptable_iter", 0);
     if (newton_) o.SetStringValue("hessian_constant", "yes");
     InnerResult out;
     if (app->Initialize() != Ipopt::Solve_Succeeded) {
@@ -488,12 +507,16 @@ class IpoptFkSolver : public RatioUpdateSolver {
       out.message = "ipopt: initialisation failed";
       return out;
     }
-    const Ipopt::ApplicationReturnStatus st = app->OptimizeTNLP(nlp);
+    app->OptimizeTNLP(nlp);
     out.iterations = nlp->iterations;
-    if (!nlp->finished_ok) {
+    const Ipopt::SolverReturn st = nlp->status;
+    // Stopping short (iteration cap, time limit, tiny step) is fine here: the ratio-update loop
+    // decides with its own test; a failure is not.
+    if (!(st == Ipopt::SUCCESS || st == Ipopt::STOP_AT_ACCEPTABLE_POINT ||
+          st == Ipopt::MAXITER_EXCEEDED || st == Ipopt::STOP_AT_TINY_STEP ||
+          st == Ipopt::USER_REQUESTED_STOP)) {
       out.ok = false;
-      out.message = "ipopt stopped: " + nlp->status_text + " (application status " +
-                    std::to_string(static_cast<int>(st)) + ")";
+      out.message = "ipopt stopped with return code " + std::to_string(static_cast<int>(st));
     }
     return out;
   }
@@ -510,19 +533,11 @@ class IpoptFkSolver : public RatioUpdateSolver {
 /// group g, sum_i m_i(x) = rho_g (M_g + L_R) - L_R (chamber volume, Eq. 3.2; cable length; DEA
 /// area). The actuation elements carry no energy: their region only defines the measured
 /// quantity. L-BFGS Hessian (the constraints' Hessians are not formed).
-class HardTnlp : public Ipopt::TNLP {
+class HardTnlp : public VertexTnlp {
  public:
   HardTnlp(const Model& m, const std::vector<double>& body_ratios, const std::vector<int>& groups,
            const std::vector<double>& targets, Eigen::MatrixX3d* X, double seconds_left)
-      : m_(m), ratios_(body_ratios), groups_(groups), targets_(targets), X_(X),
-        deadline_(Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                     std::chrono::duration<double>(std::min(seconds_left, 1e9)))) {
-    m.GatherFree(*X, &x0_);
-    int off = 0;
-    for (int d = 0; d < 3; ++d) {
-      offset_[d] = off;
-      off += static_cast<int>(m.free_vertices(d).size());
-    }
+      : VertexTnlp(m, body_ratios, X, seconds_left), groups_(groups), targets_(targets) {
     // Jacobian sparsity: the free coordinates of each group's vertices.
     for (int g : groups_) {
       std::vector<int> cols;
@@ -539,10 +554,7 @@ class HardTnlp : public Ipopt::TNLP {
       jac_cols_.push_back(std::move(cols));
     }
   }
-  int iterations = 0;
-  Ipopt::SolverReturn status = Ipopt::INTERNAL_ERROR;
-  bool timed_out = false;
-  double max_violation = 0;
+  double max_violation = 0;  ///< largest |g_q| / |target_q| at the end
 
   bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& mc, Ipopt::Index& nnz_jac, Ipopt::Index& nnz_h,
                     IndexStyleEnum& style) override {
@@ -553,30 +565,6 @@ class HardTnlp : public Ipopt::TNLP {
     nnz_h = 0;
     style = C_STYLE;
     return true;
-  }
-  bool get_bounds_info(Ipopt::Index n, Ipopt::Number* xl, Ipopt::Number* xu, Ipopt::Index mc,
-                       Ipopt::Number* gl, Ipopt::Number* gu) override {
-    for (Ipopt::Index i = 0; i < n; ++i) {
-      xl[i] = -2e19;
-      xu[i] = 2e19;
-    }
-    for (Ipopt::Index q = 0; q < mc; ++q) gl[q] = gu[q] = 0.0;
-    return true;
-  }
-  bool get_starting_point(Ipopt::Index n, bool init_x, Ipopt::Number* x, bool, Ipopt::Number*,
-                          Ipopt::Number*, Ipopt::Index, bool, Ipopt::Number*) override {
-    if (init_x) std::copy(x0_.data(), x0_.data() + n, x);
-    return true;
-  }
-  bool eval_f(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Number& f) override {
-    Eval(n, x);
-    f = E_;
-    return std::isfinite(E_);
-  }
-  bool eval_grad_f(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Number* g) override {
-    Eval(n, x);
-    std::copy(g_.data(), g_.data() + n, g);
-    return g_.allFinite();
   }
   bool eval_g(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Index mc, Ipopt::Number* g) override {
     Eval(n, x);
@@ -599,37 +587,9 @@ class HardTnlp : public Ipopt::TNLP {
       for (int c : jac_cols_[q]) values[k++] = jac_[q][c];
     return true;
   }
-  bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number,
-                             Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number,
-                             Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Index,
-                             const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
-    iterations = iter;
-    timed_out = Clock::now() >= deadline_;
-    return !timed_out;
-  }
-  void finalize_solution(Ipopt::SolverReturn st, Ipopt::Index n, const Ipopt::Number* x,
-                         const Ipopt::Number*, const Ipopt::Number*, Ipopt::Index mc,
-                         const Ipopt::Number* g, const Ipopt::Number*, Ipopt::Number,
-                         const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
-    status = st;
-    const Eigen::Map<const Eigen::VectorXd> xs(x, n);
-    if (xs.allFinite()) m_.ScatterFree(Eigen::VectorXd(xs), X_);
-    max_violation = 0;
-    for (Ipopt::Index q = 0; q < mc; ++q)
-      max_violation = std::max(max_violation, std::abs(g[q]) / std::max(1e-300, std::abs(targets_[q])));
-  }
 
- private:
-  void Eval(Ipopt::Index n, const Ipopt::Number* x) {
-    const Eigen::Map<const Eigen::VectorXd> xv(x, n);
-    if (have_ && xv == last_) return;
-    last_ = xv;
-    have_ = true;
-    work_ = *X_;
-    m_.ScatterFree(last_, &work_);
-    Eigen::MatrixX3d G;
-    E_ = FixedRatioEnergyAndGradient(m_, work_, ratios_, &G);
-    m_.GatherFree(G, &g_);
+ protected:
+  void OnEval(const Eigen::MatrixX3d& X) override {
     measure_.assign(groups_.size(), 0.0);
     jac_.assign(groups_.size(), {});
     for (size_t q = 0; q < groups_.size(); ++q) {
@@ -637,30 +597,26 @@ class HardTnlp : public Ipopt::TNLP {
       for (int i : m_.group_elements(groups_[q])) {
         const ModelElement& e = m_.elements()[i];
         ElemRows P = ElemRows::Zero();
-        for (int j = 0; j < e.k; ++j) P.row(j) = work_.row(e.v[j]);
+        for (int j = 0; j < e.k; ++j) P.row(j) = X.row(e.v[j]);
         measure_[q] += ActuationMeasure(e, P);
         const ElemRows gm = ActuationMeasureGradient(e, P);
         for (int j = 0; j < e.k; ++j) Gm.row(e.v[j]) += gm.row(j);
       }
-      Eigen::VectorXd gf;
-      m_.GatherFree(Gm, &gf);
-      jac_[q] = gf;
+      m_.GatherFree(Gm, &jac_[q]);
     }
   }
-  const Model& m_;
-  const std::vector<double>& ratios_;
+  void OnFinal(Ipopt::Index mc, const Ipopt::Number* g) override {
+    max_violation = 0;
+    for (Ipopt::Index q = 0; q < mc; ++q)
+      max_violation = std::max(max_violation, std::abs(g[q]) / std::max(1e-300, std::abs(targets_[q])));
+  }
+
+ private:
   const std::vector<int>& groups_;
   const std::vector<double>& targets_;
-  Eigen::MatrixX3d* X_;
-  Clock::time_point deadline_;
-  Eigen::VectorXd x0_, last_, g_;
-  Eigen::MatrixX3d work_;
   std::vector<double> measure_;
   std::vector<Eigen::VectorXd> jac_;
   std::vector<std::vector<int>> jac_cols_;
-  bool have_ = false;
-  double E_ = 0;
-  int offset_[3] = {0, 0, 0};
 };
 
 class IpoptHardSolver : public FkSolver {
@@ -677,22 +633,13 @@ class IpoptHardSolver : public FkSolver {
     r.solver = name();
     r.actuation = c;
     r.positions = m.rest_positions();
-    try {
-      CheckActuation(m, c);
-      if (warm_start) {
-        if (warm_start->rows() != m.num_vertices())
-          throw std::invalid_argument("warm start: expected " + std::to_string(m.num_vertices()) +
-                                      " x 3 positions, got " + std::to_string(warm_start->rows()) +
-                                      " rows");
-        if (!warm_start->allFinite()) throw std::invalid_argument("warm start: positions must be finite");
-        r.positions = *warm_start;
-      }
-    } catch (const std::invalid_argument& e) {
+    if (std::string why = SolveInputError(m, c, warm_start); !why.empty()) {
       r.status = FkStatus::InvalidInput;
-      r.message = e.what();
+      r.message = why;
       r.time_s = Seconds(t0, Clock::now());
       return r;
     }
+    if (warm_start) r.positions = *warm_start;
     Eigen::MatrixX3d& X = r.positions;
     m.ApplyConstraints(c, &X);
     // Active groups (the inactive side of a signed actuator is vented: no constraint) and their
@@ -725,19 +672,12 @@ class IpoptHardSolver : public FkSolver {
     Ipopt::SmartPtr<HardTnlp> nlp = new HardTnlp(m, body_ratios, groups, targets, &X, left);
     Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
     auto& o = *app->Options();
-    const char* pl = std::getenv("SOFTKIN_IPOPT_PRINT_LEVEL");
-    o.SetIntegerValue("print_level", pl ? std::clamp(std::atoi(pl), 0, 12) : 0);
-    o.SetStringValue("sb", "yes");
+    ConfigureIpopt(o, options_.max_iterations,
+                   options_.gradient_tolerance * ref / std::sqrt(std::max(1, m.num_free_dofs())));
     o.SetStringValue("hessian_approximation", "limited-memory");
-    o.SetStringValue("nlp_scaling_method", "none");
-    o.SetIntegerValue("max_iter", options_.max_iterations);
-    const double tol = options_.gradient_tolerance * ref / std::sqrt(std::max(1, m.num_free_dofs()));
-    o.SetNumericValue("tol", tol);
-    o.SetNumericValue("dual_inf_tol", tol);
     double tscale = 0;
     for (double t : targets) tscale = std::max(tscale, std::abs(t));
     o.SetNumericValue("constr_viol_tol", 1e-8 * std::max(1.0, tscale));
-    o.SetIntegerValue("acceptable_iter", 0);
     if (app->Initialize() != Ipopt::Solve_Succeeded) {
       r.status = FkStatus::Diverged;
       r.message = "ipopt: initialisation failed";

@@ -158,20 +158,24 @@ const std::vector<KeySpec>& KeyTable() {
                     .Roles({"cable"}));
     t.push_back(Key("fixed", A, R,
                     "Vertices held at their rest positions: the union of the entries' selections."));
-    t.push_back(Key("fixed[].region", I, Sel, "Every vertex of the elements with this region tag."));
-    t.push_back(Key("fixed[].box", O, Sel, "Every vertex inside an axis-aligned box (bounds included)."));
-    t.push_back(Key("fixed[].box.min", V, R, "Lower corner [x, y, z]."));
-    t.push_back(Key("fixed[].box.max", V, R, "Upper corner [x, y, z]."));
-    t.push_back(Key("fixed[].plane", O, Sel, "Every vertex within `tolerance` of a plane."));
-    t.push_back(Key("fixed[].plane.point", V, R, "A point on the plane [x, y, z]."));
-    t.push_back(Key("fixed[].plane.normal", V, R, "Plane normal [x, y, z] (non-zero; normalised)."));
-    t.push_back(Key("fixed[].plane.tolerance", N, Opt, "Largest distance from the plane.")
-                    .Def(1e-6).AtLeast(0.0));
-    t.push_back(Key("fixed[].file", S, Sel,
-                    "Text file of vertex indices (whitespace-separated, '#' starts a comment), "
-                    "relative to the JSON's folder."));
-    t.push_back(Key("fixed[].base", I, Opt, "Index base of `file`: 0 or 1.")
-                    .Def(0).In(0, 1).With("file"));
+    // The vertex selectors shared by fixed[] and motions[]: exactly one of region, box, plane,
+    // file per entry.
+    auto selectors = [&](const std::string& p) {
+      t.push_back(Key(p + ".region", I, Sel, "Every vertex of the elements with this region tag."));
+      t.push_back(Key(p + ".box", O, Sel, "Every vertex inside an axis-aligned box (bounds included)."));
+      t.push_back(Key(p + ".box.min", V, R, "Lower corner [x, y, z]."));
+      t.push_back(Key(p + ".box.max", V, R, "Upper corner [x, y, z]."));
+      t.push_back(Key(p + ".plane", O, Sel, "Every vertex within `tolerance` of a plane."));
+      t.push_back(Key(p + ".plane.point", V, R, "A point on the plane [x, y, z]."));
+      t.push_back(Key(p + ".plane.normal", V, R, "Plane normal [x, y, z] (non-zero; normalised)."));
+      t.push_back(Key(p + ".plane.tolerance", N, Opt, "Largest distance from the plane.")
+                      .Def(1e-6).AtLeast(0.0));
+      t.push_back(Key(p + ".file", S, Sel,
+                      "Text file of vertex indices (whitespace-separated, '#' starts a comment), "
+                      "relative to the JSON's folder."));
+      t.push_back(Key(p + ".base", I, Opt, "Index base of `file`: 0 or 1.").Def(0).In(0, 1).With("file"));
+    };
+    selectors("fixed[]");
     t.push_back(Key("fixed[].axes", S, Opt,
                     "Coordinates held: any of x, y, z once each (e.g. \"z\" for vertices that "
                     "slide on a plane z = const, or a symmetry plane's normal axis).")
@@ -188,19 +192,7 @@ const std::vector<KeySpec>& KeyTable() {
                     "displacement: translation (mm) along `axis`; twist: rotation (degrees, "
                     "right-hand rule) about the line through `centre` along `axis`.")
                     .Choices({"displacement", "twist"}));
-    t.push_back(Key("motions[].region", I, Sel, "Move every vertex of the elements with this region tag."));
-    t.push_back(Key("motions[].box", O, Sel, "Move every vertex inside an axis-aligned box."));
-    t.push_back(Key("motions[].box.min", V, R, "Lower corner [x, y, z]."));
-    t.push_back(Key("motions[].box.max", V, R, "Upper corner [x, y, z]."));
-    t.push_back(Key("motions[].plane", O, Sel, "Move every vertex within `tolerance` of a plane."));
-    t.push_back(Key("motions[].plane.point", V, R, "A point on the plane [x, y, z]."));
-    t.push_back(Key("motions[].plane.normal", V, R, "Plane normal [x, y, z] (non-zero; normalised)."));
-    t.push_back(Key("motions[].plane.tolerance", N, Opt, "Largest distance from the plane.")
-                    .Def(1e-6).AtLeast(0.0));
-    t.push_back(Key("motions[].file", S, Sel,
-                    "Move the vertices listed in a text file (whitespace-separated indices, # comments)."));
-    t.push_back(Key("motions[].base", I, Opt, "Index base of `file`: 0 or 1.")
-                    .Def(0).In(0, 1).With("file"));
+    selectors("motions[]");
     t.push_back(Key("motions[].axis", V, R,
                     "Direction of the translation, or the rotation axis (non-zero; normalised)."));
     t.push_back(Key("motions[].centre", V, Opt, "A point on the rotation axis.")
