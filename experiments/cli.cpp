@@ -195,7 +195,13 @@ int RunCli(int argc, char** argv) {
       const Eigen::VectorXd c = ParseVector(actuation, "--actuation");
       auto model = std::make_shared<const Model>(scene);
       FkResult r = MakeFkSolver(model, opt)->Solve(c);
-      if (r.status == FkStatus::InvalidInput) throw std::invalid_argument("--actuation: " + r.message);
+      if (r.status == FkStatus::InvalidInput) {
+        // Bad values are the actuation's; anything else (a scene a solver cannot express, a
+        // missing ccx) is the solver's.
+        const bool actuation = r.message.rfind("actuation", 0) == 0;
+        throw std::invalid_argument((actuation ? "--actuation: " : "--solver " + opt.solver + ": ") +
+                                    r.message);
+      }
       std::cerr << r.BriefReport() << "\n";
       nlohmann::json j;
       j["status"] = FkStatusToString(r.status);

@@ -96,6 +96,12 @@ TEST(Cli, BadValuesNameTheOptionAndWhatWasExpected) {
   r = Cli("fk --robot three_chamber --res 3 --actuation 1,1,1 --solver magic");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.out.find("lg-aa"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("calculix-nonlinear"), std::string::npos) << r.out;
+  // A scene the chosen solver cannot express is the solver's error, not the actuation's.
+  r = Cli("fk --robot dea_crawler --res 4 --actuation 0.8 --solver calculix-linear");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("--solver calculix-linear: calculix: element 0 is a prism"), std::string::npos)
+      << r.out;
 }
 
 TEST(Cli, SceneSchemaPrintsKeys) {
