@@ -222,10 +222,8 @@ FkResult CalculixSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c, const
   const Model& m = *model_;
   const auto t0 = Clock::now();
   FkResult r;
-  r.solver = name_;
-  r.actuation = c;
-  r.positions = m.rest_positions();
   history_.clear();
+  const bool input_ok = StartResult(c, nullptr, &r);  // FEM loads from rest: no warm start
   auto finish = [&](FkStatus st, const std::string& msg) {
     r.status = st;
     r.message = msg;
@@ -238,6 +236,7 @@ FkResult CalculixSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c, const
     r.time_s = Seconds(t0, Clock::now());
     return r;
   };
+  if (!input_ok) return finish(FkStatus::InvalidInput, r.message);
   const std::string ccx = FindCcx();
   if (ccx.empty())
     return finish(FkStatus::InvalidInput,

@@ -57,6 +57,20 @@ std::string SolveInputError(const Model& m, const Eigen::Ref<const Eigen::Vector
   return "";
 }
 
+bool FkSolver::StartResult(const Eigen::Ref<const Eigen::VectorXd>& c,
+                           const Eigen::MatrixX3d* warm_start, FkResult* r) const {
+  r->solver = name();
+  r->actuation = c;
+  r->positions = model_->rest_positions();
+  r->message = SolveInputError(*model_, c, warm_start);
+  if (!r->message.empty()) {
+    r->status = FkStatus::InvalidInput;
+    return false;
+  }
+  if (warm_start) r->positions = *warm_start;
+  return true;
+}
+
 std::vector<std::string> FkSolverNames() {
   return {"lg",         "lg-aa",           "ceres",           "ipopt-lbfgs",
           "ipopt-newton", "ipopt-hard", "calculix-linear", "calculix-nonlinear"};

@@ -47,6 +47,11 @@ class FkSolver {
 
  protected:
   explicit FkSolver(std::shared_ptr<const Model> m) : model_(std::move(m)) {}
+  /// Fills in what every Solve() starts from: the solver's name, the actuation, the positions
+  /// (the warm start, or the rest shape). Returns false, with status invalid_input and the reason
+  /// (SolveInputError) in *r, if c or the warm start is bad.
+  bool StartResult(const Eigen::Ref<const Eigen::VectorXd>& c, const Eigen::MatrixX3d* warm_start,
+                   FkResult* r) const;
   std::shared_ptr<const Model> model_;
 };
 

@@ -180,19 +180,11 @@ FkResult LocalGlobalSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
   const Model& m = *model_;
   const auto t0 = Clock::now();
   FkResult r;
-  r.solver = name();
-  r.actuation = c;
-  r.positions = m.rest_positions();
-  if (std::string why = SolveInputError(m, c, warm_start); !why.empty()) {
-    r.status = FkStatus::InvalidInput;
-    r.message = why;
+  if (!StartResult(c, warm_start, &r)) {
     r.time_s = Seconds(t0, Clock::now());
     return r;
   }
-  if (warm_start) {
-    r.positions = *warm_start;
-    m.ApplyConstraints(c, &r.positions);
-  }
+  if (warm_start) m.ApplyConstraints(c, &r.positions);
   const Eigen::VectorXd rest = m.scene().rest_actuation();
   const int K = warm_start ? 1 : options_.continuation_steps;  // a warm start is already close
   std::optional<Clock::time_point> deadline;

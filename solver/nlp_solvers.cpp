@@ -50,18 +50,12 @@ class RatioUpdateSolver : public FkSolver {
     const Model& m = *model_;
     const auto t0 = Clock::now();
     FkResult r;
-    r.solver = name();
-    r.actuation = c;
-    r.positions = m.rest_positions();
-    std::string why = SolveInputError(m, c, warm_start);
-    if (why.empty()) why = Unsupported();
-    if (!why.empty()) {
+    if (StartResult(c, warm_start, &r)) r.message = Unsupported();
+    if (!r.message.empty()) {
       r.status = FkStatus::InvalidInput;
-      r.message = why;
       r.time_s = Seconds(t0, Clock::now());
       return r;
     }
-    if (warm_start) r.positions = *warm_start;
     const Eigen::VectorXd rest = m.scene().rest_actuation();
     const int K = warm_start ? 1 : options_.continuation_steps;
     has_deadline_ = options_.time_limit_s > 0;
@@ -630,16 +624,10 @@ class IpoptHardSolver : public FkSolver {
     const Model& m = *model_;
     const auto t0 = Clock::now();
     FkResult r;
-    r.solver = name();
-    r.actuation = c;
-    r.positions = m.rest_positions();
-    if (std::string why = SolveInputError(m, c, warm_start); !why.empty()) {
-      r.status = FkStatus::InvalidInput;
-      r.message = why;
+    if (!StartResult(c, warm_start, &r)) {
       r.time_s = Seconds(t0, Clock::now());
       return r;
     }
-    if (warm_start) r.positions = *warm_start;
     Eigen::MatrixX3d& X = r.positions;
     m.ApplyConstraints(c, &X);
     // Active groups (the inactive side of a signed actuator is vented: no constraint) and their
