@@ -199,6 +199,21 @@ std::vector<std::pair<double, Eigen::MatrixX3d>> ReadCalculixDisplacements(const
   return out;
 }
 
+int CountConvergedIncrements(const std::string& sta) {
+  std::ifstream in(sta);
+  int n = 0;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream ss(line);
+    long step, inc;
+    std::string att;
+    if (ss >> step >> inc >> att && !att.empty() && att.back() != 'U' &&
+        att.find_first_not_of("0123456789") == std::string::npos)
+      ++n;
+  }
+  return n;
+}
+
 std::string FindCcx() {
   const char* path = std::getenv("PATH");
   if (!path) return "";
@@ -216,6 +231,7 @@ CalculixSolver::CalculixSolver(std::shared_ptr<const Model> model, const FkOptio
                                CalculixOptions options)
     : FkSolver(std::move(model)), name_(fk.solver), options_(std::move(options)) {
   if (fk.time_limit_s > 0 && options_.time_limit_s <= 0) options_.time_limit_s = fk.time_limit_s;
+  if (fk.continuation_steps > 1) options_.increments = fk.continuation_steps;
 }
 
 FkResult CalculixSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c, const Eigen::MatrixX3d*) {
@@ -280,8 +296,22 @@ FkResult CalculixSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c, const
   }
   int wstatus = 0;
   bool timed_out = false;
+  // Time-stamp each converged increment as it appears in job.sta (re-read only when it grows).
+  const std::string sta = (work / "job.sta").string();
+  std::vector<double> stamps;
+  std::uintmax_t sta_size = 0;
+  auto poll_sta = [&]() {
+    std::error_code ec;
+    const std::uintmax_t size = fs::file_size(sta, ec);
+    if (ec || size == sta_size) return;
+    sta_size = size;
+    const int n = CountConvergedIncrements(sta);
+    const double now = Seconds(t0, Clock::now());
+    while (static_cast<int>(stamps.size()) < n) stamps.push_back(now);
+  };
   for (;;) {
     const pid_t w = ::waitpid(pid, &wstatus, WNOHANG);
+    poll_sta();
     if (w == pid) break;
     if (w < 0) return finish(FkStatus::Diverged, "waitpid failed");
     if (options_.time_limit_s > 0 && Seconds(t0, Clock::now()) > options_.time_limit_s) {
@@ -290,20 +320,26 @@ FkResult CalculixSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c, const
       timed_out = true;
       break;
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
+  std::vector<std::pair<double, Eigen::MatrixX3d>> blocks;
   try {
-    history_ = ReadCalculixDisplacements((work / "job.dat").string(), m.num_vertices());
+    blocks = ReadCalculixDisplacements((work / "job.dat").string(), m.num_vertices());
   } catch (const std::runtime_error& e) {
     if (!timed_out) return finish(FkStatus::Diverged, std::string("ccx output: ") + e.what());
   }
-  for (auto& [t, U] : history_) U += m.rest_positions();
+  // Block k of job.dat is converged increment k of job.sta; a block ccx wrote after the last
+  // poll (possible only at the very end) gets the end time.
+  const double end_s = Seconds(t0, Clock::now());
+  for (size_t k = 0; k < blocks.size(); ++k)
+    history_.push_back({blocks[k].first, k < stamps.size() ? stamps[k] : end_s,
+                        blocks[k].second + m.rest_positions()});
   r.iterations = static_cast<int>(history_.size());
-  if (!history_.empty()) r.positions = history_.back().second;
+  if (!history_.empty()) r.positions = history_.back().positions;
   if (timed_out)
     return finish(FkStatus::TimeLimit,
                   "time limit of " + std::to_string(options_.time_limit_s) + " s reached");
-  const bool reached = !history_.empty() && std::abs(history_.back().first - 1.0) < 1e-6;
+  const bool reached = !history_.empty() && std::abs(history_.back().load - 1.0) < 1e-6;
   if (reached && r.positions.allFinite()) return finish(FkStatus::Converged, "");
   // The last error line of the log says why.
   std::ifstream lg(log);
@@ -313,7 +349,7 @@ FkResult CalculixSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c, const
   if (!r.positions.allFinite()) r.positions = m.rest_positions();
   char buf[64];
   std::snprintf(buf, sizeof(buf), "ccx stopped at time %.4g of 1",
-                history_.empty() ? 0.0 : history_.back().first);
+                history_.empty() ? 0.0 : history_.back().load);
   return finish(FkStatus::Diverged, std::string(buf) + (last.empty() ? "" : ": " + last));
 }
 

@@ -50,28 +50,44 @@ void WriteCalculixInput(const Model& model, const Eigen::Ref<const Eigen::Vector
 std::vector<std::pair<double, Eigen::MatrixX3d>> ReadCalculixDisplacements(const std::string& dat_path,
                                                                            int num_vertices);
 
+/// Number of converged increments listed so far in a ccx .sta file (its lines "STEP INC ATT ITRS
+/// ..." whose attempt column has no 'U', the mark of an attempt that was cut back). 0 if the file
+/// does not exist yet. Used to time-stamp increments while ccx runs.
+int CountConvergedIncrements(const std::string& sta_path);
+
 /// Path of the ccx executable found on PATH, or "" if there is none.
 std::string FindCcx();
+
+/// One converged CalculiX increment: its load fraction (the time of the temperature ramp, 0..1),
+/// the wall-clock time since Solve() started when ccx reported it, and the positions.
+struct CalculixIncrement {
+  double load = 0;
+  double wall_s = 0;
+  Eigen::MatrixX3d positions;
+};
 
 /// FK by CalculiX: writes the deck into a fresh temporary folder, runs ccx as a child process
 /// (argument list, no shell), parses the displacements and returns the final positions. Warm
 /// starts are ignored (FEM loads from the rest state in increments). status: converged if ccx
 /// reached time 1; diverged (with ccx's last message) otherwise; invalid_input if ccx is missing
 /// or the scene cannot be exported. iterations = increments completed. energy: Eq. 2.10 at the
-/// result, for comparison.
+/// result, for comparison. Increments: FkOptions::continuation_steps if > 1, else
+/// CalculixOptions::increments; ccx may cut an increment back, and every converged one is kept
+/// with the wall-clock time at which it was reported (increments()), so one run gives the time
+/// to every intermediate shape, as a FEM user would read it off the job's status file.
 class CalculixSolver : public FkSolver {
  public:
   CalculixSolver(std::shared_ptr<const Model> model, const FkOptions& fk, CalculixOptions options);
   std::string name() const override { return name_; }
   FkResult Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
                  const Eigen::MatrixX3d* warm_start = nullptr) override;
-  /// Tip trajectory etc.: the positions after each increment of the last Solve (time, positions).
-  const std::vector<std::pair<double, Eigen::MatrixX3d>>& increments() const { return history_; }
+  /// The converged increments of the last Solve, in load order.
+  const std::vector<CalculixIncrement>& increments() const { return history_; }
 
  private:
   std::string name_;
   CalculixOptions options_;
-  std::vector<std::pair<double, Eigen::MatrixX3d>> history_;
+  std::vector<CalculixIncrement> history_;
 };
 
 }  // namespace softkin

@@ -159,6 +159,22 @@ TEST(Calculix, DatReaderAcceptsIncrementsAndRejectsBadFiles) {
   fs::remove(p);
 }
 
+TEST(Calculix, StaCounterSkipsCutBackAttempts) {
+  const fs::path p = TempFile("job.sta");
+  EXPECT_EQ(CountConvergedIncrements(p.string()), 0);  // not written yet
+  {
+    std::ofstream o(p);
+    o << "SUMMARY OF JOB INFORMATION\n"
+         "  STEP      INC     ATT  ITRS     TOT TIME     STEP TIME      INC TIME\n"
+         "     1          1     1U   11  0.000000E+00  0.000000E+00  0.833333E-01\n"
+         "     1          1     2    10  0.416667E-01  0.416667E-01  0.416667E-01\n"
+         "     1          2     1     5  0.833333E-01  0.833333E-01  0.416667E-01\n"
+         "     1          3     1U    9  0.833333E-01  0.833333E-01  0.416667E-01\n";
+  }
+  EXPECT_EQ(CountConvergedIncrements(p.string()), 2);
+  fs::remove(p);
+}
+
 TEST(Calculix, TinyRunBendsTheWayLgAaDoes) {
   const Scene s = BendingBar();
   const Eigen::VectorXd c = Eigen::VectorXd::Constant(1, 2.0);
@@ -184,6 +200,24 @@ TEST(Calculix, TinyRunBendsTheWayLgAaDoes) {
     // The fixed face does not move; the chamber has grown.
     for (int v : s.fixed) EXPECT_LT((r.positions.row(v) - s.mesh.vertices.row(v)).norm(), 1e-9);
     EXPECT_GT(r.volume_ratios[0], 1.2) << name;
+    // Five increments (continuation_steps), each time-stamped as ccx reported it: loads rise to 1,
+    // wall-clock times rise and stay within the run, the last increment is the result.
+    o.continuation_steps = 5;
+    auto model = std::make_shared<const Model>(s);
+    auto solver = MakeFkSolver(model, o);
+    const FkResult r5 = solver->Solve(c);
+    ASSERT_EQ(r5.status, FkStatus::Converged) << r5.BriefReport();
+    const auto& incs = dynamic_cast<const CalculixSolver&>(*solver).increments();
+    ASSERT_GE(incs.size(), 5u) << name;
+    for (size_t k = 1; k < incs.size(); ++k) {
+      EXPECT_GT(incs[k].load, incs[k - 1].load);
+      EXPECT_GE(incs[k].wall_s, incs[k - 1].wall_s);
+    }
+    EXPECT_NEAR(incs[0].load, 0.2, 1e-9) << "the first increment is 1/5 of the load";
+    EXPECT_DOUBLE_EQ(incs.back().load, 1.0);
+    EXPECT_GT(incs.front().wall_s, 0.0);
+    EXPECT_LE(incs.back().wall_s, r5.time_s);
+    EXPECT_EQ((incs.back().positions - r5.positions).norm(), 0.0);
   }
 }
 
