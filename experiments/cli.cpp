@@ -2,6 +2,7 @@
 
 #include "experiments/results.hpp"
 #include "experiments/runner.hpp"
+#include "solver/calibration.hpp"
 #include "solver/fk_solver.hpp"
 #include "solver/mesh_io.hpp"
 #include "solver/robots.hpp"
@@ -113,6 +114,24 @@ int RunCli(int argc, char** argv) {
   run->add_flag("--quick", ropt.quick, "Quick mode: the config's small 'quick' settings (for CI)");
   run->add_flag("--no-plot", no_plot, "Do not run the paper_figs plot script");
   run->add_option("--results", ropt.results_root, "Results root folder (default: results)");
+
+  // calibrate
+  auto* cal = app.add_subcommand(
+      "calibrate",
+      "Calibrate R_omega^A / R_omega^B from a measured elasticity ratio R_m (thesis Eq. 2.9, "
+      "Table 2.1) by elongation tests on bimaterial_bar (docs/calibration.md)");
+  double cal_rm = 0;
+  BarTestOptions bar_opt;
+  std::string cal_json;
+  bool cal_twist = false;
+  cal->add_option("--rm", cal_rm, "Measured elasticity ratio R_m = E_A / E_B (> 0)")->required();
+  cal->add_option("--res", bar_opt.res, "bimaterial_bar resolution (default: its own)");
+  cal->add_option("--interface", bar_opt.interface,
+                  "Interface position, fraction of the length from the fixed end (default 0.5)");
+  cal->add_option("--stretch", bar_opt.stretch_mm, "End displacement of the elongation test, mm (default 8)");
+  cal->add_flag("--twist", cal_twist, "Also run the twisting test (Fig. 2.6d) with the result");
+  cal->add_option("--twist-deg", bar_opt.twist_deg, "End rotation of the twisting test, degrees (default 90)");
+  cal->add_option("--json", cal_json, "Write the result as JSON to this file");
 
   // scene
   auto* scene_cmd = app.add_subcommand("scene", "Check a scene JSON, or print its schema");
@@ -227,6 +246,26 @@ int RunCli(int argc, char** argv) {
       if (!vtu_out.empty()) WriteVtu(vtu_out, scene.mesh, r.positions);
       if (!obj_out.empty()) WriteSurfaceObj(obj_out, scene.mesh, r.positions);
       return r.status == FkStatus::Converged ? 0 : 1;
+    }
+    if (cal->parsed()) {
+      const CalibrationResult c = CalibrateROmega(cal_rm, bar_opt);
+      nlohmann::json j = {{"rm", c.target_rm},           {"r_omega_ratio", c.ratio},
+                          {"r_omega_a", c.r_omega_a},    {"r_omega_b", c.r_omega_b},
+                          {"achieved_rm", c.achieved_rm}, {"evaluations", c.evaluations},
+                          {"interface", bar_opt.interface}, {"stretch_mm", bar_opt.stretch_mm},
+                          {"res", bar_opt.res}};
+      std::cout << "R_omega^A / R_omega^B = " << c.ratio << "  (R_omega^A = " << c.r_omega_a
+                << ", R_omega^B = " << c.r_omega_b << "; simulated R_m = " << c.achieved_rm << " after "
+                << c.evaluations << " elongation tests)\n";
+      if (cal_twist) {
+        const TwistResult t = RunTwistTest(c.r_omega_a, c.r_omega_b, bar_opt);
+        j["twist"] = {{"twist_deg", t.twist_deg}, {"angle_a_deg", t.angle_a_deg},
+                      {"angle_b_deg", t.angle_b_deg}};
+        std::cout << "twisting test: end turned " << t.twist_deg << " deg; material A turns "
+                  << t.angle_a_deg << " deg, material B " << t.angle_b_deg << " deg\n";
+      }
+      if (!cal_json.empty()) WriteJson(cal_json, j);
+      return 0;
     }
     if (run->parsed()) {
       ropt.plot = !no_plot;

@@ -174,6 +174,7 @@ nlohmann::json RunSolverComparison(const Config& cfg, const std::string& dir, bo
     mj["iterations"] = iterations;
     mj["energy"] = r.energy;
     mj["status"] = status;
+    mj["message"] = r.message;  // the last solve's (why a method stopped)
     mj["steps_done"] = done;
     mj["total_s"] = cumulative;
     mj["final_bend_deg"] = bend(X);

@@ -24,6 +24,8 @@ const Entry kExperiments[] = {
     {"resolution_sweep", &RunResolutionSweep},
     {"marker_sweep", &RunMarkerSweep},
     {"solver_comparison", &RunSolverComparison},
+    {"calibration", &RunCalibration},
+    {"hyperelastic_fit", &RunHyperelasticFit},
     {"aa_ablation", &RunAaAblation},
     {"actuation_paths", &RunActuationPaths},
 };

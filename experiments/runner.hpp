@@ -43,5 +43,7 @@ nlohmann::json RunAaAblation(const Config& cfg, const std::string& dir, bool ver
 nlohmann::json RunActuationPaths(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunMarkerSweep(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunSolverComparison(const Config& cfg, const std::string& dir, bool verbose);
+nlohmann::json RunCalibration(const Config& cfg, const std::string& dir, bool verbose);
+nlohmann::json RunHyperelasticFit(const Config& cfg, const std::string& dir, bool verbose);
 
 }  // namespace softkin

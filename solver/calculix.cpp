@@ -108,10 +108,16 @@ void WriteCalculixInput(const Model& model, const Eigen::Ref<const Eigen::Vector
       throw std::invalid_argument("calculix: motion actuator '" + a.name + "' is not exported");
 
   // Materials and sections.
-  auto material = [&](const std::string& name, double E, double expansion) {
+  auto material = [&](const std::string& name, double E, double expansion, const Material* mr) {
     o << "*MATERIAL, NAME=" << name << "\n";
     if (opt.law == "linear") {
       o << "*ELASTIC\n" << Num(E) << ", " << Num(opt.poisson) << "\n";
+    } else if (mr) {
+      // A Mooney-Rivlin body region keeps its c1 : c2 ratio, scaled to the small-strain modulus E.
+      const double sc = E / (6.0 * (mr->c1 + mr->c2));
+      const double d1 = 6.0 * (1.0 - 2.0 * opt.poisson) / E;
+      o << "*HYPERELASTIC, MOONEY-RIVLIN\n" << Num(sc * mr->c1) << ", " << Num(sc * mr->c2) << ", "
+        << Num(d1) << "\n";
     } else {
       const double c10 = E / (4.0 * (1.0 + opt.poisson));
       const double d1 = 6.0 * (1.0 - 2.0 * opt.poisson) / E;
@@ -121,8 +127,11 @@ void WriteCalculixInput(const Model& model, const Eigen::Ref<const Eigen::Vector
   };
   for (const auto& [name, ids] : sets) {
     double E = opt.young, a = 0.0;
+    const Material* mr = nullptr;
     if (name[0] == 'R') {
-      E = s.body.at(std::stoi(name.substr(1))).weight * opt.young;
+      const Material& mat = s.body.at(std::stoi(name.substr(1)));
+      E = mat.weight * opt.young;
+      if (mat.hyperelastic()) mr = &mat;
     } else {
       const int g = std::stoi(name.substr(1));
       const Actuator& act = s.actuators[model.group_actuator(g)];
@@ -135,7 +144,7 @@ void WriteCalculixInput(const Model& model, const Eigen::Ref<const Eigen::Vector
         a = std::cbrt(model.GroupRatio(g, c)) - 1.0;
       }
     }
-    material("M" + name, E, a);
+    material("M" + name, E, a, mr);
     o << "*SOLID SECTION, ELSET=" << name << ", MATERIAL=M" << name << "\n";
   }
   const double dt = 1.0 / opt.increments;

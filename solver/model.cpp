@@ -23,6 +23,8 @@ Model::Model(const Scene& scene) : scene_(scene) {
   for (const auto& [tag, mat] : scene_.body) {
     role[tag] = {ElementRole::Body, -1};
     material[tag] = &mat;
+    if (mat.hyperelastic())
+      curves_.emplace(tag, FitMooneyRivlinROmega(MooneyRivlin{mat.c1, mat.c2}, mat.r_omega));
   }
   first_group_.assign(scene_.num_actuators(), -1);
   for (int a = 0; a < scene_.num_actuators(); ++a) {
@@ -60,6 +62,7 @@ Model::Model(const Scene& scene) : scene_(scene) {
     if (r == ElementRole::Body) {
       const Material& mat = *material.at(e.region);
       me.r_omega = mat.r_omega;
+      me.curve = curve(e.region);
       me.wv = mat.weight * me.rest_volume;
     } else {
       me.r_omega = 1.0;

@@ -4,12 +4,14 @@
 /// volumes, the vertex-element incidence and the global matrix of Eq. 2.11 with the fixed vertices
 /// eliminated, factored once with SuiteSparse CHOLMOD. Built once, then shared read-only.
 #include "solver/element_geometry.hpp"
+#include "solver/hyperelastic.hpp"
 #include "solver/scene.hpp"
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/Sparse>
 
 #include <array>
+#include <map>
 #include <memory>
 #include <vector>
 
@@ -26,6 +28,8 @@ struct ModelElement {
   double rest_volume = 0; ///< Vol_i, mm^3 (> 0)
   double wv = 0;          ///< w_i * Vol_i, the weight in Eq. 2.10
   double r_omega = 1.0;   ///< shape-blending parameter R_omega (Eq. 2.5), body elements
+  /// Hyperelastic body elements (Eq. 3.6-3.7): R_omega(strain), owned by the Model; else null.
+  const ROmegaCurve* curve = nullptr;
   ElemRows rest;          ///< N * V_i: centred rest shape (first k rows), mm
   /// Actuation elements (actuation.hpp): mu_i, the rest value of the constrained measure (volume,
   /// mm^3; mean triangle area, mm^2; the element's share l_i of the cable length, mm).
@@ -53,6 +57,11 @@ class Model {
   double size() const { return size_; }
 
   const std::vector<ModelElement>& elements() const { return elements_; }
+  /// The fitted R_omega(strain) of a hyperelastic body region, null for other regions.
+  const ROmegaCurve* curve(int region) const {
+    auto it = curves_.find(region);
+    return it == curves_.end() ? nullptr : &it->second;
+  }
 
   // ---- Actuation groups ----
   // A group is the set of actuation elements that share one constraint (Eq. 2.6-2.8): one per
@@ -135,6 +144,7 @@ class Model {
   Scene scene_;
   double size_ = 0;
   std::vector<ModelElement> elements_;
+  std::map<int, ROmegaCurve> curves_;  ///< per hyperelastic body region (stable addresses)
   std::vector<Group> groups_;
   std::vector<int> first_group_;  ///< per actuator: its first group, -1 for motion actuators
   std::array<std::vector<int>, 3> free_, free_index_;

@@ -216,7 +216,11 @@ class CeresFkSolver : public RatioUpdateSolver {
  protected:
   std::string Unsupported() const override {
     for (const auto& [tag, mat] : model_->scene().body)
-      if (mat.r_omega < 1.0)
+      if (mat.hyperelastic())
+        return "ceres: body region " + std::to_string(tag) +
+               " is hyperelastic (mooney-rivlin); the Ceres problem supports the blend law with "
+               "r_omega = 1 only (use ipopt-* or lg)";
+      else if (mat.r_omega < 1.0)
         return "ceres: body region " + std::to_string(tag) + " has r_omega " +
                std::to_string(mat.r_omega) +
                "; the Ceres problem supports r_omega = 1 only (use ipopt-* or lg)";
@@ -663,6 +667,10 @@ class IpoptHardSolver : public FkSolver {
     ConfigureIpopt(o, options_.max_iterations,
                    options_.gradient_tolerance * ref / std::sqrt(std::max(1, m.num_free_dofs())));
     o.SetStringValue("hessian_approximation", "limited-memory");
+    // Each volume constraint is a dense-ish row over the chamber's vertices. MUMPS's default
+    // ordering (SCOTCH here) then estimates a huge fill and fails to allocate (7.5 GB asked on the
+    // 46.7k-tet finger); QAMD detects dense rows and orders them last.
+    o.SetIntegerValue("mumps_pivot_order", 6);
     double tscale = 0;
     for (double t : targets) tscale = std::max(tscale, std::abs(t));
     o.SetNumericValue("constr_viol_tol", 1e-8 * std::max(1.0, tscale));

@@ -90,6 +90,13 @@ void Scene::validate() const {
            std::to_string(mat.r_omega));
     if (!(mat.weight > 0.0))
       fail("body region " + std::to_string(tag) + ": weight must be > 0");
+    if (mat.law != "blend" && mat.law != "mooney-rivlin")
+      fail("body region " + std::to_string(tag) + ": law must be \"blend\" or \"mooney-rivlin\", got \"" +
+           mat.law + "\"");
+    if (mat.hyperelastic() && !(mat.c1 >= 0 && mat.c2 >= 0 && mat.c1 + mat.c2 > 0 && mat.r_omega > 0))
+      fail("body region " + std::to_string(tag) + ": a mooney-rivlin material needs c1, c2 >= 0 "
+           "with c1 + c2 > 0 (MPa) and r_omega > 0, got c1 = " + std::to_string(mat.c1) +
+           ", c2 = " + std::to_string(mat.c2) + ", r_omega = " + std::to_string(mat.r_omega));
   }
   std::set<std::string> names;
   std::set<int> moved;

@@ -16,10 +16,17 @@ namespace softkin {
 
 /// A body material: the shape-blending parameter R_omega of Eq. 2.5 (1 = rigid target, i.e.
 /// as-rigid-as-possible; 0 = volume-preserving soft target) and the element weight w_i of Eq. 2.10.
+/// A body material. law "blend": Ch. 2 shape blending (Eq. 2.5) with a constant R_omega.
+/// law "mooney-rivlin": the hyperelastic target of Eq. 3.6-3.7 with R_omega a function of strain,
+/// fitted to the Mooney-Rivlin constants c1, c2 (MPa) with r_omega as its zero-strain value
+/// (solver/hyperelastic.hpp).
 struct Material {
   std::string name = "default";
   double r_omega = 1.0;
   double weight = 1.0;
+  std::string law = "blend";
+  double c1 = 0.0, c2 = 0.0;
+  bool hyperelastic() const { return law == "mooney-rivlin"; }
 };
 
 /// Element actuators (pneumatic, cable, DEA) drive actuation elements. Motion actuators

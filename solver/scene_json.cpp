@@ -4,6 +4,8 @@
 /// and the parser takes its defaults from it, so the documentation cannot drift from the code.
 #include "solver/scene_json.hpp"
 
+#include "solver/hyperelastic.hpp"
+
 #include "solver/mesh_io.hpp"
 
 #include <nlohmann/json.hpp>
@@ -117,8 +119,21 @@ const std::vector<KeySpec>& KeyTable() {
                     "body: passive material; pneumatic, cable, dea: the region's elements drive an "
                     "actuator.")
                     .Choices({"body", "pneumatic", "cable", "dea"}));
-    t.push_back(Key("regions[].material", S, Opt, "Material name (informational).")
+    t.push_back(Key("regions[].material", S, Opt,
+                    "Material name. With law mooney-rivlin, a named material (ecoflex-00-30, "
+                    "dragon-skin-20; thesis Sec. 3.4) supplies c1 and c2; otherwise informational.")
                     .Def(mat.name).Roles({"body"}));
+    t.push_back(Key("regions[].law", S, Opt,
+                    "Body material law: blend (Ch. 2 shape blending, Eq. 2.5, constant r_omega) or "
+                    "mooney-rivlin (hyperelastic target, Eq. 3.6-3.7: R_omega a function of strain "
+                    "fitted to c1, c2, with r_omega its zero-strain value; docs/materials.md).")
+                    .Def(mat.law).Choices({"blend", "mooney-rivlin"}).Roles({"body"}));
+    t.push_back(Key("regions[].c1", N, Opt,
+                    "mooney-rivlin: c1, MPa (>= 0). Needed unless 'material' names a known material.")
+                    .Def(0.0).DefText("from material").AtLeast(0.0).Roles({"body"}));
+    t.push_back(Key("regions[].c2", N, Opt,
+                    "mooney-rivlin: c2, MPa (>= 0). Needed unless 'material' names a known material.")
+                    .Def(0.0).DefText("from material").AtLeast(0.0).Roles({"body"}));
     t.push_back(Key("regions[].r_omega", N, Opt,
                     "Shape-blending parameter R_omega (Eq. 2.5): 1 = rigid target "
                     "(as-rigid-as-possible), 0 = volume-preserving soft target.")
@@ -700,6 +715,25 @@ void SceneParser::ReadRegions(const json& regions, Scene* scene) const {
       mat.name = Get(r, "regions[]", "material", role).get<std::string>();
       mat.r_omega = Get(r, "regions[]", "r_omega", role).get<double>();
       mat.weight = Get(r, "regions[]", "weight", role).get<double>();
+      mat.law = Get(r, "regions[]", "law", role).get<std::string>();
+      const bool has_c = r.contains("c1") || r.contains("c2");
+      if (has_c && !mat.hyperelastic())
+        Fail(path + ": c1 / c2 are given but law is \"" + mat.law +
+             "\"; expected law \"mooney-rivlin\" with them");
+      if (mat.hyperelastic()) {
+        MooneyRivlin mr;
+        const bool named = NamedMooneyRivlin(mat.name, &mr);
+        if (!named && !(r.contains("c1") && r.contains("c2"))) {
+          std::string names;
+          for (const auto& n : NamedMooneyRivlinNames()) names += (names.empty() ? "" : ", ") + n;
+          Fail(path + ": law mooney-rivlin needs c1 and c2 (MPa), or 'material' naming one of " +
+               names + "; got material \"" + mat.name + "\"");
+        }
+        mat.c1 = r.contains("c1") ? r.at("c1").get<double>() : mr.c1;
+        mat.c2 = r.contains("c2") ? r.at("c2").get<double>() : mr.c2;
+        if (!(mat.c1 + mat.c2 > 0)) Fail(path + ": expected c1 + c2 > 0 for law mooney-rivlin");
+        if (!(mat.r_omega > 0)) Fail(path + ".r_omega: expected a zero-strain R_omega > 0 for law mooney-rivlin");
+      }
       scene->body[tag] = mat;
       continue;
     }

@@ -57,6 +57,14 @@ void ComputeLocalRatios(const Model& model, const Eigen::Ref<const Eigen::Matrix
   }
 }
 
+Eigen::Matrix3d DeformationGradient(const ModelElement& e, const ElemRows& D) {
+  // Least-squares affine map of the centred rest rows onto the centred current rows (exact for a
+  // tet): D^T = F P^T, F = D^T P (P^T P)^-1.
+  const auto P = e.rest.topRows(e.k);
+  const Eigen::Matrix3d G = P.transpose() * P;
+  return (D.topRows(e.k).transpose() * P) * G.inverse();
+}
+
 void ElementTarget(const ModelElement& e, const ElemRows& D, double ratio, ElemRows* T) {
   const int k = e.k;
   if (ratio == kVented && e.role != ElementRole::Body) {
@@ -68,7 +76,15 @@ void ElementTarget(const ModelElement& e, const ElemRows& D, double ratio, ElemR
     // Best rotation from the rest shape to the current shape: max tr(R^T D^T P).
     const Eigen::Matrix3d R = BestRotation(D.topRows(k).transpose() * e.rest.topRows(k));
     T->topRows(k) = e.rest.topRows(k) * R.transpose();  // V^r = R V (rows), Eq. 2.3
-    if (e.r_omega < 1.0) {
+    if (e.curve) {
+      // Hyperelastic (Eq. 3.6-3.7): blend the current shape with the rotated rest shape by
+      // R_omega(strain), then rescale the blend to the rest volume.
+      const double rho = (*e.curve)(EquivalentStrain(DeformationGradient(e, D)));
+      T->topRows(k) = rho * T->topRows(k) + (1.0 - rho) * D.topRows(k);
+      const double vb = RowsVolume(*T, k);
+      const double s = vb > 1e-9 * e.rest_volume ? std::min(std::cbrt(e.rest_volume / vb), 10.0) : 10.0;
+      T->topRows(k) *= s;
+    } else if (e.r_omega < 1.0) {
       const double vd = RowsVolume(D, k);
       double s = 1.0;
       if (vd > 1e-9 * e.rest_volume) s = std::cbrt(e.rest_volume / vd);  // Eq. 2.4, volume restored

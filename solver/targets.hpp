@@ -5,6 +5,8 @@
 ///    the best rotation from the rest shape to the current one and S scales the current shape back
 ///    to the rest volume. Note: the thesis writes S = diag(r, r, r) with r = Vol(V)/Vol(V^d); a
 ///    uniform scale that restores the volume is the cube root of that ratio, which is what is used.
+///  - Hyperelastic body elements (Eq. 3.6-3.7, hyperelastic.hpp): the current shape blended with
+///    the rotated rest shape by R_omega(strain), rescaled to the rest volume.
 ///  - Actuation elements: the rest shape reshaped by the local ratio (actuation.hpp: pneumatic
 ///    cbrt(alpha_i) I, Eq. 2.8; cable shrink s_i along the cable, Eq. 2.6; DEA in-plane sqrt(lambda_i)
 ///    and thickness 1/lambda_i, Eq. 2.7), then rotated onto the current shape.
@@ -39,6 +41,10 @@ constexpr double kVented = -1.0;
 void ComputeLocalRatios(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
                         const Eigen::Ref<const Eigen::VectorXd>& c, std::vector<double>* ratios,
                         std::vector<double>* achieved = nullptr);
+
+/// Deformation gradient F of an element from its centred current rows D: the least-squares affine
+/// map of its centred rest rows onto D (exact for a tet).
+Eigen::Matrix3d DeformationGradient(const ModelElement& e, const ElemRows& D);
 
 /// Target of one element: D = N V^d (centred current rows), ratio = r_i (ignored for body). Writes the centred target T, already rotated to the current frame.
 void ElementTarget(const ModelElement& e, const ElemRows& D, double ratio, ElemRows* T);

@@ -256,7 +256,9 @@ TEST(RobotGrid, CableGripperTwoMaterialDistributions) {
     EXPECT_EQ(SolveGrid(s, {{1.0, 0.875, 0.75, 0.625, 0.5}},
                         [&](const Eigen::VectorXd& c, const FkResult& r) {
                           last = Marker(s, r.positions, "m3");
-                          if (c[0] < 1.0) EXPECT_GT(Marker(s, r.positions, "tip").z(), tip0.z() + 1.0);
+                          if (c[0] < 1.0) {
+                            EXPECT_GT(Marker(s, r.positions, "tip").z(), tip0.z() + 1.0);
+                          }
                         }),
               0)
         << label;

@@ -389,6 +389,35 @@ TEST(SceneJsonErrors, WrongTypeAndRange) {
   ExpectSceneError(j, {"fixed[2].base: expected an integer in [0, 1], got 2"});
 }
 
+TEST(SceneJsonTiny, MooneyRivlinMaterials) {
+  TempDir dir;
+  WriteTinyMesh(dir.path());
+  json j = TinyScene();
+  j["regions"][0] = {{"tag", 0}, {"role", "body"}, {"material", "dragon-skin-20"}, {"law", "mooney-rivlin"}};
+  Scene s = LoadFrom(dir.path(), j);
+  EXPECT_TRUE(s.body.at(0).hyperelastic());
+  EXPECT_DOUBLE_EQ(s.body.at(0).c1, 0.119);
+  EXPECT_DOUBLE_EQ(s.body.at(0).c2, 0.023);
+  j["regions"][0]["c2"] = 0.05;  // an explicit value overrides the named one
+  s = LoadFrom(dir.path(), j);
+  EXPECT_DOUBLE_EQ(s.body.at(0).c1, 0.119);
+  EXPECT_DOUBLE_EQ(s.body.at(0).c2, 0.05);
+  j["regions"][0] = {{"tag", 0}, {"role", "body"}, {"law", "mooney-rivlin"}, {"c1", 0.2}, {"c2", 0}};
+  s = LoadFrom(dir.path(), j);
+  EXPECT_DOUBLE_EQ(s.body.at(0).c1, 0.2);
+  // Errors: no constants, constants without the law, negative constants, unknown law.
+  j["regions"][0] = {{"tag", 0}, {"role", "body"}, {"material", "rubber"}, {"law", "mooney-rivlin"}};
+  ExpectSceneError(j, {"regions[0]: law mooney-rivlin needs c1 and c2", "ecoflex-00-30", "\"rubber\""});
+  j["regions"][0] = {{"tag", 0}, {"role", "body"}, {"c1", 0.1}, {"c2", 0.1}};
+  ExpectSceneError(j, {"regions[0]: c1 / c2 are given but law is \"blend\""});
+  j["regions"][0] = {{"tag", 0}, {"role", "body"}, {"law", "mooney-rivlin"}, {"c1", -0.1}, {"c2", 0.1}};
+  ExpectSceneError(j, {"regions[0].c1: expected a number >= 0, got -0.1"});
+  j["regions"][0] = {{"tag", 0}, {"role", "body"}, {"law", "ogden"}};
+  ExpectSceneError(j, {"regions[0].law: expected one of: blend, mooney-rivlin", "\"ogden\""});
+  j["regions"][0] = {{"tag", 0}, {"role", "body"}, {"law", "mooney-rivlin"}, {"c1", 0}, {"c2", 0}};
+  ExpectSceneError(j, {"regions[0]: expected c1 + c2 > 0"});
+}
+
 TEST(SceneJsonErrors, UnknownKeysAnywhere) {
   json j = TinyScene();
   j["fixed"][0] = json::parse(R"({"bx": {"min": [0, 0, 0], "max": [1, 1, 1]}})");
