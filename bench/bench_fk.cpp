@@ -248,6 +248,43 @@ void BM_LocalStep(benchmark::State& state) {
 }
 BENCHMARK(BM_LocalStep)->Apply(ResolutionSweep)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+/// The local step with the finger's body as Ch. 2 blend (law 0) or hyperelastic Ecoflex 00-30
+/// (law 1, Eq. 3.6-3.7: a deformation gradient, its strain and a volume rescale per element), at
+/// the same deformed positions. Counter law_cost: time over the blend's, measured in this run.
+void BM_LocalStepLaw(benchmark::State& state) {
+  const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
+  static std::map<int, std::shared_ptr<const Model>> hyper;
+  auto& hm = hyper[f.res];
+  if (!hm) {
+    Scene s = f.model->scene();
+    for (auto& [tag, mat] : s.body) mat = Material{"ecoflex-00-30", 1.0, mat.weight, "mooney-rivlin", 0.0418, 0.0106};
+    hm = std::make_shared<const Model>(s);
+  }
+  static std::map<int, double> blend_time;
+  const Model& m = state.range(1) ? *hm : *f.model;
+  std::vector<double> ratios;
+  std::vector<ElemRows> weighted;
+  ComputeLocalRatios(m, f.X, f.c, &ratios);
+  LocalStep(m, f.X, ratios, &weighted);
+  const auto t0 = Clock::now();
+  int64_t n = 0;
+  for (auto _ : state) {
+    double E = LocalStep(m, f.X, ratios, &weighted);
+    benchmark::DoNotOptimize(E);
+    ++n;
+  }
+  const double per = Since(t0) / std::max<int64_t>(n, 1);
+  if (!state.range(1)) blend_time[f.res] = per;
+  if (state.range(1) && blend_time.count(f.res)) state.counters["law_cost"] = per / blend_time[f.res];
+  SizeCounters(state, f, true);
+}
+BENCHMARK(BM_LocalStepLaw)
+    ->ArgNames({"res", "law"})
+    ->Args({12, 0})
+    ->Args({12, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
 /// Right-hand side gather sum_i w_i Vol_i S_i^T T_i (#V x 3).
 void BM_AssembleRhs(benchmark::State& state) {
   const Fixture& f = GetFixture(static_cast<int>(state.range(0)));

@@ -851,7 +851,7 @@ TEST(SceneJsonErrors, MeshReaderErrorPassesThrough) {
 // Every key the scene JSON accepts. The schema must list exactly these.
 const std::vector<std::string> kAllKeys = {
     "name", "mesh", "mesh.file", "mesh.format", "mesh.labels", "mesh.tag_array", "mesh.scale",
-    "regions", "regions[].tag", "regions[].role", "regions[].material", "regions[].r_omega",
+    "regions", "regions[].tag", "regions[].role", "regions[].material", "regions[].law", "regions[].c1", "regions[].c2", "regions[].r_omega",
     "regions[].weight", "regions[].name", "regions[].min", "regions[].max", "regions[].rest", "regions[].path",
     "regions[].side", "regions[].gain", "fixed[].axes", "motions", "motions[].name", "motions[].type",
     "motions[].region", "motions[].box", "motions[].box.min", "motions[].box.max", "motions[].plane",
