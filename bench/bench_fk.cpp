@@ -9,6 +9,7 @@
 //
 // See docs/benchmarks.md for what each benchmark measures and how to run them.
 #include "solver/anderson.hpp"
+#include "solver/collision.hpp"
 #include "solver/fk_solver.hpp"
 #include "solver/local_global.hpp"
 #include "solver/model.hpp"
@@ -278,6 +279,31 @@ void BM_LocalStepLaw(benchmark::State& state) {
   if (state.range(1) && blend_time.count(f.res)) state.counters["law_cost"] = per / blend_time[f.res];
   SizeCounters(state, f, true);
 }
+/// Self-collision detection (Sec. 3.2.2) at the deformed positions of the fixture: rebuilding the
+/// CGAL AABB tree over all tets at the new positions, then querying every boundary vertex.
+/// Counters: build_ms and query_ms (means), contacts found (none: the finger does not touch
+/// itself at alpha = 3).
+void BM_SelfCollision(benchmark::State& state) {
+  const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
+  SelfCollisionDetector d(f.model->scene().mesh);
+  double build = 0, query = 0;
+  size_t contacts = 0;
+  int64_t n = 0;
+  for (auto _ : state) {
+    d.Update(f.X);
+    contacts = d.Detect().size();
+    build += d.last_build_s();
+    query += d.last_query_s();
+    ++n;
+  }
+  state.counters["build_ms"] = 1e3 * build / std::max<int64_t>(n, 1);
+  state.counters["query_ms"] = 1e3 * query / std::max<int64_t>(n, 1);
+  state.counters["boundary_vertices"] = static_cast<double>(d.boundary_vertices().size());
+  state.counters["contacts"] = static_cast<double>(contacts);
+  SizeCounters(state, f, true);
+}
+BENCHMARK(BM_SelfCollision)->ArgName("res")->Arg(10)->Arg(12)->Arg(14)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 BENCHMARK(BM_LocalStepLaw)
     ->ArgNames({"res", "law"})
     ->Args({12, 0})
