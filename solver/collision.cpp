@@ -4,7 +4,9 @@
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Box_intersection_d/Box_with_info_d.h>
 #include <CGAL/Side_of_triangle_mesh.h>
+#include <CGAL/box_intersection_d.h>
 #include <CGAL/Surface_mesh.h>
 
 #include <algorithm>
@@ -356,7 +358,8 @@ struct SelfCollisionDetector::Impl {
   TetTree tree;
 };
 
-SelfCollisionDetector::SelfCollisionDetector(const Mesh& mesh) : impl_(std::make_unique<Impl>()) {
+SelfCollisionDetector::SelfCollisionDetector(const Mesh& mesh, Method method)
+    : impl_(std::make_unique<Impl>()), method_(method) {
   const int ne = mesh.num_elements();
   auto& I = *impl_;
   I.incident.assign(mesh.num_vertices(), {});
@@ -393,9 +396,11 @@ void SelfCollisionDetector::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) 
   const auto t0 = Clock::now();
   auto& I = *impl_;
   I.X = X;
-  I.tree.clear();
-  I.tree.rebuild(I.ids.begin(), I.ids.end(), TetData{&I.X, &I.tets});
-  I.tree.build();
+  if (method_ == Method::kAabbTree) {
+    I.tree.clear();
+    I.tree.rebuild(I.ids.begin(), I.ids.end(), TetData{&I.X, &I.tets});
+    I.tree.build();
+  }
   build_s_ = Seconds(t0);
 }
 
@@ -403,22 +408,57 @@ std::vector<SelfContact> SelfCollisionDetector::Detect() const {
   const auto t0 = Clock::now();
   const auto& I = *impl_;
   const int nb = static_cast<int>(boundary_.size());
+  // The exact test: the vertex is in the closed tet, which is not incident to it.
+  auto inside = [&](int v, int t) {
+    if (std::binary_search(I.incident[v].begin(), I.incident[v].end(), t)) return false;
+    const auto& tt = I.tets[t];
+    const K::Tetrahedron_3 tet(P(I.X, tt[0]), P(I.X, tt[1]), P(I.X, tt[2]), P(I.X, tt[3]));
+    return !tet.is_degenerate() && !tet.has_on_unbounded_side(P(I.X, v));
+  };
   std::vector<int> hit(nb, -1);
+  if (method_ == Method::kAabbTree) {
 #pragma omp parallel for schedule(dynamic, 64)
-  for (int q = 0; q < nb; ++q) {
-    const int v = boundary_[q];
-    const CPoint p = P(I.X, v);
-    std::vector<int> cand;
-    I.tree.all_intersected_primitives(p, std::back_inserter(cand));
-    for (int t : cand) {
-      if (std::binary_search(I.incident[v].begin(), I.incident[v].end(), t)) continue;
-      const auto& tt = I.tets[t];
-      const K::Tetrahedron_3 tet(P(I.X, tt[0]), P(I.X, tt[1]), P(I.X, tt[2]), P(I.X, tt[3]));
-      if (!tet.is_degenerate() && !tet.has_on_unbounded_side(p)) {
-        hit[q] = t;
-        break;
-      }
+    for (int q = 0; q < nb; ++q) {
+      const int v = boundary_[q];
+      std::vector<int> cand;
+      I.tree.all_intersected_primitives(P(I.X, v), std::back_inserter(cand));
+      std::sort(cand.begin(), cand.end());
+      for (int t : cand)
+        if (inside(v, t)) {
+          hit[q] = t;
+          break;
+        }
     }
+  } else {
+    // Broad phase: boxes of the boundary vertices (points) against boxes of the tets.
+    using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, int,
+                                                           CGAL::Box_intersection_d::ID_FROM_BOX_ADDRESS>;
+    std::vector<Box> vb, tb;
+    vb.reserve(nb);
+    for (int q = 0; q < nb; ++q) {
+      const int v = boundary_[q];
+      vb.emplace_back(CGAL::Bbox_3(I.X(v, 0), I.X(v, 1), I.X(v, 2), I.X(v, 0), I.X(v, 1), I.X(v, 2)), q);
+    }
+    tb.reserve(I.tets.size());
+    for (int t = 0; t < static_cast<int>(I.tets.size()); ++t) {
+      const auto& tt = I.tets[t];
+      Eigen::Vector3d lo = I.X.row(tt[0]).transpose(), hi = lo;
+      for (int k = 1; k < 4; ++k) {
+        lo = lo.cwiseMin(I.X.row(tt[k]).transpose());
+        hi = hi.cwiseMax(I.X.row(tt[k]).transpose());
+      }
+      tb.emplace_back(CGAL::Bbox_3(lo.x(), lo.y(), lo.z(), hi.x(), hi.y(), hi.z()), t);
+    }
+    std::vector<std::pair<int, int>> pairs;  // (boundary index, tet)
+    CGAL::box_intersection_d(vb.begin(), vb.end(), tb.begin(), tb.end(),
+                             [&](const Box& a, const Box& b) { pairs.emplace_back(a.info(), b.info()); });
+    std::sort(pairs.begin(), pairs.end());
+    const int np = static_cast<int>(pairs.size());
+    std::vector<char> ok(np, 0);
+#pragma omp parallel for schedule(static)
+    for (int k = 0; k < np; ++k) ok[k] = inside(boundary_[pairs[k].first], pairs[k].second);
+    for (int k = 0; k < np; ++k)
+      if (ok[k] && hit[pairs[k].first] < 0) hit[pairs[k].first] = pairs[k].second;
   }
   std::vector<SelfContact> out;
   for (int q = 0; q < nb; ++q)

@@ -8,9 +8,8 @@
 ///  - Self-collision: a boundary vertex of the robot lying inside (or on the boundary of) a
 ///    tetrahedron that is not incident to it (Eq. 3.3). On a conforming mesh a vertex touches
 ///    only its own tets, so the rest shape reports nothing; a vertex that crossed into the body
-///    is found even where it lies on a face shared by two tets. The robot's tree is a CGAL AABB tree over its tetrahedra,
-///    whose primitives read the current positions. CGAL's tree has no refit, so Update() rebuilds
-///    the hierarchy at the new positions: O(n log n), timed on its own in the reports.
+///    is found even where it lies on a face shared by two tets. The broad phase is
+///    CGAL::box_intersection_d (default) or a CGAL AABB tree over the tets (SelfCollisionDetector).
 /// Robot-obstacle contact (Eq. 3.4): a robot vertex strictly inside an obstacle.
 #include "solver/mesh.hpp"
 
@@ -85,15 +84,20 @@ struct ObstacleContact {
 };
 
 /// Self-collision detection over a tet mesh (prism elements are not supported: it throws
-/// std::invalid_argument).
+/// std::invalid_argument). Two broad phases, same exact test and same answer:
+///  - kBoxIntersection (default): CGAL::box_intersection_d between the boundary vertices' point
+///    boxes and the tets' boxes at the current positions; no hierarchy to keep up to date.
+///  - kAabbTree: a CGAL AABB tree over the tets, rebuilt by Update() (CGAL's tree has no refit),
+///    queried per boundary vertex.
 class SelfCollisionDetector {
  public:
-  explicit SelfCollisionDetector(const Mesh& mesh);
+  enum class Method { kBoxIntersection, kAabbTree };
+  explicit SelfCollisionDetector(const Mesh& mesh, Method method = Method::kBoxIntersection);
   ~SelfCollisionDetector();
-  /// Rebuilds the tree at positions X (#V x 3). Seconds spent are in last_build_s().
+  /// Takes positions X (#V x 3); kAabbTree rebuilds its tree. Seconds spent: last_build_s().
   void Update(const Eigen::Ref<const Eigen::MatrixX3d>& X);
   /// Boundary vertices inside (or on) a non-incident tet at the positions of the last Update
-  /// (each vertex once, with the first such tet found). Seconds spent are in last_query_s().
+  /// (each vertex once, with the lowest such tet id). Seconds spent are in last_query_s().
   std::vector<SelfContact> Detect() const;
   /// The boundary vertices (on faces that belong to one tet only), sorted.
   const std::vector<int>& boundary_vertices() const { return boundary_; }
@@ -103,6 +107,7 @@ class SelfCollisionDetector {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  Method method_;
   std::vector<int> boundary_;
   double build_s_ = 0;
   mutable double query_s_ = 0;

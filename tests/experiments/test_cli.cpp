@@ -33,7 +33,8 @@ std::string TempDir(const std::string& name) {
 }
 
 TEST(Cli, HelpOnEveryCommand) {
-  for (const char* c : {"--help", "robots --help", "fk --help", "run --help", "scene --help"}) {
+  for (const char* c : {"--help", "robots --help", "fk --help", "run --help", "scene --help",
+                        "calibrate --help"}) {
     const CliRun r = Cli(c);
     EXPECT_EQ(r.code, 0) << c << "\n" << r.out;
     EXPECT_NE(r.out.find("Usage"), std::string::npos) << c;
@@ -101,6 +102,20 @@ TEST(Cli, BadValuesNameTheOptionAndWhatWasExpected) {
   r = Cli("fk --robot dea_crawler --res 4 --actuation 0.8 --solver calculix-linear");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.out.find("--solver calculix-linear: calculix: element 0 is a prism"), std::string::npos)
+      << r.out;
+}
+
+TEST(Cli, CalibratePrintsTheRatioAndRejectsBadValues) {
+  CliRun r = Cli("calibrate --rm 3.75 --res 2");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("R_omega^A / R_omega^B = 5.6"), std::string::npos) << r.out;
+  r = Cli("calibrate --rm -1 --res 2");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("rm = -1, expected a finite elasticity ratio > 0"), std::string::npos) << r.out;
+  r = Cli("calibrate --rm 3 --interface 2");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("interface = 2, expected a fraction of the length in [0.05, 0.95]"),
+            std::string::npos)
       << r.out;
 }
 
