@@ -60,6 +60,10 @@ nlohmann::json RunSolverComparison(const Config& cfg, const std::string& dir, bo
   const double vmax = end_value_cfg > 0 ? end_value_cfg : act.FarEnd();
   if (vmax > act.max || vmax < act.min || vmax == act.rest)
     cfg.Fail("end_value", "a value in [min, max] of actuator '" + act.name + "', not its rest value");
+  for (const auto& m : methods)
+    if (m.rfind("calculix", 0) == 0 && (act.type != ActuatorType::Pneumatic || act.is_signed()))
+      cfg.Fail("methods", "no calculix-* method unless the first actuator is an unsigned pneumatic "
+                          "chamber (the FEM increments are read back as its volume ratio)");
   const int tip = scene.marker_index("tip");
   if (tip < 0 || scene.marker_index("tip_top") < 0 || scene.marker_index("tip_bottom") < 0)
     cfg.Fail("robot", "a robot with tip, tip_top and tip_bottom markers (e.g. pneumatic_finger)");
@@ -129,8 +133,9 @@ nlohmann::json RunSolverComparison(const Config& cfg, const std::string& dir, bo
       double prev = 0;
       Eigen::VectorXd ck = c;
       for (size_t k = 0; k < incs.size(); ++k) {
-        // A row per converged increment: its load, time, and Eq. 2.10 at its shape.
-        ck[0] = act.rest + (vmax - act.rest) * incs[k].load;
+        // A row per converged increment: the volume ratio its load stands for, its time, and
+        // Eq. 2.10 at its shape.
+        ck[0] = CalculixRatioAtLoad(vmax, incs[k].load);
         FkResult rk;
         rk.iterations = 1;
         rk.status = FkStatus::Converged;

@@ -208,6 +208,11 @@ std::vector<std::pair<double, Eigen::MatrixX3d>> ReadCalculixDisplacements(const
   return out;
 }
 
+double CalculixRatioAtLoad(double alpha, double load) {
+  const double r = 1.0 + (std::cbrt(alpha) - 1.0) * load;
+  return r * r * r;
+}
+
 int CountConvergedIncrements(const std::string& sta) {
   std::ifstream in(sta);
   int n = 0;

@@ -55,6 +55,11 @@ std::vector<std::pair<double, Eigen::MatrixX3d>> ReadCalculixDisplacements(const
 /// does not exist yet. Used to time-stamp increments while ccx runs.
 int CountConvergedIncrements(const std::string& sta_path);
 
+/// The chamber volume ratio a free chamber element has at load fraction `load` (0..1) of a run to
+/// ratio `alpha`: the expansion coefficient cbrt(alpha) - 1 ramps linearly with the load, so the
+/// ratio is (1 + (cbrt(alpha) - 1) load)^3, not linear in the load.
+double CalculixRatioAtLoad(double alpha, double load);
+
 /// Path of the ccx executable found on PATH, or "" if there is none.
 std::string FindCcx();
 

@@ -215,6 +215,9 @@ TEST(Calculix, TinyRunBendsTheWayLgAaDoes) {
     }
     EXPECT_NEAR(incs[0].load, 0.2, 1e-9) << "the first increment is 1/5 of the load";
     EXPECT_DOUBLE_EQ(incs.back().load, 1.0);
+    // The chamber ratio a load stands for: the expansion coefficient ramps with it.
+    EXPECT_DOUBLE_EQ(CalculixRatioAtLoad(2.0, 1.0), 2.0);
+    EXPECT_NEAR(CalculixRatioAtLoad(8.0, 0.5), 1.5 * 1.5 * 1.5, 1e-12);
     EXPECT_GT(incs.front().wall_s, 0.0);
     EXPECT_LE(incs.back().wall_s, r5.time_s);
     EXPECT_EQ((incs.back().positions - r5.positions).norm(), 0.0);
