@@ -9,7 +9,6 @@
 //
 // See docs/benchmarks.md for what each benchmark measures and how to run them.
 #include "solver/anderson.hpp"
-#include "solver/collision.hpp"
 #include "solver/fk_solver.hpp"
 #include "solver/local_global.hpp"
 #include "solver/model.hpp"
@@ -279,46 +278,6 @@ void BM_LocalStepLaw(benchmark::State& state) {
   if (state.range(1) && blend_time.count(f.res)) state.counters["law_cost"] = per / blend_time[f.res];
   SizeCounters(state, f, true);
 }
-/// Self-collision detection (Sec. 3.2.2) at the deformed positions of the fixture, by each broad
-/// phase (method 1: a CGAL AABB tree over the tets, rebuilt at the new positions, then queried per
-/// boundary vertex; method 0: CGAL::box_intersection_d of vertex and tet boxes), with the same
-/// exact test. Counters: build_ms and query_ms (means), contacts found (none: the finger does not
-/// touch itself at alpha = 3) and, for method 0, vs_aabb_tree: its time over the tree's in this
-/// run (registered after it).
-void BM_SelfCollision(benchmark::State& state) {
-  const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
-  const auto method = state.range(1) ? SelfCollisionDetector::Method::kAabbTree
-                                     : SelfCollisionDetector::Method::kBoxIntersection;
-  SelfCollisionDetector d(f.model->scene().mesh, method);
-  static std::map<int, double> tree_time;
-  double build = 0, query = 0;
-  size_t contacts = 0;
-  int64_t n = 0;
-  for (auto _ : state) {
-    d.Update(f.X);
-    contacts = d.Detect().size();
-    build += d.last_build_s();
-    query += d.last_query_s();
-    ++n;
-  }
-  n = std::max<int64_t>(n, 1);
-  state.counters["build_ms"] = 1e3 * build / n;
-  state.counters["query_ms"] = 1e3 * query / n;
-  state.counters["boundary_vertices"] = static_cast<double>(d.boundary_vertices().size());
-  state.counters["contacts"] = static_cast<double>(contacts);
-  if (state.range(1)) tree_time[f.res] = (build + query) / n;
-  else if (tree_time.count(f.res)) state.counters["vs_aabb_tree"] = (build + query) / n / tree_time[f.res];
-  SizeCounters(state, f, true);
-}
-BENCHMARK(BM_SelfCollision)
-    ->ArgNames({"res", "aabb_tree"})
-    ->Args({12, 1})
-    ->Args({12, 0})
-    ->Args({14, 1})
-    ->Args({14, 0})
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
-
 BENCHMARK(BM_LocalStepLaw)
     ->ArgNames({"res", "law"})
     ->Args({12, 0})

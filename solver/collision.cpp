@@ -11,14 +11,18 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <stdexcept>
+
+#include <omp.h>
 
 namespace softkin {
 
@@ -286,6 +290,8 @@ struct Obstacle::Impl {
 
 Obstacle::Obstacle(TriangleSurface surface) : surface_(std::move(surface)), impl_(std::make_unique<Impl>()) {
   CheckClosedSurface(&surface_);
+  box_min_ = surface_.vertices.colwise().minCoeff().transpose();
+  box_max_ = surface_.vertices.colwise().maxCoeff().transpose();
   auto& m = impl_->mesh;
   std::vector<SurfaceMesh::Vertex_index> vi;
   for (int i = 0; i < surface_.vertices.rows(); ++i) vi.push_back(m.add_vertex(P(surface_.vertices, i)));
@@ -306,6 +312,9 @@ Obstacle::Obstacle(Obstacle&&) noexcept = default;
 Obstacle& Obstacle::operator=(Obstacle&&) noexcept = default;
 
 bool Obstacle::Contains(const Eigen::Vector3d& p) const {
+  // A point strictly inside the closed surface lies in its (closed) bounding box; the box test
+  // is exact, so it only saves the ray casting.
+  if ((p.array() < box_min_.array()).any() || (p.array() > box_max_.array()).any()) return false;
   return (*impl_->inside)(CPoint(p.x(), p.y(), p.z())) == CGAL::ON_BOUNDED_SIDE;
 }
 
@@ -319,8 +328,13 @@ Eigen::Vector3d Obstacle::ClosestPoint(const Eigen::Vector3d& p, Eigen::Vector3d
 
 namespace {
 
+/// Positions stored row by row, so that one vertex's coordinates are contiguous.
+using RowX3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+CPoint P(const RowX3& X, int v) { return CPoint(X(v, 0), X(v, 1), X(v, 2)); }
+
 struct TetData {
-  const Eigen::MatrixX3d* X = nullptr;
+  const RowX3* X = nullptr;
   const std::vector<std::array<int, 4>>* tets = nullptr;
 };
 
@@ -348,20 +362,265 @@ class TetPrimitive {
 
 using TetTree = CGAL::AABB_tree<CGAL::AABB_traits<K, TetPrimitive>>;
 
+// -- the point-in-tet test ------------------------------------------------------------------------
+//
+// With D = orient(a, b, c, d) and D_i the same determinant with vertex i replaced by p, the
+// barycentric coordinates of p are D_i / D (Cramer). So p lies in the closed tet iff D != 0 and
+// no D_i has the sign opposite to D. This is what CGAL's Tetrahedron_3::has_on_unbounded_side
+// decides (after is_degenerate), and what the exact fallback computes with CGAL::orientation.
+
+/// Margin of the floating-point filter, relative to the permanent of the determinant (the same
+/// sum with absolute values). Evaluated in double as below, the error of det[b-a, c-a, d-a] is
+/// below 7.8e-16 times that permanent (the bound of Shewchuk's orient3d filter, without
+/// underflow); 1e-12 leaves a factor of ~1000 on top.
+constexpr double kRelMargin = 1e-12;
+/// Covers underflow in the products (the relative bound assumes none).
+constexpr double kAbsMargin = 1e-280;
+
+/// Sign of det[b - a, c - a, d - a], i.e. of CGAL::orientation(a, b, c, d), when the double
+/// evaluation certifies it; 0 when it cannot (within the margin, overflow, NaN).
+inline int FilteredOrientation(const double* a, const double* b, const double* c, const double* d) {
+  const double bx = b[0] - a[0], by = b[1] - a[1], bz = b[2] - a[2];
+  const double cx = c[0] - a[0], cy = c[1] - a[1], cz = c[2] - a[2];
+  const double dx = d[0] - a[0], dy = d[1] - a[1], dz = d[2] - a[2];
+  const double m1 = cy * dz, m2 = cz * dy, m3 = cz * dx, m4 = cx * dz, m5 = cx * dy, m6 = cy * dx;
+  const double det = bx * (m1 - m2) + by * (m3 - m4) + bz * (m5 - m6);
+  const double perm = std::abs(bx) * (std::abs(m1) + std::abs(m2)) + std::abs(by) * (std::abs(m3) + std::abs(m4)) +
+                      std::abs(bz) * (std::abs(m5) + std::abs(m6));
+  const double margin = kRelMargin * perm + kAbsMargin;
+  if (det > margin) return 1;
+  if (det < -margin) return -1;
+  return 0;
+}
+
+/// The exact test with CGAL's filtered exact orientation predicate (Epick).
+bool ContainsExact(const double* a, const double* b, const double* c, const double* d, const double* p) {
+  const CPoint q[5] = {CPoint(a[0], a[1], a[2]), CPoint(b[0], b[1], b[2]), CPoint(c[0], c[1], c[2]),
+                       CPoint(d[0], d[1], d[2]), CPoint(p[0], p[1], p[2])};
+  const int o = static_cast<int>(CGAL::orientation(q[0], q[1], q[2], q[3]));
+  if (o == 0) return false;  // a flat tet contains nothing (CGAL: is_degenerate)
+  for (int i = 0; i < 4; ++i) {
+    const CPoint& r0 = i == 0 ? q[4] : q[0];
+    const CPoint& r1 = i == 1 ? q[4] : q[1];
+    const CPoint& r2 = i == 2 ? q[4] : q[2];
+    const CPoint& r3 = i == 3 ? q[4] : q[3];
+    if (static_cast<int>(CGAL::orientation(r0, r1, r2, r3)) == -o) return false;
+  }
+  return true;
+}
+
+/// p in the closed tet (a, b, c, d): the filter decides when every sign it needs is certain
+/// (one face certainly on the wrong side: outside; all certainly on the right side: inside),
+/// the exact test otherwise. *exact tells which.
+inline bool ContainsFiltered(const double* a, const double* b, const double* c, const double* d, const double* p,
+                             bool* exact) {
+  *exact = false;
+  const int o = FilteredOrientation(a, b, c, d);
+  if (o != 0) {
+    const int s0 = FilteredOrientation(p, b, c, d);
+    if (s0 == -o) return false;
+    const int s1 = FilteredOrientation(a, p, c, d);
+    if (s1 == -o) return false;
+    const int s2 = FilteredOrientation(a, b, p, d);
+    if (s2 == -o) return false;
+    const int s3 = FilteredOrientation(a, b, c, p);
+    if (s3 == -o) return false;
+    if (s0 != 0 && s1 != 0 && s2 != 0 && s3 != 0) return true;
+  }
+  *exact = true;
+  return ContainsExact(a, b, c, d, p);
+}
+
+/// Grid cells per axis are capped so that a wildly spread-out configuration cannot ask for
+/// unbounded memory: at most kMaxCellsPerTet * #tets + kMinCellCap cells in all (the cells grow).
+constexpr long long kMaxCellsPerTet = 2;
+constexpr long long kMinCellCap = 4096;
+/// A tet whose box spans more cells than this is kept out of the cells, in a list that every
+/// vertex scans: a few huge tets (a vertex thrown far away) cannot blow up the cell lists.
+constexpr long long kLargeTetCells = 64;
+/// Cell edge as a multiple of the mean edge of the tets' boxes (measured: 1.0 to 2.0 are within
+/// 10% of each other on pneumatic_finger; see docs/collision.md).
+constexpr double kCellScale = 1.5;
+
 }  // namespace
 
+bool TetContainsPoint(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                      const Eigen::Vector3d& d, const Eigen::Vector3d& p, bool* exact_used) {
+  if (!a.allFinite() || !b.allFinite() || !c.allFinite() || !d.allFinite() || !p.allFinite())
+    throw std::invalid_argument("TetContainsPoint: expected finite coordinates");
+  bool exact = false;
+  const bool in = ContainsFiltered(a.data(), b.data(), c.data(), d.data(), p.data(), &exact);
+  if (exact_used) *exact_used = exact;
+  return in;
+}
+
+const char* SelfCollisionMethodToString(SelfCollisionDetector::Method m) {
+  switch (m) {
+    case SelfCollisionDetector::Method::kBoxIntersection: return "box_intersection";
+    case SelfCollisionDetector::Method::kAabbTree: return "aabb_tree";
+    case SelfCollisionDetector::Method::kGrid: return "grid";
+  }
+  return "unknown";
+}
+
+SelfCollisionDetector::Method SelfCollisionMethodFromString(const std::string& name) {
+  for (auto m : {SelfCollisionDetector::Method::kBoxIntersection, SelfCollisionDetector::Method::kAabbTree,
+                 SelfCollisionDetector::Method::kGrid})
+    if (name == SelfCollisionMethodToString(m)) return m;
+  throw std::invalid_argument("self-collision method '" + name +
+                              "': expected one of box_intersection, aabb_tree, grid");
+}
+
+/// The uniform grid of kGrid: cell (i, j, k) is [origin + h (i, j, k), origin + h (i+1, j+1, k+1));
+/// the first and last cells of each axis extend to infinity (coordinates are clamped). Cell
+/// c = (k n_y + j) n_x + i lists the tets whose box overlaps it in cell_tets[start[c] ..
+/// start[c+1]), ascending. Since the cell of a coordinate is a monotone function of it, a point
+/// inside a tet's closed box lies in a cell that lists the tet.
+struct UniformTetGrid {
+  std::array<double, 3> origin{{0, 0, 0}};
+  double inv_h = 1;
+  std::array<int, 3> n{{1, 1, 1}};
+  std::vector<double> box;       ///< 6 per tet: min x, y, z, max x, y, z (mm)
+  std::vector<int> start;        ///< #cells + 1
+  std::vector<int> cell_tets;    ///< tet ids, grouped by cell
+  std::vector<int> large;        ///< ascending ids of the tets spanning > kLargeTetCells cells
+  /// Per tet: first cell of its box and the box's span in cells per axis (bytes 0, 1, 2); the
+  /// first cell is -1 for a large tet.
+  std::vector<std::array<int, 2>> range;
+  std::vector<int> cursor;       ///< #threads x #cells: counts, then write positions
+
+  int Coord(double x, int axis) const {
+    const double t = std::min(std::max((x - origin[axis]) * inv_h, 0.0), static_cast<double>(n[axis] - 1));
+    return static_cast<int>(t);
+  }
+  int Cell(const double* p) const { return (Coord(p[2], 2) * n[1] + Coord(p[1], 1)) * n[0] + Coord(p[0], 0); }
+
+  /// Rebuilds the grid over the tets at positions X (row-major #V x 3, mm).
+  void Build(const RowX3& X, const std::vector<std::array<int, 4>>& tets);
+};
+
+void UniformTetGrid::Build(const RowX3& X, const std::vector<std::array<int, 4>>& tets) {
+  const int nt = static_cast<int>(tets.size());
+  box.resize(6 * static_cast<size_t>(nt));
+  double lx = std::numeric_limits<double>::infinity(), ly = lx, lz = lx;
+  double hx = -lx, hy = -lx, hz = -lx, sum = 0;
+#pragma omp parallel for schedule(static) reduction(min : lx, ly, lz) reduction(max : hx, hy, hz) reduction(+ : sum)
+  for (int t = 0; t < nt; ++t) {
+    const auto& tt = tets[t];
+    const double* p = &X(tt[0], 0);
+    double b[6] = {p[0], p[1], p[2], p[0], p[1], p[2]};
+    for (int k = 1; k < 4; ++k) {
+      const double* q = &X(tt[k], 0);
+      for (int a = 0; a < 3; ++a) {
+        b[a] = std::min(b[a], q[a]);
+        b[3 + a] = std::max(b[3 + a], q[a]);
+      }
+    }
+    std::copy(b, b + 6, &box[6 * static_cast<size_t>(t)]);
+    lx = std::min(lx, b[0]), ly = std::min(ly, b[1]), lz = std::min(lz, b[2]);
+    hx = std::max(hx, b[3]), hy = std::max(hy, b[4]), hz = std::max(hz, b[5]);
+    sum += (b[3] - b[0]) + (b[4] - b[1]) + (b[5] - b[2]);
+  }
+  large.clear();
+  if (nt == 0) {
+    n = {1, 1, 1};
+    start.assign(2, 0);
+    cell_tets.clear();
+    return;
+  }
+  range.resize(nt);
+  origin = {lx, ly, lz};
+  const double extent[3] = {hx - lx, hy - ly, hz - lz};
+  double h = kCellScale * sum / (3.0 * nt);
+  if (!(h > 0)) h = std::max({extent[0], extent[1], extent[2], std::numeric_limits<double>::min()});
+  const long long cap = kMaxCellsPerTet * nt + kMinCellCap;
+  long long cells = 0;
+  for (int grow = 0;; ++grow) {
+    cells = 1;
+    for (int a = 0; a < 3; ++a) {
+      n[a] = static_cast<int>(std::min(extent[a] / h, 1e6)) + 1;
+      cells *= n[a];
+    }
+    if (cells <= cap) break;
+    assert(grow < 64);
+    h *= 1.01 * std::cbrt(static_cast<double>(cells) / static_cast<double>(cap));
+  }
+  inv_h = 1.0 / h;
+  const int nc = static_cast<int>(cells);
+  start.resize(nc + 1);
+  // Counting sort, parallel over contiguous chunks of tets: each thread counts its chunk's
+  // entries per cell; the prefix sum over (cell, thread) gives every thread its own write
+  // positions, so each cell lists its tets in ascending order.
+  const int threads = omp_get_max_threads();
+  cursor.assign(static_cast<size_t>(threads) * nc, 0);
+#pragma omp parallel num_threads(threads)
+  {
+    const int tid = omp_get_thread_num(), nth = omp_get_num_threads();
+    const int begin = static_cast<int>(static_cast<long long>(nt) * tid / nth);
+    const int end = static_cast<int>(static_cast<long long>(nt) * (tid + 1) / nth);
+    int* cur = cursor.data() + static_cast<size_t>(tid) * nc;
+    // Calls f(cell) for every cell of tet t's box, in ascending order.
+    auto for_cells = [&](int t, auto&& f) {
+      const int base = range[t][0], span = range[t][1];
+      const int si = span & 0xff, sj = (span >> 8) & 0xff, sk = (span >> 16) & 0xff;
+      for (int k = 0; k < sk; ++k)
+        for (int j = 0; j < sj; ++j) {
+          const int row = base + (k * n[1] + j) * n[0];
+          for (int i = 0; i < si; ++i) f(row + i);
+        }
+    };
+    for (int t = begin; t < end; ++t) {
+      const double* b = &box[6 * static_cast<size_t>(t)];
+      const int i0 = Coord(b[0], 0), j0 = Coord(b[1], 1), k0 = Coord(b[2], 2);
+      const int si = Coord(b[3], 0) - i0 + 1, sj = Coord(b[4], 1) - j0 + 1, sk = Coord(b[5], 2) - k0 + 1;
+      if (static_cast<long long>(si) * sj * sk > kLargeTetCells) {
+        range[t] = {-1, 0};
+        continue;
+      }
+      range[t] = {(k0 * n[1] + j0) * n[0] + i0, si | (sj << 8) | (sk << 16)};
+      for_cells(t, [&](int c) { ++cur[c]; });
+    }
+#pragma omp barrier
+#pragma omp single
+    {
+      for (int t = 0; t < nt; ++t)
+        if (range[t][0] < 0) large.push_back(t);
+      int run = 0;
+      for (int c = 0; c < nc; ++c) {
+        start[c] = run;
+        for (int th = 0; th < nth; ++th) {
+          int& slot = cursor[static_cast<size_t>(th) * nc + c];
+          const int count = slot;
+          slot = run;
+          run += count;
+        }
+      }
+      start[nc] = run;
+      cell_tets.resize(run);
+    }  // implicit barrier
+    for (int t = begin; t < end; ++t)
+      if (range[t][0] >= 0) for_cells(t, [&](int c) { cell_tets[cur[c]++] = t; });
+  }
+}
+
 struct SelfCollisionDetector::Impl {
+  int num_vertices = 0;
   std::vector<std::array<int, 4>> tets;
   std::vector<int> ids;
-  std::vector<std::vector<int>> incident;  // per vertex, sorted tet ids
-  Eigen::MatrixX3d X;
+  std::vector<std::vector<int>> incident;  // per vertex, sorted tet ids (the CGAL methods)
+  RowX3 X;
   TetTree tree;
+  UniformTetGrid grid;
 };
 
 SelfCollisionDetector::SelfCollisionDetector(const Mesh& mesh, Method method)
     : impl_(std::make_unique<Impl>()), method_(method) {
+  if (method != Method::kBoxIntersection && method != Method::kAabbTree && method != Method::kGrid)
+    throw std::invalid_argument("self-collision detection: unknown method " +
+                                std::to_string(static_cast<int>(method)));
   const int ne = mesh.num_elements();
   auto& I = *impl_;
+  I.num_vertices = mesh.num_vertices();
   I.incident.assign(mesh.num_vertices(), {});
   std::map<std::array<int, 3>, int> face_count;
   for (int i = 0; i < ne; ++i) {
@@ -392,14 +651,30 @@ SelfCollisionDetector::SelfCollisionDetector(const Mesh& mesh, Method method)
 
 SelfCollisionDetector::~SelfCollisionDetector() = default;
 
+int SelfCollisionDetector::grid_large_tets() const {
+  return method_ == Method::kGrid ? static_cast<int>(impl_->grid.large.size()) : 0;
+}
+
 void SelfCollisionDetector::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) {
   const auto t0 = Clock::now();
   auto& I = *impl_;
+  if (X.rows() != I.num_vertices)
+    throw std::invalid_argument("SelfCollisionDetector::Update: expected positions for " +
+                                std::to_string(I.num_vertices) + " vertices, got " + std::to_string(X.rows()) +
+                                " rows");
   I.X = X;
+  if (!I.X.allFinite()) {
+    int v = 0;
+    while (I.X.row(v).allFinite()) ++v;
+    throw std::invalid_argument("SelfCollisionDetector::Update: vertex " + std::to_string(v) +
+                                " has a non-finite coordinate");
+  }
   if (method_ == Method::kAabbTree) {
     I.tree.clear();
     I.tree.rebuild(I.ids.begin(), I.ids.end(), TetData{&I.X, &I.tets});
     I.tree.build();
+  } else if (method_ == Method::kGrid) {
+    I.grid.Build(I.X, I.tets);
   }
   build_s_ = Seconds(t0);
 }
@@ -408,26 +683,71 @@ std::vector<SelfContact> SelfCollisionDetector::Detect() const {
   const auto t0 = Clock::now();
   const auto& I = *impl_;
   const int nb = static_cast<int>(boundary_.size());
-  // The exact test: the vertex is in the closed tet, which is not incident to it.
+  long long narrow = 0, exact = 0;
+  // The exact test of the CGAL methods: the vertex is in the closed tet, which is not incident
+  // to it. Returns -1 for an incident tet (no test), else 0 or 1.
   auto inside = [&](int v, int t) {
-    if (std::binary_search(I.incident[v].begin(), I.incident[v].end(), t)) return false;
+    if (std::binary_search(I.incident[v].begin(), I.incident[v].end(), t)) return -1;
     const auto& tt = I.tets[t];
     const K::Tetrahedron_3 tet(P(I.X, tt[0]), P(I.X, tt[1]), P(I.X, tt[2]), P(I.X, tt[3]));
-    return !tet.is_degenerate() && !tet.has_on_unbounded_side(P(I.X, v));
+    return !tet.is_degenerate() && !tet.has_on_unbounded_side(P(I.X, v)) ? 1 : 0;
   };
   std::vector<int> hit(nb, -1);
-  if (method_ == Method::kAabbTree) {
-#pragma omp parallel for schedule(dynamic, 64)
+  if (method_ == Method::kGrid) {
+    const UniformTetGrid& G = I.grid;
+#pragma omp parallel for schedule(dynamic, 64) reduction(+ : narrow, exact)
+    for (int q = 0; q < nb; ++q) {
+      const int v = boundary_[q];
+      const double* p = &I.X(v, 0);
+      long long my_narrow = 0, my_exact = 0;
+      // Does tet t contain p (box, incidence, then the filtered exact test)?
+      auto test = [&](int t) {
+        const double* b = &G.box[6 * static_cast<size_t>(t)];
+        if (p[0] < b[0] || p[1] < b[1] || p[2] < b[2] || p[0] > b[3] || p[1] > b[4] || p[2] > b[5]) return false;
+        const auto& tt = I.tets[t];
+        if (tt[0] == v || tt[1] == v || tt[2] == v || tt[3] == v) return false;
+        ++my_narrow;
+        bool ex = false;
+        const bool in = ContainsFiltered(&I.X(tt[0], 0), &I.X(tt[1], 0), &I.X(tt[2], 0), &I.X(tt[3], 0), p, &ex);
+        my_exact += ex;
+        return in;
+      };
+      // Both lists are ascending: the first hit of each, the lower of the two, is the lowest id.
+      int best = -1;
+      const int c = G.Cell(p);
+      for (int k = G.start[c]; k < G.start[c + 1]; ++k)
+        if (test(G.cell_tets[k])) {
+          best = G.cell_tets[k];
+          break;
+        }
+      for (int t : G.large) {
+        if (best >= 0 && t > best) break;
+        if (test(t)) {
+          best = t;
+          break;
+        }
+      }
+      hit[q] = best;
+      narrow += my_narrow;
+      exact += my_exact;
+    }
+  } else if (method_ == Method::kAabbTree) {
+#pragma omp parallel for schedule(dynamic, 64) reduction(+ : narrow, exact)
     for (int q = 0; q < nb; ++q) {
       const int v = boundary_[q];
       std::vector<int> cand;
       I.tree.all_intersected_primitives(P(I.X, v), std::back_inserter(cand));
       std::sort(cand.begin(), cand.end());
-      for (int t : cand)
-        if (inside(v, t)) {
+      for (int t : cand) {
+        const int in = inside(v, t);
+        if (in < 0) continue;
+        ++narrow;
+        ++exact;
+        if (in) {
           hit[q] = t;
           break;
         }
+      }
     }
   } else {
     // Broad phase: boxes of the boundary vertices (points) against boxes of the tets.
@@ -454,15 +774,21 @@ std::vector<SelfContact> SelfCollisionDetector::Detect() const {
                              [&](const Box& a, const Box& b) { pairs.emplace_back(a.info(), b.info()); });
     std::sort(pairs.begin(), pairs.end());
     const int np = static_cast<int>(pairs.size());
-    std::vector<char> ok(np, 0);
-#pragma omp parallel for schedule(static)
-    for (int k = 0; k < np; ++k) ok[k] = inside(boundary_[pairs[k].first], pairs[k].second);
+    std::vector<signed char> ok(np, 0);
+#pragma omp parallel for schedule(static) reduction(+ : narrow)
+    for (int k = 0; k < np; ++k) {
+      ok[k] = static_cast<signed char>(inside(boundary_[pairs[k].first], pairs[k].second));
+      narrow += ok[k] >= 0;
+    }
+    exact = narrow;
     for (int k = 0; k < np; ++k)
-      if (ok[k] && hit[pairs[k].first] < 0) hit[pairs[k].first] = pairs[k].second;
+      if (ok[k] > 0 && hit[pairs[k].first] < 0) hit[pairs[k].first] = pairs[k].second;
   }
   std::vector<SelfContact> out;
   for (int q = 0; q < nb; ++q)
     if (hit[q] >= 0) out.push_back({boundary_[q], hit[q]});
+  narrow_tests_ = narrow;
+  exact_tests_ = exact;
   query_s_ = Seconds(t0);
   return out;
 }
@@ -471,25 +797,44 @@ std::vector<ObstacleContact> DetectObstacleContacts(const std::vector<Obstacle>&
                                                     const Eigen::Ref<const Eigen::MatrixX3d>& X,
                                                     const std::vector<int>& vertices) {
   const int n = vertices.empty() ? static_cast<int>(X.rows()) : static_cast<int>(vertices.size());
-  std::vector<ObstacleContact> found(n);
-#pragma omp parallel for schedule(dynamic, 256)
+  for (int v : vertices)
+    if (v < 0 || v >= X.rows())
+      throw std::invalid_argument("DetectObstacleContacts: vertex id " + std::to_string(v) + " is not in 0.." +
+                                  std::to_string(X.rows() - 1));
+  const int no = static_cast<int>(obstacles.size());
+  if (no == 0 || n == 0) return {};
+  // The union of the obstacles' boxes: a vertex outside it touches no obstacle.
+  Eigen::Vector3d lo = obstacles[0].box_min(), hi = obstacles[0].box_max();
+  for (const auto& o : obstacles) {
+    lo = lo.cwiseMin(o.box_min());
+    hi = hi.cwiseMax(o.box_max());
+  }
+  std::vector<int> which(n, -1);  // obstacle containing the vertex
+#pragma omp parallel for schedule(dynamic, 1024)
   for (int q = 0; q < n; ++q) {
     const int v = vertices.empty() ? q : vertices[q];
-    const Eigen::Vector3d p = X.row(v).transpose();
-    for (int o = 0; o < static_cast<int>(obstacles.size()); ++o) {
-      if (!obstacles[o].Contains(p)) continue;
-      ObstacleContact c;
-      c.vertex = v;
-      c.obstacle = o;
-      c.closest = obstacles[o].ClosestPoint(p, &c.normal);
-      c.depth = (c.closest - p).norm();
-      found[q] = c;
-      break;
-    }
+    const Eigen::Vector3d p(X(v, 0), X(v, 1), X(v, 2));
+    if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
+    for (int o = 0; o < no; ++o)
+      if (obstacles[o].Contains(p)) {  // tests the obstacle's own box first
+        which[q] = o;
+        break;
+      }
   }
-  std::vector<ObstacleContact> out;
-  for (const auto& c : found)
-    if (c.vertex >= 0) out.push_back(c);
+  std::vector<int> inside;
+  for (int q = 0; q < n; ++q)
+    if (which[q] >= 0) inside.push_back(q);
+  std::vector<ObstacleContact> out(inside.size());
+#pragma omp parallel for schedule(dynamic, 16)
+  for (int k = 0; k < static_cast<int>(inside.size()); ++k) {
+    const int q = inside[k];
+    ObstacleContact& c = out[k];
+    c.vertex = vertices.empty() ? q : vertices[q];
+    c.obstacle = which[q];
+    const Eigen::Vector3d p(X(c.vertex, 0), X(c.vertex, 1), X(c.vertex, 2));
+    c.closest = obstacles[c.obstacle].ClosestPoint(p, &c.normal);
+    c.depth = (c.closest - p).norm();
+  }
   return out;
 }
 

@@ -1,19 +1,23 @@
 // Collision detection (solver/collision.hpp, thesis Sec. 3.2.2): obstacle surfaces (readers,
 // closedness checks, inside and closest-point queries) and self-collision of a tet mesh (no false
-// positives at rest, a built overlap found exactly).
+// positives at rest, a built overlap found exactly, the three broad phases and a brute-force
+// search give the same contacts on penetrating states, the filtered point-in-tet test is exact).
 #include "solver/collision.hpp"
 
 #include "solver/mesh_gen.hpp"
 #include "solver/robots.hpp"
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <fstream>
+#include <random>
 #include <set>
 #include <string>
 
@@ -21,6 +25,8 @@ namespace softkin {
 namespace {
 
 namespace fs = std::filesystem;
+using Method = SelfCollisionDetector::Method;
+const Method kMethods[] = {Method::kBoxIntersection, Method::kAabbTree, Method::kGrid};
 
 fs::path Temp(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / "softkin_collision_test";
@@ -146,7 +152,7 @@ TEST(Collision, CorruptedObstacleMeshesAreRejected) {
 
 TEST(Collision, NoSelfContactAtRestOrUnderRigidMotion) {
   for (const char* robot : {"pneumatic_finger", "three_chamber"})
-    for (auto method : {SelfCollisionDetector::Method::kBoxIntersection, SelfCollisionDetector::Method::kAabbTree}) {
+    for (auto method : kMethods) {
     const Scene s = MakeRobot(robot, robot == std::string("three_chamber") ? 3 : 5);
     SelfCollisionDetector d(s.mesh, method);
     EXPECT_GT(d.boundary_vertices().size(), 100u);
@@ -164,7 +170,7 @@ TEST(Collision, BuiltOverlapIsFoundExactly) {
   // others. (They sit on faces shared by tets, which the test must not miss.)
   const Mesh m = VoxelTetMesh(Eigen::Vector3d::Zero(), 1.0, Eigen::Vector3i(5, 2, 2),
                               [](const Eigen::Vector3d&, const Eigen::Vector3i& c) { return c.x() == 2 ? -1 : 0; });
-  for (auto method : {SelfCollisionDetector::Method::kBoxIntersection, SelfCollisionDetector::Method::kAabbTree}) {
+  for (auto method : kMethods) {
     SelfCollisionDetector d(m, method);
     EXPECT_TRUE(d.Detect().empty());
     Eigen::MatrixX3d X = m.vertices;
@@ -186,6 +192,8 @@ TEST(Collision, BuiltOverlapIsFoundExactly) {
     EXPECT_EQ(expected.size(), 18u);
     EXPECT_EQ(found, expected);
     EXPECT_GT(d.last_query_s(), 0.0);  // the timing is reported
+    // The vertices lie exactly on faces of the other block's tets: the exact predicate decided.
+    EXPECT_GT(d.last_exact_tests(), 0) << SelfCollisionMethodToString(method);
   }
 }
 
@@ -206,6 +214,233 @@ TEST(Collision, RobotVerticesInsideAnObstacle) {
   int inside = 0;
   for (int v = 0; v < s.mesh.num_vertices(); ++v) inside += s.mesh.vertices(v, 0) > 100.0;
   EXPECT_EQ(static_cast<int>(contacts.size()), inside);
+}
+
+TEST(Collision, TetContainsPointIsExact) {
+  // A tet with integer corners and points on a 1/1024 lattice: every coordinate, the tet's image
+  // under the integer affine map below and the lattice test are exact in double, so the truth is
+  // known. Many points lie exactly on a face, edge or corner (the exact predicate decides those);
+  // the rest the filter decides.
+  const Eigen::Matrix3d M = (Eigen::Matrix3d() << 2, 1, 0, 0, 1, 1, 1, 0, 3).finished();  // det 7
+  const Eigen::Vector3d shift(5, -3, 2);
+  auto map = [&](const Eigen::Vector3d& x) -> Eigen::Vector3d { return M * x + shift; };
+  const Eigen::Vector3d a(0, 0, 0), b(4, 0, 0), c(0, 4, 0), d(0, 0, 4);
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> k(-512, 4608);  // -0.5 .. 4.5 in steps of 1/1024
+  std::uniform_int_distribution<int> snap(0, 3);
+  int by_filter = 0, by_exact = 0, on_boundary = 0, inside = 0;
+  for (int i = 0; i < 20000; ++i) {
+    Eigen::Vector3d x(k(rng) / 1024.0, k(rng) / 1024.0, k(rng) / 1024.0);
+    // Put a third of the points on the slanted face x + y + z = 4 or a coordinate plane.
+    if (snap(rng) == 0) x.z() = 4 - x.x() - x.y();
+    else if (snap(rng) == 0) x[snap(rng) % 3] = 0;
+    const double sum = x.sum();  // exact: few bits
+    const bool truth = x.minCoeff() >= 0 && sum <= 4;
+    on_boundary += truth && (x.minCoeff() == 0 || sum == 4);
+    inside += truth;
+    for (int flip = 0; flip < 2; ++flip) {  // both orientations
+      bool exact = false;
+      const bool got = flip ? TetContainsPoint(map(a), map(c), map(b), map(d), map(x), &exact)
+                            : TetContainsPoint(map(a), map(b), map(c), map(d), map(x), &exact);
+      ASSERT_EQ(got, truth) << "point " << x.transpose() << " flip " << flip;
+      (exact ? by_exact : by_filter) += 1;
+    }
+  }
+  EXPECT_GT(on_boundary, 1000);
+  EXPECT_GT(inside - on_boundary, 500);
+  EXPECT_GT(by_exact, 2000);
+  EXPECT_GT(by_filter, 20000);
+  // One ulp off a face: outside, inside.
+  const double below = std::nextafter(0.0, -1.0);
+  EXPECT_FALSE(TetContainsPoint(a, b, c, d, Eigen::Vector3d(1, 1, below)));
+  EXPECT_TRUE(TetContainsPoint(a, b, c, d, Eigen::Vector3d(1, 1, 0)));
+  EXPECT_TRUE(TetContainsPoint(a, b, c, d, Eigen::Vector3d(1, 1, std::nextafter(0.0, 1.0))));
+  EXPECT_FALSE(TetContainsPoint(a, b, c, d, Eigen::Vector3d(2, 2, std::nextafter(0.0, 1.0))));  // past x+y+z=4
+  // A flat tet contains nothing, not even its own corners; a tiny tet is handled like a big one.
+  EXPECT_FALSE(TetContainsPoint(a, b, c, Eigen::Vector3d(1, 1, 0), Eigen::Vector3d(1, 0.5, 0)));
+  EXPECT_FALSE(TetContainsPoint(a, b, c, Eigen::Vector3d(1, 1, 0), a));
+  const double s = 1e-150;
+  EXPECT_TRUE(TetContainsPoint(s * a, s * b, s * c, s * d, s * Eigen::Vector3d(1, 1, 1)));
+  EXPECT_FALSE(TetContainsPoint(s * a, s * b, s * c, s * d, s * Eigen::Vector3d(1, 1, 2.5)));
+  EXPECT_THROW(TetContainsPoint(a, b, c, d, Eigen::Vector3d(NAN, 0, 0)), std::invalid_argument);
+}
+
+/// Reference answer: every boundary vertex against every non-incident tet, lowest tet first.
+std::vector<SelfContact> BruteForceContacts(const Mesh& m, const std::vector<int>& boundary, const Eigen::MatrixX3d& X) {
+  std::vector<SelfContact> out;
+  for (int v : boundary)
+    for (int t = 0; t < m.num_elements(); ++t) {
+      const auto& e = m.elements[t].v;
+      if (e[0] == v || e[1] == v || e[2] == v || e[3] == v) continue;
+      if (TetContainsPoint(X.row(e[0]), X.row(e[1]), X.row(e[2]), X.row(e[3]), X.row(v))) {
+        out.push_back({v, t});
+        break;
+      }
+    }
+  return out;
+}
+
+std::string Describe(const std::vector<SelfContact>& c) {
+  std::string s = std::to_string(c.size()) + " contacts:";
+  for (size_t i = 0; i < std::min<size_t>(c.size(), 8); ++i)
+    s += " (" + std::to_string(c[i].vertex) + ", " + std::to_string(c[i].tet) + ")";
+  return s;
+}
+
+bool Same(const std::vector<SelfContact>& a, const std::vector<SelfContact>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i)
+    if (a[i].vertex != b[i].vertex || a[i].tet != b[i].tet) return false;
+  return true;
+}
+
+/// Penetrating states of a robot mesh: its far half along the longest axis pushed back into the
+/// near half, its top half folded down into the bottom half, and random vertex jitter (seeded).
+std::vector<std::pair<std::string, Eigen::MatrixX3d>> PenetratingStates(const Mesh& m, unsigned seed) {
+  const Eigen::MatrixX3d& X0 = m.vertices;
+  const Eigen::RowVector3d lo = X0.colwise().minCoeff(), hi = X0.colwise().maxCoeff();
+  const Eigen::RowVector3d mid = 0.5 * (lo + hi), ext = hi - lo;
+  int axis = 0;
+  ext.maxCoeff(&axis);
+  const int up = (axis + 2) % 3;
+  std::vector<std::pair<std::string, Eigen::MatrixX3d>> states;
+  Eigen::MatrixX3d X = X0;
+  for (int v = 0; v < X.rows(); ++v)
+    if (X(v, axis) > mid[axis]) X(v, axis) -= 0.2 * ext[axis];
+  states.emplace_back("translated half", X);
+  X = X0;
+  for (int v = 0; v < X.rows(); ++v)
+    if (X(v, up) > mid[up]) X(v, up) = mid[up] - 0.5 * (X(v, up) - mid[up]) + 0.1 * ext[up];
+  states.emplace_back("folded top", X);
+  // Mean edge length of the tets, for the jitter amplitude.
+  double edge = 0;
+  for (const auto& e : m.elements) edge += (X0.row(e.v[0]) - X0.row(e.v[1])).norm();
+  edge /= m.num_elements();
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-0.45 * edge, 0.45 * edge);
+  X = X0;
+  for (int v = 0; v < X.rows(); ++v)
+    for (int a = 0; a < 3; ++a) X(v, a) += u(rng);
+  states.emplace_back("jitter", X);
+  return states;
+}
+
+TEST(Collision, AllMethodsAndBruteForceAgreeOnPenetratingStates) {
+  for (const auto& [robot, res] : {std::pair<std::string, int>{"pneumatic_finger", 5}, {"three_chamber", 3}}) {
+    const Scene s = MakeRobot(robot, res);
+    const Mesh& m = s.mesh;
+    std::vector<std::unique_ptr<SelfCollisionDetector>> det;
+    for (auto method : kMethods) det.push_back(std::make_unique<SelfCollisionDetector>(m, method));
+    const std::vector<int>& boundary = det[0]->boundary_vertices();
+    for (const auto& [name, X] : PenetratingStates(m, 42)) {
+      const std::vector<SelfContact> truth = BruteForceContacts(m, boundary, X);
+      // Guard: the state really penetrates, so agreement is not vacuous.
+      EXPECT_GT(truth.size(), 10u) << robot << " " << name;
+      for (size_t i = 0; i < det.size(); ++i) {
+        det[i]->Update(X);
+        const auto got = det[i]->Detect();
+        EXPECT_TRUE(Same(got, truth)) << robot << " " << name << " " << SelfCollisionMethodToString(kMethods[i])
+                                      << ": got " << Describe(got) << "; expected " << Describe(truth);
+        EXPECT_GE(det[i]->last_narrow_tests(), static_cast<long long>(truth.size()));
+      }
+      // The grid's filter decides nearly every test by itself.
+      const auto& grid = *det[2];
+      EXPECT_LT(grid.last_exact_tests(), grid.last_narrow_tests() / 10 + 10) << robot << " " << name;
+    }
+    // Back at rest: nothing, with every method (the grid reuses its buffers).
+    for (auto& d : det) {
+      d->Update(m.vertices);
+      EXPECT_TRUE(d->Detect().empty()) << robot << " " << SelfCollisionMethodToString(d->method());
+    }
+  }
+}
+
+TEST(Collision, GridIsDeterministicAcrossThreadCountsAndSurvivesOutliers) {
+  const Scene s = MakeRobot("pneumatic_finger", 5);
+  const Mesh& m = s.mesh;
+  const auto states = PenetratingStates(m, 7);
+  SelfCollisionDetector grid(m, Method::kGrid), box(m, Method::kBoxIntersection);
+  const int threads = omp_get_max_threads();
+  for (const auto& [name, X] : states) {
+    grid.Update(X);
+    const auto many = grid.Detect();
+    omp_set_num_threads(1);
+    grid.Update(X);
+    const auto one = grid.Detect();
+    omp_set_num_threads(threads);
+    EXPECT_FALSE(one.empty()) << name;
+    EXPECT_TRUE(Same(one, many)) << name << ": " << Describe(one) << " vs " << Describe(many);
+  }
+  // One vertex thrown 1e5 mm away: its tets span the whole (capped) grid and go to the list of
+  // large tets, which every vertex scans. Same answer as the CGAL broad phase.
+  Eigen::MatrixX3d X = states[0].second;
+  X.row(0) += Eigen::RowVector3d(1e5, -2e4, 3e4);
+  grid.Update(X);
+  box.Update(X);
+  EXPECT_GT(grid.grid_large_tets(), 0);
+  const auto g = grid.Detect(), b = box.Detect();
+  EXPECT_FALSE(g.empty());
+  EXPECT_TRUE(Same(g, b)) << Describe(g) << " vs " << Describe(b);
+  // Everything collapsed to a point: every tet is flat and contains nothing.
+  grid.Update(Eigen::MatrixX3d::Zero(m.num_vertices(), 3));
+  EXPECT_TRUE(grid.Detect().empty());
+  EXPECT_GT(grid.last_narrow_tests(), 0);
+}
+
+TEST(Collision, SelfCollisionInputErrorsAndMethodNames) {
+  const Scene s = MakeRobot("pneumatic_finger", 5);
+  SelfCollisionDetector d(s.mesh);
+  EXPECT_EQ(d.method(), Method::kGrid);  // the default
+  try {
+    d.Update(Eigen::MatrixX3d::Zero(5, 3));
+    ADD_FAILURE() << "accepted 5 rows";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("got 5 rows"), std::string::npos) << e.what();
+  }
+  Eigen::MatrixX3d X = s.mesh.vertices;
+  X(17, 1) = NAN;
+  try {
+    d.Update(X);
+    ADD_FAILURE() << "accepted a NaN";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("vertex 17"), std::string::npos) << e.what();
+  }
+  for (auto m : kMethods) EXPECT_EQ(SelfCollisionMethodFromString(SelfCollisionMethodToString(m)), m);
+  try {
+    SelfCollisionMethodFromString("bvh");
+    ADD_FAILURE() << "accepted 'bvh'";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'bvh'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("grid"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Collision, ObstacleContactsOfAVertexSubsetAndFarObstacles) {
+  const Scene s = MakeRobot("pneumatic_finger", 5);
+  const Eigen::MatrixX3d& X = s.mesh.vertices;
+  std::vector<Obstacle> obs;
+  obs.emplace_back(MakeBoxSurface(Eigen::Vector3d(1000, 0, 0), Eigen::Vector3d(1010, 10, 10)));  // far away
+  obs.emplace_back(MakeCylinderSurface(Eigen::Vector3d(90, 10, -50), Eigen::Vector3d(0, 0, 1), 12.0, 100.0));
+  std::vector<int> odd;
+  for (int v = 1; v < X.rows(); v += 2) odd.push_back(v);
+  const auto contacts = DetectObstacleContacts(obs, X, odd);
+  // The same as asking every obstacle about every listed vertex.
+  std::vector<int> expected;
+  for (int v : odd)
+    if (obs[0].Contains(X.row(v).transpose()) || obs[1].Contains(X.row(v).transpose())) expected.push_back(v);
+  ASSERT_FALSE(expected.empty());
+  ASSERT_EQ(contacts.size(), expected.size());
+  for (size_t i = 0; i < contacts.size(); ++i) {
+    EXPECT_EQ(contacts[i].vertex, expected[i]);
+    EXPECT_EQ(contacts[i].obstacle, 1);
+    const Eigen::Vector3d p = X.row(contacts[i].vertex);
+    EXPECT_LE((p.head<2>() - Eigen::Vector2d(90, 10)).norm(), 12.0);
+    EXPECT_NEAR(contacts[i].depth, (contacts[i].closest - p).norm(), 1e-12);
+  }
+  std::vector<Obstacle> far;
+  far.emplace_back(MakeBoxSurface(Eigen::Vector3d(1000, 0, 0), Eigen::Vector3d(1010, 10, 10)));
+  EXPECT_TRUE(DetectObstacleContacts(far, X).empty());
+  EXPECT_THROW(DetectObstacleContacts(obs, X, {0, static_cast<int>(X.rows())}), std::invalid_argument);
 }
 
 }  // namespace
