@@ -165,10 +165,32 @@ void ApplySolverJson(const nlohmann::json& j, const std::string& where, FkOption
     else if (k == "continuation_steps") { need(v.is_number_integer(), "an integer"); o->continuation_steps = v.get<int>(); }
     else if (k == "threads") { need(v.is_number_integer(), "an integer"); o->threads = v.get<int>(); }
     else if (k == "time_limit_s") { need(v.is_number(), "a number of seconds"); o->time_limit_s = v.get<double>(); }
+    else if (k == "collision") {
+      need(v.is_object(), "an object of collision options");
+      for (auto c = v.begin(); c != v.end(); ++c) {
+        const std::string& ck = c.key();
+        const auto& cv = c.value();
+        auto cneed = [&](bool ok, const char* what) {
+          if (!ok)
+            throw std::invalid_argument(where + ".collision." + ck + ": expected " + what + ", got " + Dump(cv));
+        };
+        CollisionOptions& co = o->collision;
+        if (ck == "self") { cneed(cv.is_boolean(), "true or false"); co.self = cv.get<bool>(); }
+        else if (ck == "obstacles") { cneed(cv.is_boolean(), "true or false"); co.obstacles = cv.get<bool>(); }
+        else if (ck == "epsilon") { cneed(cv.is_number(), "a number (mm)"); co.epsilon = cv.get<double>(); }
+        else if (ck == "stiffness") { cneed(cv.is_number(), "a number"); co.stiffness = cv.get<double>(); }
+        else if (ck == "check_interval") { cneed(cv.is_number_integer(), "an integer"); co.check_interval = cv.get<int>(); }
+        else if (ck == "update") { cneed(cv.is_string(), "one of updown, refactor"); co.update = cv.get<std::string>(); }
+        else
+          throw std::invalid_argument(where + ".collision." + ck + ": unknown key (expected one of self, "
+                                      "obstacles, epsilon, stiffness, check_interval, update)");
+      }
+    }
     else
       throw std::invalid_argument(where + "." + k + ": unknown key (expected one of solver, "
                                   "max_iterations, tolerance, gradient_tolerance, anderson_window, "
-                                  "anderson_safeguard, continuation_steps, threads, time_limit_s)");
+                                  "anderson_safeguard, continuation_steps, threads, time_limit_s, "
+                                  "collision)");
   }
   std::string why;
   if (!o->IsValid(&why)) throw std::invalid_argument(where + ": " + why);

@@ -4,6 +4,18 @@
 
 namespace softkin {
 
+bool CollisionOptions::IsValid(std::string* why) const {
+  auto bad = [&](const std::string& m) { if (why) *why = m; return false; };
+  if (!(epsilon >= 0.0) || !std::isfinite(epsilon))
+    return bad("collision.epsilon: expected a number >= 0 (mm)");
+  if (!(stiffness > 0.0) || !std::isfinite(stiffness))
+    return bad("collision.stiffness: expected a number > 0");
+  if (check_interval < 1) return bad("collision.check_interval: expected an integer >= 1");
+  if (update != "updown" && update != "refactor")
+    return bad("collision.update: expected one of updown, refactor; got '" + update + "'");
+  return true;
+}
+
 bool FkOptions::IsValid(std::string* why) const {
   auto bad = [&](const std::string& m) { if (why) *why = m; return false; };
   if (solver != "lg" && solver != "lg-aa" && solver != "ceres" && solver != "ipopt-lbfgs" &&
@@ -26,6 +38,7 @@ bool FkOptions::IsValid(std::string* why) const {
   if (threads < 0) return bad("threads: expected an integer >= 0");
   if (!(time_limit_s >= 0.0) || !std::isfinite(time_limit_s))
     return bad("time_limit_s: expected a number >= 0 (0: no limit)");
+  if (!collision.IsValid(why)) return false;
   return true;
 }
 

@@ -5,6 +5,26 @@
 
 namespace softkin {
 
+/// Collision response (thesis Sec. 3.2.3, Eq. 3.5, 3.8, 3.9; collision_response.hpp). It is
+/// active in the local-global solvers when `self` is on or the scene has obstacles (and
+/// `obstacles` is on).
+struct CollisionOptions {
+  bool self = false;       ///< respond to self-collision (boundary vertices inside other tets)
+  bool obstacles = true;   ///< respond to the scene's obstacles (if it has any)
+  /// Offset eps of the contact boundary (mm): springs pull a vertex eps beyond the surface, and
+  /// release it once it is more than eps beyond its target (Eq. 3.8).
+  double epsilon = 0.05;
+  /// Spring stiffness k of Eq. 3.5 relative to the median diagonal entry of the global matrix
+  /// over the boundary vertices (so it scales with the mesh and the element weights).
+  double stiffness = 20.0;
+  /// Run detection every this many iterations (1: every iteration, as Algorithm 2), and always
+  /// before the solver is allowed to stop.
+  int check_interval = 1;
+  /// How the factor follows the spring set: "updown" (CHOLMOD update/downdate) or "refactor".
+  std::string update = "updown";
+  bool IsValid(std::string* why) const;
+};
+
 struct FkOptions {
   /// Solver name: "lg" (plain local-global, Algorithm 1), "lg-aa" (Anderson-accelerated), or one
   /// of the general-purpose optimisers of nlp_solvers.hpp: "ceres", "ipopt-lbfgs", "ipopt-newton".
@@ -31,6 +51,8 @@ struct FkOptions {
   /// Wall-clock limit of one Solve() call in seconds (0 = none); when it runs out the solver
   /// returns status time_limit with its last checked iterate. For comparisons that must end.
   double time_limit_s = 0.0;
+  /// Collision response settings (used by lg and lg-aa).
+  CollisionOptions collision;
 
   bool IsValid(std::string* why) const;
 };

@@ -38,6 +38,14 @@ std::string FkResult::BriefReport() const {
                 time_s);
   std::string s = buf;
   if (!message.empty()) s += " (" + message + ")";
+  if (collision_active) {
+    std::snprintf(buf, sizeof(buf),
+                  "; collisions: %d springs left, %s (max penetration %.3g mm), check %.3f s, "
+                  "response %.3f s",
+                  springs, collision.collision_free() ? "collision-free" : "contacts left",
+                  collision.max_penetration, collision_stats.check_s, collision_stats.response_s);
+    s += buf;
+  }
   return s;
 }
 

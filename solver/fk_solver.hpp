@@ -3,6 +3,7 @@
 /// The forward-kinematics solver interface: Solve(c, warm_start) -> FkResult. Implementations are
 /// chosen by name (FkOptions::solver). Two tiers: the one-shot SolveFk(scene, c) and a stateful
 /// solver (MakeFkSolver) that reuses the model's factorisation across calls.
+#include "solver/collision_response.hpp"
 #include "solver/fk_options.hpp"
 #include "solver/model.hpp"
 
@@ -30,6 +31,13 @@ struct FkResult {
   double time_s = 0, local_time_s = 0, global_time_s = 0;
   int aa_accepted = 0, aa_rejected = 0;
   std::vector<double> volume_ratios;  ///< achieved volume ratio per actuator
+  /// Collision handling (lg / lg-aa when FkOptions::collision is active for the scene): whether
+  /// it ran, the exact check of the final positions, the springs still active at the end, and
+  /// the detection / response counts and times of this solve.
+  bool collision_active = false;
+  CollisionCheck collision;
+  int springs = 0;
+  CollisionStats collision_stats;
   /// One line: status, iterations, energy, time.
   std::string BriefReport() const;
 };

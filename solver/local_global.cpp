@@ -46,12 +46,17 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
 
   Eigen::MatrixX3d B(m.num_vertices(), 3), Mv(m.num_vertices(), 3);
   Eigen::VectorXd Bf(nf), xf(nf), Gf(nf), Gprev(nf), step(nf), AX(nf);
+  CollisionResponse* resp = response_.get();
   auto local = [&](double* E) {
     const auto t0 = Clock::now();
     ComputeLocalRatios(m, X, c, &ratios_);
     *E = LocalStep(m, X, ratios_, &weighted_, nt);
     AssembleRhs(m, weighted_, &B, nt);
     m.GatherFree(B, &Bf);
+    if (resp) {
+      *E += resp->Energy(X);
+      resp->AddToRhs(&Bf);
+    }
     r->local_time_s += Seconds(t0, Clock::now());
   };
   auto load_free = [&]() { m.GatherFree(X, &xf); };
@@ -59,6 +64,7 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
   // ||A_ff x_f + A_fc x_c - B_f||: the energy gradient over the free coordinates (up to 2).
   auto residual_norm = [&]() {
     m.GatherFree(m.A() * X, &AX);
+    if (resp) resp->AddSpringProduct(X, &AX);
     return 2.0 * (AX - Bf).norm();
   };
 
@@ -93,12 +99,18 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     ++r->aa_rejected;
     accelerated = false;
   };
+  const int interval = options_.collision.check_interval;
   for (int it = 0; it < options_.max_iterations; ++it) {
     if (deadline_ && Clock::now() > *deadline_) {
       X = X_good;
       r->status = FkStatus::TimeLimit;
       r->message = "time limit of " + std::to_string(options_.time_limit_s) + " s reached";
       return;
+    }
+    if (resp && it % interval == 0 && resp->Update(X)) {
+      // The spring set (so the energy and the map G) changed: this iterate starts a new history.
+      aa.Reset();
+      accelerated = false;
     }
     double E;
     local(&E);
@@ -117,7 +129,7 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     }
 
     const auto t1 = Clock::now();
-    Gf = m.SolveFree(Bf - Cfix);
+    Gf = resp ? resp->Solve(Bf - Cfix) : m.SolveFree(Bf - Cfix);
     r->global_time_s += Seconds(t1, Clock::now());
     ++r->iterations;
     if (!Gf.allFinite()) {
@@ -156,6 +168,12 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     const bool roundoff = grad <= 1e-12 * total_weight_ * m.size();
     if (move < tol && (r->gradient_ratio < gtol || roundoff)) {
       store_free(Gf);
+      // With collisions, stop only if a check at this state leaves the spring set as it is.
+      if (resp && (resp->Update(X) || (!resp->Check(X).collision_free() && resp->Stiffen()))) {
+        // Springs changed, or contacts are left (springs yield by force / k): raise k.
+        aa.Reset();
+        continue;
+      }
       r->status = FkStatus::Converged;
       return;
     }
@@ -192,6 +210,17 @@ FkResult LocalGlobalSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
     deadline = t0 + std::chrono::duration_cast<Clock::duration>(
                         std::chrono::duration<double>(options_.time_limit_s));
   deadline_ = deadline ? &*deadline : nullptr;
+  if (CollisionResponse::Active(m.scene(), options_.collision)) {
+    try {
+      if (!response_) response_ = std::make_unique<CollisionResponse>(m, options_.collision);
+    } catch (const std::exception& e) {
+      r.status = FkStatus::InvalidInput;
+      r.message = e.what();
+      r.time_s = Seconds(t0, Clock::now());
+      return r;
+    }
+    response_->Reset();
+  }
   for (int s = 1; s <= K; ++s) {
     const Eigen::VectorXd cs = (K == 1) ? Eigen::VectorXd(c)
                                         : Eigen::VectorXd(rest + (c - rest) * (double(s) / K));
@@ -201,6 +230,14 @@ FkResult LocalGlobalSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
   deadline_ = nullptr;
   ComputeLocalRatios(m, r.positions, c, &ratios_, &r.volume_ratios);
   r.energy = LocalStep(m, r.positions, ratios_, &weighted_, options_.threads);
+  if (response_ && CollisionResponse::Active(m.scene(), options_.collision)) {
+    r.collision_active = true;
+    r.springs = static_cast<int>(response_->springs().size());
+    r.collision_stats = response_->stats();
+    const auto tc = Clock::now();
+    r.collision = response_->Check(r.positions);  // the exact check of the final state
+    r.collision_stats.check_s += Seconds(tc, Clock::now());
+  }
   r.time_s = Seconds(t0, Clock::now());
   return r;
 }

@@ -17,6 +17,11 @@
 ///    raise E near it and the energy rule rejects most accelerated steps (measured in
 ///    docs/benchmarks.md and the aa_ablation experiment). The residual alternative still rejects
 ///    extrapolations that make both measures worse.
+///  - collision response (Sec. 3.3, Eq. 3.9), when FkOptions::collision is active for the scene:
+///    detection and the spring rule run before the local step (every check_interval iterations
+///    and always before stopping); the spring targets join the right-hand side and their k the
+///    matrix, whose factor follows the spring set by CHOLMOD update/downdate. A change of the
+///    spring set restarts the Anderson history (the map G changed).
 ///  - stop when every vertex moves less than tolerance * size in one iteration AND the residual
 ///    ||2 (A X - B)|| has dropped below gradient_tolerance times its reference (the larger of its
 ///    value at the warm start and at the rest shape for the same actuation).
@@ -38,6 +43,7 @@ class LocalGlobalSolver : public FkSolver {
   /// One continuation stage: iterate from X towards the solution for c; accumulates into r.
   void SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X, FkResult* r);
   FkOptions options_;
+  std::unique_ptr<CollisionResponse> response_;  // springs of Eq. 3.5-3.9, when active
   std::vector<ElemRows> weighted_;  // per-element w Vol T, reused across iterations
   std::vector<double> ratios_;
   double total_weight_ = 0.0;  // sum of w_i Vol_i: the scale of the residual's round-off floor

@@ -201,7 +201,7 @@ void Model::SetUpConstraints() {
     f.A_ff = std::make_unique<Eigen::SparseMatrix<double>>(nf, nf);
     f.A_ff->setFromTriplets(tff.begin(), tff.end());
     f.A_ff->makeCompressed();
-    f.chol = std::make_unique<Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower>>();
+    f.chol = std::make_unique<CholmodFactorization>();
     // Simplicial LL^T: for these sparse 3D meshes its 3-RHS solve is faster than the supernodal
     // one (3.4 vs 5.3 ms at 47k tets, bench_fk BM_GlobalSolve) and it calls no BLAS, whose own
     // threads would compete with the OpenMP local step on a small machine.

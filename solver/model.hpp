@@ -19,6 +19,15 @@ namespace softkin {
 
 enum class ElementRole : std::uint8_t { Body, Pneumatic, Cable, Dea };
 
+/// Eigen's CHOLMOD wrapper with read access to the CHOLMOD factor it holds, so that a solver can
+/// copy it and modify the copy (update/downdate, spring_system.hpp).
+class CholmodFactorization
+    : public Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> {
+ public:
+  /// The numeric factor (null before compute()).
+  const cholmod_factor* factor() const { return m_cholmodFactor; }
+};
+
 /// Per-element constants.
 struct ModelElement {
   std::array<int, 6> v{};
@@ -121,6 +130,12 @@ class Model {
   const Eigen::SparseMatrix<double>& A_ff(int d = 0) const { return *factors_[factor_of_axis_[d]].A_ff; }
   /// Number of distinct factorisations (1 when every axis has the same free vertices).
   int num_factors() const { return static_cast<int>(factors_.size()); }
+  /// Which factorisation axis d uses (in [0, num_factors())).
+  int factor_of_axis(int d) const { return factor_of_axis_[d]; }
+  /// Factorisation f (A_ff of its axes, factored by CHOLMOD; simplicial LL^T).
+  const CholmodFactorization& factorization(int f) const { return *factors_[f].chol; }
+  /// Offset of axis d's block in the free-coordinate layout (GatherFree).
+  int free_offset(int d) const { return free_offset_[d]; }
 
   /// Solves A_ff y = rhs axis by axis with the prefactored CHOLMOD factors; rhs and the result
   /// are in the free-coordinate layout (GatherFree). Not safe to call concurrently on one Model.
@@ -136,7 +151,7 @@ class Model {
   };
   struct Factor {
     std::unique_ptr<Eigen::SparseMatrix<double>> A_ff;
-    std::unique_ptr<Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower>> chol;
+    std::unique_ptr<CholmodFactorization> chol;
   };
   /// Cable group g: per-element directions, Q d and length shares; L_R.
   void SetUpCable(int g);

@@ -1,5 +1,7 @@
 #include "solver/robots.hpp"
 
+#include "solver/hyperelastic.hpp"
+
 #include "solver/mesh_gen.hpp"
 
 #include <algorithm>
@@ -675,6 +677,158 @@ Scene MakeCableGripper(int res, const RobotParams& P) {
   return s;
 }
 
+// ================================================================================================
+// selfcollision_finger (thesis Sec. 3.4.2, Fig. 3.9-3.10): a PneuNet finger as it is moulded, with
+// an air gap between neighbouring chambers, so that the chamber walls meet as the chambers swell.
+//
+// Axes as pneumatic_finger: x = long axis [0, 120] (x = 0 fixed), y = width [0, 20], z = height
+// [0, 15]; inextensible base layer z in [0, 1.5] (region 2), a 1.5 mm floor (region 0), a solid
+// proximal block, then `chambers` units along x, each a closed box of 1.5 mm walls (region 0)
+// around a 5 mm cavity (region 1, one pneumatic actuator "chamber", volume ratio in [1, 6]),
+// separated by 2 mm air gaps above the floor (no elements there). Body material: first-order
+// Mooney-Rivlin (Eq. 3.6-3.7) of Ecoflex 00-30 (parameter material = 0) or Dragon Skin 20
+// (material = 1); the element weight is the material's initial shear modulus
+// mu = 2 (c1 + c2) relative to Ecoflex 00-30's (Dragon Skin 20: 2.71, "around 3 times stiffer").
+// Snapped to cells of h = 20 / res mm (every feature >= 1 cell). At res 8: 9 chambers, 11,232 tets.
+// ================================================================================================
+
+constexpr int kScfMinRes = 5, kScfMaxRes = 32, kScfDefaultRes = 8;
+constexpr double kScfGap = 2.0, kScfMaxAlpha = 6.0;
+
+Material MooneyRivlinMaterial(const std::string& name, const std::string& named, double weight) {
+  MooneyRivlin mr;
+  if (!NamedMooneyRivlin(named, &mr))
+    throw std::logic_error("unknown built-in material '" + named + "'");
+  Material m{name, 1.0, weight};
+  m.law = "mooney-rivlin";
+  m.c1 = mr.c1;
+  m.c2 = mr.c2;
+  return m;
+}
+
+/// Initial shear modulus 2 (c1 + c2) of a named Mooney-Rivlin material, MPa.
+double ShearModulus(const std::string& named) {
+  MooneyRivlin mr;
+  if (!NamedMooneyRivlin(named, &mr))
+    throw std::logic_error("unknown built-in material '" + named + "'");
+  return 2.0 * (mr.c1 + mr.c2);
+}
+
+Scene MakeSelfCollisionFinger(int res, const RobotParams& P) {
+  const double h = kFingerWidth / res;
+  const int ny = res, nz = static_cast<int>(std::lround(kFingerHeight / h));
+  const int base = Cells(kFingerBase, h), floor = Cells(kFingerFloor, h), wall = Cells(kFingerWall, h);
+  const int cavity = Cells(kFingerCavity, h), gap = Cells(kScfGap, h);
+  const int pitch = 2 * wall + cavity + gap;
+  const int nx_nominal = static_cast<int>(std::lround(kFingerLength / h));
+  const int chambers = (nx_nominal - Cells(kFingerProximal, h) + gap) / pitch;
+  const int proximal = nx_nominal - (chambers * pitch - gap);
+  const int nx = nx_nominal;
+  auto cell = [&](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
+    const int i = c[0], j = c[1], k = c[2];
+    if (k < base) return 2;
+    if (k < base + floor || i < proximal) return 0;
+    const int w = (i - proximal) % pitch;
+    if (w >= 2 * wall + cavity) return -1;  // the air gap between two chambers
+    const bool inside = w >= wall && w < wall + cavity && j >= wall && j < ny - wall && k < nz - wall;
+    return inside ? 1 : 0;
+  };
+  Scene s;
+  s.name = "selfcollision_finger";
+  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz), cell);
+  const bool dragon = P.at("material") >= 0.5;
+  const std::string named = dragon ? "dragon-skin-20" : "ecoflex-00-30";
+  const double weight = ShearModulus(named) / ShearModulus("ecoflex-00-30");
+  s.body[0] = MooneyRivlinMaterial(named, named, weight);
+  s.body[2] = Material{"inextensible", 1.0, kFingerLayerWeight * weight};
+  Actuator a;
+  a.name = "chamber";
+  a.type = ActuatorType::Pneumatic;
+  a.regions = {1};
+  a.rest = a.min = 1.0;
+  a.max = kScfMaxAlpha;
+  s.actuators.push_back(a);
+  const double eps = 1e-6 * h;
+  s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
+  AddDistalFaceMarkers(nx * h, nz * h, eps, &s);
+  s.solver.collision.self = true;
+  s.validate();
+  return s;
+}
+
+// ================================================================================================
+// membrane (thesis Sec. 3.4.3, Fig. 3.13): a 250 x 250 mm Dragon Skin 20 membrane shaped by four
+// pneumatic chambers below it, which touch it only through contact (collision response between
+// separate bodies of one mesh).
+//
+// Axes: membrane in x, y in [0, 250], z up. Cells of h = 250 / res mm. The membrane is one cell
+// thick (region 0), its rim (x or y at 0 or 250) fixed. Below it, a 2 x 2 array of closed boxes
+// (walls region 1, one cell thick; cavities regions 2..5 = actuators c1..c4, volume ratio in
+// [1, 4]), each about 40 mm tall, one cell apart and one cell in from the rim, standing on the
+// fixed plane z = 0, with a one-cell air gap between their roofs and the membrane. Chamber k sits
+// under quadrant k: c1 (x < 125, y < 125), c2 (x > 125, y < 125), c3 (x < 125, y > 125), c4 (x >
+// 125, y > 125). Material: Mooney-Rivlin Dragon Skin 20 (Eq. 3.6-3.7) for membrane and walls.
+// Markers: tip (the membrane's top centre) and q1..q4 (membrane top above each chamber's
+// centre). Self-collision response is on in the scene's solver options.
+// ================================================================================================
+
+constexpr int kMemMinRes = 10, kMemMaxRes = 60, kMemDefaultRes = 20;
+constexpr double kMemSide = 250.0, kMemChamberHeight = 40.0, kMemMaxAlpha = 4.0;
+
+Scene MakeMembrane(int res, const RobotParams&) {
+  const double h = kMemSide / res;
+  const int n = res;
+  const int nc = (n - 3) / 2;  // chamber width in cells: 1 margin + nc + 1 gap + nc + (rest) margin
+  const int hc = std::max(3, static_cast<int>(std::lround(kMemChamberHeight / h)));
+  const int zm = hc + 1;       // membrane cell layer (one-cell air gap below it)
+  const int x0[2] = {1, 2 + nc};
+  auto cell = [&](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
+    const int i = c[0], j = c[1], k = c[2];
+    if (k == zm) return 0;
+    if (k >= hc) return -1;
+    for (int q = 0; q < 4; ++q) {
+      const int ox = x0[q % 2], oy = x0[q / 2];
+      if (i < ox || i >= ox + nc || j < oy || j >= oy + nc) continue;
+      const bool interior = i > ox && i < ox + nc - 1 && j > oy && j < oy + nc - 1 && k > 0 && k < hc - 1;
+      return interior ? 2 + q : 1;
+    }
+    return -1;
+  };
+  Scene s;
+  s.name = "membrane";
+  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(n, n, zm + 1), cell);
+  s.body[0] = MooneyRivlinMaterial("membrane", "dragon-skin-20", 1.0);
+  s.body[1] = MooneyRivlinMaterial("chamber_wall", "dragon-skin-20", 1.0);
+  for (int q = 0; q < 4; ++q) {
+    Actuator a;
+    a.name = "c" + std::to_string(q + 1);
+    a.type = ActuatorType::Pneumatic;
+    a.regions = {2 + q};
+    a.rest = a.min = 1.0;
+    a.max = kMemMaxAlpha;
+    s.actuators.push_back(a);
+  }
+  const double eps = 1e-6 * h, side = n * h, zlo = zm * h;
+  std::vector<int> fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), eps);
+  for (int v = 0; v < s.mesh.num_vertices(); ++v) {
+    const Eigen::Vector3d p = s.mesh.vertices.row(v);
+    const bool rim = p.x() < eps || p.y() < eps || p.x() > side - eps || p.y() > side - eps;
+    if (rim && p.z() > zlo - eps) fixed.push_back(v);
+  }
+  std::sort(fixed.begin(), fixed.end());
+  fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
+  s.fixed = fixed;
+  const double ztop = zlo + h;
+  s.markers.push_back({"tip", {NearestVertex(s.mesh, Eigen::Vector3d(0.5 * side, 0.5 * side, ztop))}});
+  for (int q = 0; q < 4; ++q) {
+    const double cx = (x0[q % 2] + 0.5 * nc) * h, cy = (x0[q / 2] + 0.5 * nc) * h;
+    s.markers.push_back({"q" + std::to_string(q + 1), {NearestVertex(s.mesh, Eigen::Vector3d(cx, cy, ztop))}});
+  }
+  s.solver.collision.self = true;
+  s.validate();
+  return s;
+}
+
 struct RobotEntry {
   RobotInfo info;
   int min_res, max_res;
@@ -778,6 +932,25 @@ const std::vector<RobotEntry>& Registry() {
          {"link_r_omega", 1.0, 0.0, 1.0, "R_omega of the links"},
          {"joint_r_omega", 1.0, 0.0, 1.0, "R_omega of the joints"}}},
        kCgMinRes, kCgMaxRes, &MakeCableGripper},
+      {{"selfcollision_finger",
+        "PneuNet finger with 2 mm air gaps between its chambers, whose walls touch as they swell "
+        "(thesis Sec. 3.4.2, Fig. 3.9-3.10): 120 x 20 x 15 mm, x = long axis (x = 0 fixed), "
+        "inextensible base layer (region 2), Mooney-Rivlin body (region 0; material 0 = Ecoflex "
+        "00-30, 1 = Dragon Skin 20, weighted by shear modulus), cavities (region 1) = pneumatic "
+        "actuator 'chamber' (volume ratio in [1, 6]). Self-collision response on. Markers: tip, "
+        "tip_top, tip_bottom.",
+        kScfDefaultRes, "cells across the 20 mm width (cell size 20/res mm), integer in [5, 32]",
+        {{"material", 0.0, 0.0, 1.0, "0: Ecoflex 00-30, 1: Dragon Skin 20 (rounded)"}}},
+       kScfMinRes, kScfMaxRes, &MakeSelfCollisionFinger},
+      {{"membrane",
+        "250 x 250 mm Dragon Skin 20 membrane (rim fixed) shaped by four pneumatic chambers below "
+        "it through contact only (thesis Sec. 3.4.3, Fig. 3.13). Actuators c1..c4 (volume ratio in "
+        "[1, 4]) under quadrants (x<125,y<125), (x>125,y<125), (x<125,y>125), (x>125,y>125). "
+        "Self-collision response on. Markers: tip (membrane top centre), q1..q4 (membrane top above "
+        "each chamber).",
+        kMemDefaultRes, "cells across the 250 mm side (cell size 250/res mm), integer in [10, 60]",
+        {}},
+       kMemMinRes, kMemMaxRes, &MakeMembrane},
   };
   return kRobots;
 }

@@ -3,6 +3,7 @@
 /// What the user describes: a mesh with region tags, the role of every region (body material or
 /// actuator), fixed vertices, markers and solver options. Built by an embedded robot generator
 /// (robots.hpp) or from a mesh file plus a scene JSON (scene_json.hpp).
+#include "solver/collision.hpp"
 #include "solver/fk_options.hpp"
 #include "solver/mesh.hpp"
 
@@ -104,6 +105,9 @@ struct Scene {
   /// plane z = const. Vertices in `fixed` need not be repeated here.
   std::array<std::vector<int>, 3> fixed_axis;
   std::vector<Marker> markers;
+  /// Static obstacles (closed, outward-oriented surfaces, mm) the robot must stay out of (Eq. 3.4);
+  /// the local-global solvers respond to them with springs (FkOptions::collision).
+  std::vector<TriangleSurface> obstacles;
   FkOptions solver;                  ///< default solver options for this scene
 
   int num_actuators() const { return static_cast<int>(actuators.size()); }

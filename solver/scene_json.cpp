@@ -37,7 +37,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // The key table
 // ------------------------------------------------------------------------------------------------
 
-enum class Type { Object, ObjectArray, String, Number, Integer, Vec3, Polyline };
+enum class Type { Object, ObjectArray, String, Number, Integer, Vec3, Polyline, Bool };
 /// Required: must be present. Optional: has a default. Selector: each object of that kind needs
 /// exactly one key of its selector group (e.g. fixed[]: region | box | plane | file).
 enum class Need { Required, Optional, Selector };
@@ -224,6 +224,29 @@ const std::vector<KeySpec>& KeyTable() {
                   "The mean of the vertices inside an axis-aligned box (bounds included)."));
     t.push_back(Key("markers[].box.min", V, R, "Lower corner [x, y, z]."));
     t.push_back(Key("markers[].box.max", V, R, "Upper corner [x, y, z]."));
+    t.push_back(Key("obstacles", A, Opt,
+                    "Static obstacles the robot must stay out of (Eq. 3.4): closed surfaces; the "
+                    "local-global solvers respond to them with springs (solver.collision).")
+                    .Def(json::array()).DefText("[]"));
+    t.push_back(Key("obstacles[].type", S, R,
+                    "box: axis-aligned box; cylinder: closed cylinder; file: a closed, consistently "
+                    "oriented OBJ or STL surface.")
+                    .Choices({"box", "cylinder", "file"}));
+    t.push_back(Key("obstacles[].min", V, R, "Lower corner [x, y, z] (mm).").Roles({"box"}));
+    t.push_back(Key("obstacles[].max", V, R, "Upper corner [x, y, z] (mm), above min on every axis.")
+                    .Roles({"box"}));
+    t.push_back(Key("obstacles[].base", V, R, "Centre of the cylinder's base disc [x, y, z] (mm).")
+                    .Roles({"cylinder"}));
+    t.push_back(Key("obstacles[].axis", V, R, "Cylinder axis from the base (non-zero; normalised).")
+                    .Roles({"cylinder"}));
+    t.push_back(Key("obstacles[].radius", N, R, "Cylinder radius (mm).").Above(0.0).Roles({"cylinder"}));
+    t.push_back(Key("obstacles[].height", N, R, "Cylinder length along the axis (mm).")
+                    .Above(0.0).Roles({"cylinder"}));
+    t.push_back(Key("obstacles[].segments", I, Opt, "Number of sides of the cylinder's polygon.")
+                    .Def(48).AtLeast(3).Roles({"cylinder"}));
+    t.push_back(Key("obstacles[].file", S, R,
+                    "Surface file (.obj or .stl), relative to the JSON's folder.")
+                    .Roles({"file"}));
     t.push_back(Key("solver", O, Opt, "Default forward-kinematics solver options of this scene.")
                     .Def(json::object()));
     t.push_back(Key("solver.solver", S, Opt,
@@ -254,6 +277,32 @@ const std::vector<KeySpec>& KeyTable() {
                     .Def(fk.continuation_steps).AtLeast(1));
     t.push_back(Key("solver.threads", I, Opt, "OpenMP threads for the local step (0: library default).")
                     .Def(fk.threads).AtLeast(0));
+    const CollisionOptions co;
+    t.push_back(Key("solver.collision", O, Opt,
+                    "Collision response by springs (Sec. 3.2.3, Eq. 3.5, 3.8, 3.9; lg and lg-aa).")
+                    .Def(json::object()));
+    t.push_back(Key("solver.collision.self", Type::Bool, Opt,
+                    "Respond to self-collision: boundary vertices inside tets not incident to them "
+                    "(tet meshes only).")
+                    .Def(co.self));
+    t.push_back(Key("solver.collision.obstacles", Type::Bool, Opt,
+                    "Respond to the scene's obstacles.")
+                    .Def(co.obstacles));
+    t.push_back(Key("solver.collision.epsilon", N, Opt,
+                    "Offset of the contact boundary (mm): springs pull vertices this far beyond it "
+                    "and release them once they are this far beyond their target (Eq. 3.8).")
+                    .Def(co.epsilon).AtLeast(0.0));
+    t.push_back(Key("solver.collision.stiffness", N, Opt,
+                    "Spring stiffness k (Eq. 3.5) relative to the median diagonal entry of the "
+                    "global matrix over the boundary vertices.")
+                    .Def(co.stiffness).Above(0.0));
+    t.push_back(Key("solver.collision.check_interval", I, Opt,
+                    "Run collision detection every this many iterations (and before stopping).")
+                    .Def(co.check_interval).AtLeast(1));
+    t.push_back(Key("solver.collision.update", S, Opt,
+                    "How the factor follows the spring set: CHOLMOD update/downdate, or a numeric "
+                    "refactorisation.")
+                    .Def(co.update).Choices({"updown", "refactor"}));
     return t;
   }();
   return table;
@@ -319,6 +368,7 @@ std::string TypeText(const KeySpec& k, bool with_article) {
     case Type::Integer: return art("an ", "integer") + RangeText(k);
     case Type::Vec3: return art("an ", "array of 3 numbers [x, y, z]");
     case Type::Polyline: return art("an ", "array of >= 2 points [[x, y, z], ...]");
+    case Type::Bool: return art("a ", "boolean (true or false)");
   }
   return "?";
 }
@@ -392,6 +442,7 @@ bool ValueOk(const KeySpec& k, const json& v) {
           if (!e.is_number() || !std::isfinite(e.get<double>())) return false;
       }
       return true;
+    case Type::Bool: return v.is_boolean();
   }
   return false;
 }
@@ -555,7 +606,8 @@ class SceneParser {
           }
         if (known && !any_role)
         {
-          const std::string word = pattern == "motions[]" ? "type" : "role";
+          const std::string word =
+              (pattern == "motions[]" || pattern == "obstacles[]") ? "type" : "role";
           Fail(Join(path, key) + ": not allowed for " + word + " '" + role + "' (only for " + word +
                " " + ListText(roles) + "; expected one of: " + ListText(allowed) + ")");
         }
@@ -605,6 +657,7 @@ class SceneParser {
   std::vector<int> ReadIndexFile(const json& entry, const std::string& pattern,
                                  const std::string& path, const Mesh& mesh) const;
   std::vector<Marker> ReadMarkers(const json& markers, const Mesh& mesh) const;
+  std::vector<TriangleSurface> ReadObstacles(const json& obstacles) const;
   void ReadBox(const json& box, const std::string& pattern, const std::string& path,
                Eigen::Vector3d* lo, Eigen::Vector3d* hi) const;
   std::string BoundsText(const Mesh& mesh) const {
@@ -1002,6 +1055,43 @@ void SceneParser::ReadMotions(const json& motions, Scene* scene) const {
   }
 }
 
+std::vector<TriangleSurface> SceneParser::ReadObstacles(const json& obstacles) const {
+  std::vector<TriangleSurface> out;
+  for (size_t i = 0; i < obstacles.size(); ++i) {
+    const std::string path = "obstacles[" + std::to_string(i) + "]";
+    const json& o = obstacles[i];
+    if (!o.is_object()) Fail(path + ": expected an object, got " + Got(o));
+    CheckKey(o, "obstacles[]", path, "type");
+    const std::string type = o.at("type").get<std::string>();
+    CheckObject(o, "obstacles[]", path, type);
+    fs::path file;
+    if (type == "file") {
+      file = Resolve(o.at("file").get<std::string>());
+      if (!fs::is_regular_file(file))
+        Fail(path + ".file: file not found: '" + file.string() + "' (relative to '" +
+             (base_.empty() ? std::string(".") : base_) + "')");
+    }
+    TriangleSurface s;
+    try {
+      if (type == "box") {
+        s = MakeBoxSurface(AsVec(o.at("min")), AsVec(o.at("max")));
+      } else if (type == "cylinder") {
+        s = MakeCylinderSurface(AsVec(o.at("base")), AsVec(o.at("axis")), o.at("radius").get<double>(),
+                                o.at("height").get<double>(),
+                                AsInt(Get(o, "obstacles[]", "segments", type)));
+      } else {
+        s = ReadSurfaceMesh(file.string());
+      }
+      CheckClosedSurface(&s);
+    } catch (const std::invalid_argument& e) {
+      Fail(path + ": " + e.what());
+    }
+    s.source = path + " (" + (s.source.empty() ? type : s.source) + ")";
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
 std::vector<Marker> SceneParser::ReadMarkers(const json& markers, const Mesh& mesh) const {
   std::vector<Marker> out;
   std::map<std::string, std::string> name_path;
@@ -1047,6 +1137,7 @@ Scene SceneParser::Build(const json& root) {
   ReadFixed(root.at("fixed"), &scene);
   ReadMotions(Get(root, "", "motions"), &scene);
   scene.markers = ReadMarkers(Get(root, "", "markers"), scene.mesh);
+  scene.obstacles = ReadObstacles(Get(root, "", "obstacles"));
 
   const json solver = Get(root, "", "solver");
   CheckObject(solver, "solver", "solver");
@@ -1059,6 +1150,14 @@ Scene SceneParser::Build(const json& root) {
   o.anderson_safeguard = Get(solver, "solver", "anderson_safeguard").get<std::string>();
   o.continuation_steps = AsInt(Get(solver, "solver", "continuation_steps"));
   o.threads = AsInt(Get(solver, "solver", "threads"));
+  const json col = Get(solver, "solver", "collision");
+  CheckObject(col, "solver.collision", "solver.collision");
+  o.collision.self = Get(col, "solver.collision", "self").get<bool>();
+  o.collision.obstacles = Get(col, "solver.collision", "obstacles").get<bool>();
+  o.collision.epsilon = Get(col, "solver.collision", "epsilon").get<double>();
+  o.collision.stiffness = Get(col, "solver.collision", "stiffness").get<double>();
+  o.collision.check_interval = AsInt(Get(col, "solver.collision", "check_interval"));
+  o.collision.update = Get(col, "solver.collision", "update").get<std::string>();
   std::string why;
   if (!o.IsValid(&why)) Fail("solver." + why);
 
@@ -1107,7 +1206,9 @@ std::string SceneSchema() {
       case Need::Optional: def = "default " + (k.def_text.empty() ? k.def.dump() : k.def_text); break;
     }
     if (!k.roles.empty())
-      def += std::string(k.path.rfind("motions", 0) == 0 ? " [type " : " [role ") +
+      def += std::string(k.path.rfind("motions", 0) == 0 || k.path.rfind("obstacles", 0) == 0
+                             ? " [type "
+                             : " [role ") +
              ListText(k.roles) + "]";
     if (!k.with.empty()) def += " [only with " + k.with + "]";
     std::string line = k.path;

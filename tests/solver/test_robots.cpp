@@ -452,7 +452,8 @@ TEST(Robots, ListsEveryRobotAndRejectsBadInput) {
   const std::vector<RobotInfo> list = ListRobots();
   const std::vector<std::string> names = {"pneumatic_finger", "three_chamber", "cable_finger",
                                           "finger_manipulator", "multi_segment_gripper",
-                                          "dea_crawler", "bimaterial_bar", "cable_gripper"};
+                                          "dea_crawler", "bimaterial_bar", "cable_gripper",
+                                          "selfcollision_finger", "membrane"};
   ASSERT_EQ(list.size(), names.size());
   for (size_t i = 0; i < names.size(); ++i) EXPECT_EQ(list[i].name, names[i]);
   for (const auto& r : list) {
@@ -466,7 +467,8 @@ TEST(Robots, ListsEveryRobotAndRejectsBadInput) {
   } catch (const std::invalid_argument& e) {
     EXPECT_EQ(std::string(e.what()),
               "unknown robot 'x'; known robots: pneumatic_finger, three_chamber, cable_finger, "
-              "finger_manipulator, multi_segment_gripper, dea_crawler, bimaterial_bar, cable_gripper");
+              "finger_manipulator, multi_segment_gripper, dea_crawler, bimaterial_bar, cable_gripper, "
+              "selfcollision_finger, membrane");
   }
   try {
     MakeRobot("pneumatic_finger", 2);

@@ -862,7 +862,12 @@ const std::vector<std::string> kAllKeys = {
     "fixed[].file", "fixed[].base", "markers", "markers[].name", "markers[].vertex",
     "markers[].nearest", "markers[].box", "markers[].box.min", "markers[].box.max", "solver",
     "solver.solver", "solver.max_iterations", "solver.tolerance", "solver.gradient_tolerance",
-    "solver.anderson_window", "solver.anderson_safeguard", "solver.continuation_steps", "solver.threads"};
+    "solver.anderson_window", "solver.anderson_safeguard", "solver.continuation_steps", "solver.threads",
+    "solver.collision", "solver.collision.self", "solver.collision.obstacles", "solver.collision.epsilon",
+    "solver.collision.stiffness", "solver.collision.check_interval", "solver.collision.update",
+    "obstacles", "obstacles[].type", "obstacles[].min", "obstacles[].max", "obstacles[].base",
+    "obstacles[].axis", "obstacles[].radius", "obstacles[].height", "obstacles[].segments",
+    "obstacles[].file"};
 
 /// Key lines of the schema (after the "Keys:" line, not indented): path -> the rest of the line,
 /// plus the doc line that follows.

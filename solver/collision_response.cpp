@@ -1,0 +1,401 @@
+#include "solver/collision_response.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <limits>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace softkin {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double Since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+// Face j of a positively oriented tet (the face opposite vertex j), ordered so that its normal
+// (x1 - x0) x (x2 - x0) points out of the tet.
+constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
+bool AllTets(const Mesh& m) {
+  for (const auto& e : m.elements)
+    if (e.type != ElementType::Tet) return false;
+  return true;
+}
+
+SpringSystem::Method UpdateMethod(const CollisionOptions& o) {
+  return o.update == "refactor" ? SpringSystem::Method::kRefactor : SpringSystem::Method::kUpdown;
+}
+}  // namespace
+
+bool CollisionResponse::Active(const Scene& scene, const CollisionOptions& o) {
+  return o.self || (o.obstacles && !scene.obstacles.empty());
+}
+
+CollisionResponse::CollisionResponse(const Model& model, const CollisionOptions& options)
+    : model_(model), options_(options), system_(model, UpdateMethod(options)) {
+  std::string why;
+  if (!options_.IsValid(&why)) throw std::invalid_argument("solver." + why);
+  const Mesh& mesh = model.mesh();
+  const bool tets = AllTets(mesh);
+  if (options_.self && !tets)
+    throw std::invalid_argument("scene '" + model.scene().name +
+                                "': solver.collision.self needs a tet-only mesh (it has prisms)");
+  if (options_.obstacles)
+    for (const auto& s : model.scene().obstacles) obstacles_.emplace_back(s);
+  if (options_.self) detector_ = std::make_unique<SelfCollisionDetector>(mesh);
+
+  const int nv = mesh.num_vertices();
+  if (tets) {
+    // Tet adjacency and boundary faces from the sorted list of all faces.
+    const int nt = mesh.num_elements();
+    struct FaceRef {
+      std::array<int, 3> key;
+      int slot;  // 4 t + j
+    };
+    std::vector<FaceRef> faces;
+    faces.reserve(static_cast<size_t>(nt) * 4);
+    for (int t = 0; t < nt; ++t)
+      for (int j = 0; j < 4; ++j) {
+        const auto& v = mesh.elements[t].v;
+        std::array<int, 3> k = {v[kFace[j][0]], v[kFace[j][1]], v[kFace[j][2]]};
+        std::sort(k.begin(), k.end());
+        faces.push_back({k, 4 * t + j});
+      }
+    std::sort(faces.begin(), faces.end(), [](const FaceRef& a, const FaceRef& b) {
+      return a.key != b.key ? a.key < b.key : a.slot < b.slot;
+    });
+    adj_.assign(static_cast<size_t>(nt) * 4, -1);
+    for (size_t i = 0; i < faces.size();) {
+      size_t j = i + 1;
+      while (j < faces.size() && faces[j].key == faces[i].key) ++j;
+      if (j - i == 2) {
+        adj_[faces[i].slot] = faces[i + 1].slot / 4;
+        adj_[faces[i + 1].slot] = faces[i].slot / 4;
+      } else if (j - i == 1) {
+        const int t = faces[i].slot / 4, f = faces[i].slot % 4;
+        const auto& v = mesh.elements[t].v;
+        bfaces_.push_back({v[kFace[f][0]], v[kFace[f][1]], v[kFace[f][2]]});
+      }  // a face shared by > 2 tets is non-manifold: left without a neighbour
+      i = j;
+    }
+    vface_offset_.assign(nv + 1, 0);
+    for (const auto& f : bfaces_)
+      for (int v : f) ++vface_offset_[v + 1];
+    for (int v = 0; v < nv; ++v) vface_offset_[v + 1] += vface_offset_[v];
+    vface_.resize(vface_offset_[nv]);
+    std::vector<int> fill(vface_offset_.begin(), vface_offset_.end() - 1);
+    for (int f = 0; f < static_cast<int>(bfaces_.size()); ++f)
+      for (int v : bfaces_[f]) vface_[fill[v]++] = f;
+    for (int v = 0; v < nv; ++v)
+      if (vface_offset_[v + 1] > vface_offset_[v]) check_vertices_.push_back(v);
+  } else {
+    check_vertices_.resize(nv);
+    for (int v = 0; v < nv; ++v) check_vertices_[v] = v;
+  }
+
+  // k: stiffness times the median diagonal entry of A over the tested vertices.
+  const Eigen::VectorXd diag = model.A().diagonal();
+  std::vector<double> d;
+  d.reserve(check_vertices_.size());
+  for (int v : check_vertices_)
+    if (diag[v] > 0) d.push_back(diag[v]);
+  if (d.empty()) throw std::invalid_argument("collision response: the global matrix has no positive diagonal");
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  k_ = k0_ = options_.stiffness * d[d.size() / 2];
+}
+
+CollisionResponse::~CollisionResponse() = default;
+
+Eigen::Vector3d CollisionResponse::VertexNormal(const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                                                int v) const {
+  Eigen::Vector3d n = Eigen::Vector3d::Zero();
+  if (vface_offset_.empty()) return n;
+  for (int q = vface_offset_[v]; q < vface_offset_[v + 1]; ++q) {
+    const auto& f = bfaces_[vface_[q]];
+    const Eigen::Vector3d a = X.row(f[0]), b = X.row(f[1]), c = X.row(f[2]);
+    n += (b - a).cross(c - a);
+  }
+  const double len = n.norm();
+  return len > 0 ? Eigen::Vector3d(n / len) : Eigen::Vector3d::Zero();
+}
+
+bool CollisionResponse::WalkOut(const Eigen::Ref<const Eigen::MatrixX3d>& X, int v, int tet,
+                                const Eigen::Vector3d& dir, Eigen::Vector3d* exit,
+                                int* exit_face) const {
+  if (adj_.empty() || !(dir.norm() > 0)) return false;
+  const Mesh& mesh = model_.mesh();
+  const Eigen::Vector3d p0 = X.row(v);
+  const double slack = 1e-9 * model_.size();
+  int cur = tet;
+  const int max_steps = 4 * mesh.num_elements() + 16;
+  for (int step = 0; step < max_steps; ++step) {
+    const auto& e = mesh.elements[cur].v;
+    const Eigen::Vector3d x0 = X.row(e[0]);
+    Eigen::Matrix3d M;
+    M.col(0) = X.row(e[1]).transpose() - x0;
+    M.col(1) = X.row(e[2]).transpose() - x0;
+    M.col(2) = X.row(e[3]).transpose() - x0;
+    const Eigen::PartialPivLU<Eigen::Matrix3d> lu(M);
+    if (!(std::abs(M.determinant()) > 0)) return false;
+    const Eigen::Vector3d l123 = lu.solve(p0 - x0), g123 = lu.solve(dir);
+    const double lam[4] = {1.0 - l123.sum(), l123[0], l123[1], l123[2]};
+    const double g[4] = {-g123.sum(), g123[0], g123[1], g123[2]};
+    // The ray leaves the tet where the first decreasing barycentric coordinate reaches zero.
+    int jout = -1;
+    double tout = std::numeric_limits<double>::infinity();
+    for (int j = 0; j < 4; ++j) {
+      if (!(g[j] < 0)) continue;
+      const double t = -lam[j] / g[j];
+      if (t < tout) {
+        tout = t;
+        jout = j;
+      }
+    }
+    if (jout < 0 || !std::isfinite(tout) || tout < -slack) return false;
+    const int next = adj_[4 * cur + jout];
+    if (next < 0) {
+      *exit = p0 + std::max(0.0, tout) * dir;
+      if (exit_face) *exit_face = 4 * cur + jout;
+      return true;
+    }
+    const auto& ne = mesh.elements[next].v;
+    if (ne[0] == v || ne[1] == v || ne[2] == v || ne[3] == v) return false;
+    cur = next;
+  }
+  return false;
+}
+
+bool CollisionResponse::SelfTarget(const Eigen::Ref<const Eigen::MatrixX3d>& X, int v, int tet,
+                                   CollisionSpring* s) const {
+  const auto& e = model_.mesh().elements[tet].v;
+  const Eigen::Vector3d centroid =
+      (X.row(e[0]) + X.row(e[1]) + X.row(e[2]) + X.row(e[3])).transpose() / 4.0;
+  const Eigen::Vector3d p = X.row(v);
+  // -n(v) first (the thesis's rule); if that walk fails (the ray turns back into v's own part),
+  // the shortest exit among the direction away from the collided tet's centroid and the axes.
+  std::vector<Eigen::Vector3d> dirs = {-VertexNormal(X, v), p - centroid};
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t q = 0; q < dirs.size() + 6; ++q) {
+    Eigen::Vector3d dir = q < dirs.size() ? dirs[q]
+                                          : (q % 2 ? 1.0 : -1.0) * Eigen::Vector3d::Unit((q - 2) / 2);
+    const double len = dir.norm();
+    if (!(len > 0)) continue;
+    dir /= len;
+    Eigen::Vector3d exit;
+    int face = -1;
+    if (!WalkOut(X, v, tet, dir, &exit, &face)) continue;
+    const double depth = (exit - p).norm();
+    if (depth >= best) continue;
+    best = depth;
+    s->exit_face = face;
+    s->vertex = v;
+    s->kind = CollisionSpring::Kind::Self;
+    s->other = tet;
+    s->normal = dir;
+    s->depth = depth;
+    // Both sides of a face-to-face contact have vertices inside the other: each spring takes
+    // half the overlap (the targets are refreshed at every check, so a one-sided contact still
+    // closes, halving each time), plus the offset.
+    s->target = p + 0.5 * (exit - p) + options_.epsilon * dir;
+    if (q == 0) break;  // -n(v) worked
+  }
+  return std::isfinite(best);
+}
+
+void CollisionResponse::ObstacleTarget(const Eigen::Vector3d& p, int obstacle,
+                                       CollisionSpring* s) const {
+  Eigen::Vector3d n;
+  const Eigen::Vector3d c = obstacles_[obstacle].ClosestPoint(p, &n);
+  s->kind = CollisionSpring::Kind::Obstacle;
+  s->other = obstacle;
+  s->normal = n;
+  s->target = c + options_.epsilon * n;
+}
+
+bool CollisionResponse::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) {
+  const auto t0 = Clock::now();
+  std::vector<SelfContact> self;
+  if (detector_) {
+    detector_->Update(X);
+    self = detector_->Detect();
+  }
+  std::vector<ObstacleContact> obst;
+  if (!obstacles_.empty()) obst = DetectObstacleContacts(obstacles_, X, check_vertices_);
+  stats_.check_s += Since(t0);
+  ++stats_.checks;
+
+  const auto t1 = Clock::now();
+  std::vector<CollisionSpring> next;
+  next.reserve(self.size() + obst.size() + springs_.size());
+  // An obstacle contact wins over a self contact of the same vertex: the obstacle does not move.
+  std::vector<int> obst_vertex;
+  obst_vertex.reserve(obst.size());
+  for (const auto& c : obst) {
+    CollisionSpring s;
+    s.vertex = c.vertex;
+    s.kind = CollisionSpring::Kind::Obstacle;
+    s.other = c.obstacle;
+    s.normal = c.normal;
+    s.target = c.closest + options_.epsilon * c.normal;
+    s.depth = c.depth;
+    next.push_back(s);
+    obst_vertex.push_back(c.vertex);
+  }
+  std::sort(obst_vertex.begin(), obst_vertex.end());
+  for (const auto& c : self) {
+    if (std::binary_search(obst_vertex.begin(), obst_vertex.end(), c.vertex)) continue;
+    CollisionSpring s;
+    if (SelfTarget(X, c.vertex, c.tet, &s))
+      next.push_back(s);
+    else
+      ++stats_.unresolved;
+  }
+  std::sort(next.begin(), next.end(),
+            [](const CollisionSpring& a, const CollisionSpring& b) { return a.vertex < b.vertex; });
+  // Springs of vertices no longer in collision: release by Eq. 3.8, else keep (obstacle targets
+  // follow the closest point as the vertex slides).
+  std::vector<CollisionSpring> kept;
+  int added = static_cast<int>(next.size());
+  for (auto s : springs_) {
+    const auto it = std::lower_bound(
+        next.begin(), next.end(), s.vertex,
+        [](const CollisionSpring& a, int v) { return a.vertex < v; });
+    if (it != next.end() && it->vertex == s.vertex) {
+      --added;  // still in collision: its spring stays (with a fresh target)
+      continue;
+    }
+    const Eigen::Vector3d p = X.row(s.vertex);
+    // Eq. 3.8 is tested against where the contact surface is now. An obstacle spring's target
+    // follows the closest point as the vertex slides. A self spring keeps its target while the
+    // vertex is out of collision (both parts' springs chasing each other's moving faces would
+    // make a slow, lagged iteration); the release test uses the current plane of the face the
+    // vertex was pushed out through (the other part may have moved away).
+    Eigen::Vector3d surface_target = s.target;
+    if (s.kind == CollisionSpring::Kind::Obstacle) {
+      ObstacleTarget(p, s.other, &s);
+      surface_target = s.target;
+    } else if (s.exit_face >= 0) {
+      const auto& e = model_.mesh().elements[s.exit_face / 4].v;
+      const int j = s.exit_face % 4;
+      const Eigen::Vector3d a = X.row(e[kFace[j][0]]), b = X.row(e[kFace[j][1]]),
+                            c = X.row(e[kFace[j][2]]);
+      const Eigen::Vector3d m = (b - a).cross(c - a);
+      const double mn = m.dot(s.normal);
+      if (std::abs(mn) > 1e-3 * m.norm())
+        surface_target = p + (m.dot(a - p) / mn + options_.epsilon) * s.normal;
+    }
+    if (s.normal.dot(p - surface_target) > options_.epsilon) {
+      ++stats_.springs_released;
+      continue;
+    }
+    s.depth = 0;
+    kept.push_back(s);
+  }
+  stats_.springs_added += added;
+  next.insert(next.end(), kept.begin(), kept.end());
+  std::sort(next.begin(), next.end(),
+            [](const CollisionSpring& a, const CollisionSpring& b) { return a.vertex < b.vertex; });
+  springs_ = std::move(next);
+  std::vector<int> verts(springs_.size());
+  for (size_t i = 0; i < springs_.size(); ++i) verts[i] = springs_[i].vertex;
+  const bool changed = system_.SetSprings(verts, k_);
+  stats_.max_springs = std::max(stats_.max_springs, static_cast<int>(springs_.size()));
+  stats_.response_s += Since(t1);
+  return changed;
+}
+
+void CollisionResponse::AddToRhs(Eigen::VectorXd* Bf) const {
+  for (const auto& s : springs_)
+    for (int d = 0; d < 3; ++d) {
+      const int i = model_.free_index(d)[s.vertex];
+      if (i >= 0) (*Bf)[model_.free_offset(d) + i] += k_ * s.target[d];
+    }
+}
+
+void CollisionResponse::AddSpringProduct(const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                                         Eigen::VectorXd* y) const {
+  for (const auto& s : springs_)
+    for (int d = 0; d < 3; ++d) {
+      const int i = model_.free_index(d)[s.vertex];
+      if (i >= 0) (*y)[model_.free_offset(d) + i] += k_ * X(s.vertex, d);
+    }
+}
+
+void CollisionResponse::Reset() {
+  springs_.clear();
+  k_ = k0_;
+  raises_ = 0;
+  system_.SetSprings({}, k_);
+  stats_ = CollisionStats();
+}
+
+bool CollisionResponse::Stiffen(int max_raises) {
+  if (raises_ >= max_raises || springs_.empty()) return false;
+  ++raises_;
+  ++stats_.stiffenings;
+  k_ *= 4.0;
+  const auto t0 = Clock::now();
+  std::vector<int> verts(springs_.size());
+  for (size_t i = 0; i < springs_.size(); ++i) verts[i] = springs_[i].vertex;
+  system_.SetSprings(verts, k_);
+  stats_.response_s += Since(t0);
+  return true;
+}
+
+double CollisionResponse::Energy(const Eigen::Ref<const Eigen::MatrixX3d>& X) const {
+  double e = 0;
+  for (const auto& s : springs_) e += k_ * (X.row(s.vertex).transpose() - s.target).squaredNorm();
+  return e;
+}
+
+CollisionCheck CollisionResponse::Check(const Eigen::Ref<const Eigen::MatrixX3d>& X) const {
+  CollisionCheck r;
+  std::unique_ptr<SelfCollisionDetector> own;
+  SelfCollisionDetector* det = detector_.get();
+  if (!det && !adj_.empty()) {
+    own = std::make_unique<SelfCollisionDetector>(model_.mesh());
+    det = own.get();
+  }
+  if (det) {
+    det->Update(X);
+    for (const auto& c : det->Detect()) {
+      ++r.self_contacts;
+      const Eigen::Vector3d p = X.row(c.vertex);
+      const auto& e = model_.mesh().elements[c.tet].v;
+      const Eigen::Vector3d centroid =
+          (X.row(e[0]) + X.row(e[1]) + X.row(e[2]) + X.row(e[3])).transpose() / 4.0;
+      std::vector<Eigen::Vector3d> dirs = {-VertexNormal(X, c.vertex), p - centroid};
+      for (int d = 0; d < 3; ++d) {
+        dirs.push_back(Eigen::Vector3d::Unit(d));
+        dirs.push_back(-Eigen::Vector3d::Unit(d));
+      }
+      double depth = std::numeric_limits<double>::infinity();
+      for (auto dir : dirs) {
+        if (!(dir.norm() > 0)) continue;
+        dir.normalize();
+        Eigen::Vector3d exit;
+        if (WalkOut(X, c.vertex, c.tet, dir, &exit)) depth = std::min(depth, (exit - p).norm());
+      }
+      if (std::isfinite(depth)) r.max_penetration = std::max(r.max_penetration, depth);
+    }
+  }
+  if (!model_.scene().obstacles.empty()) {
+    std::vector<Obstacle> local;
+    const std::vector<Obstacle>* obs = &obstacles_;
+    if (obstacles_.empty()) {  // response to obstacles is off: still report them
+      for (const auto& s : model_.scene().obstacles) local.emplace_back(s);
+      obs = &local;
+    }
+    for (const auto& c : DetectObstacleContacts(*obs, X, check_vertices_)) {
+      ++r.obstacle_contacts;
+      r.max_penetration = std::max(r.max_penetration, c.depth);
+    }
+  }
+  return r;
+}
+
+}  // namespace softkin

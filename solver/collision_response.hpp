@@ -1,0 +1,139 @@
+#pragma once
+/// \file collision_response.hpp
+/// Collision response by spring elements (thesis Sec. 3.2.3 and 3.3.1, Eq. 3.5, 3.8, 3.9).
+///
+/// Each collided vertex v gets a "virtual" spring of energy k ||v - v_c||^2 (Eq. 3.5) that pulls
+/// it to a collision-free target v_c:
+///  - self-collision (v inside a tet not incident to it): from v along -n(v), n(v) the outward
+///    normal of the robot's boundary at v (area-weighted over its boundary faces, at the current
+///    positions), walking tet to tet through the collided region until the ray leaves it through
+///    a boundary face at v_s; v_c = v_s + eps (-n(v)). If the ray re-enters a tet incident to v
+///    (a fold, where -n(v) points back into v's own part), the walk is retried from v along the
+///    direction from the collided tet's centroid to v.
+///  - obstacle (v strictly inside it): v_s = the closest point on the obstacle surface (CGAL
+///    AABB tree), v_c = v_s + eps n, n the obstacle's outward normal there.
+/// Springs are added for every newly collided vertex and their targets refreshed at every check.
+/// A spring whose vertex is no longer in collision is released once the vertex is more than eps
+/// beyond its target along the spring normal (Eq. 3.8: n . (v - v_c) > eps), i.e. when the body
+/// pulls away from the contact on its own; until then it holds the vertex at the contact, which
+/// keeps contact without adhesion. The local-global solver minimises E_ela + E_col (Eq. 3.9):
+/// targets are fixed in the global step, whose matrix gains k on the springs' rows, kept factored
+/// by SpringSystem (CHOLMOD update/downdate).
+#include "solver/collision.hpp"
+#include "solver/model.hpp"
+#include "solver/spring_system.hpp"
+
+#include <Eigen/Dense>
+
+#include <array>
+#include <memory>
+#include <vector>
+
+namespace softkin {
+
+/// One spring element.
+struct CollisionSpring {
+  enum class Kind { Self, Obstacle };
+  int vertex = -1;
+  Kind kind = Kind::Self;
+  int other = -1;  ///< collided tet (Self) or obstacle index (Obstacle) when last detected
+  Eigen::Vector3d target = Eigen::Vector3d::Zero();  ///< v_c, mm
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< unit direction out of the collided region
+  double depth = 0;  ///< |v - v_s| when last detected in collision, mm
+  /// Self: the boundary face the walk left the collided region through (tet * 4 + local face),
+  /// whose current plane gives the contact surface while the vertex is out of collision.
+  int exit_face = -1;
+};
+
+/// Result of an exact collision check of a state.
+struct CollisionCheck {
+  int self_contacts = 0;      ///< boundary vertices inside a non-incident tet (exact predicates)
+  int obstacle_contacts = 0;  ///< vertices strictly inside an obstacle
+  double max_penetration = 0; ///< largest depth among them, mm (0 if collision-free)
+  bool collision_free() const { return self_contacts == 0 && obstacle_contacts == 0; }
+};
+
+/// Timings and counts of the collision handling in one solve.
+struct CollisionStats {
+  int checks = 0;
+  int springs_added = 0, springs_released = 0;
+  int max_springs = 0;
+  int unresolved = 0;      ///< self contacts for which no exit point was found (no spring)
+  int stiffenings = 0;     ///< times k was raised (CollisionResponse::Stiffen)
+  double check_s = 0;      ///< detection (self + obstacles)
+  double response_s = 0;   ///< targets, release rule and the factor update
+};
+
+class CollisionResponse {
+ public:
+  /// Builds the detectors for `model`'s mesh (self-collision needs a tet-only mesh: throws
+  /// std::invalid_argument otherwise) and the obstacles of its scene. `model` must outlive it.
+  CollisionResponse(const Model& model, const CollisionOptions& options);
+  ~CollisionResponse();
+
+  /// Whether a scene with these options needs collision handling at all.
+  static bool Active(const Scene& scene, const CollisionOptions& options);
+
+  /// Detection at positions X (#V x 3) and the spring rule: adds, refreshes and releases springs.
+  /// Returns true if the set of spring vertices (hence the global matrix) changed.
+  bool Update(const Eigen::Ref<const Eigen::MatrixX3d>& X);
+  /// Adds the springs' k v_c to the free right-hand side (layout of Model::GatherFree).
+  void AddToRhs(Eigen::VectorXd* Bf) const;
+  /// Adds K x (the springs' k on their free coordinates, x = the free coordinates of X) to y.
+  void AddSpringProduct(const Eigen::Ref<const Eigen::MatrixX3d>& X, Eigen::VectorXd* y) const;
+  /// Releases every spring and zeroes the statistics (the start of a new solve).
+  void Reset();
+  /// E_col = sum k ||v - v_c||^2 at positions X.
+  double Energy(const Eigen::Ref<const Eigen::MatrixX3d>& X) const;
+  /// Solves (A_ff + K) y = rhs (free layout).
+  Eigen::VectorXd Solve(const Eigen::VectorXd& rhs) const { return system_.Solve(rhs); }
+  /// (A_ff + K) x (free layout).
+  Eigen::VectorXd Multiply(const Eigen::VectorXd& x) const { return system_.Multiply(x); }
+  /// Exact check of positions X: contacts left and the deepest penetration (for a self contact,
+  /// the shortest exit found along -n(v), away from the collided tet's centroid and the six axis
+  /// directions: an upper bound on the distance to the collided region's surface).
+  CollisionCheck Check(const Eigen::Ref<const Eigen::MatrixX3d>& X) const;
+
+  /// Penalty continuation: multiplies k by 4 (refactoring the system) unless it has already been
+  /// raised `max_raises` times; returns whether it did. The solver calls it when it has converged
+  /// with contacts left (finite springs yield by force / k).
+  bool Stiffen(int max_raises = 3);
+
+  const std::vector<CollisionSpring>& springs() const { return springs_; }
+  double stiffness() const { return k_; }
+  const CollisionStats& stats() const { return stats_; }
+  const SpringSystem& system() const { return system_; }
+  const std::vector<Obstacle>& obstacles() const { return obstacles_; }
+
+  /// Exit point of the ray from v (at X) along unit `dir` through the tets starting at `tet`,
+  /// where it leaves the region for the outside of the mesh. Returns false if the ray meets a tet
+  /// incident to v first, degenerates, or takes too many steps. Exposed for tests.
+  bool WalkOut(const Eigen::Ref<const Eigen::MatrixX3d>& X, int v, int tet,
+               const Eigen::Vector3d& dir, Eigen::Vector3d* exit, int* exit_face = nullptr) const;
+  /// Outward unit normal of the boundary at vertex v (at X); zero for an interior vertex.
+  Eigen::Vector3d VertexNormal(const Eigen::Ref<const Eigen::MatrixX3d>& X, int v) const;
+
+ private:
+  /// Target of a self-collided vertex v inside `tet`; false if none was found.
+  bool SelfTarget(const Eigen::Ref<const Eigen::MatrixX3d>& X, int v, int tet,
+                  CollisionSpring* s) const;
+  void ObstacleTarget(const Eigen::Vector3d& p, int obstacle, CollisionSpring* s) const;
+
+  const Model& model_;
+  CollisionOptions options_;
+  std::vector<Obstacle> obstacles_;
+  std::unique_ptr<SelfCollisionDetector> detector_;
+  SpringSystem system_;
+  double k_ = 0, k0_ = 0;
+  int raises_ = 0;
+  std::vector<CollisionSpring> springs_;  // sorted by vertex
+  std::vector<int> check_vertices_;       // vertices tested against obstacles
+  // Tet faces: neighbour across face j of tet t is adj_[4 t + j] (-1: boundary face).
+  std::vector<int> adj_;
+  // Boundary faces (outward, v0 v1 v2) and, per vertex, its boundary faces (CSR).
+  std::vector<std::array<int, 3>> bfaces_;
+  std::vector<int> vface_offset_, vface_;
+  CollisionStats stats_;
+};
+
+}  // namespace softkin

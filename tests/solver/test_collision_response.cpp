@@ -1,0 +1,301 @@
+// Collision response by spring elements (solver/collision_response.hpp, spring_system.hpp; thesis
+// Sec. 3.2.3, Eq. 3.5, 3.8, 3.9): the spring system solves A_ff + K exactly after any sequence of
+// updates and downdates; the spring energy, its gradient and the global system agree (finite
+// differences); a pressed-in state fails the exact collision check without response and passes
+// with it, for self-collision and for an obstacle.
+#include "solver/collision_response.hpp"
+
+#include "solver/fk_solver.hpp"
+#include "solver/mesh_gen.hpp"
+#include "solver/robots.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/SparseCholesky>
+
+#include <algorithm>
+#include <memory>
+#include <random>
+
+namespace softkin {
+namespace {
+
+constexpr double kH = 2.0;  // cell size, mm
+
+/// Two 4 x 4 x 2-cell blocks stacked in z with a one-cell air gap (z in [0, 4] and [6, 10]). The
+/// lower block's bottom is fixed; the "press" displacement actuator moves the upper block's top
+/// face along -z (range [0, 6] mm), so values above 2 mm push it into the lower block.
+Scene TwoBlocks() {
+  Scene s;
+  s.name = "two_blocks";
+  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), kH, Eigen::Vector3i(4, 4, 5),
+                        [](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
+                          return c[2] == 2 ? -1 : 0;
+                        });
+  s.body[0] = Material{"body", 0.5, 1.0};
+  s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 1e-9);
+  Actuator press;
+  press.name = "press";
+  press.type = ActuatorType::Displacement;
+  press.vertices = VerticesOnPlane(s.mesh, Eigen::Vector3d(0, 0, 10), Eigen::Vector3d::UnitZ(), 1e-9);
+  press.axis = -Eigen::Vector3d::UnitZ();
+  press.rest = press.min = 0.0;
+  press.max = 6.0;
+  s.actuators.push_back(press);
+  s.markers.push_back({"top", press.vertices});
+  s.validate();
+  return s;
+}
+
+TEST(SpringSystem, UpdateDowndateMatchesADirectSolve) {
+  const Scene scene = MakeRobot("pneumatic_finger", 5);
+  const Model model(scene);
+  SpringSystem updown(model), refactor(model, SpringSystem::Method::kRefactor);
+  updown.set_refactor_after(0);  // never refactor: every change is an update/downdate
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> vert(0, model.num_vertices() - 1);
+  const double k = 3.0 * model.A().diagonal().mean();
+  Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(model.num_free_dofs(), -1.0, 2.0);
+  std::vector<int> set;
+  for (int round = 0; round < 6; ++round) {
+    // Keep about half, add a few new ones: both updates and downdates.
+    std::vector<int> next;
+    for (int v : set)
+      if (rng() % 2) next.push_back(v);
+    for (int q = 0; q < 5; ++q) next.push_back(vert(rng));
+    set = next;
+    EXPECT_TRUE(updown.SetSprings(set, k) || set.empty());
+    refactor.SetSprings(set, k);
+    // Reference: Eigen's own LDL^T of A_ff + K, axis by axis.
+    Eigen::VectorXd ref(model.num_free_dofs());
+    for (int d = 0; d < 3; ++d) {
+      Eigen::SparseMatrix<double> M = model.A_ff(d);
+      for (int v : updown.springs()) {
+        const int i = model.free_index(d)[v];
+        if (i >= 0) M.coeffRef(i, i) += k;
+      }
+      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(M);
+      ASSERT_EQ(ldlt.info(), Eigen::Success);
+      const int off = model.free_offset(d), n = model.free_offset(d + 1) - off;
+      ref.segment(off, n) = ldlt.solve(b.segment(off, n));
+    }
+    const Eigen::VectorXd y1 = updown.Solve(b), y2 = refactor.Solve(b);
+    EXPECT_LT((y1 - ref).norm(), 1e-9 * ref.norm()) << "round " << round;
+    EXPECT_LT((y2 - ref).norm(), 1e-9 * ref.norm()) << "round " << round;
+    EXPECT_LT((updown.Multiply(y1) - b).norm(), 1e-9 * b.norm());
+  }
+  EXPECT_GT(updown.stats().columns_updated, 0);
+  EXPECT_EQ(updown.stats().refactors, 0);
+  EXPECT_GT(refactor.stats().refactors, 0);
+  EXPECT_FALSE(updown.SetSprings(updown.springs(), k));  // same set: nothing to do
+  EXPECT_THROW(updown.SetSprings({1}, 0.0), std::invalid_argument);
+}
+
+TEST(CollisionResponse, SpringEnergyGradientMatchesFiniteDifferences) {
+  Scene scene = TwoBlocks();
+  scene.solver.collision.self = true;
+  const Model model(scene);
+  CollisionResponse resp(model, scene.solver.collision);
+  // Push the upper block 3 mm down rigidly: its bottom layer enters the lower block.
+  Eigen::MatrixX3d X = model.rest_positions();
+  for (int v = 0; v < X.rows(); ++v)
+    if (X(v, 2) > 5.0) X(v, 2) -= 3.0;
+  EXPECT_TRUE(resp.Update(X));
+  ASSERT_FALSE(resp.springs().empty());
+  for (const auto& s : resp.springs()) {
+    EXPECT_EQ(s.kind, CollisionSpring::Kind::Self);
+    EXPECT_GT(s.depth, 0.0);
+  }
+  // Move off the targets, so the gradient is not zero.
+  Eigen::MatrixX3d Y = X;
+  for (int v = 0; v < Y.rows(); ++v) Y.row(v) += 0.1 * Eigen::RowVector3d(std::sin(v), std::cos(v), 0.3);
+  // Analytic: dE_col/dx_free = 2 (K x - K t) = 2 (AddSpringProduct - AddToRhs).
+  Eigen::VectorXd Kx = Eigen::VectorXd::Zero(model.num_free_dofs()), Kt = Kx;
+  resp.AddSpringProduct(Y, &Kx);
+  resp.AddToRhs(&Kt);
+  const Eigen::VectorXd grad = 2.0 * (Kx - Kt);
+  const double h = 1e-6;
+  double worst = 0, scale = grad.cwiseAbs().maxCoeff();
+  ASSERT_GT(scale, 0.0);
+  for (const auto& s : resp.springs())
+    for (int d = 0; d < 3; ++d) {
+      const int i = model.free_index(d)[s.vertex];
+      if (i < 0) continue;
+      Eigen::MatrixX3d P = Y, M = Y;
+      P(s.vertex, d) += h;
+      M(s.vertex, d) -= h;
+      const double fd = (resp.Energy(P) - resp.Energy(M)) / (2 * h);
+      worst = std::max(worst, std::abs(fd - grad[model.free_offset(d) + i]));
+    }
+  EXPECT_LT(worst, 1e-6 * scale);
+  // Vertices without a spring have no spring gradient.
+  int zero = 0;
+  for (int v = 0; v < Y.rows(); ++v) {
+    const int i = model.free_index(0)[v];
+    if (i < 0) continue;
+    const bool has = std::any_of(resp.springs().begin(), resp.springs().end(),
+                                 [&](const CollisionSpring& s) { return s.vertex == v; });
+    if (!has) {
+      EXPECT_EQ(grad[i], 0.0);
+      ++zero;
+    }
+  }
+  EXPECT_GT(zero, 0);
+}
+
+TEST(CollisionResponse, TargetsLieOutsideTheCollidedBlock) {
+  Scene scene = TwoBlocks();
+  scene.solver.collision.self = true;
+  scene.solver.collision.epsilon = 0.1;
+  const Model model(scene);
+  CollisionResponse resp(model, scene.solver.collision);
+  Eigen::MatrixX3d X = model.rest_positions();
+  for (int v = 0; v < X.rows(); ++v)
+    if (X(v, 2) > 5.0) X(v, 2) -= 3.0;  // upper block bottom (z = 6) now at z = 3, inside
+  resp.Update(X);
+  int upper = 0, lower = 0;
+  for (const auto& s : resp.springs()) {
+    // Vertices on the blocks' side faces have slanted normals; check the faces' interiors.
+    const Eigen::Vector3d r = model.rest_positions().row(s.vertex);
+    if (r.x() < 1e-9 || r.x() > 8 - 1e-9 || r.y() < 1e-9 || r.y() > 8 - 1e-9) continue;
+    if (r.z() > 5.0) {
+      // A vertex of the upper block (at z = 3) inside the lower one: pulled up along its
+      // -n = +z by half the overlap to the lower block's top face z = 4 (the other side takes
+      // the other half), plus eps.
+      ++upper;
+      EXPECT_NEAR(s.target.z(), 3.0 + 0.5 + 0.1, 1e-9);
+      EXPECT_NEAR(s.normal.z(), 1.0, 1e-9);
+      EXPECT_NEAR(s.depth, 1.0, 1e-9);
+    } else {
+      // A lower-block vertex (at z = 4) inside the upper block: pushed down towards its bottom
+      // z = 3, half way, plus eps.
+      ++lower;
+      EXPECT_NEAR(s.target.z(), 4.0 - 0.5 - 0.1, 1e-9);
+      EXPECT_NEAR(s.normal.z(), -1.0, 1e-9);
+    }
+  }
+  EXPECT_EQ(upper, 9);  // the 3 x 3 interior vertices of each face
+  EXPECT_EQ(lower, 9);
+  const CollisionCheck check = resp.Check(X);
+  EXPECT_FALSE(check.collision_free());
+  EXPECT_NEAR(check.max_penetration, 1.0, 1e-9);
+  EXPECT_TRUE(resp.Check(model.rest_positions()).collision_free());
+}
+
+TEST(CollisionResponse, PressedBlocksAreCollisionFreeOnlyWithResponse) {
+  Scene scene = TwoBlocks();
+  Eigen::VectorXd c(1);
+  c << 4.0;  // the upper block's top moves 4 mm down: 2 mm more than the gap
+  // Without response the upper block simply passes into the lower one.
+  {
+    auto model = std::make_shared<const Model>(scene);
+    auto solver = MakeFkSolver(model, scene.solver);
+    const FkResult r = solver->Solve(c);
+    ASSERT_EQ(r.status, FkStatus::Converged) << r.BriefReport();
+    EXPECT_FALSE(r.collision_active);
+    Scene checked = scene;
+    checked.solver.collision.self = true;
+    const Model m2(checked);
+    CollisionResponse probe(m2, checked.solver.collision);
+    const CollisionCheck check = probe.Check(r.positions);
+    EXPECT_GT(check.self_contacts, 0);
+    EXPECT_GT(check.max_penetration, 1.0);
+  }
+  for (const char* update : {"updown", "refactor"}) {
+    scene.solver.collision.self = true;
+    scene.solver.continuation_steps = 4;  // progressive, as Algorithm 2: 1 mm per step
+    scene.solver.collision.update = update;
+    auto model = std::make_shared<const Model>(scene);
+    auto solver = MakeFkSolver(model, scene.solver);
+    const FkResult r = solver->Solve(c);
+    ASSERT_EQ(r.status, FkStatus::Converged) << r.BriefReport();
+    EXPECT_TRUE(r.collision_active);
+    EXPECT_TRUE(r.collision.collision_free()) << r.BriefReport();
+    EXPECT_EQ(r.collision.max_penetration, 0.0);
+    EXPECT_EQ(r.collision.self_contacts, 0);
+    EXPECT_GT(r.collision_stats.springs_added, 0);
+    EXPECT_GT(r.springs, 0);  // the blocks are pressed together: contact holds
+    EXPECT_TRUE(r.positions.allFinite());
+    // The blocks touch rather than bounce apart: across the middle of the contact, the upper
+    // block's bottom face sits on the lower block's top face, a few eps above it.
+    double upper_bottom = 0, lower_top = 0;
+    int nu = 0, nl = 0;
+    for (int v = 0; v < r.positions.rows(); ++v) {
+      const Eigen::Vector3d p = model->rest_positions().row(v);
+      if (p.x() < 3 || p.x() > 5 || p.y() < 3 || p.y() > 5) continue;  // the central vertices
+      if (std::abs(p.z() - 6.0) < 1e-9) upper_bottom += r.positions(v, 2), ++nu;
+      if (std::abs(p.z() - 4.0) < 1e-9) lower_top += r.positions(v, 2), ++nl;
+    }
+    ASSERT_GT(nu, 0);
+    ASSERT_GT(nl, 0);
+    const double gap = upper_bottom / nu - lower_top / nl;
+    EXPECT_GT(gap, 0.0);
+    EXPECT_LT(gap, 0.5);
+    EXPECT_LT(lower_top / nl, 4.0 - 0.2);  // the lower block is compressed by the contact
+  }
+}
+
+TEST(CollisionResponse, BlockPressedIntoAnObstacleStaysOut) {
+  // One block, its top face pressed 3 mm down onto a box obstacle under it.
+  Scene s;
+  s.name = "block_on_obstacle";
+  s.mesh = VoxelTetMesh(Eigen::Vector3d(0, 0, 2), kH, Eigen::Vector3i(4, 4, 2),
+                        [](const Eigen::Vector3d&, const Eigen::Vector3i&) { return 0; });
+  s.body[0] = Material{"body", 0.5, 1.0};
+  Actuator press;
+  press.name = "press";
+  press.type = ActuatorType::Displacement;
+  press.vertices = VerticesOnPlane(s.mesh, Eigen::Vector3d(0, 0, 6), Eigen::Vector3d::UnitZ(), 1e-9);
+  press.axis = -Eigen::Vector3d::UnitZ();
+  press.rest = press.min = 0.0;
+  press.max = 4.0;
+  s.actuators.push_back(press);
+  // The moved top face is held in every coordinate; nothing else is fixed.
+  s.obstacles.push_back(MakeBoxSurface(Eigen::Vector3d(-5, -5, -3), Eigen::Vector3d(15, 15, 1)));
+  Eigen::VectorXd c(1);
+  c << 3.0;  // the bottom (z = 2) would reach z = -1 if it moved rigidly
+  for (bool respond : {false, true}) {
+    Scene t = s;
+    t.solver.collision.obstacles = respond;
+    t.validate();
+    auto model = std::make_shared<const Model>(t);
+    auto solver = MakeFkSolver(model, t.solver);
+    const FkResult r = solver->Solve(c);
+    ASSERT_NE(r.status, FkStatus::InvalidInput) << r.BriefReport();
+    const double lowest = r.positions.col(2).minCoeff();
+    if (respond) {
+      ASSERT_EQ(r.status, FkStatus::Converged) << r.BriefReport();
+      EXPECT_TRUE(r.collision.collision_free()) << r.BriefReport();
+      EXPECT_GT(lowest, 1.0 - 1e-9);  // on the obstacle's top face, not through it
+      EXPECT_GT(r.springs, 0);
+    } else {
+      EXPECT_LT(lowest, 0.0);  // passes through
+    }
+  }
+}
+
+TEST(CollisionResponse, OptionsAreValidated) {
+  CollisionOptions o;
+  std::string why;
+  EXPECT_TRUE(o.IsValid(&why));
+  o.update = "magic";
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("collision.update"), std::string::npos);
+  o = CollisionOptions();
+  o.stiffness = -1;
+  EXPECT_FALSE(o.IsValid(&why));
+  o = CollisionOptions();
+  o.check_interval = 0;
+  EXPECT_FALSE(o.IsValid(&why));
+  // Self-collision on a prism mesh is refused with a clear message (through the solver).
+  Scene crawler = MakeRobot("dea_crawler", 4);
+  crawler.solver.collision.self = true;
+  auto model = std::make_shared<const Model>(crawler);
+  auto solver = MakeFkSolver(model, crawler.solver);
+  const FkResult r = solver->Solve(crawler.rest_actuation());
+  EXPECT_EQ(r.status, FkStatus::InvalidInput);
+  EXPECT_NE(r.message.find("tet-only"), std::string::npos) << r.message;
+}
+
+}  // namespace
+}  // namespace softkin
