@@ -26,6 +26,8 @@ const Entry kExperiments[] = {
     {"solver_comparison", &RunSolverComparison},
     {"calibration", &RunCalibration},
     {"hyperelastic_fit", &RunHyperelasticFit},
+    {"collision_sweep", &RunCollisionSweep},
+    {"collision_costs", &RunCollisionCosts},
     {"aa_ablation", &RunAaAblation},
     {"actuation_paths", &RunActuationPaths},
 };

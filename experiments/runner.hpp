@@ -45,5 +45,7 @@ nlohmann::json RunMarkerSweep(const Config& cfg, const std::string& dir, bool ve
 nlohmann::json RunSolverComparison(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunCalibration(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunHyperelasticFit(const Config& cfg, const std::string& dir, bool verbose);
+nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool verbose);
+nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool verbose);
 
 }  // namespace softkin

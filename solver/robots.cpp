@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
+#include <map>
 #include <stdexcept>
 #include <string>
 
@@ -685,15 +687,17 @@ Scene MakeCableGripper(int res, const RobotParams& P) {
 // [0, 15]; inextensible base layer z in [0, 1.5] (region 2), a 1.5 mm floor (region 0), a solid
 // proximal block, then `chambers` units along x, each a closed box of 1.5 mm walls (region 0)
 // around a 5 mm cavity (region 1, one pneumatic actuator "chamber", volume ratio in [1, 6]),
-// separated by 2 mm air gaps above the floor (no elements there). Body material: first-order
+// separated above the floor by 0.2 mm slits (the mesh is cut there: the distal side's vertices
+// are doubled and moved 0.2 mm), so neighbouring walls press on each other as soon as the
+// chambers swell, as in a moulded PneuNet. Body material: first-order
 // Mooney-Rivlin (Eq. 3.6-3.7) of Ecoflex 00-30 (parameter material = 0) or Dragon Skin 20
 // (material = 1); the element weight is the material's initial shear modulus
 // mu = 2 (c1 + c2) relative to Ecoflex 00-30's (Dragon Skin 20: 2.71, "around 3 times stiffer").
-// Snapped to cells of h = 20 / res mm (every feature >= 1 cell). At res 8: 9 chambers, 11,232 tets.
+// Snapped to cells of h = 20 / res mm (every feature >= 1 cell).
 // ================================================================================================
 
 constexpr int kScfMinRes = 5, kScfMaxRes = 32, kScfDefaultRes = 8;
-constexpr double kScfGap = 2.0, kScfMaxAlpha = 6.0;
+constexpr double kScfGap = 0.2, kScfCavity = 5.0, kScfMaxAlpha = 6.0;
 
 Material MooneyRivlinMaterial(const std::string& name, const std::string& named, double weight) {
   MooneyRivlin mr;
@@ -714,28 +718,70 @@ double ShearModulus(const std::string& named) {
   return 2.0 * (mr.c1 + mr.c2);
 }
 
+/// Cuts a slit through a tet mesh along a set of vertices: every vertex with on_cut(position)
+/// that is used by tets on both sides (far_side(tet centroid) true and false) is doubled, and
+/// the far-side tets take the copy; a vertex used by far-side tets only is simply moved. The
+/// far side's vertices of the cut are then moved by `shift` (mm), opening the slit.
+void CutSlit(Mesh* mesh, const std::function<bool(const Eigen::Vector3d&)>& on_cut,
+             const std::function<bool(const Eigen::Vector3d&)>& far_side,
+             const Eigen::Vector3d& shift) {
+  const int n0 = mesh->num_vertices();
+  std::vector<char> near(n0, 0), far(n0, 0);
+  std::vector<char> tet_far(mesh->elements.size(), 0);
+  for (size_t t = 0; t < mesh->elements.size(); ++t) {
+    const auto& e = mesh->elements[t];
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (int a = 0; a < e.k(); ++a) c += mesh->vertices.row(e.v[a]).transpose() / e.k();
+    tet_far[t] = far_side(c);
+    for (int a = 0; a < e.k(); ++a) (tet_far[t] ? far : near)[e.v[a]] = 1;
+  }
+  std::vector<int> copy(n0, -1);
+  int next = n0;
+  for (int v = 0; v < n0; ++v)
+    if (far[v] && on_cut(mesh->vertices.row(v).transpose())) copy[v] = near[v] ? next++ : v;
+  mesh->vertices.conservativeResize(next, 3);
+  for (int v = 0; v < n0; ++v) {
+    if (copy[v] < 0) continue;
+    mesh->vertices.row(copy[v]) = mesh->vertices.row(v) + shift.transpose();
+  }
+  for (size_t t = 0; t < mesh->elements.size(); ++t) {
+    if (!tet_far[t]) continue;
+    auto& e = mesh->elements[t];
+    for (int a = 0; a < e.k(); ++a)
+      if (copy[e.v[a]] >= 0) e.v[a] = copy[e.v[a]];
+  }
+}
+
 Scene MakeSelfCollisionFinger(int res, const RobotParams& P) {
   const double h = kFingerWidth / res;
   const int ny = res, nz = static_cast<int>(std::lround(kFingerHeight / h));
   const int base = Cells(kFingerBase, h), floor = Cells(kFingerFloor, h), wall = Cells(kFingerWall, h);
-  const int cavity = Cells(kFingerCavity, h), gap = Cells(kScfGap, h);
-  const int pitch = 2 * wall + cavity + gap;
-  const int nx_nominal = static_cast<int>(std::lround(kFingerLength / h));
-  const int chambers = (nx_nominal - Cells(kFingerProximal, h) + gap) / pitch;
-  const int proximal = nx_nominal - (chambers * pitch - gap);
-  const int nx = nx_nominal;
+  const int cavity = Cells(kScfCavity, h);
+  const int pitch = 2 * wall + cavity;
+  const int nx = static_cast<int>(std::lround(kFingerLength / h));
+  const int chambers = (nx - Cells(kFingerProximal, h)) / pitch;
+  const int proximal = nx - chambers * pitch;
   auto cell = [&](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
     const int i = c[0], j = c[1], k = c[2];
     if (k < base) return 2;
     if (k < base + floor || i < proximal) return 0;
     const int w = (i - proximal) % pitch;
-    if (w >= 2 * wall + cavity) return -1;  // the air gap between two chambers
     const bool inside = w >= wall && w < wall + cavity && j >= wall && j < ny - wall && k < nz - wall;
     return inside ? 1 : 0;
   };
+  Mesh mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz), cell);
+  // Cut the slits: above the floor, the vertices on the plane between two chambers are doubled,
+  // the copies taken by the tets on the distal side and moved kScfGap along +x.
+  const double z_floor = (base + floor) * h, tol = 1e-6 * h;
+  for (int q = chambers - 1; q >= 1; --q) {
+    const double xs = (proximal + q * pitch) * h;
+    CutSlit(&mesh,
+            [&](const Eigen::Vector3d& p) { return std::abs(p.x() - xs) < tol && p.z() > z_floor + tol; },
+            [&](const Eigen::Vector3d& c) { return c.x() > xs; }, Eigen::Vector3d(kScfGap, 0, 0));
+  }
   Scene s;
   s.name = "selfcollision_finger";
-  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz), cell);
+  s.mesh = std::move(mesh);
   const bool dragon = P.at("material") >= 0.5;
   const std::string named = dragon ? "dragon-skin-20" : "ecoflex-00-30";
   const double weight = ShearModulus(named) / ShearModulus("ecoflex-00-30");
@@ -765,7 +811,8 @@ Scene MakeSelfCollisionFinger(int res, const RobotParams& P) {
 // thick (region 0), its rim (x or y at 0 or 250) fixed. Below it, a 2 x 2 array of closed boxes
 // (walls region 1, one cell thick; cavities regions 2..5 = actuators c1..c4, volume ratio in
 // [1, 4]), each about 40 mm tall, one cell apart and one cell in from the rim, standing on the
-// fixed plane z = 0, with a one-cell air gap between their roofs and the membrane. Chamber k sits
+// fixed plane z = 0, with a 2 mm air gap between their roofs and the membrane (the mesh is cut
+// there, CutSlit). Chamber k sits
 // under quadrant k: c1 (x < 125, y < 125), c2 (x > 125, y < 125), c3 (x < 125, y > 125), c4 (x >
 // 125, y > 125). Material: Mooney-Rivlin Dragon Skin 20 (Eq. 3.6-3.7) for membrane and walls.
 // Markers: tip (the membrane's top centre) and q1..q4 (membrane top above each chamber's
@@ -773,14 +820,14 @@ Scene MakeSelfCollisionFinger(int res, const RobotParams& P) {
 // ================================================================================================
 
 constexpr int kMemMinRes = 10, kMemMaxRes = 60, kMemDefaultRes = 20;
-constexpr double kMemSide = 250.0, kMemChamberHeight = 40.0, kMemMaxAlpha = 4.0;
+constexpr double kMemSide = 250.0, kMemChamberHeight = 40.0, kMemGap = 2.0, kMemMaxAlpha = 4.0;
 
 Scene MakeMembrane(int res, const RobotParams&) {
   const double h = kMemSide / res;
   const int n = res;
   const int nc = (n - 3) / 2;  // chamber width in cells: 1 margin + nc + 1 gap + nc + (rest) margin
   const int hc = std::max(3, static_cast<int>(std::lround(kMemChamberHeight / h)));
-  const int zm = hc + 1;       // membrane cell layer (one-cell air gap below it)
+  const int zm = hc;           // membrane cell layer, on the roofs (then lifted by the slit)
   const int x0[2] = {1, 2 + nc};
   auto cell = [&](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
     const int i = c[0], j = c[1], k = c[2];
@@ -797,6 +844,10 @@ Scene MakeMembrane(int res, const RobotParams&) {
   Scene s;
   s.name = "membrane";
   s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(n, n, zm + 1), cell);
+  // The membrane is a separate body: lift it off the roofs by kMemGap.
+  const double z_roof = zm * h;
+  CutSlit(&s.mesh, [&](const Eigen::Vector3d& p) { return std::abs(p.z() - z_roof) < 1e-6 * h; },
+          [&](const Eigen::Vector3d& c) { return c.z() > z_roof; }, Eigen::Vector3d(0, 0, kMemGap));
   s.body[0] = MooneyRivlinMaterial("membrane", "dragon-skin-20", 1.0);
   s.body[1] = MooneyRivlinMaterial("chamber_wall", "dragon-skin-20", 1.0);
   for (int q = 0; q < 4; ++q) {
@@ -808,7 +859,7 @@ Scene MakeMembrane(int res, const RobotParams&) {
     a.max = kMemMaxAlpha;
     s.actuators.push_back(a);
   }
-  const double eps = 1e-6 * h, side = n * h, zlo = zm * h;
+  const double eps = 1e-6 * h, side = n * h, zlo = zm * h + kMemGap;
   std::vector<int> fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), eps);
   for (int v = 0; v < s.mesh.num_vertices(); ++v) {
     const Eigen::Vector3d p = s.mesh.vertices.row(v);
@@ -933,7 +984,7 @@ const std::vector<RobotEntry>& Registry() {
          {"joint_r_omega", 1.0, 0.0, 1.0, "R_omega of the joints"}}},
        kCgMinRes, kCgMaxRes, &MakeCableGripper},
       {{"selfcollision_finger",
-        "PneuNet finger with 2 mm air gaps between its chambers, whose walls touch as they swell "
+        "PneuNet finger with 0.2 mm slits between its chambers, whose walls press on each other as they swell "
         "(thesis Sec. 3.4.2, Fig. 3.9-3.10): 120 x 20 x 15 mm, x = long axis (x = 0 fixed), "
         "inextensible base layer (region 2), Mooney-Rivlin body (region 0; material 0 = Ecoflex "
         "00-30, 1 = Dragon Skin 20, weighted by shear modulus), cavities (region 1) = pneumatic "

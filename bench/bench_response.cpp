@@ -1,0 +1,113 @@
+// Google Benchmark suite for collision response (solver/spring_system.hpp,
+// solver/collision_response.hpp; thesis Sec. 3.2.3 and Table 3.1's "Col. Resp." column).
+//
+// Mesh: pneumatic_finger at resolution `res` (27 res^3 tets; res 12 = 46,656 tets).
+//   BM_SpringUpdate/res/n/method   one change of the spring set that adds n springs and releases
+//                                  n others (2n rank-one modifications), then one 3-column solve:
+//                                  method 0 = CHOLMOD update/downdate, 1 = numeric refactorisation.
+//                                  Counter vs_refactor: this time over the refactorisation's at
+//                                  the same (res, n), measured in the same run.
+//   BM_CollisionResponseUpdate     one CollisionResponse::Update (detection + spring rule +
+//                                  factor update) on the finger pressed into a box obstacle
+//                                  (springs on ~ every vertex under the tip), res 6/9/12.
+// Wall-clock times (UseRealTime). See docs/benchmarks.md, "Collision response".
+#include "solver/collision_response.hpp"
+#include "solver/fk_solver.hpp"
+#include "solver/robots.hpp"
+#include "solver/spring_system.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <memory>
+#include <random>
+#include <vector>
+
+namespace softkin {
+namespace {
+
+std::shared_ptr<const Model> FingerModel(int res) {
+  static std::map<int, std::shared_ptr<const Model>> cache;
+  auto& m = cache[res];
+  if (!m) m = std::make_shared<const Model>(MakeRobot("pneumatic_finger", res));
+  return m;
+}
+
+std::map<std::pair<int, int>, double>& RefactorTimes() {
+  static std::map<std::pair<int, int>, double> t;
+  return t;
+}
+
+void BM_SpringUpdate(benchmark::State& state) {
+  const int res = static_cast<int>(state.range(0));
+  const int n = static_cast<int>(state.range(1));
+  const bool refactor = state.range(2) != 0;
+  auto model = FingerModel(res);
+  SpringSystem sys(*model, refactor ? SpringSystem::Method::kRefactor : SpringSystem::Method::kUpdown);
+  sys.set_refactor_after(0);
+  const double k = 20.0 * model->A().diagonal().mean();
+  // Boundary-ish candidates: vertices of the top face (z = max), as contacts would be.
+  std::vector<int> cand;
+  const double zmax = model->rest_positions().col(2).maxCoeff();
+  for (int v = 0; v < model->num_vertices(); ++v)
+    if (model->rest_positions()(v, 2) > zmax - 1e-9) cand.push_back(v);
+  std::mt19937 rng(3);
+  std::shuffle(cand.begin(), cand.end(), rng);
+  // Two disjoint sets of n springs: each iteration swaps one for the other.
+  std::vector<int> a(cand.begin(), cand.begin() + n), b(cand.begin() + n, cand.begin() + 2 * n);
+  sys.SetSprings(a, k);
+  Eigen::VectorXd rhs = Eigen::VectorXd::Ones(model->num_free_dofs());
+  bool flip = false;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (auto _ : state) {
+    sys.SetSprings(flip ? a : b, k);
+    flip = !flip;
+    benchmark::DoNotOptimize(sys.Solve(rhs));
+  }
+  const double per = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() /
+                     std::max<double>(1, state.iterations());
+  auto& ref = RefactorTimes();
+  if (refactor) ref[{res, n}] = per;
+  if (!refactor && ref.count({res, n})) state.counters["vs_refactor"] = per / ref[{res, n}];
+  state.counters["tets"] = model->mesh().num_elements();
+  state.counters["springs_changed"] = 2 * n;
+}
+
+void BM_CollisionResponseUpdate(benchmark::State& state) {
+  const int res = static_cast<int>(state.range(0));
+  Scene s = MakeRobot("pneumatic_finger", res);
+  s.obstacles.push_back(MakeBoxSurface(Eigen::Vector3d(100, -10, -10), Eigen::Vector3d(140, 30, 2)));
+  const Model model(s);
+  CollisionResponse resp(model, s.solver.collision);
+  // The tip end of the finger moved 2 mm down into the box's top (z <= 2).
+  Eigen::MatrixX3d X = model.rest_positions();
+  for (int v = 0; v < X.rows(); ++v)
+    if (X(v, 0) > 100) X(v, 2) -= 2.0;
+  for (auto _ : state) {
+    resp.Reset();
+    benchmark::DoNotOptimize(resp.Update(X));
+  }
+  state.counters["tets"] = model.mesh().num_elements();
+  state.counters["springs"] = static_cast<double>(resp.springs().size());
+  state.counters["check_ms"] = 1e3 * resp.stats().check_s / std::max(1, resp.stats().checks);
+  state.counters["response_ms"] = 1e3 * resp.stats().response_s / std::max(1, resp.stats().checks);
+}
+
+}  // namespace
+
+BENCHMARK(BM_SpringUpdate)
+    ->ArgNames({"res", "n", "refactor"})
+    ->ArgsProduct({{6, 12}, {8, 64}, {1, 0}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_CollisionResponseUpdate)
+    ->ArgNames({"res"})
+    ->Arg(6)->Arg(9)->Arg(12)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+}  // namespace softkin
+
+BENCHMARK_MAIN();

@@ -1,0 +1,407 @@
+// Chapter 3 collision experiments (Sec. 3.4; Fig. 3.8, 3.10, 3.12, 3.13, Table 3.1).
+//
+// "collision_sweep": one robot, optional obstacles, several variants (collision options and/or
+// robot parameters), each driven from rest to its end actuation in `steps` warm-started steps.
+// Per step: tip, bend, springs, the exact collision check of the state (contacts left and the
+// deepest penetration, with or without response), contact with each obstacle and the time split
+// (detection, response, local-global). VTU of every variant's final shape.
+//
+// "collision_costs" (Table 3.1): per robot, the time of one simulation step split as the thesis
+// does: mesh generation, collision check, collision response and iterative solver.
+#include "experiments/measure.hpp"
+#include "experiments/results.hpp"
+#include "experiments/runner.hpp"
+#include "solver/collision_response.hpp"
+#include "solver/fk_solver.hpp"
+#include "solver/mesh_io.hpp"
+#include "solver/robots.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <map>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+namespace softkin {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+Eigen::Vector3d JsonVec(const Config& cfg, const std::string& key, const nlohmann::json& v) {
+  if (!v.is_array() || v.size() != 3)
+    cfg.Fail(key, "an array of 3 numbers [x, y, z]");
+  Eigen::Vector3d out;
+  for (int d = 0; d < 3; ++d) {
+    if (!v[d].is_number() || !std::isfinite(v[d].get<double>())) cfg.Fail(key, "an array of 3 finite numbers");
+    out[d] = v[d].get<double>();
+  }
+  return out;
+}
+
+/// Obstacles of a config: [{"type": "box", "min": [..], "max": [..]} | {"type": "cylinder",
+/// "base", "axis", "radius", "height", ["segments"]} | {"type": "file", "path": "x.obj"}] (paths
+/// relative to the config's folder).
+std::vector<TriangleSurface> ConfigObstacles(const Config& cfg, const nlohmann::json& list) {
+  std::vector<TriangleSurface> out;
+  if (list.is_null()) return out;
+  if (!list.is_array()) cfg.Fail("obstacles", "an array of obstacle objects");
+  for (size_t i = 0; i < list.size(); ++i) {
+    const std::string key = "obstacles[" + std::to_string(i) + "]";
+    const auto& o = list[i];
+    if (!o.is_object() || !o.contains("type") || !o["type"].is_string())
+      cfg.Fail(key, "an object with \"type\": box, cylinder or file");
+    const std::string type = o["type"].get<std::string>();
+    auto need = [&](const char* k) -> const nlohmann::json& {
+      if (!o.contains(k)) cfg.Fail(key + "." + k, std::string("a value (required for type ") + type + ")");
+      return o.at(k);
+    };
+    std::vector<std::string> allowed;
+    if (type == "box") allowed = {"type", "min", "max"};
+    else if (type == "cylinder") allowed = {"type", "base", "axis", "radius", "height", "segments"};
+    else if (type == "file") allowed = {"type", "path"};
+    else cfg.Fail(key + ".type", "one of box, cylinder, file");
+    for (auto it = o.begin(); it != o.end(); ++it)
+      if (std::find(allowed.begin(), allowed.end(), it.key()) == allowed.end())
+        cfg.Fail(key + "." + it.key(), "no such key for type " + type);
+    try {
+      if (type == "box") {
+        out.push_back(MakeBoxSurface(JsonVec(cfg, key + ".min", need("min")), JsonVec(cfg, key + ".max", need("max"))));
+      } else if (type == "cylinder") {
+        const auto& r = need("radius");
+        const auto& h = need("height");
+        if (!r.is_number() || !h.is_number()) cfg.Fail(key, "numbers for radius and height (mm)");
+        const int seg = o.contains("segments") && o["segments"].is_number_integer() ? o["segments"].get<int>() : 48;
+        out.push_back(MakeCylinderSurface(JsonVec(cfg, key + ".base", need("base")),
+                                          JsonVec(cfg, key + ".axis", need("axis")), r.get<double>(),
+                                          h.get<double>(), seg));
+      } else {
+        const auto& p = need("path");
+        if (!p.is_string()) cfg.Fail(key + ".path", "a file name (.obj or .stl)");
+        std::filesystem::path file(p.get<std::string>());
+        if (file.is_relative()) file = std::filesystem::path(cfg.path()).parent_path() / file;
+        out.push_back(ReadSurfaceMesh(file.string()));
+      }
+      CheckClosedSurface(&out.back());
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(cfg.path() + ": " + key + ": " + e.what());
+    }
+  }
+  return out;
+}
+
+/// Actuation from {"name": value, ...} on top of the scene's rest actuation.
+Eigen::VectorXd ConfigActuation(const Config& cfg, const std::string& key, const nlohmann::json& j,
+                                const Scene& scene) {
+  Eigen::VectorXd c = scene.rest_actuation();
+  if (!j.is_object() || j.empty()) cfg.Fail(key, "an object {\"actuator name\": end value, ...}");
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const int a = scene.actuator_index(it.key());
+    if (a < 0) {
+      std::string known;
+      for (const auto& act : scene.actuators) known += (known.empty() ? "" : ", ") + act.name;
+      cfg.Fail(key + "." + it.key(), "an actuator of robot '" + scene.name + "' (" + known + ")");
+    }
+    const auto& act = scene.actuators[a];
+    if (!it.value().is_number() || it.value().get<double>() < act.min || it.value().get<double>() > act.max)
+      cfg.Fail(key + "." + it.key(), "a number in [" + std::to_string(act.min) + ", " + std::to_string(act.max) + "]");
+    c[a] = it.value().get<double>();
+  }
+  return c;
+}
+
+/// Robot vertices within `dist` of an obstacle's surface (touching it), and their extent along x.
+struct ContactPatch {
+  int vertices = 0;
+  double extent_mm = 0, area_mm2 = 0;
+};
+
+ContactPatch MeasureContact(const Obstacle& obs, const Mesh& mesh, const Eigen::MatrixX3d& X,
+                            double dist) {
+  ContactPatch c;
+  std::vector<char> touch(mesh.num_vertices(), 0);
+  double lo = 1e300, hi = -1e300;
+  for (int v = 0; v < mesh.num_vertices(); ++v) {
+    const Eigen::Vector3d p = X.row(v);
+    const double d = (obs.ClosestPoint(p) - p).norm();
+    if (d <= dist || obs.Contains(p)) {
+      touch[v] = 1;
+      ++c.vertices;
+      lo = std::min(lo, p.x());
+      hi = std::max(hi, p.x());
+    }
+  }
+  if (c.vertices) c.extent_mm = hi - lo;
+  // Area of boundary triangles whose three corners all touch (tet meshes).
+  std::map<std::array<int, 3>, int> faces;
+  static constexpr int kF[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+  for (const auto& e : mesh.elements) {
+    if (e.type != ElementType::Tet) continue;
+    for (const auto& f : kF) {
+      std::array<int, 3> k = {e.v[f[0]], e.v[f[1]], e.v[f[2]]};
+      if (!touch[k[0]] || !touch[k[1]] || !touch[k[2]]) continue;
+      std::sort(k.begin(), k.end());
+      ++faces[k];
+    }
+  }
+  for (const auto& [k, n] : faces)
+    if (n == 1) {
+      const Eigen::Vector3d a = X.row(k[0]), b = X.row(k[1]), cc = X.row(k[2]);
+      c.area_mm2 += 0.5 * (b - a).cross(cc - a).norm();
+    }
+  return c;
+}
+
+}  // namespace
+
+nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool verbose) {
+  const std::string robot = cfg.String("robot", "selfcollision_finger");
+  const int res = cfg.Int("res", 0);
+  const int steps = cfg.Int("steps", 10);
+  const nlohmann::json obstacles_j = cfg.Raw("obstacles");
+  const nlohmann::json end_j = cfg.Raw("actuation");
+  const nlohmann::json variants_j = cfg.Raw("variants");
+  const double contact_dist = cfg.Number("contact_distance_mm", 0.5);
+  // Optional: the final positions of the vertices of this region tag, per variant (for height
+  // maps, e.g. the membrane), in surface_<variant>.csv.
+  const int export_region = cfg.Int("export_region", -1);
+  Scene base = ConfigRobot(cfg, robot, res);
+  const FkOptions base_opts = cfg.Solver(base.solver);
+  cfg.CheckNoUnknownKeys();
+  if (steps < 1) cfg.Fail("steps", "an integer >= 1");
+  if (!(contact_dist >= 0)) cfg.Fail("contact_distance_mm", "a number >= 0");
+  const std::vector<TriangleSurface> obstacles = ConfigObstacles(cfg, obstacles_j);
+  const Eigen::VectorXd c_end = ConfigActuation(cfg, "actuation", end_j, base);
+  if (!variants_j.is_array() || variants_j.empty())
+    cfg.Fail("variants", "a non-empty array of {\"name\", [\"collision\"], [\"robot_params\"]}");
+
+  std::filesystem::create_directories(dir + "/frames");
+  CsvWriter csv(dir + "/steps.csv",
+                {"variant", "step", "actuation_scale", "tip_x", "tip_y", "tip_z", "bend_deg",
+                 "iterations", "converged", "springs", "self_contacts", "obstacle_contacts",
+                 "max_penetration_mm", "check_s", "response_s", "solver_s", "time_s"});
+  nlohmann::json out_variants = nlohmann::json::array();
+  std::vector<std::pair<double, std::string>> frames;
+  for (size_t vi = 0; vi < variants_j.size(); ++vi) {
+    const std::string key = "variants[" + std::to_string(vi) + "]";
+    const auto& v = variants_j[vi];
+    if (!v.is_object() || !v.contains("name") || !v["name"].is_string())
+      cfg.Fail(key, "an object with a \"name\"");
+    for (auto it = v.begin(); it != v.end(); ++it)
+      if (it.key() != "name" && it.key() != "collision" && it.key() != "robot_params")
+        cfg.Fail(key + "." + it.key(), "one of name, collision, robot_params");
+    const std::string name = v["name"].get<std::string>();
+    Scene scene = base;
+    if (v.contains("robot_params")) {
+      RobotParams p = cfg.NumberMap("robot_params");
+      if (!v["robot_params"].is_object()) cfg.Fail(key + ".robot_params", "an object of numbers");
+      for (auto it = v["robot_params"].begin(); it != v["robot_params"].end(); ++it) {
+        if (!it.value().is_number()) cfg.Fail(key + ".robot_params." + it.key(), "a number");
+        p[it.key()] = it.value().get<double>();
+      }
+      try {
+        scene = MakeRobot(robot, res, p);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(cfg.path() + ": " + key + ".robot_params: " + e.what());
+      }
+    }
+    scene.obstacles = obstacles;
+    FkOptions opts = base_opts;  // the robot's defaults (e.g. self on), then the config's solver
+    if (v.contains("collision")) {
+      nlohmann::json wrap = {{"collision", v["collision"]}};
+      ApplySolverJson(wrap, cfg.path() + ": " + key, &opts);
+    }
+    scene.solver = opts;
+    auto model = std::make_shared<const Model>(scene);
+    auto solver = MakeFkSolver(model, opts);
+    // The exact check, also for variants without response.
+    CollisionOptions probe_opts = opts.collision;
+    probe_opts.self = scene.mesh.num_prisms() == 0;
+    CollisionResponse probe(*model, probe_opts);
+    const int tip = scene.marker_index("tip");
+    const bool has_bend = scene.marker_index("tip_top") >= 0 && scene.marker_index("tip_bottom") >= 0;
+    std::unique_ptr<BendAngle> bend;
+    if (has_bend) bend = std::make_unique<BendAngle>(scene);
+    const Eigen::VectorXd rest = scene.rest_actuation();
+    Eigen::MatrixX3d X = scene.mesh.vertices;
+    double check_s = 0, resp_s = 0, solver_s = 0, total_s = 0;
+    int iterations = 0, failed = 0;
+    FkResult last;
+    CollisionCheck last_check;
+    nlohmann::json tips = nlohmann::json::array();
+    for (int s = 1; s <= steps; ++s) {
+      const double t = double(s) / steps;
+      const Eigen::VectorXd c = rest + t * (c_end - rest);
+      FkResult r = solver->Solve(c, s > 1 ? &X : nullptr);
+      if (r.status == FkStatus::InvalidInput) throw std::runtime_error(cfg.path() + ": " + key + ": " + r.message);
+      X = r.positions;
+      const CollisionCheck ck = probe.Check(X);
+      const bool ok = r.status == FkStatus::Converged;
+      failed += !ok;
+      iterations += r.iterations;
+      check_s += r.collision_stats.check_s;
+      resp_s += r.collision_stats.response_s;
+      solver_s += r.local_time_s + r.global_time_s;
+      total_s += r.time_s;
+      const Eigen::MatrixX3d P = scene.marker_positions(X);
+      const double ang = has_bend ? (*bend)(X) : 0.0;
+      tips.push_back({P(tip, 0), P(tip, 1), P(tip, 2)});
+      csv.RowStrings({name, std::to_string(s), std::to_string(t), std::to_string(P(tip, 0)),
+                      std::to_string(P(tip, 1)), std::to_string(P(tip, 2)), std::to_string(ang),
+                      std::to_string(r.iterations), ok ? "1" : "0", std::to_string(r.springs),
+                      std::to_string(ck.self_contacts), std::to_string(ck.obstacle_contacts),
+                      std::to_string(ck.max_penetration), std::to_string(r.collision_stats.check_s),
+                      std::to_string(r.collision_stats.response_s),
+                      std::to_string(r.local_time_s + r.global_time_s), std::to_string(r.time_s)});
+      if (verbose)
+        std::fprintf(stderr, "  [%s %d/%d] %s; exact check: %d self + %d obstacle contacts, max depth %.3g mm\n",
+                     name.c_str(), s, steps, r.BriefReport().c_str(), ck.self_contacts,
+                     ck.obstacle_contacts, ck.max_penetration);
+      last = r;
+      last_check = ck;
+    }
+    if (export_region >= 0) {
+      CsvWriter surf(dir + "/surface_" + name + ".csv", {"x0", "y0", "z0", "x", "y", "z"});
+      const std::vector<int> verts = VerticesOfRegions(scene.mesh, {export_region});
+      if (verts.empty()) cfg.Fail("export_region", "a region tag of robot '" + robot + "'");
+      for (int q : verts)
+        surf.Row({scene.mesh.vertices(q, 0), scene.mesh.vertices(q, 1), scene.mesh.vertices(q, 2),
+                  X(q, 0), X(q, 1), X(q, 2)});
+    }
+    const std::string vtu = "frames/" + name + ".vtu";
+    WriteVtu(dir + "/" + vtu, scene.mesh, X);
+    frames.emplace_back(double(vi), vtu);
+    nlohmann::json jv;
+    jv["name"] = name;
+    jv["tets"] = scene.mesh.num_tets();
+    jv["response_self"] = opts.collision.self;
+    jv["response_obstacles"] = opts.collision.obstacles && !obstacles.empty();
+    const Eigen::MatrixX3d P = scene.marker_positions(X);
+    jv["tip"] = {P(tip, 0), P(tip, 1), P(tip, 2)};
+    jv["tips"] = tips;
+    if (has_bend) jv["bend_deg"] = (*bend)(X);
+    nlohmann::json markers;
+    for (int q = 0; q < static_cast<int>(scene.markers.size()); ++q)
+      markers[scene.markers[q].name] = {P(q, 0), P(q, 1), P(q, 2)};
+    jv["markers"] = markers;
+    jv["self_contacts_left"] = last_check.self_contacts;
+    jv["obstacle_contacts_left"] = last_check.obstacle_contacts;
+    jv["max_penetration_mm"] = last_check.max_penetration;
+    jv["collision_free"] = last_check.collision_free();
+    jv["springs_at_end"] = last.springs;
+    jv["iterations"] = iterations;
+    jv["non_converged_steps"] = failed;
+    jv["check_s"] = check_s;
+    jv["response_s"] = resp_s;
+    jv["solver_s"] = solver_s;
+    jv["total_s"] = total_s;
+    jv["collision_share"] = total_s > 0 ? (check_s + resp_s) / total_s : 0.0;
+    if (!obstacles.empty()) {
+      nlohmann::json contacts = nlohmann::json::array();
+      for (const auto& o : probe.obstacles()) {
+        const ContactPatch cp = MeasureContact(o, scene.mesh, X, contact_dist);
+        contacts.push_back({{"vertices", cp.vertices}, {"extent_x_mm", cp.extent_mm}, {"area_mm2", cp.area_mm2}});
+      }
+      jv["contact"] = contacts;
+    }
+    out_variants.push_back(jv);
+  }
+  WritePvd(dir + "/variants.pvd", frames);
+  nlohmann::json j;
+  j["robot"] = robot;
+  j["steps"] = steps;
+  j["variants"] = out_variants;
+  j["contact_distance_mm"] = contact_dist;
+  return j;
+}
+
+nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool verbose) {
+  const nlohmann::json robots_j = cfg.Raw("robots");
+  const nlohmann::json solver_j = cfg.Raw("solver");
+  (void)cfg.Solver(FkOptions());  // checks the solver object once
+  cfg.CheckNoUnknownKeys();
+  if (!robots_j.is_array() || robots_j.empty())
+    cfg.Fail("robots", "a non-empty array of {\"robot\", \"res\", \"actuation\", \"steps\", [\"obstacles\"], [\"thesis\"]}");
+  CsvWriter csv(dir + "/costs.csv", {"robot", "tets", "mesh_gen_s", "col_check_s", "col_resp_s",
+                                     "solver_s", "step_s", "steps", "collision_free"});
+  nlohmann::json rows = nlohmann::json::array();
+  for (size_t i = 0; i < robots_j.size(); ++i) {
+    const std::string key = "robots[" + std::to_string(i) + "]";
+    const auto& rj = robots_j[i];
+    if (!rj.is_object() || !rj.contains("robot") || !rj["robot"].is_string())
+      cfg.Fail(key, "an object with \"robot\"");
+    for (auto it = rj.begin(); it != rj.end(); ++it)
+      if (it.key() != "robot" && it.key() != "res" && it.key() != "actuation" && it.key() != "steps" &&
+          it.key() != "obstacles" && it.key() != "thesis")
+        cfg.Fail(key + "." + it.key(), "one of robot, res, actuation, steps, obstacles, thesis");
+    const std::string robot = rj["robot"].get<std::string>();
+    const int res = rj.value("res", 0);
+    const int steps = rj.value("steps", 4);
+    if (steps < 1) cfg.Fail(key + ".steps", "an integer >= 1");
+    const auto t0 = Clock::now();
+    Scene scene;
+    try {
+      scene = MakeRobot(robot, res);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(cfg.path() + ": " + key + ": " + e.what());
+    }
+    const double mesh_gen_s = Since(t0);
+    if (rj.contains("obstacles")) scene.obstacles = ConfigObstacles(cfg, rj["obstacles"]);
+    if (!rj.contains("actuation")) cfg.Fail(key + ".actuation", "an object {\"actuator\": end value}");
+    const Eigen::VectorXd c_end = ConfigActuation(cfg, key + ".actuation", rj["actuation"], scene);
+    FkOptions opts = scene.solver;  // the robot's defaults, then the config's solver object
+    if (!solver_j.is_null()) ApplySolverJson(solver_j, cfg.path() + ": solver", &opts);
+    scene.solver = opts;
+    auto model = std::make_shared<const Model>(scene);
+    auto solver = MakeFkSolver(model, opts);
+    const Eigen::VectorXd rest = scene.rest_actuation();
+    Eigen::MatrixX3d X = scene.mesh.vertices;
+    double check = 0, resp = 0, solve = 0, total = 0;
+    bool free = true;
+    for (int s = 1; s <= steps; ++s) {
+      const Eigen::VectorXd c = rest + (double(s) / steps) * (c_end - rest);
+      FkResult r = solver->Solve(c, s > 1 ? &X : nullptr);
+      if (r.status == FkStatus::InvalidInput) throw std::runtime_error(cfg.path() + ": " + key + ": " + r.message);
+      X = r.positions;
+      check += r.collision_stats.check_s;
+      resp += r.collision_stats.response_s;
+      solve += r.local_time_s + r.global_time_s;
+      total += r.time_s;
+      free = free && (!r.collision_active || r.collision.collision_free());
+      if (verbose) std::fprintf(stderr, "  [%s %d/%d] %s\n", robot.c_str(), s, steps, r.BriefReport().c_str());
+    }
+    nlohmann::json row;
+    row["robot"] = robot;
+    row["tets"] = scene.mesh.num_tets();
+    row["mesh_gen_s"] = mesh_gen_s;
+    row["col_check_s"] = check / steps;
+    row["col_resp_s"] = resp / steps;
+    row["solver_s"] = solve / steps;
+    row["step_s"] = total / steps;
+    row["collision_share"] = total > 0 ? (check + resp) / total : 0.0;
+    row["collision_free"] = free;
+    if (rj.contains("thesis")) {
+      const auto& t = rj["thesis"];
+      row["thesis"] = t;
+      // Per-step speed ratios against the thesis (same robot type, its tet count in "tets").
+      if (t.contains("solver_s") && t["solver_s"].is_number() && row["step_s"].get<double>() > 0) {
+        const double thesis_step = t.value("col_check_s", 0.0) + t.value("col_resp_s", 0.0) + t["solver_s"].get<double>();
+        row["speedup_vs_thesis_step"] = thesis_step / (total / steps);
+      }
+    }
+    csv.RowStrings({robot, std::to_string(scene.mesh.num_tets()), std::to_string(mesh_gen_s),
+                    std::to_string(check / steps), std::to_string(resp / steps),
+                    std::to_string(solve / steps), std::to_string(total / steps),
+                    std::to_string(steps), free ? "1" : "0"});
+    rows.push_back(row);
+  }
+  nlohmann::json j;
+  j["rows"] = rows;
+  return j;
+}
+
+}  // namespace softkin
