@@ -94,6 +94,12 @@ class CollisionResponse {
   /// directions: an upper bound on the distance to the collided region's surface).
   CollisionCheck Check(const Eigen::Ref<const Eigen::MatrixX3d>& X) const;
 
+  /// Whether `check` has contacts of a kind this response handles (self contacts only count when
+  /// options.self is on, obstacle contacts when it responds to obstacles).
+  bool HasHandledContacts(const CollisionCheck& check) const {
+    return (options_.self && check.self_contacts > 0) ||
+           (!obstacles_.empty() && check.obstacle_contacts > 0);
+  }
   /// Penalty continuation: multiplies k by 4 (refactoring the system) unless it has already been
   /// raised `max_raises` times; returns whether it did. The solver calls it when it has converged
   /// with contacts left (finite springs yield by force / k).

@@ -169,7 +169,7 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     if (move < tol && (r->gradient_ratio < gtol || roundoff)) {
       store_free(Gf);
       // With collisions, stop only if a check at this state leaves the spring set as it is.
-      if (resp && (resp->Update(X) || (!resp->Check(X).collision_free() && resp->Stiffen()))) {
+      if (resp && (resp->Update(X) || (resp->HasHandledContacts(resp->Check(X)) && resp->Stiffen()))) {
         // Springs changed, or contacts are left (springs yield by force / k): raise k.
         aa.Reset();
         continue;
