@@ -435,6 +435,11 @@ inline bool ContainsFiltered(const double* a, const double* b, const double* c, 
 /// unbounded memory: at most kMaxCellsPerTet * #tets + kMinCellCap cells in all (the cells grow).
 constexpr long long kMaxCellsPerTet = 2;
 constexpr long long kMinCellCap = 4096;
+/// Below these sizes the grid's build (#tets) and query (#boundary vertices) run on one thread:
+/// on 2 cores the parallel passes gain nothing there (res 6, 6.5k tets), and every parallel
+/// region costs a wake-up, a scheduler time slice when the machine is loaded.
+constexpr int kParallelTets = 16384;
+constexpr int kParallelVertices = 1024;
 /// A tet whose box spans more cells than this is kept out of the cells, in a list that every
 /// vertex scans: a few huge tets (a vertex thrown far away) cannot blow up the cell lists.
 constexpr long long kLargeTetCells = 64;
@@ -504,7 +509,9 @@ void UniformTetGrid::Build(const RowX3& X, const std::vector<std::array<int, 4>>
   box.resize(6 * static_cast<size_t>(nt));
   double lx = std::numeric_limits<double>::infinity(), ly = lx, lz = lx;
   double hx = -lx, hy = -lx, hz = -lx, sum = 0;
-#pragma omp parallel for schedule(static) reduction(min : lx, ly, lz) reduction(max : hx, hy, hz) reduction(+ : sum)
+  const bool parallel = nt >= kParallelTets;
+#pragma omp parallel for schedule(static) reduction(min : lx, ly, lz) reduction(max : hx, hy, hz) \
+    reduction(+ : sum) if (parallel)
   for (int t = 0; t < nt; ++t) {
     const auto& tt = tets[t];
     const double* p = &X(tt[0], 0);
@@ -551,9 +558,9 @@ void UniformTetGrid::Build(const RowX3& X, const std::vector<std::array<int, 4>>
   // Counting sort, parallel over contiguous chunks of tets: each thread counts its chunk's
   // entries per cell; the prefix sum over (cell, thread) gives every thread its own write
   // positions, so each cell lists its tets in ascending order.
-  const int threads = omp_get_max_threads();
+  const int threads = parallel ? omp_get_max_threads() : 1;
   cursor.assign(static_cast<size_t>(threads) * nc, 0);
-#pragma omp parallel num_threads(threads)
+#pragma omp parallel num_threads(threads) if (parallel)
   {
     const int tid = omp_get_thread_num(), nth = omp_get_num_threads();
     const int begin = static_cast<int>(static_cast<long long>(nt) * tid / nth);
@@ -695,7 +702,7 @@ std::vector<SelfContact> SelfCollisionDetector::Detect() const {
   std::vector<int> hit(nb, -1);
   if (method_ == Method::kGrid) {
     const UniformTetGrid& G = I.grid;
-#pragma omp parallel for schedule(dynamic, 64) reduction(+ : narrow, exact)
+#pragma omp parallel for schedule(dynamic, 64) reduction(+ : narrow, exact) if (nb >= kParallelVertices)
     for (int q = 0; q < nb; ++q) {
       const int v = boundary_[q];
       const double* p = &I.X(v, 0);
@@ -803,38 +810,41 @@ std::vector<ObstacleContact> DetectObstacleContacts(const std::vector<Obstacle>&
                                   std::to_string(X.rows() - 1));
   const int no = static_cast<int>(obstacles.size());
   if (no == 0 || n == 0) return {};
-  // The union of the obstacles' boxes: a vertex outside it touches no obstacle.
+  // Serial pass: the vertices inside the union of the obstacles' boxes (a vertex outside it
+  // touches no obstacle). A few comparisons per vertex; no parallel region when few are near.
   Eigen::Vector3d lo = obstacles[0].box_min(), hi = obstacles[0].box_max();
   for (const auto& o : obstacles) {
     lo = lo.cwiseMin(o.box_min());
     hi = hi.cwiseMax(o.box_max());
   }
-  std::vector<int> which(n, -1);  // obstacle containing the vertex
-#pragma omp parallel for schedule(dynamic, 1024)
+  std::vector<int> near;
   for (int q = 0; q < n; ++q) {
     const int v = vertices.empty() ? q : vertices[q];
+    if (X(v, 0) >= lo.x() && X(v, 1) >= lo.y() && X(v, 2) >= lo.z() && X(v, 0) <= hi.x() && X(v, 1) <= hi.y() &&
+        X(v, 2) <= hi.z())
+      near.push_back(v);
+  }
+  // The CGAL inside test (after each obstacle's own box) and, for contained vertices, the
+  // closest point; in parallel when there are enough of them to pay for it.
+  const int nn = static_cast<int>(near.size());
+  std::vector<ObstacleContact> found(nn);
+#pragma omp parallel for schedule(dynamic, 64) if (nn > 256)
+  for (int k = 0; k < nn; ++k) {
+    const int v = near[k];
     const Eigen::Vector3d p(X(v, 0), X(v, 1), X(v, 2));
-    if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
     for (int o = 0; o < no; ++o)
-      if (obstacles[o].Contains(p)) {  // tests the obstacle's own box first
-        which[q] = o;
+      if (obstacles[o].Contains(p)) {
+        ObstacleContact& c = found[k];
+        c.vertex = v;
+        c.obstacle = o;
+        c.closest = obstacles[o].ClosestPoint(p, &c.normal);
+        c.depth = (c.closest - p).norm();
         break;
       }
   }
-  std::vector<int> inside;
-  for (int q = 0; q < n; ++q)
-    if (which[q] >= 0) inside.push_back(q);
-  std::vector<ObstacleContact> out(inside.size());
-#pragma omp parallel for schedule(dynamic, 16)
-  for (int k = 0; k < static_cast<int>(inside.size()); ++k) {
-    const int q = inside[k];
-    ObstacleContact& c = out[k];
-    c.vertex = vertices.empty() ? q : vertices[q];
-    c.obstacle = which[q];
-    const Eigen::Vector3d p(X(c.vertex, 0), X(c.vertex, 1), X(c.vertex, 2));
-    c.closest = obstacles[c.obstacle].ClosestPoint(p, &c.normal);
-    c.depth = (c.closest - p).norm();
-  }
+  std::vector<ObstacleContact> out;
+  for (const auto& c : found)
+    if (c.vertex >= 0) out.push_back(c);
   return out;
 }
 

@@ -101,7 +101,9 @@ struct ObstacleContact {
 ///    the tets' boxes; every candidate goes to CGAL's exact point-in-tetrahedron test.
 ///  - kAabbTree: a CGAL AABB tree over the tets, rebuilt by Update() (CGAL's tree has no refit),
 ///    queried per boundary vertex; the same exact test as kBoxIntersection.
-/// Update() and Detect() use OpenMP; the result does not depend on the number of threads.
+/// Update() and Detect() use OpenMP (kGrid: from 16384 tets for the build and 1024 boundary
+/// vertices for the query; one thread below); the result does not depend on the number of
+/// threads.
 /// Not thread-safe: one detector per thread (Detect() stores its timings and counts).
 class SelfCollisionDetector {
  public:
