@@ -759,6 +759,55 @@ TEST(SceneJsonErrors, FixedAxesBadValues) {
   ExpectSceneError(j, {"fixed[1].axes: expected a string, got 3"});
 }
 
+TEST(SceneJsonErrors, ObstaclesAndCollisionOptions) {
+  auto with_obstacle = [](const json& o) {
+    json j = SignedMotionScene();
+    j["obstacles"] = json::array({o});
+    return j;
+  };
+  ExpectSceneError(with_obstacle(json::parse(R"({"type": "box", "min": [0, 0, 0], "max": [0, 1, 1]})")),
+                   {"obstacles[0]: box obstacle: expected min < max on every axis"});
+  ExpectSceneError(with_obstacle(json::parse(R"({"type": "box", "min": [0, 0, 0]})")),
+                   {"obstacles[0]: missing required key 'max'"});
+  ExpectSceneError(with_obstacle(json::parse(R"({"type": "cylinder", "min": [0, 0, 0], "base": [0, 0, 0],
+                                                 "axis": [0, 0, 1], "radius": 1, "height": 1})")),
+                   {"obstacles[0].min: not allowed for type 'cylinder'"});
+  ExpectSceneError(with_obstacle(json::parse(R"({"type": "cylinder", "base": [0, 0, 0], "axis": [0, 0, 1],
+                                                 "radius": -1, "height": 1})")),
+                   {"obstacles[0].radius: expected a number > 0"});
+  ExpectSceneError(with_obstacle(json::parse(R"({"type": "file", "file": "no_such_surface.obj"})")),
+                   {"obstacles[0].file: file not found", "no_such_surface.obj"});
+  ExpectSceneError(with_obstacle(json::parse(R"({"type": "sphere"})")),
+                   {"obstacles[0].type: expected one of: box, cylinder, file"});
+  json j = SignedMotionScene();
+  j["solver"]["collision"] = json::parse(R"({"self": "yes"})");
+  ExpectSceneError(j, {"solver.collision.self: expected a boolean (true or false)"});
+  j["solver"]["collision"] = json::parse(R"({"update": "magic"})");
+  ExpectSceneError(j, {"solver.collision.update: expected one of: updown, refactor"});
+  j["solver"]["collision"] = json::parse(R"({"check_interval": 0})");
+  ExpectSceneError(j, {"solver.collision.check_interval: expected an integer >= 1"});
+  // And a good one: both kinds of obstacle and every collision option are read.
+  json ok = SignedMotionScene();
+  ok["obstacles"] = json::parse(R"([{"type": "box", "min": [5, 5, 5], "max": [6, 7, 8]},
+      {"type": "cylinder", "base": [9, 0, 0], "axis": [0, 0, 2], "radius": 1.5, "height": 4, "segments": 12}])");
+  ok["solver"]["collision"] = json::parse(R"({"self": true, "obstacles": false, "epsilon": 0.1,
+      "stiffness": 5, "check_interval": 3, "update": "refactor"})");
+  TempDir dir;
+  WriteTinyMesh(dir.path());
+  const Scene s = LoadFrom(dir.path(), ok);
+  ASSERT_EQ(s.obstacles.size(), 2u);
+  EXPECT_EQ(s.obstacles[0].faces.rows(), 12);
+  EXPECT_NEAR(s.obstacles[0].vertices.col(2).maxCoeff(), 8.0, 1e-12);
+  EXPECT_EQ(s.obstacles[1].faces.rows(), 4 * 12);
+  EXPECT_NE(s.obstacles[1].source.find("obstacles[1]"), std::string::npos);
+  EXPECT_TRUE(s.solver.collision.self);
+  EXPECT_FALSE(s.solver.collision.obstacles);
+  EXPECT_EQ(s.solver.collision.epsilon, 0.1);
+  EXPECT_EQ(s.solver.collision.stiffness, 5.0);
+  EXPECT_EQ(s.solver.collision.check_interval, 3);
+  EXPECT_EQ(s.solver.collision.update, "refactor");
+}
+
 TEST(SceneJsonErrors, MotionBadValues) {
   auto with = [](const std::string& key, const json& v) {
     json j = SignedMotionScene();
