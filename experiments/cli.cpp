@@ -7,6 +7,7 @@
 #include "solver/mesh_io.hpp"
 #include "solver/robots.hpp"
 #include "solver/scene_json.hpp"
+#include "solver/tessellation.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -140,6 +141,30 @@ int RunCli(int argc, char** argv) {
   scene_cmd->add_flag("--schema", schema, "Print every key with its type, default and doc");
   scene_cmd->add_option("file", scene_check, "Scene JSON to load and summarise");
 
+  // tessellate
+  auto* tess = app.add_subcommand(
+      "tessellate",
+      "Volume tessellation T(S_c, S_b) (thesis Sec. 3.2.1): a labelled tet mesh of a closed body "
+      "surface with a closed chamber surface inside it, by CGAL Mesh_3 (docs/remeshing.md). "
+      "Region 0 = body, 1 = chamber");
+  std::string tess_body, tess_chamber, tess_out, tess_json;
+  TessellationOptions tess_opt;
+  tess->add_option("--body", tess_body, "Outer surface S_b: closed, .obj or .stl, mm")->required();
+  tess->add_option("--chamber", tess_chamber, "Chamber surface S_c strictly inside S_b: closed, .obj or .stl, mm")
+      ->required();
+  tess->add_option("--out", tess_out,
+                   "Output mesh by extension: .vtu (ParaView), .vtk (legacy VTK), .msh (Gmsh 2.2) or "
+                   ".node (TetGen .node + .ele)")
+      ->required();
+  tess->add_option("--size", tess_opt.cell_size, "Largest tet: bound on its circumradius (Mesh_3 cell_size), mm (default 2)");
+  tess->add_option("--facet-size", tess_opt.facet_size, "Bound on surface facet size, mm (default: --size)");
+  tess->add_option("--facet-distance", tess_opt.facet_distance,
+                   "Bound on the distance of a facet to the input surface, mm (default: --size / 10)");
+  tess->add_option("--feature-angle", tess_opt.feature_angle,
+                   "Protect input edges sharper than this dihedral angle, degrees (0: none; default 60)");
+  tess->add_option("--seed", tess_opt.seed, "Seed of Mesh_3's random choices (default 1)");
+  tess->add_option("--json", tess_json, "Write the report (tets per region, volumes, time) as JSON to this file");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -265,6 +290,44 @@ int RunCli(int argc, char** argv) {
                   << t.angle_a_deg << " deg, material B " << t.angle_b_deg << " deg\n";
       }
       if (!cal_json.empty()) WriteJson(cal_json, j);
+      return 0;
+    }
+    if (tess->parsed()) {
+      auto flag = [&](const char* name, bool ok, const std::string& expected, double got) {
+        if (!ok) {
+          std::ostringstream os;
+          os << name << ": expected " << expected << ", got " << got;
+          throw std::invalid_argument(os.str());
+        }
+      };
+      flag("--size", tess_opt.cell_size > 0 && std::isfinite(tess_opt.cell_size), "a size > 0 mm", tess_opt.cell_size);
+      flag("--facet-size", tess_opt.facet_size >= 0, "a size >= 0 mm (0: --size)", tess_opt.facet_size);
+      flag("--facet-distance", tess_opt.facet_distance >= 0, "a distance >= 0 mm (0: --size / 10)", tess_opt.facet_distance);
+      flag("--feature-angle", tess_opt.feature_angle >= 0 && tess_opt.feature_angle < 180,
+           "an angle in [0, 180) degrees", tess_opt.feature_angle);
+      const auto dot = tess_out.find_last_of('.');
+      const std::string ext = dot == std::string::npos ? "" : tess_out.substr(dot);
+      if (ext != ".vtu" && ext != ".vtk" && ext != ".msh" && ext != ".node")
+        throw std::invalid_argument("--out: expected a file name ending in .vtu, .vtk, .msh or .node, got '" +
+                                    tess_out + "'");
+      const TriangleSurface body = ReadSurfaceMesh(tess_body);
+      const TriangleSurface chamber = ReadSurfaceMesh(tess_chamber);
+      TessellationReport rep;
+      const Mesh mesh = Tessellate(chamber, body, tess_opt, &rep);
+      if (ext == ".vtu") WriteVtu(tess_out, mesh, mesh.vertices);
+      else if (ext == ".vtk") WriteVtk(tess_out, mesh);
+      else if (ext == ".msh") WriteGmsh(tess_out, mesh);
+      else WriteTetGen(tess_out.substr(0, dot), mesh);
+      std::cout << "wrote " << tess_out << ": " << rep.tets << " tets (body " << rep.body_tets << ", chamber "
+                << rep.chamber_tets << "), " << rep.vertices << " vertices; volume body " << rep.body_volume
+                << " mm^3 (surfaces enclose " << rep.body_enclosed << "), chamber " << rep.chamber_volume
+                << " mm^3 (" << rep.chamber_enclosed << "); " << rep.seconds << " s\n";
+      if (!tess_json.empty())
+        WriteJson(tess_json, {{"out", tess_out}, {"tets", rep.tets}, {"body_tets", rep.body_tets},
+                              {"chamber_tets", rep.chamber_tets}, {"vertices", rep.vertices},
+                              {"body_volume", rep.body_volume}, {"chamber_volume", rep.chamber_volume},
+                              {"body_enclosed", rep.body_enclosed}, {"chamber_enclosed", rep.chamber_enclosed},
+                              {"seconds", rep.seconds}, {"cell_size", tess_opt.cell_size}, {"seed", tess_opt.seed}});
       return 0;
     }
     if (run->parsed()) {

@@ -14,6 +14,9 @@ namespace softkin {
 
 namespace fs = std::filesystem;
 
+// Declared here rather than in runner.hpp: experiments/exp_remesh.cpp (Fig. 3.7).
+nlohmann::json RunTwistingRemesh(const Config& cfg, const std::string& dir, bool verbose);
+
 namespace {
 struct Entry {
   const char* type;
@@ -30,6 +33,7 @@ const Entry kExperiments[] = {
     {"collision_costs", &RunCollisionCosts},
     {"aa_ablation", &RunAaAblation},
     {"actuation_paths", &RunActuationPaths},
+    {"twisting_remesh", &RunTwistingRemesh},
 };
 }  // namespace
 

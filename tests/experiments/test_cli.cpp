@@ -181,4 +181,49 @@ TEST(Cli, RunWritesSummaryWithConfigCommitAndMachine) {
   EXPECT_NE(r.out.find("seed"), std::string::npos) << r.out;
 }
 
+/// An axis-aligned box [lo, hi]^3 as a Wavefront OBJ (outward triangles).
+void WriteBoxObj(const std::string& path, double lo, double hi) {
+  std::ofstream f(path);
+  for (int i = 0; i < 8; ++i)
+    f << "v " << (i & 1 ? hi : lo) << " " << (i & 2 ? hi : lo) << " " << (i & 4 ? hi : lo) << "\n";
+  const int t[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                        {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  for (const auto& tri : t) f << "f " << tri[0] + 1 << " " << tri[1] + 1 << " " << tri[2] + 1 << "\n";
+}
+
+TEST(Cli, TessellateMeshesABoxChamberInABoxBody) {
+  const std::string dir = TempDir("tessellate");
+  WriteBoxObj(dir + "/body.obj", -3, 3);
+  WriteBoxObj(dir + "/chamber.obj", -1, 1);
+  CliRun r = Cli("tessellate --help");
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("--chamber"), std::string::npos) << r.out;
+  r = Cli("tessellate --body " + dir + "/body.obj --chamber " + dir + "/chamber.obj --size 1 --out " + dir +
+          "/mesh.vtk --json " + dir + "/report.json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::ifstream f(dir + "/report.json");
+  const auto j = nlohmann::json::parse(f);
+  EXPECT_GT(j["body_tets"].get<int>(), 50);
+  EXPECT_GT(j["chamber_tets"].get<int>(), 5);
+  EXPECT_NEAR(j["body_volume"].get<double>(), 208.0, 0.2);
+  EXPECT_NEAR(j["chamber_volume"].get<double>(), 8.0, 0.01);
+  // The VTK file holds both regions.
+  std::ifstream vtk(dir + "/mesh.vtk");
+  const std::string text((std::istreambuf_iterator<char>(vtk)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("CELL_TYPES"), std::string::npos);
+  // A chamber that sticks out of the body is rejected, naming the file.
+  WriteBoxObj(dir + "/big.obj", -2, 4);
+  r = Cli("tessellate --body " + dir + "/body.obj --chamber " + dir + "/big.obj --out " + dir + "/bad.vtk");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("big.obj"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("strictly inside"), std::string::npos) << r.out;
+  // Bad sizes and output formats name the flag.
+  r = Cli("tessellate --body " + dir + "/body.obj --chamber " + dir + "/chamber.obj --size -1 --out " + dir + "/m.vtk");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("--size"), std::string::npos) << r.out;
+  r = Cli("tessellate --body " + dir + "/body.obj --chamber " + dir + "/chamber.obj --out " + dir + "/m.xyz");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("--out"), std::string::npos) << r.out;
+}
+
 }  // namespace

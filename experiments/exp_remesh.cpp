@@ -1,0 +1,253 @@
+// Fig. 3.7 (thesis Sec. 3.3.2, Algorithm 2): the twisting robot inflated progressively with chamber
+// remeshing up to alpha = 115, with the shapes at alpha = 5, 28 and 115, against alpha = 28
+// applied at once on the initial mesh without remeshing.
+#include "experiments/results.hpp"
+#include "experiments/runner.hpp"
+#include "solver/fk_solver.hpp"
+#include "solver/mesh_io.hpp"
+#include "solver/model.hpp"
+#include "solver/remesh.hpp"
+#include "solver/robot_twisting.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+namespace softkin {
+
+namespace {
+
+/// The chamber tets of `mesh` alone (same vertex array), for writing the chamber surface.
+Mesh ChamberPart(const Mesh& mesh, const std::vector<int>& regions) {
+  Mesh m;
+  m.vertices = mesh.vertices;
+  for (const auto& e : mesh.elements)
+    if (std::find(regions.begin(), regions.end(), e.region) != regions.end()) m.elements.push_back(e);
+  return m;
+}
+
+int InvertedTets(const Mesh& mesh, const Eigen::MatrixX3d& X) {
+  int n = 0;
+  for (const auto& e : mesh.elements) n += SignedVolume(e, X) > 0 ? 0 : 1;
+  return n;
+}
+
+std::string Tag(const std::string& variant, double alpha) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%s_a%g", variant.c_str(), alpha);
+  return buf;
+}
+
+}  // namespace
+
+nlohmann::json RunTwistingRemesh(const Config& cfg, const std::string& dir, bool verbose) {
+  const std::string robot = cfg.String("robot", "twisting_robot");
+  const int res = cfg.Int("res", 1);
+  const std::vector<double> alphas = cfg.NumberList("alphas", {5, 28, 115});
+  const double at_once = cfg.Number("at_once_alpha", 28);
+  const double alpha_max = cfg.Number("alpha_max", 4.0);
+  const double d_max = cfg.Number("d_max", 4.0);
+  const double step = cfg.Number("step", 0.0);
+  const std::string method_name = cfg.String("remesh_method", "auto");
+  const int remesh_iterations = cfg.Int("remesh_iterations", 3);
+  const int max_remeshes = cfg.Int("max_remeshes_per_step", 2);
+  const int sections = cfg.Int("sections", 20);
+  const bool write_vtu = cfg.Bool("vtu", true);
+  if (robot != "twisting_robot")
+    cfg.Fail("robot", "twisting_robot (the twist is measured about its z axis over its 100 mm length)");
+  const auto t_build0 = std::chrono::steady_clock::now();
+  Scene scene = ConfigRobot(cfg, robot, res);
+  const double build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_build0).count();
+  scene.solver = cfg.Solver(scene.solver);
+  cfg.CheckNoUnknownKeys();
+  if (alphas.empty()) cfg.Fail("alphas", "a non-empty list of chamber volume ratios > 1");
+  for (size_t i = 0; i < alphas.size(); ++i)
+    if (!(alphas[i] > 1) || (i > 0 && !(alphas[i] > alphas[i - 1])))
+      cfg.Fail("alphas", "increasing chamber volume ratios > 1");
+  const Actuator& act = scene.actuators.at(ChamberActuator(scene));
+  if (alphas.back() > act.max) cfg.Fail("alphas", "ratios up to the chamber's maximum " + std::to_string(act.max));
+  if (!(at_once > 1) || at_once > act.max) cfg.Fail("at_once_alpha", "a chamber volume ratio in (1, max]");
+  if (sections < 2 || sections > 100) cfg.Fail("sections", "an integer in [2, 100]");
+  if (remesh_iterations < 1) cfg.Fail("remesh_iterations", "an integer >= 1");
+  if (max_remeshes < 1) cfg.Fail("max_remeshes_per_step", "an integer >= 1");
+  ProgressiveOptions popt;
+  popt.criteria = {alpha_max, d_max};
+  popt.step = step;
+  popt.max_remeshes_per_step = max_remeshes;
+  if (!RemeshMethodFromString(method_name, &popt.remesh_options.method))
+    cfg.Fail("remesh_method", "auto, chamber or whole");
+  popt.remesh_options.region.iterations = remesh_iterations;
+  popt.remesh_options.region.seed = cfg.seed();
+  popt.remesh_options.tessellation = TwistingRobotTessellation(res <= 0 ? kTwistDefaultRes : res);
+  popt.remesh_options.tessellation.seed = cfg.seed();
+  popt.snapshots.assign(alphas.begin(), alphas.end() - 1);
+  std::string why;
+  if (!popt.IsValid(&why)) cfg.Fail(why.substr(0, why.find(':')), why);
+  const std::vector<int> chamber_regions = act.regions;
+
+  std::filesystem::create_directories(dir + "/shapes");
+  CsvWriter steps_csv(dir + "/steps.csv",
+                      {"variant", "k", "alpha", "remeshes", "methods", "remesh_failures", "tets", "chamber_tets", "mesh_s",
+                       "solver_s", "iterations", "status", "chamber_volume_ratio", "max_volume_ratio",
+                       "max_distortion", "tip_twist_deg", "tip_x", "tip_y", "tip_z"});
+  CsvWriter profile_csv(dir + "/twist_profile.csv", {"variant", "alpha", "section", "z", "twist_deg"});
+  CsvWriter shapes_csv(dir + "/shapes.csv",
+                       {"variant", "alpha", "tip_twist_deg", "chamber_volume_ratio", "remeshes", "tets",
+                        "inverted_tets", "mesh_s", "solver_s", "tip_x", "tip_y", "tip_z", "outer_obj",
+                        "chamber_obj", "vtu"});
+  const int tip = scene.marker_index("tip");
+  auto twist = [&](const Scene& s, const Eigen::MatrixX3d& X) {
+    return TwistProfileDegrees(s, X, kTwistLength, sections);
+  };
+  auto fmt = [](double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.9g", v);
+    return std::string(b);
+  };
+  std::vector<std::pair<double, std::string>> frames;
+  // Writes one shape: surfaces (outer, chamber) as OBJ for the figure, the mesh as VTU, a row of
+  // shapes.csv and the twist profile; returns its summary entry.
+  auto record_shape = [&](const std::string& variant, double alpha, const Scene& s, const Eigen::MatrixX3d& X,
+                          double volume_ratio, int remeshes, double mesh_s, double solver_s) {
+    const std::string tag = Tag(variant, alpha);
+    const std::vector<double> prof = twist(s, X);
+    for (int i = 0; i < sections; ++i)
+      profile_csv.RowStrings({variant, fmt(alpha), std::to_string(i), fmt(kTwistLength * (i + 1) / sections), fmt(prof[i])});
+    const std::string outer = "shapes/" + tag + "_outer.obj", chamber = "shapes/" + tag + "_chamber.obj";
+    WriteSurfaceObj(dir + "/" + outer, s.mesh, X);
+    WriteSurfaceObj(dir + "/" + chamber, ChamberPart(s.mesh, chamber_regions), X);
+    std::string vtu;
+    if (write_vtu) {
+      vtu = "shapes/" + tag + ".vtu";
+      WriteVtu(dir + "/" + vtu, s.mesh, X);
+      if (variant == "progressive") frames.emplace_back(alpha, vtu);
+    }
+    const Eigen::MatrixX3d P = s.marker_positions(X);
+    const int inverted = InvertedTets(s.mesh, X);
+    shapes_csv.RowStrings({variant, fmt(alpha), fmt(prof.back()), fmt(volume_ratio), std::to_string(remeshes),
+                           std::to_string(s.mesh.num_tets()), std::to_string(inverted), fmt(mesh_s), fmt(solver_s),
+                           fmt(P(tip, 0)), fmt(P(tip, 1)), fmt(P(tip, 2)), outer, chamber, vtu});
+    return nlohmann::json{{"alpha", alpha},
+                          {"tip_twist_deg", prof.back()},
+                          {"chamber_volume_ratio", volume_ratio},
+                          {"remeshes", remeshes},
+                          {"tets", s.mesh.num_tets()},
+                          {"inverted_tets", inverted},
+                          {"mesh_seconds", mesh_s},
+                          {"solver_seconds", solver_s},
+                          {"tip", {P(tip, 0), P(tip, 1), P(tip, 2)}}};
+  };
+
+  // ---- progressive, with remeshing ----
+  auto log_step = [&](const std::string& variant) {
+    return [&, variant](const ProgressiveStep& st, const Scene& s, const Eigen::MatrixX3d& X) {
+      const std::vector<double> prof = twist(s, X);
+      const Eigen::MatrixX3d P = s.marker_positions(X);
+      steps_csv.RowStrings({variant, std::to_string(st.k), fmt(st.alpha), std::to_string(st.remeshes), st.methods,
+                            std::to_string(st.remesh_failures), std::to_string(st.tets), std::to_string(st.chamber_tets), fmt(st.mesh_seconds),
+                            fmt(st.solver_seconds), std::to_string(st.iterations), FkStatusToString(st.status),
+                            fmt(st.chamber_volume_ratio), fmt(st.max_volume_ratio), fmt(st.max_distortion),
+                            fmt(prof.back()), fmt(P(tip, 0)), fmt(P(tip, 1)), fmt(P(tip, 2))});
+      if (verbose)
+        std::fprintf(stderr, "  %s alpha %g: %s, %d iterations, %.1f s; %d remesh(es)%s%s, %d tets; chamber x%.2f, tip twist %.1f deg\n",
+                     variant.c_str(), st.alpha, FkStatusToString(st.status), st.iterations, st.solver_seconds,
+                     st.remeshes, st.methods.empty() ? "" : " ", st.methods.c_str(), st.tets,
+                     st.chamber_volume_ratio, prof.back());
+    };
+  };
+  popt.on_step = log_step("progressive");
+  const ProgressiveResult prog = SolveProgressive(scene, alphas.back(), popt);
+  if (verbose) std::fprintf(stderr, "  progressive: %s\n", prog.BriefReport().c_str());
+
+  nlohmann::json prog_shapes = nlohmann::json::array();
+  {
+    // Cumulative counts up to each snapshot.
+    auto upto = [&](double alpha, auto field) {
+      double v = 0;
+      for (const auto& st : prog.steps)
+        if (st.alpha <= alpha + 1e-12) v += field(st);
+      return v;
+    };
+    auto add = [&](double alpha, const Scene& s, const Eigen::MatrixX3d& X, double ratio) {
+      prog_shapes.push_back(record_shape(
+          "progressive", alpha, s, X, ratio, static_cast<int>(upto(alpha, [](const ProgressiveStep& st) { return double(st.remeshes); })),
+          upto(alpha, [](const ProgressiveStep& st) { return st.mesh_seconds; }),
+          upto(alpha, [](const ProgressiveStep& st) { return st.solver_seconds; })));
+    };
+    for (const auto& snap : prog.snapshots) add(snap.alpha, snap.scene, snap.positions, snap.chamber_volume_ratio);
+    if (prog.completed) add(alphas.back(), prog.scene, prog.positions, prog.chamber_volume_ratio);
+  }
+  if (!frames.empty()) WritePvd(dir + "/progressive.pvd", frames);
+
+  // ---- at once, no remeshing ----
+  nlohmann::json once;
+  {
+    auto model = std::make_shared<const Model>(scene);
+    auto solver = MakeFkSolver(model, scene.solver);
+    Eigen::VectorXd c = scene.rest_actuation();
+    c[ChamberActuator(scene)] = at_once;
+    const FkResult r = solver->Solve(c);
+    if (r.status == FkStatus::InvalidInput) throw std::runtime_error("at_once_alpha: " + r.message);
+    const double ratio = RegionVolume(scene.mesh, r.positions, chamber_regions) /
+                         RegionVolume(scene.mesh, scene.mesh.vertices, chamber_regions);
+    once = record_shape("at_once", at_once, scene, r.positions, ratio, 0, 0.0, r.time_s);
+    once["status"] = FkStatusToString(r.status);
+    once["iterations"] = r.iterations;
+    ProgressiveStep st;
+    st.k = 1;
+    st.alpha = at_once;
+    st.tets = scene.mesh.num_tets();
+    st.solver_seconds = r.time_s;
+    st.iterations = r.iterations;
+    st.status = r.status;
+    st.chamber_volume_ratio = ratio;
+    const RemeshCheck chk = CheckRemesh(scene.mesh, scene.mesh.vertices, r.positions, chamber_regions, popt.criteria);
+    st.max_volume_ratio = chk.max_volume_ratio;
+    st.max_distortion = chk.max_distortion;
+    for (const auto& e : scene.mesh.elements)
+      if (std::find(chamber_regions.begin(), chamber_regions.end(), e.region) != chamber_regions.end()) ++st.chamber_tets;
+    log_step("at_once")(st, scene, r.positions);
+  }
+
+  int whole = 0, chamber_only = 0;
+  for (const auto& st : prog.steps) {
+    for (size_t p = 0; p < st.methods.size();) {
+      const size_t q = std::min(st.methods.find(',', p), st.methods.size());
+      const std::string m = st.methods.substr(p, q - p);
+      (m == "whole" ? whole : chamber_only)++;
+      p = q + 1;
+    }
+  }
+  nlohmann::json j;
+  j["robot"] = robot;
+  j["res"] = res;
+  j["initial_tets"] = scene.mesh.num_tets();
+  j["robot_build_seconds"] = build_s;
+  j["alpha_max"] = alpha_max;
+  j["d_max"] = d_max;
+  j["progressive"] = {{"status", FkStatusToString(prog.status)},
+                      {"completed", prog.completed},
+                      {"message", prog.message},
+                      {"steps", prog.steps.size()},
+                      {"remeshes", prog.remeshes},
+                      {"remesh_failures", prog.remesh_failures},
+                      {"first_remesh_failure", prog.first_remesh_failure},
+                      {"remeshes_whole", whole},
+                      {"remeshes_chamber_only", chamber_only},
+                      {"final_tets", prog.scene.mesh.num_tets()},
+                      {"chamber_volume_ratio", prog.chamber_volume_ratio},
+                      {"mesh_seconds", prog.mesh_seconds},
+                      {"solver_seconds", prog.solver_seconds},
+                      {"mesh_seconds_per_remesh", prog.remeshes > 0 ? prog.mesh_seconds / prog.remeshes : 0.0},
+                      {"solver_seconds_per_step", prog.steps.empty() ? 0.0 : prog.solver_seconds / prog.steps.size()},
+                      {"shapes", prog_shapes}};
+  j["at_once"] = once;
+  j["thesis_table_3_1_twisting"] = {{"tets", 28198}, {"mesh_gen_s", 2.81}, {"collision_check_s", 0.03},
+                                    {"collision_response_s", 1.71}, {"solver_s", 3.54}};
+  return j;
+}
+
+}  // namespace softkin
