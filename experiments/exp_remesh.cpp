@@ -81,7 +81,10 @@ nlohmann::json RunTwistingRemesh(const Config& cfg, const std::string& dir, bool
     cfg.Fail("remesh_method", "auto, chamber or whole");
   popt.remesh_options.region.iterations = remesh_iterations;
   popt.remesh_options.region.seed = cfg.seed();
-  popt.remesh_options.tessellation = TwistingRobotTessellation(res <= 0 ? kTwistDefaultRes : res);
+  const auto params = cfg.NumberMap("robot_params");
+  const auto tube = params.find("tube_radius");
+  popt.remesh_options.tessellation = TwistingRobotTessellation(res <= 0 ? kTwistDefaultRes : res,
+                                                               tube == params.end() ? 2.5 : tube->second);
   popt.remesh_options.tessellation.seed = cfg.seed();
   popt.snapshots.assign(alphas.begin(), alphas.end() - 1);
   std::string why;
@@ -215,7 +218,7 @@ nlohmann::json RunTwistingRemesh(const Config& cfg, const std::string& dir, bool
   int whole = 0, chamber_only = 0;
   for (const auto& st : prog.steps) {
     for (size_t p = 0; p < st.methods.size();) {
-      const size_t q = std::min(st.methods.find(',', p), st.methods.size());
+      const size_t q = std::min(st.methods.find('+', p), st.methods.size());
       const std::string m = st.methods.substr(p, q - p);
       (m == "whole" ? whole : chamber_only)++;
       p = q + 1;

@@ -26,9 +26,10 @@ using Clock = std::chrono::steady_clock;
 using Rows4 = Eigen::Matrix<double, 4, 3>;
 
 /// SolveProgressive treats a solution whose bounding-box diagonal exceeds this multiple of the
-/// rest one as a runaway (diverged). A chamber inflated 120 times grows the twisting robot's box
-/// by less than 2x.
-constexpr double kRunawayExtent = 20.0;
+/// rest one as a runaway (diverged)...
+constexpr double kRunawayExtent = 5.0;
+/// ... or whose chamber volume ratio exceeds this multiple of the ratio asked for.
+constexpr double kRunawayRatio = 2.0;
 
 double Seconds(Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); }
 
@@ -827,13 +828,17 @@ ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target, cons
       st.iterations += r.iterations;
       st.status = r.status;
       // A state that has grown far beyond any inflation is a runaway of the iteration, not a
-      // shape: treat it as diverged (and keep the previous state).
+      // shape: treat it as diverged (and keep the previous state). The soft actuation of the
+      // local-global solver reaches less than the ratio asked for, so a chamber beyond twice it
+      // has run away too.
       if (r.status != FkStatus::Diverged && r.status != FkStatus::InvalidInput) {
         const double extent = (r.positions.colwise().maxCoeff() - r.positions.colwise().minCoeff()).norm();
-        if (!(extent <= kRunawayExtent * rest_extent)) {
+        const double ratio = RegionVolume(res.scene.mesh, r.positions, regions) / V0;
+        if (!(extent <= kRunawayExtent * rest_extent) || !(ratio <= kRunawayRatio * st.alpha)) {
+          r.message = "runaway: the chamber reached " + Num(ratio) + " times its volume for alpha " +
+                      Num(st.alpha) + ", the bounding box " + Num(extent / rest_extent) + " times the rest one (" +
+                      FkStatusToString(r.status) + "); treated as diverged";
           r.status = FkStatus::Diverged;
-          r.message = "the solution's bounding box grew to " + Num(extent / rest_extent) +
-                      " times the rest one (" + FkStatusToString(st.status) + "); treated as diverged";
           st.status = r.status;
         }
       }
@@ -864,7 +869,7 @@ ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target, cons
       st.mesh_seconds += rm.seconds;
       ++st.remeshes;
       ++res.remeshes;
-      st.methods += (st.methods.empty() ? "" : ",") + std::string(RemeshMethodToString(rm.method));
+      st.methods += (st.methods.empty() ? "" : "+") + std::string(RemeshMethodToString(rm.method));
       res.scene = std::move(rm.scene);
       X = std::move(rm.positions);
       Xref = X;

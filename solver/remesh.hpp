@@ -170,7 +170,7 @@ struct ProgressiveStep {
   int k = 0;                    ///< 1-based ladder index
   double alpha = 1.0;           ///< chamber volume ratio asked for (of the original chamber)
   int remeshes = 0;             ///< remeshes done at this value
-  std::string methods;          ///< the methods used by them, comma-separated ("" if none)
+  std::string methods;          ///< the methods used by them, joined by '+' ("" if none)
   int remesh_failures = 0;      ///< remeshes that threw std::runtime_error (the step went on without)
   int tets = 0, chamber_tets = 0;       ///< after the step
   double mesh_seconds = 0;      ///< time in RemeshChamber at this step, s
@@ -241,8 +241,8 @@ struct ProgressiveResult {
 /// whole re-tessellation changes it slightly; the actuator's range is widened to match). A remesh
 /// that throws std::runtime_error is counted (remesh_failures) and the step keeps its state on the
 /// current mesh; a diverged or invalid solve ends the ladder (completed = false), and so does a
-/// runaway (a solution whose bounding box exceeds 20 times the rest one, reported as diverged;
-/// the state before it is kept). Throws
+/// runaway (a solution whose bounding box exceeds 5 times the rest one or whose chamber volume
+/// ratio exceeds twice alpha, reported as diverged; the state before it is kept). Throws
 /// std::invalid_argument for a bad scene, options or an alpha_target outside the actuator's
 /// range.
 ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target,
