@@ -455,7 +455,7 @@ TEST(Robots, ListsEveryRobotAndRejectsBadInput) {
   const std::vector<std::string> names = {"pneumatic_finger", "three_chamber", "cable_finger",
                                           "finger_manipulator", "multi_segment_gripper",
                                           "dea_crawler", "bimaterial_bar", "cable_gripper",
-                                          "selfcollision_finger", "membrane"};
+                                          "selfcollision_finger", "membrane", "twisting_robot"};
   ASSERT_EQ(list.size(), names.size());
   for (size_t i = 0; i < names.size(); ++i) EXPECT_EQ(list[i].name, names[i]);
   for (const auto& r : list) {
@@ -470,7 +470,7 @@ TEST(Robots, ListsEveryRobotAndRejectsBadInput) {
     EXPECT_EQ(std::string(e.what()),
               "unknown robot 'x'; known robots: pneumatic_finger, three_chamber, cable_finger, "
               "finger_manipulator, multi_segment_gripper, dea_crawler, bimaterial_bar, cable_gripper, "
-              "selfcollision_finger, membrane");
+              "selfcollision_finger, membrane, twisting_robot");
   }
   try {
     MakeRobot("pneumatic_finger", 2);
