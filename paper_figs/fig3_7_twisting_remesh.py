@@ -10,7 +10,7 @@ steps.csv (one row per ladder step) and summary.json, written by
   top row:    the deformed shapes, progressive (one panel per alpha) and at once (last panel);
               the body surface in grey, the chamber in red; the tip twist in the title;
   bottom row: tip twist and reached chamber volume ratio against the asked alpha, and the tet
-              count and remeshes along the progressive ladder.
+              count, remeshes and failed remeshes along the progressive ladder.
 Exit status 2 with a message on stderr if a file is missing or malformed.
 """
 import os
@@ -102,7 +102,7 @@ def main(argv):
 
     ps = [r for r in steps if r["variant"] == "progressive"]
     os_ = [r for r in steps if r["variant"] == "at_once"]
-    ax = fig.add_subplot(2, 3, 4)
+    ax = fig.add_subplot(2, n, n + 1)
     ax.plot([r["alpha"] for r in ps], [r["tip_twist_deg"] for r in ps], "o-", color="tab:blue", ms=3,
             label="progressive remeshing")
     ax.plot([r["alpha"] for r in os_], [r["tip_twist_deg"] for r in os_], "s", color="tab:red", ms=7,
@@ -111,7 +111,7 @@ def main(argv):
     ax.set_ylabel("tip twist about the axis (deg)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
-    ax = fig.add_subplot(2, 3, 5)
+    ax = fig.add_subplot(2, n, n + 2)
     ax.plot([r["alpha"] for r in ps], [r["chamber_volume_ratio"] for r in ps], "o-", color="tab:blue", ms=3,
             label="progressive remeshing")
     ax.plot([r["alpha"] for r in os_], [r["chamber_volume_ratio"] for r in os_], "s", color="tab:red", ms=7,
@@ -122,10 +122,13 @@ def main(argv):
     ax.set_ylabel("chamber volume ratio reached")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
-    ax = fig.add_subplot(2, 3, 6)
+    ax = fig.add_subplot(2, n, n + 3)
     ax.plot([r["alpha"] for r in ps], [r["tets"] for r in ps], "o-", color="tab:green", ms=3, label="tets")
     rem = [r for r in ps if r["remeshes"] > 0]
     ax.plot([r["alpha"] for r in rem], [r["tets"] for r in rem], "kx", ms=8, label="remeshed at this step")
+    bad = [r for r in ps if r["remesh_failures"] > 0]
+    ax.plot([r["alpha"] for r in bad], [r["tets"] for r in bad], "o", mfc="none", mec="tab:red", ms=7,
+            label="remesh failed (kept the mesh)")
     ax.set_xlabel("alpha asked")
     ax.set_ylabel("tets")
     ax.grid(True, alpha=0.3)
