@@ -57,6 +57,25 @@ void ComputeLocalRatios(const Model& model, const Eigen::Ref<const Eigen::Matrix
   }
 }
 
+double HyperelasticBlendWeight(const ElemRows& Rr, const ElemRows& D, int k, double rho,
+                               double rest_volume) {
+  auto volume = [&](double t) {
+    ElemRows B = ElemRows::Zero();
+    B.topRows(k) = t * Rr.topRows(k) + (1.0 - t) * D.topRows(k);
+    return RowsVolume(B, k);
+  };
+  const double floor = kMinBlendVolume * rest_volume;
+  if (volume(rho) >= floor) return rho;
+  // volume(1) = rest_volume > floor: bisection on [rho, 1] for the crossing (the volume is a cubic
+  // in t; 50 halvings leave an interval of 1e-15).
+  double lo = rho, hi = 1.0;
+  for (int it = 0; it < 50; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (volume(mid) < floor ? lo : hi) = mid;
+  }
+  return hi;
+}
+
 Eigen::Matrix3d DeformationGradient(const ModelElement& e, const ElemRows& D) {
   // Least-squares affine map of the centred rest rows onto the centred current rows (exact for a
   // tet): D^T = F P^T, F = D^T P (P^T P)^-1.
@@ -80,10 +99,9 @@ void ElementTarget(const ModelElement& e, const ElemRows& D, double ratio, ElemR
       // Hyperelastic (Eq. 3.6-3.7): blend the current shape with the rotated rest shape by
       // R_omega(strain), then rescale the blend to the rest volume.
       const double rho = (*e.curve)(EquivalentStrain(DeformationGradient(e, D)));
-      T->topRows(k) = rho * T->topRows(k) + (1.0 - rho) * D.topRows(k);
-      const double vb = RowsVolume(*T, k);
-      const double s = vb > 1e-9 * e.rest_volume ? std::min(std::cbrt(e.rest_volume / vb), 10.0) : 10.0;
-      T->topRows(k) *= s;
+      const double t = HyperelasticBlendWeight(*T, D, k, rho, e.rest_volume);
+      T->topRows(k) = t * T->topRows(k) + (1.0 - t) * D.topRows(k);
+      T->topRows(k) *= std::cbrt(e.rest_volume / RowsVolume(*T, k));
     } else if (e.r_omega < 1.0) {
       const double vd = RowsVolume(D, k);
       double s = 1.0;

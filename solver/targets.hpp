@@ -46,6 +46,20 @@ void ComputeLocalRatios(const Model& model, const Eigen::Ref<const Eigen::Matrix
 /// map of its centred rest rows onto D (exact for a tet).
 Eigen::Matrix3d DeformationGradient(const ModelElement& e, const ElemRows& D);
 
+/// A hyperelastic blend (Eq. 3.6) whose volume falls below this fraction of the rest volume
+/// (an inverted or nearly flat element at a small R_omega) is not rescaled as it is: its weight
+/// moves toward the rotated rest shape until its volume reaches the fraction, so that the volume
+/// rescale of Eq. 3.7 stays within a factor of 2 and never turns an inverted blend into a large
+/// inverted target.
+constexpr double kMinBlendVolume = 0.125;
+
+/// Blend weight t >= rho of the rotated rest rows Rr (P R^T) against the current rows D (both
+/// centred) for a hyperelastic body element: rho itself when Vol(t Rr + (1 - t) D) >=
+/// kMinBlendVolume * rest_volume, otherwise the t in (rho, 1] where the blend's volume reaches that
+/// floor (bisection; Vol(Rr) = rest_volume). The target's volume factor is then at most 2.
+double HyperelasticBlendWeight(const ElemRows& Rr, const ElemRows& D, int k, double rho,
+                               double rest_volume);
+
 /// Target of one element: D = N V^d (centred current rows), ratio = r_i (ignored for body). Writes the centred target T, already rotated to the current frame.
 void ElementTarget(const ModelElement& e, const ElemRows& D, double ratio, ElemRows* T);
 

@@ -5,6 +5,7 @@
 #include "solver/calibration.hpp"
 #include "solver/energy.hpp"
 #include "solver/hyperelastic.hpp"
+#include "solver/rotation.hpp"
 #include "solver/targets.hpp"
 #include "test_util.hpp"
 
@@ -128,6 +129,54 @@ TEST(Hyperelastic, ElementIdentities) {
       worst = std::max(worst, std::abs(fd - G(v, d)) / (1e-3 + std::abs(fd)));
     }
   EXPECT_LT(worst, 1e-4);
+}
+
+// An inverted or flattened element at a small R_omega: the blend of Eq. 3.6 is inverted or nearly
+// flat, and rescaling it to the rest volume as it is would blow it up (or keep it inverted). The
+// target must keep the rest volume with the right orientation and stay near the rest size; the
+// blend weight moves toward the rotated rest shape only as far as needed (Eq. 3.7 guard).
+TEST(Hyperelastic, InvertedAndFlatElementsGetBoundedRestVolumeTargets) {
+  const Scene s = HyperBar(0.05);  // R_omega(0) = 0.05: nearly the current shape
+  const Model model(s);
+  const ModelElement& e = model.elements().front();
+  ASSERT_EQ(e.k, 4);
+  ElemRows P = ElemRows::Zero();
+  P.topRows(4) = e.rest.topRows(4);
+  const double rest_size = P.topRows(4).norm();
+  std::mt19937 rng(3);
+  int guarded = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    // Rest rows under a random rotation, with one vertex pushed through the opposite face by a
+    // random amount (from nearly flat to fully inverted).
+    const Eigen::Matrix3d Q = test::RandomRotation(rng);
+    ElemRows D = ElemRows::Zero();
+    D.topRows(4) = P.topRows(4) * Q.transpose();
+    const Eigen::RowVector3d f = (D.row(1) + D.row(2) + D.row(3)) / 3.0;
+    const double depth = std::uniform_real_distribution<double>(0.9, 2.5)(rng);
+    D.row(0) = f + (1.0 - depth) * (D.row(0) - f);
+    CenterRows(D, 4);
+    ElemRows T;
+    ElementTarget(e, D, 1.0, &T);
+    ASSERT_TRUE(T.allFinite());
+    EXPECT_NEAR(RowsVolume(T, 4), e.rest_volume, 1e-9 * e.rest_volume) << "trial " << trial;
+    EXPECT_LT(T.topRows(4).norm(), 2.0 * std::max(rest_size, D.topRows(4).norm())) << "trial " << trial;
+    // The weight actually moved where the plain blend is below the volume floor.
+    ElemRows R = ElemRows::Zero();
+    R.topRows(4) = P.topRows(4) * BestRotation(D.topRows(4).transpose() * P.topRows(4)).transpose();
+    const double rho = (*e.curve)(EquivalentStrain(DeformationGradient(e, D)));
+    ElemRows B = ElemRows::Zero();
+    B.topRows(4) = rho * R.topRows(4) + (1.0 - rho) * D.topRows(4);
+    const double t = HyperelasticBlendWeight(R, D, 4, rho, e.rest_volume);
+    if (RowsVolume(B, 4) < kMinBlendVolume * e.rest_volume) {
+      ++guarded;
+      EXPECT_GT(t, rho);
+      B.topRows(4) = t * R.topRows(4) + (1.0 - t) * D.topRows(4);
+      EXPECT_NEAR(RowsVolume(B, 4), kMinBlendVolume * e.rest_volume, 1e-9 * e.rest_volume);
+    } else {
+      EXPECT_EQ(t, rho);
+    }
+  }
+  EXPECT_GT(guarded, 100);  // most trials are inverted: the guard ran
 }
 
 TEST(Hyperelastic, SimulatedTensionFollowsMooneyRivlin) {
