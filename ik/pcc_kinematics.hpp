@@ -33,7 +33,7 @@ struct PccParams {
   double max_pull = 20.0;       ///< c_max, mm (> 0)
   int backbone_points = 8;      ///< K >= 1 tracked points along the backbone
   bool axial = true;            ///< equal pulls compress the backbone (a = 1) or not (a = 0)
-  /// "" if valid, else the reason.
+  /// True if every field is in range; else false and *why (if given) names the field.
   bool IsValid(std::string* why) const;
 };
 
