@@ -1,0 +1,264 @@
+#include "ik/trajectory.hpp"
+
+#include "ik/objectives.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+namespace softkin {
+namespace {
+
+double Seconds(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::string JoinNumbers(const Eigen::VectorXd& v) {
+  std::ostringstream s;
+  s << std::setprecision(17);
+  for (int i = 0; i < v.size(); ++i) s << (i ? "," : "") << v[i];
+  return s.str();
+}
+
+// The header lines a cache must carry to be reused, in file order.
+std::vector<std::pair<std::string, std::string>> CacheHeader(const Kinematics& kin,
+                                                             const std::string& point,
+                                                             const SamplingOptions& o) {
+  return {{"format", "softkin configuration-space samples v1"},
+          {"kinematics", kin.name()},
+          {"key", o.cache_key},
+          {"point", point},
+          {"actuators", std::to_string(kin.num_actuators())},
+          {"samples_per_axis", std::to_string(o.samples_per_axis)},
+          {"lower", JoinNumbers(kin.lower())},
+          {"upper", JoinNumbers(kin.upper())}};
+}
+
+// Loads the cache; "" on success, else why it cannot be used.
+std::string LoadCache(const std::string& path,
+                      const std::vector<std::pair<std::string, std::string>>& header, int n,
+                      ConfigurationSamples* out) {
+  std::ifstream in(path);
+  if (!in) return "cannot read " + path;
+  std::map<std::string, std::string> got;
+  std::string line;
+  std::vector<std::vector<double>> rows;
+  int lineno = 0;
+  while (std::getline(in, line)) {
+    ++lineno;
+    if (line.empty()) continue;
+    if (line[0] == '#') {
+      const size_t eq = line.find('=');
+      if (eq != std::string::npos) got[line.substr(2, eq - 2)] = line.substr(eq + 1);
+      continue;
+    }
+    if (line.rfind("c0", 0) == 0) continue;  // the column header
+    std::vector<double> row;
+    std::stringstream ss(line);
+    std::string tok;
+    while (std::getline(ss, tok, ',')) {
+      char* end = nullptr;
+      const double v = std::strtod(tok.c_str(), &end);
+      if (end == tok.c_str() || *end != '\0' || !std::isfinite(v))
+        return path + ":" + std::to_string(lineno) + ": '" + tok + "' is not a finite number";
+      row.push_back(v);
+    }
+    if (static_cast<int>(row.size()) != n + 3)
+      return path + ":" + std::to_string(lineno) + ": expected " + std::to_string(n + 3) +
+             " columns, found " + std::to_string(row.size());
+    rows.push_back(std::move(row));
+  }
+  for (const auto& [k, v] : header) {
+    auto it = got.find(k);
+    if (it == got.end()) return "the cache has no '" + k + "' line";
+    if (it->second != v) return "the cache was built for " + k + "=" + it->second + ", not " + v;
+  }
+  if (rows.empty()) return "the cache has no samples";
+  out->c.resize(rows.size(), n);
+  out->p.resize(rows.size(), 3);
+  for (size_t i = 0; i < rows.size(); ++i) {
+    for (int a = 0; a < n; ++a) out->c(i, a) = rows[i][a];
+    for (int d = 0; d < 3; ++d) out->p(i, d) = rows[i][n + d];
+  }
+  out->failed = std::stoi(got.count("failed") ? got["failed"] : "0");
+  return "";
+}
+
+}  // namespace
+
+bool SamplingOptions::IsValid(std::string* why) const {
+  std::string s;
+  if (samples_per_axis < 2) s = "samples_per_axis must be >= 2, got " + std::to_string(samples_per_axis);
+  if (why) *why = s;
+  return s.empty();
+}
+
+bool TrajectoryOptions::IsValid(std::string* why) const {
+  std::string s;
+  if (point.empty()) s = "point must be named";
+  else if (!ik.IsValid(&s)) s = "ik." + s;
+  else if (!sampling.IsValid(&s)) s = "sampling." + s;
+  else if (first_waypoint < 0) s = "first_waypoint must be >= 0";
+  if (why) *why = s;
+  return s.empty();
+}
+
+ConfigurationSamples SampleConfigurationSpace(Kinematics& kin, const std::string& point,
+                                              const SamplingOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string why;
+  if (!options.IsValid(&why)) throw std::invalid_argument("SamplingOptions: " + why);
+  const int k = ResolvePoint(kin.point_names(), point, "configuration-space sampling");
+  const int n = kin.num_actuators(), m = options.samples_per_axis;
+  const double total = std::pow(static_cast<double>(m), n);
+  if (total > 1e6)
+    throw std::invalid_argument("configuration-space sampling: " + std::to_string(m) + "^" +
+                                std::to_string(n) + " samples is more than 10^6");
+  const auto header = CacheHeader(kin, point, options);
+  ConfigurationSamples out;
+  std::string rejected;
+  if (!options.cache_file.empty() && std::ifstream(options.cache_file).good()) {
+    rejected = LoadCache(options.cache_file, header, n, &out);
+    if (rejected.empty()) {
+      out.cache_status = "loaded";
+      out.time_s = Seconds(t0);
+      return out;
+    }
+  }
+  // The grid, first actuator fastest.
+  const int count = static_cast<int>(total);
+  std::vector<Eigen::VectorXd> cs;
+  std::vector<Eigen::Vector3d> ps;
+  Eigen::VectorXi digit = Eigen::VectorXi::Zero(n);
+  for (int s = 0; s < count; ++s) {
+    Eigen::VectorXd c(n);
+    for (int a = 0; a < n; ++a)
+      c[a] = digit[a] == m - 1 ? kin.upper()[a]
+                               : kin.lower()[a] + (kin.upper()[a] - kin.lower()[a]) * digit[a] / (m - 1);
+    const KinematicsEval e = kin.Evaluate(c, false);
+    if (e.ok && e.p.rows() > k && e.p.row(k).allFinite()) {
+      cs.push_back(c);
+      ps.push_back(e.p.row(k).transpose());
+    } else {
+      ++out.failed;
+    }
+    for (int a = 0; a < n && ++digit[a] == m; ++a) digit[a] = 0;
+  }
+  out.c.resize(cs.size(), n);
+  out.p.resize(ps.size(), 3);
+  for (size_t i = 0; i < cs.size(); ++i) {
+    out.c.row(i) = cs[i].transpose();
+    out.p.row(i) = ps[i].transpose();
+  }
+  if (options.cache_file.empty()) {
+    out.cache_status = "built";
+  } else {
+    std::ofstream f(options.cache_file);
+    if (!f) throw std::runtime_error("cannot write the sample cache " + options.cache_file);
+    for (const auto& [key, v] : header) f << "# " << key << "=" << v << "\n";
+    f << "# failed=" << out.failed << "\n";
+    for (int a = 0; a < n; ++a) f << "c" << a << ",";
+    f << "x,y,z\n" << std::setprecision(17);
+    for (int i = 0; i < out.c.rows(); ++i) {
+      for (int a = 0; a < n; ++a) f << out.c(i, a) << ",";
+      f << out.p(i, 0) << "," << out.p(i, 1) << "," << out.p(i, 2) << "\n";
+    }
+    if (!f) throw std::runtime_error("cannot write the sample cache " + options.cache_file);
+    out.cache_status = rejected.empty() ? "written" : "rebuilt: " + rejected;
+  }
+  out.time_s = Seconds(t0);
+  return out;
+}
+
+int ClosestSample(const ConfigurationSamples& samples, const Eigen::Vector3d& target) {
+  int best = -1;
+  double best_d = 0.0;
+  for (int i = 0; i < samples.p.rows(); ++i) {
+    const double d = (samples.p.row(i).transpose() - target).squaredNorm();
+    if (best < 0 || d < best_d) {
+      best = i;
+      best_d = d;
+    }
+  }
+  return best;
+}
+
+TrajectoryResult FollowTrajectory(Kinematics& kin, const Eigen::Ref<const Eigen::MatrixX3d>& waypoints,
+                                  const TrajectoryOptions& options,
+                                  const WaypointCallback& on_waypoint) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string why;
+  if (!options.IsValid(&why)) throw std::invalid_argument("TrajectoryOptions: " + why);
+  const int k = ResolvePoint(kin.point_names(), options.point, "trajectory");
+  for (int w = 0; w < waypoints.rows(); ++w)
+    if (!waypoints.row(w).allFinite())
+      throw std::invalid_argument("trajectory: waypoint " + std::to_string(w) + " is not finite");
+  TrajectoryResult res;
+  Eigen::VectorXd c_prev;
+  if (options.warm_start.size() > 0) {
+    why = CheckKinematicsInput(kin, options.warm_start);
+    if (!why.empty()) throw std::invalid_argument("trajectory warm start: " + why);
+    c_prev = options.warm_start;
+  } else if (options.first_waypoint < waypoints.rows()) {
+    res.samples = SampleConfigurationSpace(kin, options.point, options.sampling);
+    res.initial_sample = ClosestSample(res.samples, waypoints.row(options.first_waypoint).transpose());
+    c_prev = res.initial_sample >= 0 ? Eigen::VectorXd(res.samples.c.row(res.initial_sample).transpose())
+                                     : kin.rest();
+  }
+  res.initial_guess = c_prev;
+  const Eigen::VectorXd range = (kin.upper() - kin.lower()).cwiseMax(1e-300);
+  double err_sum = 0.0;
+  int err_count = 0;
+  for (int w = options.first_waypoint; w < waypoints.rows(); ++w) {
+    WaypointResult wr;
+    wr.index = w;
+    wr.target = waypoints.row(w).transpose();
+    const PointTrackingObjective objective(kin.point_names(), options.point, wr.target);
+    const IkResult ik = SolveIk(kin, objective, c_prev, options.ik);
+    wr.c = ik.c;
+    wr.termination = ik.summary.termination;
+    wr.message = ik.summary.message;
+    wr.iterations = ik.summary.iterations;
+    wr.evaluations = ik.summary.evaluations;
+    wr.fk_solves = ik.summary.fk_solves;
+    wr.time_s = ik.summary.time_s;
+    if (ik.p.rows() > k) {
+      wr.reached = ik.p.row(k).transpose();
+      wr.error_mm = (wr.reached - wr.target).norm();
+      wr.objective = ik.objective;
+      wr.converged = ik.summary.converged();
+    } else {  // not even c_prev could be evaluated: no point to report
+      wr.reached = Eigen::Vector3d::Zero();
+      wr.error_mm = -1.0;
+      wr.objective = -1.0;
+    }
+    const Eigen::VectorXd dc = (wr.c - c_prev).cwiseAbs();
+    wr.jump = dc.maxCoeff();
+    wr.jump_fraction = dc.cwiseQuotient(range).maxCoeff();
+    if (w > options.first_waypoint || options.warm_start.size() > 0) {
+      if (res.max_jump_index < 0 || wr.jump > res.max_jump) {
+        res.max_jump = wr.jump;
+        res.max_jump_index = w;
+      }
+      res.max_jump_fraction = std::max(res.max_jump_fraction, wr.jump_fraction);
+    }
+    c_prev = wr.c;
+    if (wr.converged) ++res.converged;
+    if (wr.error_mm >= 0) {
+      err_sum += wr.error_mm;
+      ++err_count;
+      res.max_error_mm = std::max(res.max_error_mm, wr.error_mm);
+    }
+    res.waypoints.push_back(wr);
+    if (on_waypoint) on_waypoint(res.waypoints.back());
+  }
+  if (err_count > 0) res.mean_error_mm = err_sum / err_count;
+  res.total_time_s = Seconds(t0);
+  return res;
+}
+
+}  // namespace softkin

@@ -1,0 +1,115 @@
+#pragma once
+/// \file
+/// Trajectory following (thesis Algorithm 4, Sec. 4.3.1): drive one tracked point through a list
+/// of waypoints by solving point-tracking IK (Eq. 4.4) at each.
+///  1. The configuration space is sampled on a regular grid (samples_per_axis per actuator, e.g.
+///     5^3 = 125); the first waypoint starts from the actuation of the sample whose point is
+///     closest to it. The samples can be cached in a CSV file (see SampleConfigurationSpace).
+///  2. Each later waypoint starts from the previous waypoint's solution (the warm start; a
+///     simulator Kinematics also keeps its own deformed state).
+///  3. For every waypoint: the actuation, the reached point, its distance to the target (for a
+///     waypoint outside the workspace, the distance to the closest point IK found), iterations,
+///     evaluations, FK solves and time; and the largest actuation jump between neighbours.
+/// Results go to a callback as they are computed (the CLI streams CSV rows), and a run can resume
+/// from a waypoint with the previous actuation as the warm start.
+
+#include "ik/ik_solver.hpp"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace softkin {
+
+struct SamplingOptions {
+  int samples_per_axis = 5;   ///< grid points per actuator, >= 2 (the box corners included)
+  /// CSV cache file, or "" for none. If it exists and was built for the same kinematics name,
+  /// point, key, bounds and grid, it is loaded; else the samples are computed and it is
+  /// (over)written.
+  std::string cache_file;
+  /// What the samples were built for beyond the kinematics' name (e.g. "cable_finger res=8
+  /// jacobian=fd"), recorded in the cache and compared on load.
+  std::string cache_key;
+  bool IsValid(std::string* why) const;
+};
+
+/// A sampled configuration space: one row per sample that could be evaluated.
+struct ConfigurationSamples {
+  Eigen::MatrixXd c;      ///< #samples x #actuators
+  Eigen::MatrixX3d p;     ///< #samples x 3, the tracked point, mm
+  int failed = 0;         ///< grid points whose evaluation failed (left out)
+  double time_s = 0.0;    ///< time to build or load
+  /// "built" (no cache file), "loaded", "written" (built, cache written) or
+  /// "rebuilt: <reason the cache was rejected>".
+  std::string cache_status;
+};
+
+/// Samples the grid of samples_per_axis^#actuators actuations over [lower, upper] (deterministic,
+/// no randomness: the grid is regular), evaluating the tracked point `point`. Throws
+/// std::invalid_argument for invalid options, an unknown point or a grid above 10^6 samples, and
+/// std::runtime_error if the cache file cannot be written.
+ConfigurationSamples SampleConfigurationSpace(Kinematics& kin, const std::string& point,
+                                              const SamplingOptions& options);
+
+/// Row of the sample whose point is closest to `target` (ties: the first), or -1 if none.
+int ClosestSample(const ConfigurationSamples& samples, const Eigen::Vector3d& target);
+
+struct TrajectoryOptions {
+  std::string point = "tip";  ///< the tracked point that follows the path
+  IkOptions ik;               ///< per waypoint; lambda on |p - target|^2 (0.04 = 0.2 mm)
+  SamplingOptions sampling;
+  /// Resume: solve waypoints from this index on (>= 0)...
+  int first_waypoint = 0;
+  /// ...starting from this actuation (the solution of waypoint first_waypoint - 1). Empty: start
+  /// from the closest configuration-space sample (Algorithm 4, line 2).
+  Eigen::VectorXd warm_start;
+  bool IsValid(std::string* why) const;
+};
+
+struct WaypointResult {
+  int index = 0;
+  Eigen::Vector3d target = Eigen::Vector3d::Zero();   ///< mm
+  Eigen::VectorXd c;                                  ///< actuation found
+  Eigen::Vector3d reached = Eigen::Vector3d::Zero();  ///< the tracked point at c, mm
+  /// |reached - target|; -1 (and reached = 0) when not even the start actuation could be
+  /// evaluated (the kinematics failed there; `message` says why).
+  double error_mm = 0.0;
+  double objective = 0.0;     ///< error_mm^2 (-1 as error_mm)
+  bool converged = false;     ///< objective <= lambda
+  IkTermination termination = IkTermination::kConverged;
+  std::string message;
+  int iterations = 0;
+  int evaluations = 0;
+  long long fk_solves = 0;
+  double time_s = 0.0;
+  /// max over actuators of |c - c_previous| (actuation units), and as a fraction of each range;
+  /// the previous is the last waypoint's solution (or the initial guess for the first one).
+  double jump = 0.0;
+  double jump_fraction = 0.0;
+};
+
+struct TrajectoryResult {
+  std::vector<WaypointResult> waypoints;
+  double max_jump = 0.0;           ///< largest WaypointResult::jump after the first waypoint
+  double max_jump_fraction = 0.0;  ///< the same as a fraction of the range
+  int max_jump_index = -1;         ///< the waypoint where it happened (-1: fewer than 2 waypoints)
+  int converged = 0;               ///< waypoints with O <= lambda
+  double mean_error_mm = 0.0, max_error_mm = 0.0;  ///< over the waypoints with a reached point
+  int initial_sample = -1;         ///< sample used for the first waypoint (-1: warm start given)
+  Eigen::VectorXd initial_guess;   ///< the actuation the first waypoint started from
+  ConfigurationSamples samples;    ///< empty when a warm start was given
+  double total_time_s = 0.0;       ///< including the sampling
+};
+
+using WaypointCallback = std::function<void(const WaypointResult&)>;
+
+/// Algorithm 4 over `waypoints` (#waypoints x 3, mm), solving from options.first_waypoint on.
+/// Calls on_waypoint (if set) after each waypoint. Throws std::invalid_argument for invalid
+/// options, an unknown point, non-finite waypoints or a warm start of the wrong size / outside
+/// the box; IK failures are reported per waypoint (a kinematics failure at a waypoint keeps the
+/// previous actuation for the next one).
+TrajectoryResult FollowTrajectory(Kinematics& kin, const Eigen::Ref<const Eigen::MatrixX3d>& waypoints,
+                                  const TrajectoryOptions& options,
+                                  const WaypointCallback& on_waypoint = {});
+
+}  // namespace softkin
