@@ -25,8 +25,8 @@ nlopt::algorithm Algorithm(IkMethod m) {
 }
 
 struct Context {
-  IkProblem* problem;
-  IkSummary* summary;
+  IkProblem* problem = nullptr;
+  IkSummary* summary = nullptr;
   bool stopped = false;  // by us: a failed evaluation or the budget
   IkTermination stop_reason = IkTermination::kSolverFailure;
   std::string stop_message;
@@ -63,7 +63,9 @@ IkResult SolveNlopt(Kinematics& kin, const Objective& objective,
                     const Eigen::Ref<const Eigen::VectorXd>& c0, const IkOptions& options) {
   IkProblem P(kin, objective, options);
   IkSummary S;
-  Context ctx{&P, &S};
+  Context ctx;
+  ctx.problem = &P;
+  ctx.summary = &S;
   const int n = P.n();
   std::vector<double> x(c0.data(), c0.data() + n);
   std::vector<double> lo(P.lower().data(), P.lower().data() + n);
