@@ -183,7 +183,8 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
   CsvWriter csv(dir + "/steps.csv",
                 {"variant", "step", "actuation_scale", "tip_x", "tip_y", "tip_z", "bend_deg",
                  "iterations", "converged", "springs", "self_contacts", "obstacle_contacts",
-                 "max_penetration_mm", "check_s", "response_s", "solver_s", "time_s"});
+                 "max_penetration_mm", "contact_vertices", "contact_area_mm2", "check_s", "response_s",
+                 "solver_s", "time_s"});
   nlohmann::json out_variants = nlohmann::json::array();
   std::vector<std::pair<double, std::string>> frames;
   for (size_t vi = 0; vi < variants_j.size(); ++vi) {
@@ -250,11 +251,20 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
       const Eigen::MatrixX3d P = scene.marker_positions(X);
       const double ang = has_bend ? (*bend)(X) : 0.0;
       tips.push_back({P(tip, 0), P(tip, 1), P(tip, 2)});
+      // The contact region with every obstacle (vertices within contact_distance_mm, area).
+      int touch = 0;
+      double touch_area = 0.0;
+      for (const auto& o : probe.obstacles()) {
+        const ContactPatch cp = MeasureContact(o, scene.mesh, X, contact_dist);
+        touch += cp.vertices;
+        touch_area += cp.area_mm2;
+      }
       csv.RowStrings({name, std::to_string(s), std::to_string(t), std::to_string(P(tip, 0)),
                       std::to_string(P(tip, 1)), std::to_string(P(tip, 2)), std::to_string(ang),
                       std::to_string(r.iterations), ok ? "1" : "0", std::to_string(r.springs),
                       std::to_string(ck.self_contacts), std::to_string(ck.obstacle_contacts),
-                      std::to_string(ck.max_penetration), std::to_string(r.collision_stats.check_s),
+                      std::to_string(ck.max_penetration), std::to_string(touch), std::to_string(touch_area),
+                      std::to_string(r.collision_stats.check_s),
                       std::to_string(r.collision_stats.response_s),
                       std::to_string(r.local_time_s + r.global_time_s), std::to_string(r.time_s)});
       if (verbose)
@@ -325,7 +335,7 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
   (void)cfg.Solver(FkOptions());  // checks the solver object once
   cfg.CheckNoUnknownKeys();
   if (!robots_j.is_array() || robots_j.empty())
-    cfg.Fail("robots", "a non-empty array of {\"robot\", \"res\", \"actuation\", \"steps\", [\"obstacles\"], [\"thesis\"]}");
+    cfg.Fail("robots", "a non-empty array of {\"robot\", \"res\", [\"robot_params\"], \"actuation\", \"steps\", [\"obstacles\"], [\"thesis\"]}");
   CsvWriter csv(dir + "/costs.csv", {"robot", "tets", "mesh_gen_s", "col_check_s", "col_resp_s",
                                      "solver_s", "step_s", "steps", "collision_free"});
   nlohmann::json rows = nlohmann::json::array();
@@ -335,17 +345,25 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
     if (!rj.is_object() || !rj.contains("robot") || !rj["robot"].is_string())
       cfg.Fail(key, "an object with \"robot\"");
     for (auto it = rj.begin(); it != rj.end(); ++it)
-      if (it.key() != "robot" && it.key() != "res" && it.key() != "actuation" && it.key() != "steps" &&
-          it.key() != "obstacles" && it.key() != "thesis")
-        cfg.Fail(key + "." + it.key(), "one of robot, res, actuation, steps, obstacles, thesis");
+      if (it.key() != "robot" && it.key() != "res" && it.key() != "robot_params" && it.key() != "actuation" &&
+          it.key() != "steps" && it.key() != "obstacles" && it.key() != "thesis")
+        cfg.Fail(key + "." + it.key(), "one of robot, res, robot_params, actuation, steps, obstacles, thesis");
     const std::string robot = rj["robot"].get<std::string>();
     const int res = rj.value("res", 0);
     const int steps = rj.value("steps", 4);
     if (steps < 1) cfg.Fail(key + ".steps", "an integer >= 1");
+    RobotParams params;
+    if (rj.contains("robot_params")) {
+      if (!rj["robot_params"].is_object()) cfg.Fail(key + ".robot_params", "an object of numbers");
+      for (auto it = rj["robot_params"].begin(); it != rj["robot_params"].end(); ++it) {
+        if (!it.value().is_number()) cfg.Fail(key + ".robot_params." + it.key(), "a number");
+        params[it.key()] = it.value().get<double>();
+      }
+    }
     const auto t0 = Clock::now();
     Scene scene;
     try {
-      scene = MakeRobot(robot, res);
+      scene = MakeRobot(robot, res, params);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(cfg.path() + ": " + key + ": " + e.what());
     }

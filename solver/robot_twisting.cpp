@@ -149,6 +149,31 @@ Scene MakeTwistingRobot(int res, const RobotParams& P) {
   } else {
     s.body[0] = Material{"as-rigid-as-possible", 1.0, 1.0};  // Ch. 2 shape blending, R_omega = 1
   }
+  // Optional strain-limiting strip: body tets whose centroid lies beyond x = body radius - strip
+  // (a slab along the whole length on the +x side) become region 2, `strip_weight` times stiffer.
+  // The chamber elongates the rest of the body, so the robot bends toward +x while it twists, and
+  // coils around an object (Fig. 3.8) instead of only twisting.
+  const double strip = Param(P, "strip", 0.0);
+  if (strip > 0) {
+    const double x0 = kTwistBodyRadius - strip;
+    int n = 0;
+    for (auto& e : s.mesh.elements) {
+      if (e.region != 0) continue;
+      double cx = 0;
+      for (int j = 0; j < e.k(); ++j) cx += s.mesh.vertices(e.v[j], 0);
+      if (cx / e.k() > x0) {
+        e.region = 2;
+        ++n;
+      }
+    }
+    if (n == 0)
+      throw std::invalid_argument("twisting_robot: strip = " + std::to_string(strip) +
+                                  " mm holds no body tet at this resolution; expected a thicker strip");
+    Material m = s.body[0];
+    m.name += "+strip";
+    m.weight *= Param(P, "strip_weight", 20.0);
+    s.body[2] = m;
+  }
   Actuator a;
   a.name = "chamber";
   a.type = ActuatorType::Pneumatic;
