@@ -1,0 +1,135 @@
+// Google Benchmark: one Jacobian J(c) = dp/dc of the simulator Kinematics per mode (fd, fd-warm,
+// implicit; ik/simulator_kinematics.hpp) against one warm-started forward solve, on three_chamber
+// (default res 7) and cable_finger (default res 10).
+//
+// Setting (an IK step): the model is solved at a base actuation c0, then at c = c0 + a step of 2 %
+// of each actuator's range (warm-started from c0's state). Each timed iteration is one
+// Evaluate(c, with_jacobian = true) on that primed state, so only the Jacobian is timed (the state
+// at c is reused); fd probes start from c0's state (as a plain FK solve of each probe would),
+// fd-warm probes from c's. BM_WarmFk times the forward solve from c0's state to c.
+// Counters:
+//   fk_solves        forward solves per Jacobian (0 for implicit, 2 #actuators for differences)
+//   ratio_warm_fk    time of one Jacobian / time of one warm-started forward solve (measured once
+//                    per fixture, median of 5) -- the target for implicit is <= 1
+//   gmres_its        implicit only: GMRES iterations summed over the columns
+//   fk_iterations    BM_WarmFk: local-global iterations of the warm solve
+// Run with OMP_NUM_THREADS=2 on a quiet machine (docs/kinematics.md).
+#include "ik/simulator_kinematics.hpp"
+#include "solver/robots.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace softkin {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct Fixture {
+  std::shared_ptr<const Model> model;
+  Eigen::VectorXd c0, c;
+  Eigen::MatrixX3d X0;       ///< converged state at c0
+  double warm_fk_s = 0.0;    ///< median time of the warm solve c0 -> c
+  int warm_fk_iterations = 0;
+};
+
+const char* kRobots[] = {"three_chamber", "cable_finger"};
+
+const Fixture& GetFixture(int robot) {
+  static std::map<int, std::unique_ptr<Fixture>> cache;
+  auto it = cache.find(robot);
+  if (it != cache.end()) return *it->second;
+  auto f = std::make_unique<Fixture>();
+  f->model = std::make_shared<const Model>(MakeRobot(kRobots[robot]));
+  const Scene& s = f->model->scene();
+  const int na = s.num_actuators();
+  f->c0.resize(na);
+  f->c.resize(na);
+  // A generic bent configuration: actuators at 30 %, 50 %, 20 % ... of the way to their far end.
+  const double frac[] = {0.3, 0.5, 0.2, 0.4};
+  for (int a = 0; a < na; ++a) {
+    const Actuator& act = s.actuators[a];
+    f->c0[a] = act.rest + frac[a % 4] * (act.FarEnd() - act.rest);
+    f->c[a] = f->c0[a] + 0.02 * (act.FarEnd() - act.rest);
+  }
+  auto solver = MakeFkSolver(f->model, s.solver);
+  const FkResult r0 = solver->Solve(f->c0);
+  f->X0 = r0.positions;
+  std::vector<double> t;
+  for (int rep = 0; rep < 5; ++rep) {
+    const FkResult r = solver->Solve(f->c, &f->X0);
+    t.push_back(r.time_s);
+    f->warm_fk_iterations = r.iterations;
+  }
+  std::sort(t.begin(), t.end());
+  f->warm_fk_s = t[t.size() / 2];
+  return *cache.emplace(robot, std::move(f)).first->second;
+}
+
+void BM_WarmFk(benchmark::State& state) {
+  const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
+  auto solver = MakeFkSolver(f.model, f.model->scene().solver);
+  int its = 0;
+  for (auto _ : state) {
+    const FkResult r = solver->Solve(f.c, &f.X0);
+    its = r.iterations;
+    benchmark::DoNotOptimize(r.positions.data());
+  }
+  state.SetLabel(kRobots[state.range(0)]);
+  state.counters["fk_iterations"] = its;
+  state.counters["tets"] = static_cast<double>(f.model->elements().size());
+}
+
+void BM_Jacobian(benchmark::State& state) {
+  const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
+  const JacobianMode mode = static_cast<JacobianMode>(state.range(1));
+  SimulatorKinematicsOptions o;
+  o.jacobian = mode;
+  SimulatorKinematics k(f.model, o);
+  // Prime: converged at c0, then at c (warm from c0).
+  if (!k.Evaluate(f.c0, false).ok || !k.Evaluate(f.c, false).ok) {
+    state.SkipWithError("forward solve failed");
+    return;
+  }
+  int solves = 0, gmres = 0;
+  double secs = 0.0;
+  long long n = 0;
+  for (auto _ : state) {
+    const auto t0 = Clock::now();
+    const KinematicsEval e = k.Evaluate(f.c, true);
+    secs += std::chrono::duration<double>(Clock::now() - t0).count();
+    ++n;
+    if (!e.ok) {
+      state.SkipWithError(e.message.c_str());
+      return;
+    }
+    solves = e.fk_solves;
+    benchmark::DoNotOptimize(e.J.data());
+  }
+  if (mode == JacobianMode::kImplicit)
+    for (int its : k.last_implicit().iterations) gmres += its;
+  state.SetLabel(std::string(kRobots[state.range(0)]) + " " + JacobianModeToString(mode));
+  state.counters["fk_solves"] = solves;
+  state.counters["ratio_warm_fk"] = n > 0 ? (secs / n) / f.warm_fk_s : 0.0;
+  state.counters["warm_fk_ms"] = 1e3 * f.warm_fk_s;
+  if (mode == JacobianMode::kImplicit) state.counters["gmres_its"] = gmres;
+}
+
+BENCHMARK(BM_WarmFk)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Jacobian)
+    ->ArgsProduct({{0, 1},
+                   {static_cast<int>(JacobianMode::kFd), static_cast<int>(JacobianMode::kFdWarm),
+                    static_cast<int>(JacobianMode::kImplicit)}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+}  // namespace
+}  // namespace softkin
+
+BENCHMARK_MAIN();

@@ -1,0 +1,322 @@
+#include "ik/simulator_kinematics.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace softkin {
+
+const char* JacobianModeToString(JacobianMode m) {
+  switch (m) {
+    case JacobianMode::kFd: return "fd";
+    case JacobianMode::kFdWarm: return "fd-warm";
+    case JacobianMode::kImplicit: return "implicit";
+  }
+  return "unknown";
+}
+
+bool JacobianModeFromString(const std::string& s, JacobianMode* m) {
+  for (JacobianMode x : {JacobianMode::kFd, JacobianMode::kFdWarm, JacobianMode::kImplicit})
+    if (s == JacobianModeToString(x)) {
+      *m = x;
+      return true;
+    }
+  return false;
+}
+
+std::string JacobianModeNames() { return "fd, fd-warm, implicit"; }
+
+bool SimulatorKinematicsOptions::IsValid(std::string* why) const {
+  auto bad = [&](const std::string& m) { if (why) *why = m; return false; };
+  if (!(fd_step > 0.0 && fd_step <= 0.25))
+    return bad("fd_step: expected a fraction of the actuator range in (0, 0.25]");
+  if (!implicit.IsValid(why)) return false;
+  return true;
+}
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double Seconds(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+}  // namespace
+
+SimulatorKinematics::SimulatorKinematics(const Scene& scene, const SimulatorKinematicsOptions& options,
+                                         const FkOptions* fk)
+    : model_(std::make_shared<const Model>(scene)) {
+  Init(options, fk);
+}
+
+SimulatorKinematics::SimulatorKinematics(std::shared_ptr<const Model> model,
+                                         const SimulatorKinematicsOptions& options,
+                                         const FkOptions* fk)
+    : model_(std::move(model)) {
+  if (!model_) throw std::invalid_argument("SimulatorKinematics: null model");
+  Init(options, fk);
+}
+
+void SimulatorKinematics::Init(const SimulatorKinematicsOptions& options, const FkOptions* fk) {
+  options_ = options;
+  std::string why;
+  if (!options_.IsValid(&why)) throw std::invalid_argument("kinematics options: " + why);
+  const Scene& scene = model_->scene();
+  fk_ = fk ? *fk : scene.solver;
+  if (!fk_.IsValid(&why)) throw std::invalid_argument("solver options: " + why);
+  if (options_.jacobian == JacobianMode::kImplicit && fk_.solver != "lg" && fk_.solver != "lg-aa")
+    throw std::invalid_argument(
+        "jacobian 'implicit' differentiates the local-global equilibrium; it needs solver lg or "
+        "lg-aa, got '" + fk_.solver + "' (use fd or fd-warm with other solvers)");
+  solver_ = MakeFkSolver(model_, fk_);
+
+  // Tracked points.
+  std::vector<std::string> spec = options_.points;
+  if (spec.empty())
+    for (const auto& m : scene.markers) spec.push_back(m.name);
+  offset_.assign(1, 0);
+  auto add = [&](const std::string& name, const std::vector<int>& verts) {
+    names_.push_back(name);
+    for (int v : verts) {
+      vertex_.push_back(v);
+      weight_.push_back(1.0 / static_cast<double>(verts.size()));
+    }
+    offset_.push_back(static_cast<int>(vertex_.size()));
+  };
+  for (const std::string& s : spec) {
+    const size_t br = s.find('[');
+    const std::string base = s.substr(0, br);
+    const int mi = scene.marker_index(base);
+    if (mi < 0) {
+      std::string known;
+      for (const auto& m : scene.markers) known += (known.empty() ? "" : ", ") + m.name;
+      throw std::invalid_argument("tracked point '" + s + "': scene '" + scene.name +
+                                  "' has no marker '" + base + "'; its markers: " + known);
+    }
+    const auto& verts = scene.markers[mi].vertices;
+    if (br == std::string::npos) {
+      add(base, verts);
+      continue;
+    }
+    if (s.back() != ']')
+      throw std::invalid_argument("tracked point '" + s + "': expected name, name[*] or name[i]");
+    const std::string inner = s.substr(br + 1, s.size() - br - 2);
+    if (inner == "*") {
+      for (size_t i = 0; i < verts.size(); ++i)
+        add(base + "[" + std::to_string(i) + "]", {verts[i]});
+      continue;
+    }
+    size_t used = 0;
+    int idx = -1;
+    try {
+      idx = std::stoi(inner, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != inner.size() || inner.empty() || idx < 0 || idx >= static_cast<int>(verts.size()))
+      throw std::invalid_argument("tracked point '" + s + "': expected an index in [0, " +
+                                  std::to_string(verts.size() - 1) + "] or '*' inside [] (marker '" +
+                                  base + "' has " + std::to_string(verts.size()) + " vertices)");
+    add(base + "[" + std::to_string(idx) + "]", {verts[idx]});
+  }
+
+  const int na = model_->num_actuators();
+  lower_.resize(na);
+  upper_.resize(na);
+  for (int a = 0; a < na; ++a) {
+    lower_[a] = scene.actuators[a].min;
+    upper_[a] = scene.actuators[a].max;
+  }
+}
+
+std::string SimulatorKinematics::name() const {
+  return std::string("simulator(") + JacobianModeToString(options_.jacobian) + ")";
+}
+
+void SimulatorKinematics::Reset() {
+  last_X_.resize(0, 3);
+  last_c_.resize(0);
+  last_start_.resize(0, 3);
+}
+
+double SimulatorKinematics::fd_step(int a) const {
+  return options_.fd_step * (upper_[a] - lower_[a]);
+}
+
+Eigen::MatrixX3d SimulatorKinematics::Points(const Eigen::Ref<const Eigen::MatrixX3d>& X) const {
+  const int np = num_points();
+  Eigen::MatrixX3d P = Eigen::MatrixX3d::Zero(np, 3);
+  for (int q = 0; q < np; ++q)
+    for (int t = offset_[q]; t < offset_[q + 1]; ++t) P.row(q) += weight_[t] * X.row(vertex_[t]);
+  return P;
+}
+
+std::string SimulatorKinematics::Solve(const Eigen::VectorXd& c, const Eigen::MatrixX3d* start,
+                                       FkResult* r, std::string* note) {
+  *r = solver_->Solve(c, start);
+  ++total_fk_solves_;
+  if (r->status == FkStatus::Converged) return "";
+  std::ostringstream s;
+  s << "forward solve at c = (" << c.transpose() << ") ended with status "
+    << FkStatusToString(r->status) << (r->message.empty() ? "" : ": ") << r->message;
+  if (r->status == FkStatus::IterationCap && options_.accept_iteration_cap &&
+      r->positions.allFinite()) {
+    if (note) *note += (note->empty() ? "" : "; ") + s.str() + " (accepted)";
+    return "";
+  }
+  return s.str();
+}
+
+KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::VectorXd>& c_in,
+                                             bool with_jacobian) {
+  const auto t0 = Clock::now();
+  KinematicsEval ev;
+  auto finish = [&]() -> KinematicsEval {
+    ev.time_s = Seconds(t0, Clock::now());
+    if (!ev.ok) {
+      ev.J.resize(0, 0);
+    }
+    return ev;
+  };
+  ev.message = CheckKinematicsInput(*this, c_in);
+  if (!ev.message.empty()) {
+    // Name the actuator, not only its index.
+    for (int a = 0; a < num_actuators() && c_in.size() == num_actuators(); ++a) {
+      const double lo = lower_[a], hi = upper_[a], slack = 1e-12 * std::max(1.0, hi - lo);
+      if (!std::isfinite(c_in[a]) || c_in[a] < lo - slack || c_in[a] > hi + slack) {
+        ev.message += " (actuator '" + model_->scene().actuators[a].name + "')";
+        break;
+      }
+    }
+    return finish();
+  }
+  // Clamp the 1e-12 slack CheckKinematicsInput allows, so the solver sees an in-range value.
+  const Eigen::VectorXd c = c_in.cwiseMax(lower_).cwiseMin(upper_);
+  std::string note;
+
+  // p(c): reuse, or warm start from the last converged state.
+  const bool have_last = options_.warm_start && last_X_.rows() == model_->num_vertices();
+  const Eigen::MatrixX3d* start = have_last ? &last_X_ : nullptr;
+  // The start of the centre solve, kept for fd probes (solved as plain FK would be).
+  Eigen::MatrixX3d centre_start;
+  if (start) centre_start = *start;
+  Eigen::MatrixX3d X;
+  if (have_last && last_c_.size() == c.size() && last_c_ == c) {
+    X = last_X_;
+    centre_start = last_start_;  // where the reused state was solved from
+  } else {
+    FkResult r;
+    const std::string err = Solve(c, start, &r, &note);
+    ++ev.fk_solves;
+    if (!err.empty()) {
+      ev.message = err;
+      return finish();
+    }
+    X = r.positions;
+    last_X_ = X;
+    last_c_ = c;
+    last_start_ = centre_start;
+  }
+  ev.p = Points(X);
+  if (!with_jacobian) {
+    ev.ok = true;
+    ev.message = note;
+    return finish();
+  }
+
+  const int na = num_actuators(), np = num_points();
+  ev.J.setZero(3 * np, na);
+  auto flatten = [&](const Eigen::MatrixX3d& P) {
+    Eigen::VectorXd v(3 * np);
+    for (int q = 0; q < np; ++q)
+      for (int d = 0; d < 3; ++d) v[3 * q + d] = P(q, d);
+    return v;
+  };
+
+  // Columns by differences (fd, fd-warm, or implicit's fallback at a kink).
+  auto fd_column = [&](int a, bool warm_from_centre) -> std::string {
+    const double h = fd_step(a);
+    const Eigen::MatrixX3d* probe_start =
+        warm_from_centre ? &X : (centre_start.rows() > 0 ? &centre_start : nullptr);
+    auto probe = [&](double delta, Eigen::VectorXd* p) -> std::string {
+      Eigen::VectorXd cp = c;
+      cp[a] = std::min(upper_[a], std::max(lower_[a], c[a] + delta));
+      FkResult r;
+      const std::string err = Solve(cp, probe_start, &r, &note);
+      ++ev.fk_solves;
+      if (!err.empty())
+        return "probe of actuator '" + model_->scene().actuators[a].name + "': " + err;
+      *p = flatten(Points(r.positions));
+      return "";
+    };
+    Eigen::VectorXd p1, p2;
+    std::string err;
+    if (c[a] + h <= upper_[a] && c[a] - h >= lower_[a]) {
+      if (!(err = probe(h, &p1)).empty() || !(err = probe(-h, &p2)).empty()) return err;
+      ev.J.col(a) = (p1 - p2) / (2.0 * h);
+    } else {
+      // One-sided, second order, towards the inside of the box.
+      const double s = (c[a] + h > upper_[a]) ? -1.0 : 1.0;
+      if (!(err = probe(s * h, &p1)).empty() || !(err = probe(2.0 * s * h, &p2)).empty()) return err;
+      const Eigen::VectorXd p0 = flatten(ev.p);
+      ev.J.col(a) = (-3.0 * p0 + 4.0 * p1 - p2) / (2.0 * s * h);
+    }
+    return "";
+  };
+
+  if (options_.jacobian == JacobianMode::kFd || options_.jacobian == JacobianMode::kFdWarm) {
+    const bool warm = options_.jacobian == JacobianMode::kFdWarm;
+    for (int a = 0; a < na; ++a) {
+      const std::string err = fd_column(a, warm);
+      if (!err.empty()) {
+        ev.message = err;
+        return finish();
+      }
+    }
+    ev.ok = true;
+    ev.message = note;
+    return finish();
+  }
+
+  // Implicit.
+  if (CollisionResponse::Active(model_->scene(), fk_.collision)) {
+    ev.message =
+        "jacobian 'implicit' does not include collision springs, and collision response is "
+        "active for scene '" + model_->scene().name + "'; use fd or fd-warm";
+    return finish();
+  }
+  // A signed actuator at exactly 0 sits on a kink (both sides vented; p is not differentiable
+  // there): its column is the central difference from the converged state (as fd-warm).
+  std::vector<int> smooth, kinked;
+  for (int a = 0; a < na; ++a) {
+    const Actuator& act = model_->scene().actuators[a];
+    (act.is_signed() && c[a] == 0.0 ? kinked : smooth).push_back(a);
+  }
+  if (!smooth.empty()) {
+    last_implicit_ = ComputeEquilibriumJacobian(*model_, X, c, smooth, options_.implicit);
+    if (!last_implicit_.ok) {
+      ev.message = last_implicit_.message;
+      return finish();
+    }
+    for (size_t j = 0; j < smooth.size(); ++j)
+      for (int q = 0; q < np; ++q)
+        for (int t = offset_[q]; t < offset_[q + 1]; ++t)
+          for (int d = 0; d < 3; ++d)
+            ev.J(3 * q + d, smooth[j]) +=
+                weight_[t] * last_implicit_.dXdc(3 * vertex_[t] + d, static_cast<Eigen::Index>(j));
+  }
+  for (int a : kinked) {
+    const std::string err = fd_column(a, true);
+    if (!err.empty()) {
+      ev.message = err;
+      return finish();
+    }
+    note += (note.empty() ? "" : "; ") + std::string("actuator '") +
+            model_->scene().actuators[a].name +
+            "' is a signed actuator at 0 (a kink): its column is a central difference";
+  }
+  ev.ok = true;
+  ev.message = note;
+  return finish();
+}
+
+}  // namespace softkin

@@ -1,0 +1,127 @@
+#pragma once
+/// \file simulator_kinematics.hpp
+/// The simulator as a Kinematics (DESIGN.md): p(c) by a forward solve of the scene's model, J(c)
+/// by one of three modes (docs/kinematics.md):
+///   fd        central differences (thesis Eq. 4.2 / 5.3), every probe solved as the plain FK at
+///             that actuation would be (warm-started from the same state the centre solve starts
+///             from);
+///   fd-warm   central differences whose probes start from the converged state at c;
+///   implicit  implicit differentiation of the local-global equilibrium
+///             (solver/equilibrium_jacobian.hpp): no extra forward solves.
+/// Step of the differences: delta_a = fd_step * (c_max,a - c_min,a) (default 1/160 = 1/(10 N) with
+/// N = 16 samples per actuator, thesis Sec. 5.2.1 and 5.3.2). At a bound, where c +- delta would
+/// leave [c_min, c_max], the second-order one-sided difference (3 p(c) - 4 p(c -+ delta) +
+/// p(c -+ 2 delta)) / (+-2 delta) is used instead, so probes stay in the box.
+///
+/// Warm-start policy (deterministic for a given call sequence): the solve for p(c) starts from the
+/// converged state of the previous successful p solve of this object (the rest shape for the
+/// first call, after Reset(), or with warm_start = false). Probes never change that state. If c
+/// equals the previous successful c exactly, its state is reused without a solve (fk_solves = 0):
+/// IK often asks for p(c) and then J(c) at the same c. `fd` probes start from the state the
+/// centre solve started from (so each probe is solved exactly as a plain p solve would have been
+/// in its place); `fd-warm` probes start from the converged state at c.
+///
+/// A forward solve that does not converge (status iteration_cap, diverged, time_limit) makes the
+/// evaluation fail (ok = false, message with the FK status and the actuation), unless
+/// accept_iteration_cap is set, in which case an iteration_cap result is used and `message` says
+/// so. p and J are never NaN when ok.
+#include "ik/kinematics.hpp"
+#include "solver/equilibrium_jacobian.hpp"
+#include "solver/fk_solver.hpp"
+#include "solver/scene.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace softkin {
+
+enum class JacobianMode { kFd, kFdWarm, kImplicit };
+/// "fd", "fd-warm", "implicit".
+const char* JacobianModeToString(JacobianMode m);
+/// Parses the names of JacobianModeToString; returns false for anything else.
+bool JacobianModeFromString(const std::string& s, JacobianMode* m);
+/// The accepted names, for help texts: "fd, fd-warm, implicit".
+std::string JacobianModeNames();
+
+struct SimulatorKinematicsOptions {
+  JacobianMode jacobian = JacobianMode::kImplicit;
+  /// Tracked points, in row order of p. Each entry is
+  ///   "name"      a scene marker, tracked as the mean of its vertices (Scene::marker_positions);
+  ///   "name[*]"   every vertex of marker `name`, as points "name[0]", "name[1]", ... in the
+  ///               marker's vertex order (e.g. grip_layer for the grasp circle fit);
+  ///   "name[i]"   vertex i (0-based, in the marker's vertex order) of marker `name`.
+  /// Empty: every marker of the scene, as means, in scene order.
+  std::vector<std::string> points;
+  /// Central-difference step as a fraction of each actuator's range, in (0, 0.25].
+  double fd_step = 1.0 / 160.0;
+  /// Warm-start each p solve from the previous converged state (see the file comment).
+  bool warm_start = true;
+  /// Accept forward solves that stop at the iteration cap (message says so); else ok = false.
+  bool accept_iteration_cap = false;
+  /// Options of the implicit mode's linear solve.
+  EquilibriumJacobianOptions implicit;
+  bool IsValid(std::string* why) const;
+};
+
+class SimulatorKinematics : public Kinematics {
+ public:
+  /// Builds the model of `scene` once (shared), with forward-solver options `fk` (nullptr: the
+  /// scene's). Throws std::invalid_argument for invalid options, an unknown marker or a vertex
+  /// index out of range in the point spec, or an invalid scene.
+  SimulatorKinematics(const Scene& scene, const SimulatorKinematicsOptions& options,
+                      const FkOptions* fk = nullptr);
+  /// Shares an existing model (e.g. with other solvers).
+  SimulatorKinematics(std::shared_ptr<const Model> model, const SimulatorKinematicsOptions& options,
+                      const FkOptions* fk = nullptr);
+
+  std::string name() const override;
+  int num_actuators() const override { return model_->num_actuators(); }
+  const std::vector<std::string>& point_names() const override { return names_; }
+  const Eigen::VectorXd& lower() const override { return lower_; }
+  const Eigen::VectorXd& upper() const override { return upper_; }
+  Eigen::VectorXd rest() const override { return model_->scene().rest_actuation(); }
+  /// p(c) (#points x 3, mm) and, with with_jacobian, J (3 #points x #actuators). ok = false with a
+  /// message naming the actuator for bad c (wrong size, NaN, out of range), and with the FK
+  /// status for a forward solve that fails.
+  KinematicsEval Evaluate(const Eigen::Ref<const Eigen::VectorXd>& c, bool with_jacobian) override;
+  long long total_fk_solves() const override { return total_fk_solves_; }
+
+  /// Forgets the warm-start state: the next p solve starts from the rest shape.
+  void Reset();
+  const Model& model() const { return *model_; }
+  std::shared_ptr<const Model> shared_model() const { return model_; }
+  const SimulatorKinematicsOptions& options() const { return options_; }
+  const FkOptions& fk_options() const { return fk_; }
+  /// Central-difference step of actuator a (fd_step times its range).
+  double fd_step(int a) const;
+  /// Positions (#V x 3) of the last successful p solve (empty before the first).
+  const Eigen::MatrixX3d& last_positions() const { return last_X_; }
+  /// Diagnostics of the last implicit Jacobian (GMRES iterations and residuals per column).
+  const EquilibriumJacobianResult& last_implicit() const { return last_implicit_; }
+
+ private:
+  void Init(const SimulatorKinematicsOptions& options, const FkOptions* fk);
+  /// Tracked points for positions X (#points x 3).
+  Eigen::MatrixX3d Points(const Eigen::Ref<const Eigen::MatrixX3d>& X) const;
+  /// One forward solve from `start` (nullptr: rest); "" or the failure message. Counts the solve.
+  std::string Solve(const Eigen::VectorXd& c, const Eigen::MatrixX3d* start, FkResult* r,
+                    std::string* note);
+
+  std::shared_ptr<const Model> model_;
+  SimulatorKinematicsOptions options_;
+  FkOptions fk_;
+  std::unique_ptr<FkSolver> solver_;
+  std::vector<std::string> names_;
+  /// Point q = sum over [offset_[q], offset_[q+1]) of weight_ * X.row(vertex_).
+  std::vector<int> offset_, vertex_;
+  std::vector<double> weight_;
+  Eigen::VectorXd lower_, upper_;
+  Eigen::MatrixX3d last_X_;
+  Eigen::MatrixX3d last_start_;  ///< where last_X_ was solved from (empty: rest shape)
+  Eigen::VectorXd last_c_;
+  long long total_fk_solves_ = 0;
+  EquilibriumJacobianResult last_implicit_;
+};
+
+}  // namespace softkin

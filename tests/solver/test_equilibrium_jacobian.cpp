@@ -1,0 +1,174 @@
+// Tests of the implicit differentiation of the local-global equilibrium
+// (solver/equilibrium_jacobian.hpp): the exact derivative of the global step's right-hand side
+// against central differences on every supported element kind, dX/dc against differences of
+// tightly converged forward solves, and the failure paths (unsupported law, GMRES budget).
+#include "solver/equilibrium_jacobian.hpp"
+#include "solver/fk_solver.hpp"
+#include "solver/robots.hpp"
+#include "solver/targets.hpp"
+
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <random>
+#include <string>
+
+namespace softkin {
+namespace {
+
+Eigen::VectorXd Vec(std::initializer_list<double> v) {
+  Eigen::VectorXd x(v.size());
+  int i = 0;
+  for (double d : v) x[i++] = d;
+  return x;
+}
+
+// B(X, c): the right-hand side of the global step, as the local-global solver forms it.
+Eigen::MatrixX3d Rhs(const Model& m, const Eigen::MatrixX3d& X, const Eigen::VectorXd& c) {
+  std::vector<double> ratios;
+  std::vector<ElemRows> weighted;
+  ComputeLocalRatios(m, X, c, &ratios);
+  LocalStep(m, X, ratios, &weighted, 1);
+  Eigen::MatrixX3d B;
+  AssembleRhs(m, weighted, &B, 1);
+  return B;
+}
+
+FkOptions Opts(double tol = 1e-6, double gtol = 1e-7) {
+  FkOptions o;
+  o.solver = "lg-aa";
+  o.threads = 1;
+  o.tolerance = tol;
+  o.gradient_tolerance = gtol;
+  return o;
+}
+
+struct Case {
+  std::string robot;
+  int res;
+  RobotParams params;
+  Eigen::VectorXd c;
+};
+
+// The linearised right-hand side equals central differences of B along random directions in
+// positions and actuation, at a generic state near the equilibrium (every element kind: rigid and
+// blended bodies, pneumatic, vented, cable, DEA, motion actuators).
+TEST(EquilibriumJacobian, RhsDerivativeMatchesCentralDifferences) {
+  const std::vector<Case> cases = {
+      {"three_chamber", 3, {}, Vec({2.0, 1.4, 1.1})},
+      {"cable_finger", 5, {}, Vec({0.8, 0.9, 0.95})},
+      {"dea_crawler", 4, {}, Vec({0.85})},
+      {"finger_manipulator", 6, {{"body_r_omega", 0.6}}, Vec({1.5, -1.0, 0.5})},
+      {"bimaterial_bar", 2, {{"r_omega_b", 0.4}}, Vec({30.0, 10.0})},
+      {"finger_manipulator", 6, {{"body_r_omega", 1.0}}, Vec({1.5, -1.0, 0.5})},
+      {"finger_manipulator", 6, {{"body_r_omega", 1.0}}, Vec({0.5, -0.2, 0.1})},
+  };
+  std::mt19937 rng(7);
+  std::normal_distribution<double> nd;
+  int checked = 0;
+  for (const Case& k : cases) {
+    SCOPED_TRACE(k.robot);
+    const Scene s = MakeRobot(k.robot, k.res, k.params);
+    ASSERT_EQ(k.c.size(), s.num_actuators());
+    auto model = std::make_shared<const Model>(s);
+    auto solver = MakeFkSolver(model, Opts(1e-4, 1e-3));
+    const FkResult r = solver->Solve(k.c);
+    ASSERT_TRUE(r.positions.allFinite());
+    // A generic nearby state (not exactly an equilibrium), prescribed coordinates kept.
+    Eigen::MatrixX3d X = r.positions;
+    for (int v = 0; v < X.rows(); ++v)
+      for (int d = 0; d < 3; ++d) X(v, d) += 1e-3 * model->size() * 0.01 * nd(rng);
+    model->ApplyConstraints(k.c, &X);
+    EquilibriumLinearization lin;
+    std::string why;
+    ASSERT_TRUE(lin.Setup(*model, X, k.c, &why, 1)) << why;
+    for (int trial = 0; trial < 2; ++trial) {
+      Eigen::MatrixX3d dX(X.rows(), 3);
+      for (int v = 0; v < X.rows(); ++v)
+        for (int d = 0; d < 3; ++d) dX(v, d) = nd(rng);
+      Eigen::VectorXd dc(k.c.size());
+      for (int a = 0; a < dc.size(); ++a) dc[a] = trial == 0 ? 0.0 : nd(rng);
+      Eigen::MatrixX3d dB;
+      lin.ApplyRhsDerivative(dX, dc, &dB);
+      const double h = 1e-6 * model->size() / dX.norm() * std::sqrt(double(X.rows()));
+      const Eigen::MatrixX3d fd =
+          (Rhs(*model, X + h * dX, k.c + h * dc) - Rhs(*model, X - h * dX, k.c - h * dc)) / (2 * h);
+      const double rel = (dB - fd).norm() / fd.norm();
+      EXPECT_LT(rel, 1e-6) << "trial " << trial << ": |dB| " << dB.norm() << " |fd| " << fd.norm();
+      EXPECT_GT(fd.norm(), 0.0);
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 14);
+}
+
+// dX/dc at a tightly converged equilibrium equals central differences of tightly converged forward
+// solves over the whole mesh (pneumatic, and motion actuators with a blended body).
+TEST(EquilibriumJacobian, MatchesDifferencesOfForwardSolves) {
+  const std::vector<Case> cases = {
+      {"three_chamber", 3, {}, Vec({1.8, 1.2, 1.1})},
+      {"bimaterial_bar", 2, {{"r_omega_b", 0.5}}, Vec({20.0, 5.0})},
+  };
+  for (const Case& k : cases) {
+    SCOPED_TRACE(k.robot);
+    const Scene s = MakeRobot(k.robot, k.res, k.params);
+    auto model = std::make_shared<const Model>(s);
+    auto solver = MakeFkSolver(model, Opts(1e-11, 1e-11));
+    const FkResult r = solver->Solve(k.c);
+    ASSERT_EQ(r.status, FkStatus::Converged) << r.message;
+    const EquilibriumJacobianResult jr = ComputeEquilibriumJacobian(*model, r.positions, k.c);
+    ASSERT_TRUE(jr.ok) << jr.message;
+    ASSERT_EQ(jr.dXdc.cols(), k.c.size());
+    for (int a = 0; a < k.c.size(); ++a) {
+      const Actuator& act = s.actuators[a];
+      const double h = 1e-4 * (act.max - act.min);
+      Eigen::VectorXd cp = k.c, cm = k.c;
+      cp[a] += h;
+      cm[a] -= h;
+      const FkResult rp = solver->Solve(cp, &r.positions), rm = solver->Solve(cm, &r.positions);
+      ASSERT_EQ(rp.status, FkStatus::Converged);
+      ASSERT_EQ(rm.status, FkStatus::Converged);
+      const Eigen::MatrixX3d d = (rp.positions - rm.positions) / (2 * h);
+      Eigen::VectorXd fd(3 * d.rows());
+      for (int v = 0; v < d.rows(); ++v)
+        for (int q = 0; q < 3; ++q) fd[3 * v + q] = d(v, q);
+      const double rel = (jr.dXdc.col(a) - fd).norm() / fd.norm();
+      EXPECT_LT(rel, 1e-4) << act.name << ": " << jr.iterations[a] << " GMRES iterations";
+      EXPECT_LT(jr.residuals[a], 1e-8);
+      EXPECT_GT(fd.norm(), 0.0);
+    }
+  }
+}
+
+TEST(EquilibriumJacobian, HyperelasticBodyIsRefusedWithAReason) {
+  Scene s = MakeRobot("three_chamber", 3);
+  s.body[0].law = "mooney-rivlin";
+  s.body[0].c1 = 0.0418;
+  s.body[0].c2 = 0.0106;
+  const Model model(s);
+  const auto jr = ComputeEquilibriumJacobian(model, model.rest_positions(), s.rest_actuation());
+  EXPECT_FALSE(jr.ok);
+  EXPECT_NE(jr.message.find("hyperelastic"), std::string::npos) << jr.message;
+  EXPECT_EQ(jr.dXdc.size(), 0);
+}
+
+TEST(EquilibriumJacobian, GmresBudgetExhaustedFailsNamingTheActuator) {
+  const Scene s = MakeRobot("three_chamber", 3);
+  auto model = std::make_shared<const Model>(s);
+  const Eigen::VectorXd c = Vec({2.0, 1.0, 1.0});
+  const FkResult r = MakeFkSolver(model, Opts())->Solve(c);
+  EquilibriumJacobianOptions o;
+  o.max_iterations = 1;
+  o.tolerance = 1e-14;
+  const auto jr = ComputeEquilibriumJacobian(*model, r.positions, c, {0}, o);
+  EXPECT_FALSE(jr.ok);
+  EXPECT_NE(jr.message.find("'c1'"), std::string::npos) << jr.message;
+  EXPECT_EQ(jr.dXdc.size(), 0);
+  std::string why;
+  o.restart = 0;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("restart"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace softkin
