@@ -119,7 +119,9 @@ TEST(Kinematics, JacobianTimesStepMatchesDifferenceOfP) {
     const Eigen::VectorXd lin = e0.J * (t * dir);
     const double rem = (dp - lin).norm();
     EXPECT_LT(rem, 0.05 * dp.norm()) << "t = " << t;
-    if (prev > 0) EXPECT_GT(prev / rem, 3.0) << "t = " << t;  // second-order remainder
+    if (prev > 0) {
+      EXPECT_GT(prev / rem, 3.0) << "t = " << t;  // second-order remainder
+    }
     prev = rem;
   }
 }

@@ -134,7 +134,7 @@ TEST(EquilibriumJacobian, MatchesDifferencesOfForwardSolves) {
         for (int q = 0; q < 3; ++q) fd[3 * v + q] = d(v, q);
       const double rel = (jr.dXdc.col(a) - fd).norm() / fd.norm();
       EXPECT_LT(rel, 1e-4) << act.name << ": " << jr.iterations[a] << " GMRES iterations";
-      EXPECT_LT(jr.residuals[a], 1e-8);
+      EXPECT_LT(jr.residuals[a], 1e-6);  // unpreconditioned; GMRES stops at 1e-8 preconditioned
       EXPECT_GT(fd.norm(), 0.0);
     }
   }
