@@ -60,6 +60,8 @@ bool EquilibriumJacobianOptions::IsValid(std::string* why) const {
   if (max_iterations < 1) return bad("implicit.max_iterations: expected an integer >= 1");
   if (restart < 1 || restart > 1000) return bad("implicit.restart: expected an integer in [1, 1000]");
   if (threads < 0) return bad("implicit.threads: expected an integer >= 0");
+  if (krylov != "gmres" && krylov != "bicgstab")
+    return bad("implicit.krylov: expected one of gmres, bicgstab; got '" + krylov + "'");
   return true;
 }
 
@@ -203,7 +205,9 @@ void EquilibriumLinearization::ApplyRhsDerivative(const Eigen::Ref<const Eigen::
       dratio_[i] = (gc.sigma * dratio_[i] + measure_[i] * dsigma) / els[i].measure0;
   }
 
-  // Pass 2: per-element target derivatives dT (already in the current frame, centred).
+  // Pass 2: per-element target derivatives dT (already in the current frame, centred). Products
+  // use the fixed 6 x 3 row blocks: rows k..5 of the rest and centred rows are zero, so the
+  // fixed-size kernels give the same result without dynamic-size overhead.
   const int nt = threads_ > 0 ? threads_ : omp_get_max_threads();
 #pragma omp parallel for schedule(static) num_threads(nt)
   for (int i = 0; i < ne; ++i) {
@@ -211,44 +215,44 @@ void EquilibriumLinearization::ApplyRhsDerivative(const Eigen::Ref<const Eigen::
     const ElementCache& ec = cache_[i];
     const int k = e.k;
     const double r = ratios_[i];
-    ElemRows dD, dT = ElemRows::Zero();
+    ElemRows dD, dT;
     Gather(e, dX, &dD);
-    const auto P = e.rest.topRows(k);
+    const ElemRows& P = e.rest;
     if (e.role != ElementRole::Body && r == kVented) {
       dT = dD;  // vented: T = D
     } else if (e.role == ElementRole::Body) {
-      const Eigen::Matrix3d W = PolarDerivativeW(ec.R, ec.Sinv, dD.topRows(k).transpose() * P);
+      const Eigen::Matrix3d dM = dD.transpose() * P;
+      const Eigen::Matrix3d W = PolarDerivativeW(ec.R, ec.Sinv, dM);
       // T = r_w P R^T + (1 - r_w) s D; d(P R^T) = P dR^T = -P W R^T.
-      dT.topRows(k) = -e.r_omega * (P * W * ec.R.transpose());
+      const Eigen::Matrix3d WRt = W * ec.R.transpose();
+      dT.noalias() = (-e.r_omega) * (P * WRt);
       if (e.r_omega < 1.0) {
         ElemRows D;
         Gather(e, X_, &D);
         double ds = 0.0;
         if (ec.s_active) {
-          const double dvol =
-              RowsVolumeGradient(D, k).topRows(k).cwiseProduct(dD.topRows(k)).sum();
+          const double dvol = RowsVolumeGradient(D, k).cwiseProduct(dD).sum();
           ds = -(ec.s / 3.0) * dvol / ec.vol;
         }
-        dT.topRows(k) += (1.0 - e.r_omega) * (ds * D.topRows(k) + ec.s * dD.topRows(k));
+        dT += (1.0 - e.r_omega) * (ds * D + ec.s * dD);
       }
     } else if (e.role == ElementRole::Pneumatic) {
       // T = q P R^T, q = cbrt(r).
       const double q = std::cbrt(r), dq = q * dratio_[i] / (3.0 * r);
-      const Eigen::Matrix3d W = PolarDerivativeW(ec.R, ec.Sinv, dD.topRows(k).transpose() * P);
-      dT.topRows(k) = dq * (P * ec.R.transpose()) - q * (P * W * ec.R.transpose());
+      const Eigen::Matrix3d dM = dD.transpose() * P;
+      const Eigen::Matrix3d W = PolarDerivativeW(ec.R, ec.Sinv, dM);
+      const Eigen::Matrix3d G = dq * ec.R.transpose() - q * (W * ec.R.transpose());
+      dT.noalias() = P * G;
     } else {
       // Cable / DEA: T = Ps R^T, Ps = P S(r)^T, R = polar(D^T Ps).
       ElemRows D;
       Gather(e, X_, &D);
       const Eigen::Matrix3d Sr = ActuationShape(e, r);
       const Eigen::Matrix3d dSr = dratio_[i] * ActuationShapeDerivative(e, r);
-      ElemRows Ps = ElemRows::Zero(), dPs = ElemRows::Zero();
-      Ps.topRows(k) = P * Sr.transpose();
-      dPs.topRows(k) = P * dSr.transpose();
-      const Eigen::Matrix3d dM =
-          dD.topRows(k).transpose() * Ps.topRows(k) + D.topRows(k).transpose() * dPs.topRows(k);
+      const ElemRows Ps = P * Sr.transpose(), dPs = P * dSr.transpose();
+      const Eigen::Matrix3d dM = dD.transpose() * Ps + D.transpose() * dPs;
       const Eigen::Matrix3d W = PolarDerivativeW(ec.R, ec.Sinv, dM);
-      dT.topRows(k) = dPs.topRows(k) * ec.R.transpose() - Ps.topRows(k) * W * ec.R.transpose();
+      dT.noalias() = dPs * ec.R.transpose() - Ps * (W * ec.R.transpose());
     }
     weighted_[i] = e.wv * dT;
   }
@@ -368,6 +372,54 @@ int Gmres(const Op& op, const Prec& prec, const Eigen::VectorXd& rhs, int restar
   return total;
 }
 
+/// BiCGSTAB for op(y) = rhs, left-preconditioned by prec, from y = 0: two operator products per
+/// iteration and no stored basis (GMRES's orthogonalisation reads its whole basis every step).
+/// Returns the number of operator products; *rel receives the final preconditioned relative
+/// residual (recomputed from scratch at the end).
+template <class Op, class Prec>
+int BiCgStab(const Op& op, const Prec& prec, const Eigen::VectorXd& rhs, int max_it, double tol,
+             Eigen::VectorXd* y, double* rel) {
+  const int n = static_cast<int>(rhs.size());
+  y->setZero(n);
+  Eigen::VectorXd r = prec(rhs);
+  const double beta0 = r.norm();
+  *rel = 0.0;
+  if (!(beta0 > 0.0)) return 0;
+  const Eigen::VectorXd r0 = r;
+  Eigen::VectorXd p = Eigen::VectorXd::Zero(n), v = Eigen::VectorXd::Zero(n), s(n), t(n);
+  double rho = 1.0, alpha = 1.0, omega = 1.0;
+  int total = 0;
+  while (total + 2 <= max_it) {
+    const double rho_new = r0.dot(r);
+    if (!(std::abs(rho_new) > 0.0)) break;  // breakdown
+    const double beta = (rho_new / rho) * (alpha / omega);
+    p = r + beta * (p - omega * v);
+    v = prec(op(p));
+    ++total;
+    const double r0v = r0.dot(v);
+    if (!(std::abs(r0v) > 0.0)) break;
+    alpha = rho_new / r0v;
+    s = r - alpha * v;
+    if (s.norm() <= tol * beta0) {
+      *y += alpha * p;
+      r = s;
+      break;
+    }
+    t = prec(op(s));
+    ++total;
+    const double tt = t.squaredNorm();
+    if (!(tt > 0.0)) break;
+    omega = t.dot(s) / tt;
+    *y += alpha * p + omega * s;
+    r = s - omega * t;
+    rho = rho_new;
+    if (r.norm() <= tol * beta0 || !(std::abs(omega) > 0.0)) break;
+  }
+  *rel = (prec(rhs) - prec(op(*y))).norm() / beta0;
+  ++total;
+  return total;
+}
+
 }  // namespace
 
 EquilibriumJacobianResult ComputeEquilibriumJacobian(const Model& model,
@@ -432,8 +484,11 @@ EquilibriumJacobianResult ComputeEquilibriumJacobian(const Model& model,
     lin.ApplyRhsDerivative(dXc, dc, &dB);
     model.GatherFree(dB - model.A() * dXc, &rhs);
     double rel = 0.0;
-    const int its = Gmres(op, prec, rhs, options.restart, options.max_iterations,
-                          options.tolerance, &y, &rel, options.recycle ? &memory : nullptr);
+    const int its =
+        options.krylov == "bicgstab"
+            ? BiCgStab(op, prec, rhs, options.max_iterations, options.tolerance, &y, &rel)
+            : Gmres(op, prec, rhs, options.restart, options.max_iterations, options.tolerance, &y,
+                    &rel, options.recycle ? &memory : nullptr);
     res.iterations.push_back(its);
     const double rn = rhs.norm();
     const double true_rel = rn > 0 ? (op(y) - rhs).norm() / rn : 0.0;

@@ -40,6 +40,8 @@
 namespace softkin {
 
 struct EquilibriumJacobianOptions {
+  /// Krylov method: "gmres" (restarted, see restart) or "bicgstab" (no stored basis).
+  std::string krylov = "gmres";
   /// Stop GMRES when the preconditioned residual has dropped by this factor.
   double tolerance = 1e-8;
   /// Krylov iterations (operator products) allowed per column, over all restarts.
