@@ -823,7 +823,7 @@ Scene MakeSelfCollisionFinger(int res, const RobotParams& P) {
 constexpr int kMemMinRes = 10, kMemMaxRes = 60, kMemDefaultRes = 20;
 constexpr double kMemSide = 250.0, kMemChamberHeight = 40.0, kMemGap = 2.0, kMemMaxAlpha = 4.0;
 
-Scene MakeMembrane(int res, const RobotParams& P) {
+Scene MakeMembrane(int res, const RobotParams&) {
   const double h = kMemSide / res;
   const int n = res;
   const int nc = (n - 3) / 2;  // chamber width in cells: 1 margin + nc + 1 gap + nc + (rest) margin
@@ -845,35 +845,8 @@ Scene MakeMembrane(int res, const RobotParams& P) {
   Scene s;
   s.name = "membrane";
   s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(n, n, zm + 1), cell);
-  // Thin walls: the voxel grid's cell widths are remapped so that chamber walls, floors and roofs
-  // are `wall` mm thick and the membrane `thickness` mm, the other cells sharing what is left.
-  // (Walls one voxel thick would be 10-25 mm of rubber: the chambers could hardly lift their roofs.)
-  const double wall = P.at("wall"), thick = P.at("thickness");
-  std::vector<double> wx(n, 0.0), wz(zm + 1, 0.0);
-  for (int i = 0; i < n; ++i)
-    for (int q = 0; q < 2; ++q)
-      if (i == x0[q] || i == x0[q] + nc - 1) wx[i] = wall;
-  {
-    int free_cells = 0;
-    for (double w : wx) free_cells += w == 0.0;
-    const double share = (kMemSide - 4 * wall) / free_cells;
-    for (double& w : wx)
-      if (w == 0.0) w = share;
-    wz[0] = wz[hc - 1] = wall;
-    for (int k = 1; k < hc - 1; ++k) wz[k] = (kMemChamberHeight - 2 * wall) / (hc - 2);
-    wz[zm] = thick + kMemGap;  // the slit below lifts only the membrane's bottom by kMemGap
-  }
-  std::vector<double> X(n + 1, 0.0), Z(zm + 2, 0.0);  // node coordinates
-  for (int i = 0; i < n; ++i) X[i + 1] = X[i] + wx[i];
-  for (int k = 0; k <= zm; ++k) Z[k + 1] = Z[k] + wz[k];
-  for (int v = 0; v < s.mesh.num_vertices(); ++v) {
-    const auto idx = [&](double c) { return static_cast<int>(std::lround(c / h)); };
-    s.mesh.vertices(v, 0) = X[idx(s.mesh.vertices(v, 0))];
-    s.mesh.vertices(v, 1) = X[idx(s.mesh.vertices(v, 1))];
-    s.mesh.vertices(v, 2) = Z[idx(s.mesh.vertices(v, 2))];
-  }
   // The membrane is a separate body: lift it off the roofs by kMemGap.
-  const double z_roof = Z[zm];
+  const double z_roof = zm * h;
   CutSlit(&s.mesh, [&](const Eigen::Vector3d& p) { return std::abs(p.z() - z_roof) < 1e-6 * h; },
           [&](const Eigen::Vector3d& c) { return c.z() > z_roof; }, Eigen::Vector3d(0, 0, kMemGap));
   s.body[0] = MooneyRivlinMaterial("membrane", "dragon-skin-20", 1.0);
@@ -887,7 +860,7 @@ Scene MakeMembrane(int res, const RobotParams& P) {
     a.max = kMemMaxAlpha;
     s.actuators.push_back(a);
   }
-  const double eps = 1e-6 * h, side = kMemSide, zlo = z_roof + kMemGap;
+  const double eps = 1e-6 * h, side = n * h, zlo = zm * h + kMemGap;
   std::vector<int> fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), eps);
   for (int v = 0; v < s.mesh.num_vertices(); ++v) {
     const Eigen::Vector3d p = s.mesh.vertices.row(v);
@@ -897,10 +870,10 @@ Scene MakeMembrane(int res, const RobotParams& P) {
   std::sort(fixed.begin(), fixed.end());
   fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
   s.fixed = fixed;
-  const double ztop = zlo + thick;
+  const double ztop = zlo + h;
   s.markers.push_back({"tip", {NearestVertex(s.mesh, Eigen::Vector3d(0.5 * side, 0.5 * side, ztop))}});
   for (int q = 0; q < 4; ++q) {
-    const double cx = 0.5 * (X[x0[q % 2]] + X[x0[q % 2] + nc]), cy = 0.5 * (X[x0[q / 2]] + X[x0[q / 2] + nc]);
+    const double cx = (x0[q % 2] + 0.5 * nc) * h, cy = (x0[q / 2] + 0.5 * nc) * h;
     s.markers.push_back({"q" + std::to_string(q + 1), {NearestVertex(s.mesh, Eigen::Vector3d(cx, cy, ztop))}});
   }
   s.solver.collision.self = true;
@@ -1027,9 +1000,8 @@ const std::vector<RobotEntry>& Registry() {
         "[1, 4]) under quadrants (x<125,y<125), (x>125,y<125), (x<125,y>125), (x>125,y>125). "
         "Self-collision response on. Markers: tip (membrane top centre), q1..q4 (membrane top above "
         "each chamber).",
-        kMemDefaultRes, "cells across the 250 mm side (about 250/res mm; wall cells are thinner), integer in [10, 60]",
-        {{"wall", 3.0, 1.0, 8.0, "thickness of the chambers' walls, floors and roofs, mm"},
-         {"thickness", 3.0, 1.0, 10.0, "thickness of the membrane, mm"}}},
+        kMemDefaultRes, "cells across the 250 mm side (cell size 250/res mm), integer in [10, 60]",
+        {}},
        kMemMinRes, kMemMaxRes, &MakeMembrane},
       {{"twisting_robot",
         "Plant-inspired twisting robot (thesis Sec. 3.4.1, Fig. 3.7-3.8): a 100 mm long cylinder of "

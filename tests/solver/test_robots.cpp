@@ -735,51 +735,6 @@ TEST(RobotsThreeChamber, ChambersAreEnclosedAndSeparateAtEveryResolution) {
 namespace softkin {
 namespace {
 
-// The membrane's thin-walled layout: wall cells `wall` mm thick, the membrane `thickness` mm, the
-// chambers 40 mm tall, the whole 250 mm wide, and each marker above its chamber's centre.
-TEST(RobotsMembrane, ThinWallsAndMembraneThickness) {
-  for (const double wall : {2.0, 4.0}) {
-    const Scene s = MakeRobot("membrane", 12, {{"wall", wall}, {"thickness", 2.5}});
-    SCOPED_TRACE("wall " + std::to_string(wall));
-    const Eigen::MatrixX3d& V = s.mesh.vertices;
-    EXPECT_NEAR(V.col(0).minCoeff(), 0.0, 1e-12);
-    EXPECT_NEAR(V.col(0).maxCoeff(), 250.0, 1e-9);
-    EXPECT_NEAR(V.col(1).maxCoeff(), 250.0, 1e-9);
-    // Top of the membrane: 40 mm chamber + 2 mm gap + 2.5 mm membrane.
-    EXPECT_NEAR(V.col(2).maxCoeff(), 44.5, 1e-9);
-    // Every wall tet (region 1) is at most `wall` thick in x, y or z; chamber tets (regions 2-5)
-    // are thicker in every direction; membrane tets (region 0) are 2.5 mm thick in z.
-    for (const auto& e : s.mesh.elements) {
-      Eigen::Vector3d lo = V.row(e.v[0]), hi = lo;
-      for (int j = 1; j < 4; ++j) {
-        lo = lo.cwiseMin(V.row(e.v[j]).transpose());
-        hi = hi.cwiseMax(V.row(e.v[j]).transpose());
-      }
-      const Eigen::Vector3d ext = hi - lo;
-      if (e.region == 1) {
-        EXPECT_LE(ext.minCoeff(), wall + 1e-9);
-      } else if (e.region == 0) {
-        EXPECT_NEAR(ext.z(), 2.5, 1e-9);
-      } else {
-        EXPECT_GT(ext.minCoeff(), wall);
-      }
-    }
-    // q1 sits above the centre of chamber 1's cavity (regions 2).
-    Eigen::Vector3d c = Eigen::Vector3d::Zero();
-    int n = 0;
-    for (const auto& e : s.mesh.elements)
-      if (e.region == 2)
-        for (int j = 0; j < 4; ++j, ++n) c += V.row(e.v[j]).transpose();
-    c /= n;
-    const Eigen::MatrixX3d P = s.marker_positions(V);
-    const int q1 = s.marker_index("q1");
-    ASSERT_GE(q1, 0);
-    EXPECT_NEAR(P(q1, 0), c.x(), 0.5 * 250.0 / 12);
-    EXPECT_NEAR(P(q1, 1), c.y(), 0.5 * 250.0 / 12);
-  }
-  EXPECT_THROW(MakeRobot("membrane", 12, {{"wall", 0.5}}), std::invalid_argument);
-}
-
 // The twisting robot's strain-limiting strip: body tets beyond x = 10 - strip become region 2 with
 // strip_weight times the body's weight; without a strip there is no region 2.
 TEST(RobotsTwisting, StrainLimitingStripRegion) {
