@@ -57,8 +57,43 @@ Config Config::Load(const std::string& path, bool quick) {
   return c;
 }
 
+namespace {
+/// The value at a nested config key such as "robots[0].robot_params.a", or nullptr.
+const nlohmann::json* FindNested(const nlohmann::json& root, const std::string& key) {
+  const nlohmann::json* at = &root;
+  size_t i = 0;
+  while (i < key.size()) {
+    if (key[i] == '.') {
+      ++i;
+      continue;
+    }
+    if (key[i] == '[') {
+      const size_t close = key.find(']', i);
+      if (close == std::string::npos || !at->is_array()) return nullptr;
+      size_t idx = 0;
+      try {
+        idx = std::stoul(key.substr(i + 1, close - i - 1));
+      } catch (const std::exception&) {
+        return nullptr;
+      }
+      if (idx >= at->size()) return nullptr;
+      at = &(*at)[idx];
+      i = close + 1;
+      continue;
+    }
+    const size_t end = key.find_first_of(".[", i);
+    const std::string name = key.substr(i, end == std::string::npos ? std::string::npos : end - i);
+    if (!at->is_object() || !at->contains(name)) return nullptr;
+    at = &(*at)[name];
+    i = end == std::string::npos ? key.size() : end;
+  }
+  return at;
+}
+}  // namespace
+
 void Config::Fail(const std::string& key, const std::string& expected) const {
-  std::string got = j_.contains(key) ? ", got " + Dump(j_.at(key)) : " (missing)";
+  const nlohmann::json* v = j_.contains(key) ? &j_.at(key) : FindNested(j_, key);
+  std::string got = v ? ", got " + Dump(*v) : " (missing)";
   throw std::invalid_argument(path_ + ": " + key + ": expected " + expected + got);
 }
 

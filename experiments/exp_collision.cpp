@@ -156,6 +156,16 @@ ContactPatch MeasureContact(const Obstacle& obs, const Mesh& mesh, const Eigen::
   return c;
 }
 
+/// Adds (or overrides) the numbers of the JSON object `j` (at config key `key`) in *p; anything but
+/// an object of numbers fails with the key.
+void MergeRobotParams(const Config& cfg, const std::string& key, const nlohmann::json& j, RobotParams* p) {
+  if (!j.is_object()) cfg.Fail(key, "an object of numbers");
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (!it.value().is_number()) cfg.Fail(key + "." + it.key(), "a number");
+    (*p)[it.key()] = it.value().get<double>();
+  }
+}
+
 }  // namespace
 
 nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool verbose) {
@@ -199,11 +209,7 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
     Scene scene = base;
     if (v.contains("robot_params")) {
       RobotParams p = cfg.NumberMap("robot_params");
-      if (!v["robot_params"].is_object()) cfg.Fail(key + ".robot_params", "an object of numbers");
-      for (auto it = v["robot_params"].begin(); it != v["robot_params"].end(); ++it) {
-        if (!it.value().is_number()) cfg.Fail(key + ".robot_params." + it.key(), "a number");
-        p[it.key()] = it.value().get<double>();
-      }
+      MergeRobotParams(cfg, key + ".robot_params", v["robot_params"], &p);
       try {
         scene = MakeRobot(robot, res, p);
       } catch (const std::invalid_argument& e) {
@@ -353,13 +359,7 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
     const int steps = rj.value("steps", 4);
     if (steps < 1) cfg.Fail(key + ".steps", "an integer >= 1");
     RobotParams params;
-    if (rj.contains("robot_params")) {
-      if (!rj["robot_params"].is_object()) cfg.Fail(key + ".robot_params", "an object of numbers");
-      for (auto it = rj["robot_params"].begin(); it != rj["robot_params"].end(); ++it) {
-        if (!it.value().is_number()) cfg.Fail(key + ".robot_params." + it.key(), "a number");
-        params[it.key()] = it.value().get<double>();
-      }
-    }
+    if (rj.contains("robot_params")) MergeRobotParams(cfg, key + ".robot_params", rj["robot_params"], &params);
     const auto t0 = Clock::now();
     Scene scene;
     try {
