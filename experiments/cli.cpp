@@ -1,5 +1,7 @@
 #include "experiments/cli.hpp"
 
+#include "experiments/cli_args.hpp"
+#include "experiments/cli_ik.hpp"
 #include "experiments/results.hpp"
 #include "experiments/runner.hpp"
 #include "solver/calibration.hpp"
@@ -19,29 +21,6 @@
 namespace softkin {
 
 namespace {
-
-/// Parses "v1,v2,..." into numbers; throws invalid_argument naming the option.
-Eigen::VectorXd ParseVector(const std::string& text, const std::string& option) {
-  std::vector<double> v;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    size_t pos = 0;
-    double x = 0;
-    try {
-      x = std::stod(item, &pos);
-    } catch (const std::exception&) {
-      pos = 0;
-    }
-    while (pos < item.size() && isspace(static_cast<unsigned char>(item[pos]))) ++pos;
-    if (item.empty() || pos != item.size() || !std::isfinite(x))
-      throw std::invalid_argument(option + ": expected comma-separated finite numbers, got '" +
-                                  text + "'");
-    v.push_back(x);
-  }
-  if (v.empty()) throw std::invalid_argument(option + ": expected at least one number");
-  return Eigen::Map<Eigen::VectorXd>(v.data(), v.size());
-}
 
 nlohmann::json RobotsJson() {
   nlohmann::json out = nlohmann::json::array();
@@ -165,6 +144,10 @@ int RunCli(int argc, char** argv) {
   tess->add_option("--seed", tess_opt.seed, "Seed of Mesh_3's random choices (default 1)");
   tess->add_option("--json", tess_json, "Write the report (tets per region, volumes, time) as JSON to this file");
 
+  // ik (experiments/cli_ik.cpp)
+  IkCommandArgs ik_args;
+  auto* ik_cmd = AddIkCommand(&app, &ik_args);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -213,18 +196,7 @@ int RunCli(int argc, char** argv) {
       if (robot.empty() == scene_file.empty())
         throw std::invalid_argument("fk: give exactly one of --robot NAME or --scene FILE");
       if (res < 0) throw std::invalid_argument("--res: expected a positive integer");
-      RobotParams params;
-      for (const auto& text : robot_params) {
-        const auto eq = text.find('=');
-        char* end = nullptr;
-        const std::string value = eq == std::string::npos ? "" : text.substr(eq + 1);
-        const double v = value.empty() ? 0.0 : std::strtod(value.c_str(), &end);
-        if (eq == std::string::npos || eq == 0 || value.empty() || end != value.c_str() + value.size() ||
-            !std::isfinite(v))
-          throw std::invalid_argument("--param: expected NAME=VALUE with a finite number, got '" +
-                                      text + "'");
-        params[text.substr(0, eq)] = v;
-      }
+      const RobotParams params = ParseRobotParams(robot_params);
       Scene scene = robot.empty() ? LoadSceneJson(scene_file) : MakeRobot(robot, res, params);
       FkOptions opt = scene.solver;
       if (!solver_name.empty()) opt.solver = solver_name;
@@ -236,7 +208,7 @@ int RunCli(int argc, char** argv) {
       if (fk->count("--aa-safeguard")) opt.anderson_safeguard = safeguard;
       std::string why;
       if (!opt.IsValid(&why)) throw std::invalid_argument("option " + why);
-      const Eigen::VectorXd c = ParseVector(actuation, "--actuation");
+      const Eigen::VectorXd c = ParseNumberList(actuation, "--actuation");
       auto model = std::make_shared<const Model>(scene);
       FkResult r = MakeFkSolver(model, opt)->Solve(c);
       if (r.status == FkStatus::InvalidInput) {
@@ -330,6 +302,7 @@ int RunCli(int argc, char** argv) {
                               {"seconds", rep.seconds}, {"cell_size", tess_opt.cell_size}, {"seed", tess_opt.seed}});
       return 0;
     }
+    if (ik_cmd->parsed()) return RunIkCommand(ik_args);
     if (run->parsed()) {
       ropt.plot = !no_plot;
       RunExperiment(config, ropt);

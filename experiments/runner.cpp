@@ -34,6 +34,10 @@ const Entry kExperiments[] = {
     {"aa_ablation", &RunAaAblation},
     {"actuation_paths", &RunActuationPaths},
     {"twisting_remesh", &RunTwistingRemesh},
+    {"ik_initial_guess", &RunIkInitialGuess},
+    {"ik_trajectory", &RunIkTrajectory},
+    {"ik_methods", &RunIkMethods},
+    {"ik_pick_and_place", &RunIkPickAndPlace},
 };
 }  // namespace
 

@@ -47,5 +47,10 @@ nlohmann::json RunCalibration(const Config& cfg, const std::string& dir, bool ve
 nlohmann::json RunHyperelasticFit(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool verbose);
+// Chapter 4 (experiments/exp_ik.cpp, exp_pick_place.cpp).
+nlohmann::json RunIkInitialGuess(const Config& cfg, const std::string& dir, bool verbose);
+nlohmann::json RunIkTrajectory(const Config& cfg, const std::string& dir, bool verbose);
+nlohmann::json RunIkMethods(const Config& cfg, const std::string& dir, bool verbose);
+nlohmann::json RunIkPickAndPlace(const Config& cfg, const std::string& dir, bool verbose);
 
 }  // namespace softkin

@@ -101,3 +101,32 @@ def read_marker_table(name, path):
         return None
 
     return read_table(name, path, MARKER_COLUMNS, MARKER_NUMERIC, check=check, min_rows=2)
+
+
+WAYPOINT_COLUMNS = ["index", "target_x", "target_y", "target_z", "reached_x", "reached_y",
+                    "reached_z", "error_mm", "objective", "converged", "termination", "iterations",
+                    "evaluations", "fk_solves", "time_s", "jump"]
+WAYPOINT_NUMERIC = [c for c in WAYPOINT_COLUMNS if c != "termination"]
+
+
+def read_waypoints(name, path):
+    """Reads a waypoint CSV of `softkin ik` or an IK experiment (ik/trajectory_io.hpp): one row
+    per waypoint, indices consecutive, converged 0 or 1, error_mm >= 0 or -1 (not evaluated)."""
+    state = {"next": None}
+
+    def check(v):
+        if state["next"] is not None and v["index"] != state["next"]:
+            return f"index is {v['index']:g}, expected {state['next']:g}"
+        state["next"] = v["index"] + 1
+        if v["converged"] not in (0.0, 1.0):
+            return f"converged is {v['converged']:g}, expected 0 or 1"
+        if v["error_mm"] < 0 and v["error_mm"] != -1:
+            return f"error_mm is {v['error_mm']:g}, expected >= 0 or -1"
+        return None
+
+    return read_table(name, path, WAYPOINT_COLUMNS, WAYPOINT_NUMERIC, check=check, min_rows=1)
+
+
+def read_samples(name, path):
+    """The configuration-space samples (c0.., x, y, z) an IK experiment wrote."""
+    return read_table(name, path, ["x", "y", "z"], min_rows=1)

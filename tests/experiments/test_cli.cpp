@@ -6,7 +6,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -227,3 +229,122 @@ TEST(Cli, TessellateMeshesABoxChamberInABoxBody) {
 }
 
 }  // namespace
+
+// ---- softkin ik ----------------------------------------------------------------------------
+
+namespace {
+
+std::string ReadText(const std::string& path) {
+  std::ifstream f(path);
+  return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+}
+
+int CountLines(const std::string& text) {
+  int n = 0;
+  for (char c : text) n += c == '\n';
+  return n;
+}
+
+}  // namespace
+
+TEST(Cli, IkHelpDocumentsEveryOption) {
+  const CliRun r = Cli("ik --help");
+  ASSERT_EQ(r.code, 0) << r.out;
+  for (const char* k : {"--robot", "--scene", "--target", "--trajectory", "--point", "--method",
+                        "--jacobian", "--lambda", "--max-iterations", "--samples", "--cache", "--out",
+                        "--resume", "nlopt-bobyqa", "fd-warm"})
+    EXPECT_NE(r.out.find(k), std::string::npos) << k;
+}
+
+TEST(Cli, IkBadInputExitsWithCode2AndNamesTheOptionOrFileLine) {
+  const std::string dir = TempDir("ik_bad");
+  const std::string out = " --out " + dir + "/out.csv";
+  const std::string base = "ik --robot cable_finger --res 5";
+  struct Case {
+    std::string args;
+    std::vector<std::string> expect;
+  };
+  std::ofstream(dir + "/two_columns.txt") << "100 12.5 20\n100 12.5\n";
+  std::ofstream(dir + "/nan.txt") << "# x y z\n100 12.5 20\n\n100 nan 20\n";
+  std::ofstream(dir + "/word.txt") << "x y z\n100 12.5 20\n100 12.5 2O\n";
+  const std::vector<Case> cases = {
+      {"ik --robot no_such_robot --target 1,2,3" + out, {"known robots"}},
+      {base + " --target 1,2,3 --point nose" + out, {"--point", "nose", "tip_top"}},
+      {base + " --target 1,2,3 --method magic" + out, {"--method", "magic", "softls", "gauss-newton"}},
+      {base + " --target 1,2,3 --jacobian exact" + out, {"--jacobian", "fd-warm"}},
+      {base + " --target 1,2" + out, {"--target", "x,y,z"}},
+      {base + " --target 1,abc,3" + out, {"--target", "expected"}},
+      {base + " --target 1,2,3 --lambda -1" + out, {"--lambda"}},
+      {base + " --target 1,2,3 --samples 1" + out, {"--samples"}},
+      {base + out, {"--target", "--trajectory"}},
+      {base + " --target 1,2,3 --trajectory " + dir + "/nan.txt" + out, {"excludes"}},
+      {base + " --trajectory " + dir + "/two_columns.txt" + out, {"two_columns.txt:2", "3 values"}},
+      {base + " --trajectory " + dir + "/nan.txt" + out, {"nan.txt:4", "finite"}},
+      {base + " --trajectory " + dir + "/word.txt" + out, {"word.txt:3", "2O"}},
+      {base + " --trajectory " + dir + "/missing.txt" + out, {"missing.txt"}},
+      {base + " --target 1,2,3", {"--out"}},
+  };
+  for (const auto& c : cases) {
+    const CliRun r = Cli(c.args);
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.out;
+    for (const auto& e : c.expect) EXPECT_NE(r.out.find(e), std::string::npos) << c.args << "\n" << r.out;
+  }
+}
+
+TEST(Cli, IkReachesAForwardSolvedTargetAndResumesATrajectory) {
+  const std::string dir = TempDir("ik_run");
+  // A reachable target: where the tip goes at a known actuation.
+  CliRun r = Cli("fk --robot cable_finger --res 5 --actuation 0.9,0.85,0.95 --json " + dir + "/fk.json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::ifstream f(dir + "/fk.json");
+  const auto tip = nlohmann::json::parse(f)["markers"]["tip"];
+  std::ostringstream target;
+  target << tip[0].get<double>() << "," << tip[1].get<double>() << "," << tip[2].get<double>();
+  r = Cli("ik --robot cable_finger --res 5 --target " + target.str() + " --samples 3 --method gauss-newton --out " +
+          dir + "/one.csv");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("[1/1]"), std::string::npos) << r.out;  // progress on stderr
+  std::string text = ReadText(dir + "/one.csv");
+  ASSERT_EQ(CountLines(text), 2) << text;
+  EXPECT_EQ(text.rfind("index,target_x,target_y,target_z,c0,c1,c2,reached_x", 0), 0u) << text;
+  // error_mm is column 11 (after index, target x3, c0..c2, reached x3): within lambda = 0.2 mm.
+  {
+    std::stringstream row(text.substr(text.find('\n') + 1));
+    std::string cell;
+    for (int i = 0; i < 11; ++i) std::getline(row, cell, ',');
+    EXPECT_LE(std::stod(cell), 0.2) << text;
+  }
+
+  // A three-waypoint path near that target; interrupt it after one row (plus half a row) and resume.
+  const double x = tip[0].get<double>(), y = tip[1].get<double>(), z = tip[2].get<double>();
+  std::ofstream(dir + "/path.txt") << x << " " << y << " " << z << "\n"
+                                   << x << " " << y << " " << z + 1 << "\n"
+                                   << x - 1 << " " << y << " " << z + 1 << "\n";
+  const std::string run = "ik --robot cable_finger --res 5 --trajectory " + dir + "/path.txt --samples 3 "
+                          "--method gauss-newton --jacobian fd-warm --cache " + dir + "/samples.csv --out " +
+                          dir + "/path.csv";
+  r = Cli(run);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const std::string full = ReadText(dir + "/path.csv");
+  ASSERT_EQ(CountLines(full), 4) << full;
+  const size_t second_row = full.find('\n', full.find('\n') + 1) + 1;
+  std::ofstream(dir + "/path.csv", std::ios::trunc) << full.substr(0, second_row) << "1,123.4";
+  r = Cli(run + " --resume");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("resuming"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("samples"), std::string::npos) << r.out;
+  const std::string resumed = ReadText(dir + "/path.csv");
+  ASSERT_EQ(CountLines(resumed), 4) << resumed;
+  EXPECT_EQ(resumed.substr(0, second_row), full.substr(0, second_row));
+  EXPECT_EQ(resumed.substr(second_row, 2), "1,") << resumed;
+  // Nothing left to do.
+  r = Cli(run + " --resume");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("nothing to do"), std::string::npos) << r.out;
+  // Resuming against another path is refused with the CSV line.
+  std::ofstream(dir + "/other.txt") << x + 5 << " " << y << " " << z << "\n" << x << " " << y << " " << z << "\n";
+  r = Cli("ik --robot cable_finger --res 5 --trajectory " + dir + "/other.txt --samples 3 --out " + dir +
+          "/path.csv --resume");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("path.csv:2"), std::string::npos) << r.out;
+}

@@ -1,0 +1,42 @@
+#pragma once
+/// \file cli_ik.hpp
+/// `softkin ik`: simulation-in-the-loop inverse kinematics of an embedded robot or a scene file for
+/// one target point or a waypoint file (thesis Algorithm 4), one CSV row per waypoint as it
+/// finishes, resumable (docs/ik.md, "The softkin ik command").
+#include <CLI/CLI.hpp>
+
+#include <string>
+#include <vector>
+
+namespace softkin {
+
+/// The values of `softkin ik`'s options, filled in by CLI11.
+struct IkCommandArgs {
+  std::string robot, scene;
+  int res = 0;
+  std::vector<std::string> params;
+  std::string target, trajectory;
+  std::string point = "tip";
+  std::string method = "softls";
+  std::string jacobian = "implicit";
+  double lambda_mm = 0.2;
+  int max_iterations = 30;
+  int max_evaluations = 300;
+  int samples = 5;
+  double max_time_s = 600;
+  double gradient_tolerance = 0;  ///< 0: the scene's FK setting
+  std::string cache;
+  std::string out;
+  bool resume = false;
+  bool quiet = false;
+};
+
+/// Adds the `ik` subcommand to `app`, bound to *args; returns it.
+CLI::App* AddIkCommand(CLI::App* app, IkCommandArgs* args);
+
+/// Runs `softkin ik`. Throws std::invalid_argument for bad input (the message names the option, or
+/// the file and line) and std::runtime_error when a file cannot be written; returns the exit code
+/// (0: every waypoint was solved, converged or not; 1: the kinematics failed at some waypoint).
+int RunIkCommand(const IkCommandArgs& args);
+
+}  // namespace softkin

@@ -1,0 +1,287 @@
+#include "experiments/ik_config.hpp"
+
+#include "experiments/runner.hpp"
+#include "ik/trajectory_io.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <set>
+#include <stdexcept>
+
+namespace softkin {
+
+namespace {
+
+[[noreturn]] void Bad(const std::string& where, const std::string& what) {
+  throw std::invalid_argument(where + ": " + what);
+}
+
+Eigen::Vector3d Vec3(const nlohmann::json& v, const std::string& where) {
+  if (!v.is_array() || v.size() != 3) Bad(where, "expected [x, y, z] in mm");
+  Eigen::Vector3d p;
+  for (int d = 0; d < 3; ++d) {
+    if (!v[d].is_number()) Bad(where, "expected [x, y, z] in mm");
+    p[d] = v[d].get<double>();
+    if (!std::isfinite(p[d])) Bad(where, "expected finite coordinates");
+  }
+  return p;
+}
+
+double Num(const nlohmann::json& spec, const std::string& key, const std::string& where, double def,
+           bool required = false) {
+  if (!spec.contains(key)) {
+    if (required) Bad(where + "." + key, "missing (expected a number)");
+    return def;
+  }
+  if (!spec[key].is_number()) Bad(where + "." + key, "expected a number");
+  return spec[key].get<double>();
+}
+
+int Int(const nlohmann::json& spec, const std::string& key, const std::string& where, int lo) {
+  if (!spec.contains(key) || !spec[key].is_number_integer() || spec[key].get<int>() < lo)
+    Bad(where + "." + key, "expected an integer >= " + std::to_string(lo));
+  return spec[key].get<int>();
+}
+
+void OnlyKeys(const nlohmann::json& spec, const std::set<std::string>& keys, const std::string& where) {
+  for (auto it = spec.begin(); it != spec.end(); ++it)
+    if (!keys.count(it.key())) {
+      std::string list;
+      for (const auto& k : keys) list += (list.empty() ? "" : ", ") + k;
+      Bad(where + "." + it.key(), "unknown key (expected one of " + list + ")");
+    }
+}
+
+/// The thesis flame (Fig. 4.2): a teardrop, round at the bottom and pointed at the top, with a
+/// flicker on its sides. Parameter t in [0, 2 pi): u = w sin t cos^2(t/2) (1 + 0.3 sin 3t),
+/// v = -h cos t / 2 (t = 0 is the bottom). Returned densely as a closed polyline.
+std::vector<Eigen::Vector3d> FlameCurve(const Eigen::Vector3d& c, int au, int av, double w, double h) {
+  const double pi = std::acos(-1.0);
+  std::vector<Eigen::Vector3d> v;
+  const int m = 2000;
+  for (int i = 0; i < m; ++i) {
+    const double t = 2 * pi * i / m;
+    const double ct = std::cos(0.5 * t);
+    Eigen::Vector3d p = c;
+    p[au] += w * std::sin(t) * ct * ct * (1.0 + 0.3 * std::sin(3 * t));
+    p[av] += -0.5 * h * std::cos(t);
+    v.push_back(p);
+  }
+  return v;
+}
+
+/// Maps waypoints given in another robot's frame into this robot's workspace:
+///   p' = t0 + R S (p - p0),
+/// p0 = the file's first waypoint (the other robot's rest tip), t0 = this robot's point at rest,
+/// S = diag scaling: the horizontal plane (the two axes other than `axis`) by s_h and `axis` by
+/// s_v, R = a rotation about `axis`. They are chosen so that the file's waypoint farthest from p0
+/// in the horizontal plane lands exactly on this robot's point at `anchor_actuation`: s_h = ratio
+/// of horizontal distances from the rest point, s_v = ratio of the displacements along the axis
+/// (s_h if the file's is zero), R = the angle between the two horizontal directions.
+Eigen::MatrixX3d MapToWorkspace(const Eigen::MatrixX3d& W, const nlohmann::json& m,
+                                const std::string& where, Kinematics& kin,
+                                const ConfigurationSamples& samples, nlohmann::json* info) {
+  OnlyKeys(m, {"axis", "anchor_actuation"}, where);
+  if (!m.contains("axis") || !m["axis"].is_number_integer() || m["axis"].get<int>() < 0 ||
+      m["axis"].get<int>() > 2)
+    Bad(where + ".axis", "expected 0, 1 or 2 (the robot's long axis)");
+  const int ax = m["axis"].get<int>(), au = (ax + 1) % 3, av = (ax + 2) % 3;
+  if (!m.contains("anchor_actuation") || !m["anchor_actuation"].is_array() ||
+      static_cast<int>(m["anchor_actuation"].size()) != kin.num_actuators())
+    Bad(where + ".anchor_actuation", "expected " + std::to_string(kin.num_actuators()) + " actuation values");
+  Eigen::VectorXd ca(kin.num_actuators());
+  for (int a = 0; a < ca.size(); ++a) {
+    if (!m["anchor_actuation"][a].is_number()) Bad(where + ".anchor_actuation", "expected numbers");
+    ca[a] = m["anchor_actuation"][a].get<double>();
+  }
+  const std::string why = CheckKinematicsInput(kin, ca);
+  if (!why.empty()) Bad(where + ".anchor_actuation", why);
+  const KinematicsEval rest = kin.Evaluate(kin.rest(), false);
+  if (!rest.ok) throw std::runtime_error(where + ": the forward solve at rest failed: " + rest.message);
+  const Eigen::Vector3d t0 = rest.p.row(0).transpose();
+  const KinematicsEval anc = kin.Evaluate(ca, false);
+  if (!anc.ok) throw std::runtime_error(where + ": the forward solve at the anchor failed: " + anc.message);
+  const Eigen::Vector3d ta = anc.p.row(0).transpose();
+  const Eigen::Vector3d p0 = W.row(0).transpose();
+  int far = 0;
+  double far_r = 0;
+  auto hdist = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    return std::hypot(a[au] - b[au], a[av] - b[av]);
+  };
+  for (int i = 0; i < W.rows(); ++i) {
+    const double r = hdist(W.row(i).transpose(), p0);
+    if (r > far_r) { far_r = r; far = i; }
+  }
+  if (far_r <= 0) Bad(where, "every waypoint has the first one's horizontal position; nothing to scale");
+  const Eigen::Vector3d pf = W.row(far).transpose();
+  const double anchor_r = hdist(ta, t0);
+  if (anchor_r <= 1e-9) Bad(where + ".anchor_actuation", "does not move the point off the axis");
+  const double s_h = anchor_r / far_r;
+  const double dv_file = pf[ax] - p0[ax], dv_ours = ta[ax] - t0[ax];
+  const double s_v = std::abs(dv_file) > 1e-9 ? dv_ours / dv_file : s_h;
+  const double ang = std::atan2(ta[av] - t0[av], ta[au] - t0[au]) - std::atan2(pf[av] - p0[av], pf[au] - p0[au]);
+  const double co = std::cos(ang), si = std::sin(ang);
+  Eigen::MatrixX3d out(W.rows(), 3);
+  for (int i = 0; i < W.rows(); ++i) {
+    const Eigen::Vector3d d = W.row(i).transpose() - p0;
+    Eigen::Vector3d q = t0;
+    q[au] += s_h * (co * d[au] - si * d[av]);
+    q[av] += s_h * (si * d[au] + co * d[av]);
+    q[ax] += s_v * d[ax];
+    out.row(i) = q.transpose();
+  }
+  double sampled_reach = 0;
+  for (int i = 0; i < samples.p.rows(); ++i)
+    sampled_reach = std::max(sampled_reach, hdist(samples.p.row(i).transpose(), t0));
+  (*info)["mapping"] = {
+      {"formula", "p' = t0 + R S (p - p0)"},
+      {"p0_file_first_waypoint", {p0[0], p0[1], p0[2]}},
+      {"t0_rest_point", {t0[0], t0[1], t0[2]}},
+      {"anchor_waypoint", far},
+      {"anchor_point", {ta[0], ta[1], ta[2]}},
+      {"scale_horizontal", s_h},
+      {"scale_axis", s_v},
+      {"rotation_deg", ang * 180.0 / std::acos(-1.0)},
+      {"file_max_horizontal_mm", far_r},
+      {"anchor_horizontal_mm", anchor_r},
+      {"sampled_max_horizontal_mm", sampled_reach}};
+  return out;
+}
+
+}  // namespace
+
+nlohmann::json IkExperimentSetup::Json() const {
+  return {{"robot", robot},
+          {"res", res},
+          {"n_vertices", scene.mesh.num_vertices()},
+          {"n_tets", scene.mesh.num_tets()},
+          {"point", point},
+          {"method", IkMethodToString(ik.method)},
+          {"jacobian", JacobianModeToString(kin.jacobian)},
+          {"lambda_mm", lambda_mm},
+          {"max_iterations", ik.max_iterations},
+          {"max_evaluations", ik.max_evaluations},
+          {"samples_per_axis", samples_per_axis},
+          {"fk_solver", fk.solver}};
+}
+
+SimulatorKinematicsOptions IkExperimentSetup::KinematicsFor(const std::vector<std::string>& points) const {
+  SimulatorKinematicsOptions o = kin;
+  o.points = points;
+  return o;
+}
+
+IkExperimentSetup ReadIkSetup(const Config& cfg, const std::string& default_robot) {
+  IkExperimentSetup s;
+  s.robot = cfg.String("robot", default_robot);
+  s.res = cfg.Int("res", 0);
+  s.scene = ConfigRobot(cfg, s.robot, s.res);
+  s.fk = cfg.Solver(s.scene.solver);
+  s.point = cfg.String("point", "tip");
+  const std::string jac = cfg.String("jacobian", "implicit");
+  if (!JacobianModeFromString(jac, &s.kin.jacobian)) cfg.Fail("jacobian", "one of " + JacobianModeNames());
+  s.kin.fd_step = cfg.Number("fd_step", s.kin.fd_step);
+  std::string why;
+  if (!s.kin.IsValid(&why)) cfg.Fail("fd_step", "a valid step (" + why + ")");
+  const std::string method = cfg.String("method", "softls");
+  if (!StringToIkMethod(method, &s.ik.method)) cfg.Fail("method", "one of " + IkMethodNames());
+  s.lambda_mm = cfg.Number("lambda_mm", 0.2);
+  if (!(s.lambda_mm >= 0) || !std::isfinite(s.lambda_mm)) cfg.Fail("lambda_mm", "a distance >= 0 mm");
+  s.ik.lambda = s.lambda_mm * s.lambda_mm;
+  s.ik.max_iterations = cfg.Int("max_iterations", 30);
+  s.ik.max_evaluations = cfg.Int("max_evaluations", 300);
+  s.ik.max_time_s = cfg.Number("max_time_s", 600.0);
+  if (!s.ik.IsValid(&why)) throw std::invalid_argument(cfg.path() + ": " + why);
+  s.samples_per_axis = cfg.Int("samples_per_axis", 5);
+  if (s.samples_per_axis < 2 || s.samples_per_axis > 20) cfg.Fail("samples_per_axis", "an integer in [2, 20]");
+  if (s.scene.marker_index(s.point.substr(0, s.point.find('['))) < 0)
+    cfg.Fail("point", "a marker of robot '" + s.robot + "'");
+  return s;
+}
+
+Eigen::MatrixX3d ResamplePolyline(const std::vector<Eigen::Vector3d>& v, int n, bool closed) {
+  if (v.size() < 2) throw std::invalid_argument("a polyline needs at least 2 vertices");
+  if (n < 2) throw std::invalid_argument("a path needs at least 2 waypoints");
+  std::vector<Eigen::Vector3d> pts = v;
+  if (closed) pts.push_back(v.front());
+  std::vector<double> s(pts.size(), 0.0);
+  for (size_t i = 1; i < pts.size(); ++i) s[i] = s[i - 1] + (pts[i] - pts[i - 1]).norm();
+  const double total = s.back();
+  if (!(total > 0)) throw std::invalid_argument("the polyline has zero length");
+  Eigen::MatrixX3d out(n, 3);
+  size_t seg = 1;
+  for (int k = 0; k < n; ++k) {
+    const double target = closed ? total * k / n : total * k / (n - 1);
+    while (seg + 1 < s.size() && s[seg] < target) ++seg;
+    const double len = s[seg] - s[seg - 1];
+    const double f = len > 0 ? std::clamp((target - s[seg - 1]) / len, 0.0, 1.0) : 0.0;
+    out.row(k) = ((1 - f) * pts[seg - 1] + f * pts[seg]).transpose();
+  }
+  return out;
+}
+
+IkPath MakeIkPath(const nlohmann::json& spec, const std::string& where, Kinematics& kin,
+                  const ConfigurationSamples& samples) {
+  if (!spec.is_object()) Bad(where, "expected a path object {\"name\", \"type\", ...}");
+  IkPath path;
+  if (!spec.contains("name") || !spec["name"].is_string() || spec["name"].get<std::string>().empty())
+    Bad(where + ".name", "expected a non-empty string");
+  path.name = spec["name"].get<std::string>();
+  for (char ch : path.name)
+    if (!(isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-'))
+      Bad(where + ".name", "letters, digits, '_' or '-' only (it names a CSV file)");
+  const std::string type = spec.value("type", "");
+  path.info = spec;
+  path.thesis_time_s = Num(spec, "thesis_time_s", where, -1);
+  path.thesis_max_error_mm = Num(spec, "thesis_max_error_mm", where, -1);
+  const std::set<std::string> common = {"name", "type", "thesis_time_s", "thesis_max_error_mm", "description"};
+  auto with = [&](std::set<std::string> extra) {
+    extra.insert(common.begin(), common.end());
+    return extra;
+  };
+  if (type == "polyline") {
+    OnlyKeys(spec, with({"vertices", "n", "closed"}), where);
+    if (!spec.contains("vertices") || !spec["vertices"].is_array() || spec["vertices"].size() < 2)
+      Bad(where + ".vertices", "expected at least 2 vertices [x, y, z]");
+    std::vector<Eigen::Vector3d> v;
+    for (size_t i = 0; i < spec["vertices"].size(); ++i)
+      v.push_back(Vec3(spec["vertices"][i], where + ".vertices[" + std::to_string(i) + "]"));
+    const bool closed = spec.value("closed", false);
+    path.waypoints = ResamplePolyline(v, Int(spec, "n", where, 2), closed);
+  } else if (type == "flame") {
+    OnlyKeys(spec, with({"center", "axes", "width", "height", "n"}), where);
+    const Eigen::Vector3d c = Vec3(spec.value("center", nlohmann::json()), where + ".center");
+    int au = 0, av = 2;
+    if (spec.contains("axes")) {
+      const auto& a = spec["axes"];
+      if (!a.is_array() || a.size() != 2 || !a[0].is_number_integer() || !a[1].is_number_integer() ||
+          a[0].get<int>() < 0 || a[0].get<int>() > 2 || a[1].get<int>() < 0 || a[1].get<int>() > 2 ||
+          a[0] == a[1])
+        Bad(where + ".axes", "expected two different axes out of 0, 1, 2 (e.g. [0, 2]: x, z)");
+      au = a[0].get<int>();
+      av = a[1].get<int>();
+    }
+    const double w = Num(spec, "width", where, 0, true), h = Num(spec, "height", where, 0, true);
+    if (!(w > 0) || !(h > 0)) Bad(where, "width and height must be > 0 mm");
+    path.waypoints = ResamplePolyline(FlameCurve(c, au, av, w, h), Int(spec, "n", where, 2), true);
+  } else if (type == "file") {
+    OnlyKeys(spec, with({"file", "map"}), where);
+    if (!spec.contains("file") || !spec["file"].is_string()) Bad(where + ".file", "expected a file name");
+    std::filesystem::path f = spec["file"].get<std::string>();
+    if (f.is_relative()) f = std::filesystem::path(SOFTKIN_SOURCE_DIR) / f;
+    Eigen::MatrixX3d w = ReadWaypoints(f.lexically_normal().string());
+    path.info["file_resolved"] = f.lexically_normal().string();
+    path.info["file_waypoints"] = w.rows();
+    if (spec.contains("map")) {
+      if (!spec["map"].is_object()) Bad(where + ".map", "expected an object {axis, anchor_actuation}");
+      w = MapToWorkspace(w, spec["map"], where + ".map", kin, samples, &path.info);
+    }
+    path.waypoints = w;
+  } else {
+    Bad(where + ".type", "expected one of polyline, flame, file");
+  }
+  return path;
+}
+
+}  // namespace softkin
