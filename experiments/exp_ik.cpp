@@ -221,8 +221,7 @@ nlohmann::json RunIkTrajectory(const Config& cfg, const std::string& dir, bool v
     pj["initial_guess"] = Vec(guess);
     pj["total_time_s"] = r.total_time_s;
     pj["total_time_with_sampling_s"] = r.total_time_s + samples.time_s;
-    if (path.thesis_time_s >= 0) pj["thesis_time_s"] = path.thesis_time_s;
-    if (path.thesis_max_error_mm >= 0) pj["thesis_max_error_mm"] = path.thesis_max_error_mm;
+    pj["thesis"] = path.thesis;
     total += r.total_time_s;
     out.push_back(pj);
     if (verbose)

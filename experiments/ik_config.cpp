@@ -55,20 +55,25 @@ void OnlyKeys(const nlohmann::json& spec, const std::set<std::string>& keys, con
 
 /// The thesis flame (Fig. 4.2): a teardrop, round at the bottom and pointed at the top, with a
 /// flicker on its sides. Parameter t in [0, 2 pi): u = w sin t cos^2(t/2) (1 + 0.3 sin 3t),
-/// v = -h cos t / 2 (t = 0 is the bottom). Returned densely as a closed polyline.
-std::vector<Eigen::Vector3d> FlameCurve(const Eigen::Vector3d& c, int au, int av, double w, double h) {
+/// v = -h cos t / 2 (t = 0 is the bottom), turned by tilt_deg from the u axis towards the v axis.
+/// Returned densely as a closed polyline.
+std::vector<Eigen::Vector3d> FlameCurve(const Eigen::Vector3d& c, int au, int av, double w, double h,
+                                        double tilt_deg) {
   const double pi = std::acos(-1.0);
-  std::vector<Eigen::Vector3d> v;
+  std::vector<Eigen::Vector3d> curve;
   const int m = 2000;
   for (int i = 0; i < m; ++i) {
     const double t = 2 * pi * i / m;
     const double ct = std::cos(0.5 * t);
+    const double u = w * std::sin(t) * ct * ct * (1.0 + 0.3 * std::sin(3 * t));
+    const double v = -0.5 * h * std::cos(t);
+    const double a = tilt_deg * pi / 180.0;
     Eigen::Vector3d p = c;
-    p[au] += w * std::sin(t) * ct * ct * (1.0 + 0.3 * std::sin(3 * t));
-    p[av] += -0.5 * h * std::cos(t);
-    v.push_back(p);
+    p[au] += std::cos(a) * u - std::sin(a) * v;
+    p[av] += std::sin(a) * u + std::cos(a) * v;
+    curve.push_back(p);
   }
-  return v;
+  return curve;
 }
 
 /// Maps waypoints given in another robot's frame into this robot's workspace:
@@ -233,9 +238,13 @@ IkPath MakeIkPath(const nlohmann::json& spec, const std::string& where, Kinemati
       Bad(where + ".name", "letters, digits, '_' or '-' only (it names a CSV file)");
   const std::string type = spec.value("type", "");
   path.info = spec;
-  path.thesis_time_s = Num(spec, "thesis_time_s", where, -1);
-  path.thesis_max_error_mm = Num(spec, "thesis_max_error_mm", where, -1);
-  const std::set<std::string> common = {"name", "type", "thesis_time_s", "thesis_max_error_mm", "description"};
+  if (spec.contains("thesis")) {
+    if (!spec["thesis"].is_object()) Bad(where + ".thesis", "expected an object of numbers");
+    for (auto it = spec["thesis"].begin(); it != spec["thesis"].end(); ++it)
+      if (!it.value().is_number()) Bad(where + ".thesis." + it.key(), "expected a number");
+    path.thesis = spec["thesis"];
+  }
+  const std::set<std::string> common = {"name", "type", "thesis", "description"};
   auto with = [&](std::set<std::string> extra) {
     extra.insert(common.begin(), common.end());
     return extra;
@@ -250,7 +259,7 @@ IkPath MakeIkPath(const nlohmann::json& spec, const std::string& where, Kinemati
     const bool closed = spec.value("closed", false);
     path.waypoints = ResamplePolyline(v, Int(spec, "n", where, 2), closed);
   } else if (type == "flame") {
-    OnlyKeys(spec, with({"center", "axes", "width", "height", "n"}), where);
+    OnlyKeys(spec, with({"center", "axes", "width", "height", "tilt_deg", "n"}), where);
     const Eigen::Vector3d c = Vec3(spec.value("center", nlohmann::json()), where + ".center");
     int au = 0, av = 2;
     if (spec.contains("axes")) {
@@ -264,15 +273,21 @@ IkPath MakeIkPath(const nlohmann::json& spec, const std::string& where, Kinemati
     }
     const double w = Num(spec, "width", where, 0, true), h = Num(spec, "height", where, 0, true);
     if (!(w > 0) || !(h > 0)) Bad(where, "width and height must be > 0 mm");
-    path.waypoints = ResamplePolyline(FlameCurve(c, au, av, w, h), Int(spec, "n", where, 2), true);
+    path.waypoints = ResamplePolyline(FlameCurve(c, au, av, w, h, Num(spec, "tilt_deg", where, 0.0)), Int(spec, "n", where, 2), true);
   } else if (type == "file") {
-    OnlyKeys(spec, with({"file", "map"}), where);
+    OnlyKeys(spec, with({"file", "map", "stride"}), where);
     if (!spec.contains("file") || !spec["file"].is_string()) Bad(where + ".file", "expected a file name");
     std::filesystem::path f = spec["file"].get<std::string>();
     if (f.is_relative()) f = std::filesystem::path(SOFTKIN_SOURCE_DIR) / f;
     Eigen::MatrixX3d w = ReadWaypoints(f.lexically_normal().string());
     path.info["file_resolved"] = f.lexically_normal().string();
     path.info["file_waypoints"] = w.rows();
+    if (spec.contains("stride")) {
+      const int k = Int(spec, "stride", where, 1);
+      Eigen::MatrixX3d sub((w.rows() + k - 1) / k, 3);
+      for (int i = 0; i < sub.rows(); ++i) sub.row(i) = w.row(i * k);
+      w = sub;
+    }
     if (spec.contains("map")) {
       if (!spec["map"].is_object()) Bad(where + ".map", "expected an object {axis, anchor_actuation}");
       w = MapToWorkspace(w, spec["map"], where + ".map", kin, samples, &path.info);

@@ -14,11 +14,13 @@
 ///               polyline (both ends included), "closed" (false) to return to the first vertex;
 ///   "flame":    a closed teardrop with a flickering side (the thesis's flame, Fig. 4.2) in the
 ///               plane of two axes "axes" ([0, 2]: x and z), centred at "center" [x,y,z], "width"
-///               and "height" (mm), "n" waypoints evenly by arc length, starting at its bottom;
+///               and "height" (mm), turned by "tilt_deg" (0) in that plane, "n" waypoints evenly by arc length, starting at its bottom;
 ///   "file":     a waypoint file "file" (ik/trajectory_io.hpp; relative paths are taken from the
-///               source tree), optionally mapped into the robot's workspace with "map" (see
+///               source tree), every "stride"-th waypoint (1: all; the first is always kept, and
+///               the mapping uses the file's first waypoint), optionally mapped into the robot's workspace with "map" (see
 ///               MapToWorkspace).
-/// Every path may carry "thesis_time_s" and "thesis_max_error_mm", copied into the summary.
+/// Every path may carry "thesis": {...}, the thesis's numbers for it (e.g. {"total_time_s": 38}),
+/// copied into the summary beside ours.
 #include "experiments/config.hpp"
 #include "ik/ik_solver.hpp"
 #include "ik/simulator_kinematics.hpp"
@@ -56,7 +58,7 @@ struct IkPath {
   std::string name;
   Eigen::MatrixX3d waypoints;  ///< #waypoints x 3, mm
   nlohmann::json info;         ///< the spec, plus the mapping applied (for "file")
-  double thesis_time_s = -1, thesis_max_error_mm = -1;
+  nlohmann::json thesis = nlohmann::json::object();  ///< the thesis's numbers, from the spec
 };
 
 /// Builds a path from its JSON spec; `where` names it in errors ("config.json: paths[1]").

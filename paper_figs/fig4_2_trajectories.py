@@ -56,7 +56,7 @@ def main(argv):
         ax2.set_xlabel("waypoint")
         ax2.set_ylabel("error (mm)")
         t = p.get("total_time_s")
-        th = p.get("thesis_time_s")
+        th = (p.get("thesis") or {}).get("total_time_s")
         title = f"'{name}': error per waypoint"
         if isinstance(t, (int, float)):
             title += f"; ours {t:.1f} s"

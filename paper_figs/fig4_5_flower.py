@@ -51,7 +51,7 @@ def main(argv):
     b.legend(fontsize=8)
     b.grid(True, alpha=0.3)
     c.plot([r["index"] for r in ok], [r["error_mm"] for r in ok], "o-", ms=3, label="ours")
-    th = p.get("thesis_max_error_mm")
+    th = (p.get("thesis") or {}).get("max_error_mm")
     if isinstance(th, (int, float)):
         c.axhline(th, color="k", ls="--", lw=1, label=f"thesis bound {th:g} mm")
     c.set_xlabel("waypoint")
@@ -60,7 +60,7 @@ def main(argv):
     c.legend(fontsize=8)
     c.grid(True, alpha=0.3)
     d.plot([r["index"] for r in w], [r["time_s"] for r in w], "o-", ms=3, label="ours")
-    tt = p.get("thesis_time_s")
+    tt = (p.get("thesis") or {}).get("s_per_waypoint")
     if isinstance(tt, (int, float)):
         d.set_title(f"(d) IK time per waypoint (thesis: {tt:g} s per waypoint)")
     else:
