@@ -76,18 +76,21 @@ std::vector<Eigen::Vector3d> FlameCurve(const Eigen::Vector3d& c, int au, int av
   return curve;
 }
 
-/// Maps waypoints given in another robot's frame into this robot's workspace:
-///   p' = t0 + R S (p - p0),
+/// Maps waypoints given in another robot's frame into this robot's workspace. Sideways (the plane
+/// of the two axes other than `axis`) it is a similarity about the rest points:
+///   h' = t0_h + s_h R (p_h - p0_h),
 /// p0 = the file's first waypoint (the other robot's rest tip), t0 = this robot's point at rest,
-/// S = diag scaling: the horizontal plane (the two axes other than `axis`) by s_h and `axis` by
-/// s_v, R = a rotation about `axis`. They are chosen so that the file's waypoint farthest from p0
-/// in the horizontal plane lands exactly on this robot's point at `anchor_actuation`: s_h = ratio
-/// of horizontal distances from the rest point, s_v = ratio of the displacements along the axis
-/// (s_h if the file's is zero), R = the angle between the two horizontal directions.
+/// s_h and the rotation R about `axis` chosen so that the file's waypoint farthest from p0 lands
+/// on this robot's point at `anchor_actuation`. Along `axis`, the file's heights follow the other
+/// robot's bending, which differs from ours (three_chamber's tip first rises, then drops, as one
+/// chamber inflates), so a linear scale would put the inner waypoints out of reach. The height is
+/// therefore this robot's own: the height of its point along the actuation ray
+/// c(s) = rest + s (anchor - rest), s in [0, 1] (`profile_steps` forward solves), at the same
+/// sideways distance from t0 (linear interpolation), plus `lift` mm.
 Eigen::MatrixX3d MapToWorkspace(const Eigen::MatrixX3d& W, const nlohmann::json& m,
                                 const std::string& where, Kinematics& kin,
                                 const ConfigurationSamples& samples, nlohmann::json* info) {
-  OnlyKeys(m, {"axis", "anchor_actuation"}, where);
+  OnlyKeys(m, {"axis", "anchor_actuation", "profile_steps", "lift"}, where);
   if (!m.contains("axis") || !m["axis"].is_number_integer() || m["axis"].get<int>() < 0 ||
       m["axis"].get<int>() > 2)
     Bad(where + ".axis", "expected 0, 1 or 2 (the robot's long axis)");
@@ -102,29 +105,52 @@ Eigen::MatrixX3d MapToWorkspace(const Eigen::MatrixX3d& W, const nlohmann::json&
   }
   const std::string why = CheckKinematicsInput(kin, ca);
   if (!why.empty()) Bad(where + ".anchor_actuation", why);
-  const KinematicsEval rest = kin.Evaluate(kin.rest(), false);
-  if (!rest.ok) throw std::runtime_error(where + ": the forward solve at rest failed: " + rest.message);
-  const Eigen::Vector3d t0 = rest.p.row(0).transpose();
-  const KinematicsEval anc = kin.Evaluate(ca, false);
-  if (!anc.ok) throw std::runtime_error(where + ": the forward solve at the anchor failed: " + anc.message);
-  const Eigen::Vector3d ta = anc.p.row(0).transpose();
-  const Eigen::Vector3d p0 = W.row(0).transpose();
-  int far = 0;
-  double far_r = 0;
+  int steps = 8;
+  if (m.contains("profile_steps")) {
+    if (!m["profile_steps"].is_number_integer() || m["profile_steps"].get<int>() < 2)
+      Bad(where + ".profile_steps", "expected an integer >= 2");
+    steps = m["profile_steps"].get<int>();
+  }
+  const double lift = Num(m, "lift", where, 0.0);
   auto hdist = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
     return std::hypot(a[au] - b[au], a[av] - b[av]);
   };
+  // The profile along the anchor's actuation ray: sideways distance -> height.
+  const Eigen::VectorXd c_rest = kin.rest();
+  std::vector<double> prof_r, prof_h;
+  Eigen::Vector3d t0 = Eigen::Vector3d::Zero(), ta = Eigen::Vector3d::Zero();
+  for (int k = 0; k <= steps; ++k) {
+    const Eigen::VectorXd c = c_rest + (ca - c_rest) * (double(k) / steps);
+    const KinematicsEval e = kin.Evaluate(c, false);
+    if (!e.ok) throw std::runtime_error(where + ": the forward solve along the anchor ray failed: " + e.message);
+    const Eigen::Vector3d p = e.p.row(0).transpose();
+    if (k == 0) t0 = p;
+    if (k == steps) ta = p;
+    prof_r.push_back(hdist(p, t0));
+    prof_h.push_back(p[ax]);
+  }
+  for (size_t k = 1; k < prof_r.size(); ++k)
+    if (!(prof_r[k] > prof_r[k - 1]))
+      Bad(where + ".anchor_actuation", "the point does not move steadily sideways along the ray (step " +
+                                           std::to_string(k) + ")");
+  auto height = [&](double r) {
+    size_t k = 1;
+    while (k + 1 < prof_r.size() && prof_r[k] < r) ++k;
+    const double f = std::clamp((r - prof_r[k - 1]) / (prof_r[k] - prof_r[k - 1]), 0.0, 1.0);
+    return (1 - f) * prof_h[k - 1] + f * prof_h[k];
+  };
+  const Eigen::Vector3d p0 = W.row(0).transpose();
+  int far = 0;
+  double far_r = 0;
   for (int i = 0; i < W.rows(); ++i) {
     const double r = hdist(W.row(i).transpose(), p0);
     if (r > far_r) { far_r = r; far = i; }
   }
-  if (far_r <= 0) Bad(where, "every waypoint has the first one's horizontal position; nothing to scale");
+  if (far_r <= 0) Bad(where, "every waypoint has the first one's sideways position; nothing to scale");
   const Eigen::Vector3d pf = W.row(far).transpose();
-  const double anchor_r = hdist(ta, t0);
-  if (anchor_r <= 1e-9) Bad(where + ".anchor_actuation", "does not move the point off the axis");
+  const double anchor_r = prof_r.back();
+  if (anchor_r <= 1e-9) Bad(where + ".anchor_actuation", "does not move the point sideways");
   const double s_h = anchor_r / far_r;
-  const double dv_file = pf[ax] - p0[ax], dv_ours = ta[ax] - t0[ax];
-  const double s_v = std::abs(dv_file) > 1e-9 ? dv_ours / dv_file : s_h;
   const double ang = std::atan2(ta[av] - t0[av], ta[au] - t0[au]) - std::atan2(pf[av] - p0[av], pf[au] - p0[au]);
   const double co = std::cos(ang), si = std::sin(ang);
   Eigen::MatrixX3d out(W.rows(), 3);
@@ -133,24 +159,28 @@ Eigen::MatrixX3d MapToWorkspace(const Eigen::MatrixX3d& W, const nlohmann::json&
     Eigen::Vector3d q = t0;
     q[au] += s_h * (co * d[au] - si * d[av]);
     q[av] += s_h * (si * d[au] + co * d[av]);
-    q[ax] += s_v * d[ax];
+    q[ax] = height(hdist(q, t0)) + lift;
     out.row(i) = q.transpose();
   }
   double sampled_reach = 0;
   for (int i = 0; i < samples.p.rows(); ++i)
     sampled_reach = std::max(sampled_reach, hdist(samples.p.row(i).transpose(), t0));
   (*info)["mapping"] = {
-      {"formula", "p' = t0 + R S (p - p0)"},
+      {"sideways", "h' = t0_h + s_h R (p_h - p0_h)"},
+      {"height", "our point's height along the anchor's actuation ray at the same sideways distance, + lift"},
       {"p0_file_first_waypoint", {p0[0], p0[1], p0[2]}},
       {"t0_rest_point", {t0[0], t0[1], t0[2]}},
       {"anchor_waypoint", far},
       {"anchor_point", {ta[0], ta[1], ta[2]}},
-      {"scale_horizontal", s_h},
-      {"scale_axis", s_v},
+      {"scale_sideways", s_h},
       {"rotation_deg", ang * 180.0 / std::acos(-1.0)},
-      {"file_max_horizontal_mm", far_r},
-      {"anchor_horizontal_mm", anchor_r},
-      {"sampled_max_horizontal_mm", sampled_reach}};
+      {"lift_mm", lift},
+      {"profile_sideways_mm", prof_r},
+      {"profile_height_mm", prof_h},
+      {"file_max_sideways_mm", far_r},
+      {"file_height_range_mm", W.col(ax).maxCoeff() - W.col(ax).minCoeff()},
+      {"anchor_sideways_mm", anchor_r},
+      {"sampled_max_sideways_mm", sampled_reach}};
   return out;
 }
 

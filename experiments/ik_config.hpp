@@ -17,8 +17,9 @@
 ///               and "height" (mm), turned by "tilt_deg" (0) in that plane, "n" waypoints evenly by arc length, starting at its bottom;
 ///   "file":     a waypoint file "file" (ik/trajectory_io.hpp; relative paths are taken from the
 ///               source tree), every "stride"-th waypoint (1: all; the first is always kept, and
-///               the mapping uses the file's first waypoint), optionally mapped into the robot's workspace with "map" (see
-///               MapToWorkspace).
+///               the mapping uses the file's first waypoint), optionally mapped into the robot's workspace with "map"
+///               {axis, anchor_actuation, profile_steps, lift} (see MapToWorkspace in
+///               ik_config.cpp and docs/ik.md).
 /// Every path may carry "thesis": {...}, the thesis's numbers for it (e.g. {"total_time_s": 38}),
 /// copied into the summary beside ours.
 #include "experiments/config.hpp"

@@ -350,3 +350,48 @@ TEST(Cli, IkReachesAForwardSolvedTargetAndResumesATrajectory) {
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("path.csv:2"), std::string::npos) << r.out;
 }
+
+TEST(Cli, IkExperimentsRunTinyConfigsAndRejectBadPaths) {
+  const std::string dir = TempDir("ik_exp");
+  const std::string cfg = dir + "/tiny.json";
+  // Two waypoints near the rest tip of the coarse finger, loose forward solves (fast).
+  std::ofstream(cfg) << R"({"name": "tiny_traj", "experiment": "ik_trajectory", "seed": 2,
+    "robot": "cable_finger", "res": 5, "solver": {"gradient_tolerance": 1e-3},
+    "method": "gauss-newton", "samples_per_axis": 2,
+    "paths": [{"name": "seg", "type": "polyline", "n": 2,
+               "vertices": [[119.5, 12.5, 16.0], [119.0, 12.5, 18.0]], "thesis": {"total_time_s": 1}}]})";
+  CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  {
+    std::ifstream f(dir + "/tiny_traj/summary.json");
+    const auto j = nlohmann::json::parse(f);
+    ASSERT_EQ(j["paths"].size(), 1u);
+    const auto& p = j["paths"][0];
+    EXPECT_EQ(p["waypoints"], 2);
+    EXPECT_EQ(p["thesis"]["total_time_s"], 1);
+    for (const char* k : {"mean_error_mm", "max_error_mm", "total_time_s", "max_jump", "max_reached_step_mm",
+                          "fk_solves", "beyond_lambda"})
+      EXPECT_TRUE(p.contains(k)) << k;
+    EXPECT_EQ(j["samples"]["n"], 8);
+    EXPECT_TRUE(std::filesystem::exists(dir + "/tiny_traj/path_seg.csv"));
+    EXPECT_TRUE(std::filesystem::exists(dir + "/tiny_traj/samples.csv"));
+  }
+  // A path of an unknown type, a file path with a bad stride, a bad method: exit 2 with the key.
+  std::ofstream(cfg) << R"({"name": "tiny_traj", "experiment": "ik_trajectory", "seed": 2,
+    "robot": "cable_finger", "res": 5, "samples_per_axis": 2, "solver": {"gradient_tolerance": 1e-3},
+    "paths": [{"name": "seg", "type": "spiral"}]})";
+  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("paths[0].type"), std::string::npos) << r.out;
+  std::ofstream(cfg) << R"({"name": "tiny_m", "experiment": "ik_methods", "seed": 2,
+    "robot": "cable_finger", "res": 5, "methods": ["softls", "newton"], "path": {}})";
+  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("methods"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("newton"), std::string::npos) << r.out;
+  std::ofstream(cfg) << R"({"name": "tiny_pp", "experiment": "ik_pick_and_place", "seed": 2,
+    "robot": "multi_segment_gripper", "res": 6, "pick_design_actuation": [2, 2]})";
+  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("place_offset"), std::string::npos) << r.out;
+}
