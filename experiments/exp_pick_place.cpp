@@ -1,8 +1,8 @@
 // Thesis Sec. 4.4, Fig. 4.7-4.11: pick-and-place with multi_segment_gripper in three IK stages.
 //  1. pick (Eq. 4.5, 4.6): c1, c2 (gripper c3 at rest) put P0 at distance R + d from the object's
 //     centre p1, with n . (p1 - p0) = 0;
-//  2. grasp (Eq. 4.7): c3 alone (c1, c2 held) bends the gripper until the circle fitted to its
-//     inextensible layer has the object's diameter 2R;
+//  2. grasp (Eq. 4.7): c3 alone (c1, c2 held), from `grasp_start`, bends the gripper until the
+//     circle fitted to its inextensible layer has the object's diameter 2R;
 //  3. place: c1, c2 (c3 held) bring P0 to R + d from the object's new centre p1t.
 //
 // Geometry (docs/ik.md, objectives): P0 is the centre of the end face of the second segment's
@@ -52,6 +52,10 @@ nlohmann::json RunIkPickAndPlace(const Config& cfg, const std::string& dir, bool
   // Stop rule of the three stages on O itself (mm^2): the stages' objectives are not distances
   // to one point, so lambda_mm (for point tracking) does not apply.
   const double stage_lambda = cfg.Number("stage_lambda", 0.04);
+  // Where the grasp stage starts c3: at rest the gripper is straight and its layer's circle fit is
+  // degenerate (two parallel rows of points), so it starts part-way (default: the middle of c3's
+  // range).
+  const double grasp_start = cfg.Number("grasp_start", -1.0);
   cfg.CheckNoUnknownKeys();
   if (!(R > 0)) cfg.Fail("object_radius", "a radius > 0 mm");
   if (!(d >= 0)) cfg.Fail("half_width", "a distance >= 0 mm");
@@ -170,7 +174,10 @@ nlohmann::json RunIkPickAndPlace(const Config& cfg, const std::string& dir, bool
   gp.object_diameter = 2 * R;
   gp.plane_normal = Eigen::Vector3d::UnitY();
   const GraspObjective grasp(names, gp);
-  Eigen::VectorXd c3_start = kin.rest().tail(1);
+  Eigen::VectorXd c3_start(1);
+  c3_start[0] = grasp_start >= 0 ? grasp_start : 0.5 * (kin.lower()[2] + kin.upper()[2]);
+  if (c3_start[0] < kin.lower()[2] || c3_start[0] > kin.upper()[2])
+    cfg.Fail("grasp_start", "a value of c3 inside its range");
   auto [c_grasp, j_grasp] = run_stage("grasp", gripper, c_pick, grasp, c3_start);
   {
     const KinematicsEval e = write_shape("grasp", c_grasp);
@@ -198,6 +205,7 @@ nlohmann::json RunIkPickAndPlace(const Config& cfg, const std::string& dir, bool
   nlohmann::json j = s.Json();
   j.erase("point");
   j["stage_lambda"] = stage_lambda;
+  j["grasp_start"] = c3_start[0];
   j["object"] = {{"radius_mm", R}, {"half_width_mm", d}, {"omega1", omega1},
                  {"pick_design_actuation", design}, {"center", V3(p1)}, {"place_center", V3(p1t)},
                  {"design_p0", V3(dp0)}, {"design_normal", V3(n)}};
