@@ -2,7 +2,7 @@
 //  1. pick (Eq. 4.5, 4.6): c1, c2 (gripper c3 at rest) put P0 at distance R + d from the object's
 //     centre p1, with n . (p1 - p0) = 0;
 //  2. grasp (Eq. 4.7): c3 alone (c1, c2 held), from `grasp_start`, bends the gripper until the
-//     circle fitted to its inextensible layer has the object's diameter 2R;
+//     circle fitted to its inextensible layer's inner surface has the object's diameter 2R;
 //  3. place: c1, c2 (c3 held) bring P0 to R + d from the object's new centre p1t.
 //
 // Geometry (docs/ik.md, objectives): P0 is the centre of the end face of the second segment's
@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 
 namespace softkin {
@@ -74,7 +75,22 @@ nlohmann::json RunIkPickAndPlace(const Config& cfg, const std::string& dir, bool
   const int vc = MarkerVertex(s.scene, pm, [](const Eigen::RowVector3d& x) { return x.y() - x.z(); });
   const std::string pa = "P0[" + std::to_string(va) + "]", pb = "P0[" + std::to_string(vb) + "]",
                     pc = "P0[" + std::to_string(vc) + "]";
-  SimulatorKinematics kin(s.scene, s.KinematicsFor({"P0", pa, pb, pc, "grip_layer[*]", "tip"}), &s.fk);
+  // The grasp circle is fitted to the layer's inner surface (its vertices at the lowest rest z): the
+  // surface that closes on the object. Fitting both faces of the thin layer at once makes the fit
+  // degenerate as the gripper straightens (two parallel rows), and the diameter then peaks
+  // (about 67 mm at c3 = 4.9 on res 6) instead of growing without bound.
+  const Marker& gm = s.scene.markers[mg];
+  double zmin = std::numeric_limits<double>::infinity();
+  for (int v : gm.vertices) zmin = std::min(zmin, s.scene.mesh.vertices(v, 2));
+  std::vector<std::string> points = {"P0", pa, pb, pc};
+  int inner_count = 0;
+  for (size_t i = 0; i < gm.vertices.size(); ++i)
+    if (std::abs(s.scene.mesh.vertices(gm.vertices[i], 2) - zmin) < 1e-9) {
+      points.push_back("grip_layer[" + std::to_string(i) + "]");
+      ++inner_count;
+    }
+  points.push_back("tip");
+  SimulatorKinematics kin(s.scene, s.KinematicsFor(points), &s.fk);
   const auto& names = kin.point_names();
   const int i0 = 0, ia = 1, ib = 2, ic = 3;
 
@@ -210,6 +226,7 @@ nlohmann::json RunIkPickAndPlace(const Config& cfg, const std::string& dir, bool
                  {"pick_design_actuation", design}, {"center", V3(p1)}, {"place_center", V3(p1t)},
                  {"design_p0", V3(dp0)}, {"design_normal", V3(n)}};
   j["normal_points"] = {pa, pb, pc};
+  j["grip_points"] = inner_count;
   j["stages"] = out;
   j["total_time_s"] = total_time;
   return j;
