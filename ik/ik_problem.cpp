@@ -21,6 +21,20 @@ double IkProblem::elapsed_s() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 
+bool IkProblem::Stalled(double o_prev, double o_now, double step, IkSummary* summary) const {
+  if (o_prev - o_now <= options_.function_tolerance * o_prev) {
+    summary->termination = IkTermination::kNoProgress;
+    summary->message = "relative decrease of O below function_tolerance";
+    return true;
+  }
+  if (step <= options_.parameter_tolerance) {
+    summary->termination = IkTermination::kNoProgress;
+    summary->message = "step below parameter_tolerance (fraction of the range)";
+    return true;
+  }
+  return false;
+}
+
 bool IkProblem::OutOfBudget(IkTermination* why, std::string* message) const {
   std::ostringstream s;
   if (evaluations_ >= options_.max_evaluations) {

@@ -46,6 +46,11 @@ class IkProblem {
   /// True when another evaluation would exceed max_evaluations or the time is up; *why says which.
   bool OutOfBudget(IkTermination* why, std::string* message) const;
   double elapsed_s() const;
+  /// The shared "no progress" stop of the descent methods after an accepted step: the objective
+  /// fell from o_prev to o_now by less than function_tolerance * o_prev, or the step (as a
+  /// fraction of the range) was below parameter_tolerance. Sets termination kNoProgress and the
+  /// message in *summary and returns true when it applies.
+  bool Stalled(double o_prev, double o_now, double step, IkSummary* summary) const;
 
   int evaluations() const { return evaluations_; }
   int jacobian_evaluations() const { return jacobian_evaluations_; }

@@ -124,16 +124,7 @@ IkResult SolveSoftLineSearch(Kinematics& kin, const Objective& objective,
     }
     S.history.push_back(cur.value);
     if (cur.value <= options.lambda) continue;  // reported as converged at the loop's top
-    if (o_prev - cur.value <= options.function_tolerance * o_prev) {
-      S.termination = IkTermination::kNoProgress;
-      S.message = "relative decrease of O below function_tolerance";
-      break;
-    }
-    if (step <= options.parameter_tolerance) {
-      S.termination = IkTermination::kNoProgress;
-      S.message = "step below parameter_tolerance (fraction of the range)";
-      break;
-    }
+    if (P.Stalled(o_prev, cur.value, step, &S)) break;
   }
   return P.Finish(c0, S);
 }
