@@ -11,7 +11,6 @@ Reads RESULTS_DIR/steps.csv and summary.json (written by
   right: contact region per material: vertices touching and the touching area.
 Exit status 2 with a message on stderr if a file is missing or malformed.
 """
-import math
 import os
 import sys
 
@@ -45,12 +44,7 @@ def main(argv):
         verts.append(contact.get("vertices", 0))
         areas.append(contact.get("area_mm2", 0.0))
     cfg = summary.get("config", {})
-    for o in cfg.get("obstacles", []):
-        if o.get("type") == "cylinder":
-            b, r = o["base"], o["radius"]
-            t = [2 * math.pi * k / 100 for k in range(101)]
-            ax0.plot([b[0] + r * math.cos(a) for a in t], [b[2] + r * math.sin(a) for a in t], "k-",
-                     lw=1.5, label="obstacle")
+    figlib.plot_cylinder_sections(ax0, cfg)
     ax0.set_xlabel("tip x (mm)")
     ax0.set_ylabel("tip z (mm)")
     ax0.set_aspect("equal", adjustable="datalim")

@@ -11,7 +11,6 @@ Reads RESULTS_DIR/steps.csv and summary.json (written by
          deepest penetration of the exact check, against the chamber volume ratio asked for.
 Exit status 2 with a message on stderr if a file is missing or malformed.
 """
-import math
 import os
 import sys
 
@@ -53,12 +52,7 @@ def main(argv):
                  label=f"{name}: vertices inside the cylinder")
         ax1b.plot(alpha, [r["max_penetration_mm"] for r in pts], "s--", color=c, alpha=0.6,
                   label=f"{name}: max penetration")
-    for o in cfg.get("obstacles", []):
-        if o.get("type") == "cylinder":
-            b, r = o["base"], o["radius"]
-            t = [2 * math.pi * k / 100 for k in range(101)]
-            ax0.plot([b[0] + r * math.cos(a) for a in t], [b[2] + r * math.sin(a) for a in t], "k-",
-                     lw=1.5, label="obstacle")
+    figlib.plot_cylinder_sections(ax0, cfg)
     ax0.plot([-10, 10, 10, -10, -10], [0, 0, 100, 100, 0], ":", color="gray", label="robot at rest")
     ax0.set_xlabel("tip x (mm)")
     ax0.set_ylabel("tip z (mm)")

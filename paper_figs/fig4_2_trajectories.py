@@ -12,7 +12,6 @@ RESULTS_DIR/fig4_2_trajectories.png, one row per path:
          thesis's.
 Exit status 2 with a message on stderr if a file is missing or malformed.
 """
-import os
 import sys
 
 import figlib
@@ -22,11 +21,7 @@ NAME = "fig4_2_trajectories"
 
 def main(argv):
     results = figlib.results_dir(NAME, argv, __doc__)
-    summary = figlib.read_summary(NAME, os.path.join(results, "summary.json"))
-    paths = summary.get("paths")
-    if not isinstance(paths, list) or not paths:
-        figlib.fail(NAME, f"{results}/summary.json: expected a non-empty 'paths' list")
-    samples = figlib.read_samples(NAME, os.path.join(results, "samples.csv"))
+    summary, paths, samples = figlib.read_ik_paths(NAME, results)
 
     import matplotlib
     matplotlib.use("Agg")
@@ -36,7 +31,7 @@ def main(argv):
     fig, axes = plt.subplots(len(paths), 2, figsize=(12, 4.6 * len(paths)), squeeze=False)
     for row, p in enumerate(paths):
         name = p.get("name", "?")
-        w = figlib.read_waypoints(NAME, os.path.join(results, f"path_{name}.csv"))
+        w = figlib.read_path_waypoints(NAME, results, p)
         ax, ax2 = axes[row]
         ax.plot([s["x"] for s in samples], [s["z"] for s in samples], ".", color="0.8", ms=4,
                 label="configuration-space samples")

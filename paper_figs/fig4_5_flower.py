@@ -10,7 +10,6 @@ RESULTS_DIR/path_<name>.csv and RESULTS_DIR/samples.csv. Writes RESULTS_DIR/fig4
   (c) the error per waypoint (mm) and (d) the IK time per waypoint (s), with the thesis's values.
 Exit status 2 with a message on stderr if a file is missing or malformed.
 """
-import os
 import sys
 
 import figlib
@@ -20,13 +19,9 @@ NAME = "fig4_5_flower"
 
 def main(argv):
     results = figlib.results_dir(NAME, argv, __doc__)
-    summary = figlib.read_summary(NAME, os.path.join(results, "summary.json"))
-    paths = summary.get("paths")
-    if not isinstance(paths, list) or not paths:
-        figlib.fail(NAME, f"{results}/summary.json: expected a non-empty 'paths' list")
-    samples = figlib.read_samples(NAME, os.path.join(results, "samples.csv"))
+    summary, paths, samples = figlib.read_ik_paths(NAME, results)
     p = paths[0]
-    w = figlib.read_waypoints(NAME, os.path.join(results, f"path_{p.get('name', '?')}.csv"))
+    w = figlib.read_path_waypoints(NAME, results, p)
     ok = [r for r in w if r["error_mm"] >= 0]
 
     import matplotlib

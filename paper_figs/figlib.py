@@ -2,6 +2,7 @@
 line and what was expected, and the script exits with status 2."""
 import csv
 import json
+import math
 import os
 import sys
 
@@ -130,3 +131,30 @@ def read_waypoints(name, path):
 def read_samples(name, path):
     """The configuration-space samples (c0.., x, y, z) an IK experiment wrote."""
     return read_table(name, path, ["x", "y", "z"], min_rows=1)
+
+
+def read_ik_paths(name, results):
+    """The summary, its non-empty 'paths' list and the configuration-space samples of an IK
+    trajectory experiment (fig4_2, fig4_3, fig4_5)."""
+    summary = read_summary(name, os.path.join(results, "summary.json"))
+    paths = summary.get("paths")
+    if not isinstance(paths, list) or not paths:
+        fail(name, f"{results}/summary.json: expected a non-empty 'paths' list")
+    samples = read_samples(name, os.path.join(results, "samples.csv"))
+    return summary, paths, samples
+
+
+def read_path_waypoints(name, results, path):
+    """The waypoint rows of one path entry of an IK experiment's summary (path_<name>.csv)."""
+    return read_waypoints(name, os.path.join(results, f"path_{path.get('name', '?')}.csv"))
+
+
+def plot_cylinder_sections(ax, config):
+    """Draws the x-z cross-section of every cylinder obstacle of an experiment config (axis along
+    y) on ax, labelled 'obstacle'."""
+    for o in config.get("obstacles", []):
+        if o.get("type") == "cylinder":
+            b, r = o["base"], o["radius"]
+            t = [2 * math.pi * k / 100 for k in range(101)]
+            ax.plot([b[0] + r * math.cos(a) for a in t], [b[2] + r * math.sin(a) for a in t], "k-",
+                    lw=1.5, label="obstacle")
