@@ -136,7 +136,10 @@ def read_samples(name, path):
 def read_ik_paths(name, results):
     """The summary, its non-empty 'paths' list and the configuration-space samples of an IK
     trajectory experiment (fig4_2, fig4_3, fig4_5)."""
-    summary = read_summary(name, os.path.join(results, "summary.json"))
+    path = os.path.join(results, "summary.json")
+    if not os.path.isfile(path):
+        fail(name, f"{path}: missing (run the experiment first)")
+    summary = read_summary(name, path)
     paths = summary.get("paths")
     if not isinstance(paths, list) or not paths:
         fail(name, f"{results}/summary.json: expected a non-empty 'paths' list")
