@@ -239,6 +239,7 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
     int iterations = 0, failed = 0;
     FkResult last;
     CollisionCheck last_check;
+    std::vector<ContactPatch> patches;  // per obstacle, at the last step
     nlohmann::json tips = nlohmann::json::array();
     for (int s = 1; s <= steps; ++s) {
       const double t = double(s) / steps;
@@ -260,10 +261,11 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
       // The contact region with every obstacle (vertices within contact_distance_mm, area).
       int touch = 0;
       double touch_area = 0.0;
+      patches.clear();
       for (const auto& o : probe.obstacles()) {
-        const ContactPatch cp = MeasureContact(o, scene.mesh, X, contact_dist);
-        touch += cp.vertices;
-        touch_area += cp.area_mm2;
+        patches.push_back(MeasureContact(o, scene.mesh, X, contact_dist));
+        touch += patches.back().vertices;
+        touch_area += patches.back().area_mm2;
       }
       csv.RowStrings({name, std::to_string(s), std::to_string(t), std::to_string(P(tip, 0)),
                       std::to_string(P(tip, 1)), std::to_string(P(tip, 2)), std::to_string(ang),
@@ -318,8 +320,7 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
     jv["collision_share"] = total_s > 0 ? (check_s + resp_s) / total_s : 0.0;
     if (!obstacles.empty()) {
       nlohmann::json contacts = nlohmann::json::array();
-      for (const auto& o : probe.obstacles()) {
-        const ContactPatch cp = MeasureContact(o, scene.mesh, X, contact_dist);
+      for (const ContactPatch& cp : patches) {
         contacts.push_back({{"vertices", cp.vertices}, {"extent_x_mm", cp.extent_mm}, {"area_mm2", cp.area_mm2}});
       }
       jv["contact"] = contacts;
