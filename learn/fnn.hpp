@@ -56,7 +56,8 @@
 
 namespace softkin {
 
-/// Eq. 5.7: tansig(n) = 2 / (1 + exp(-2 n)) - 1 (= tanh(n)).
+/// Eq. 5.7: tansig(n) = 2 / (1 + exp(-2 n)) - 1 (= tanh(n) to a few 1e-16 absolute; the network
+/// evaluates this form, vectorised).
 double Tansig(double n);
 
 /// Per-row min-max map of vectors of length size() to [-1, 1] (MATLAB mapminmax, see the file

@@ -16,9 +16,14 @@ using test::NearMatrix;
 
 TEST(Fnn, TansigIsEquation57) {
   for (double n : {-30.0, -3.0, -0.7, -1e-3, 0.0, 1e-3, 0.25, 1.0, 4.0, 30.0})
-    EXPECT_NEAR(Tansig(n), 2.0 / (1.0 + std::exp(-2.0 * n)) - 1.0, 1e-15) << n;
+    EXPECT_NEAR(Tansig(n), std::tanh(n), 1e-15) << n;
   EXPECT_EQ(Tansig(0.0), 0.0);
-  EXPECT_EQ(Tansig(-0.5), -Tansig(0.5));
+  EXPECT_NEAR(Tansig(-0.5), -Tansig(0.5), 1e-16);
+  // The network's vectorised form is the same function: a 1-1 network with unit weights is tansig.
+  Fnn net({1, 1, 1});
+  net.set_parameters(Eigen::Vector4d(1.0, 0.0, 1.0, 0.0));  // W1, b1, W2, b2
+  for (double n : {-0.9, -0.3, 0.0, 0.2, 0.8})  // identity maps: inputs and outputs in [-1, 1]
+    EXPECT_NEAR(net.Forward(Eigen::VectorXd::Constant(1, n))(0), std::tanh(n), 1e-15) << n;
 }
 
 TEST(MinMaxMap, FitMapsTheRangeToMinusOneOne) {

@@ -1,0 +1,148 @@
+// The learned-network kernels (issue 7 targets): one forward pass (one input, and a batch), the
+// input Jacobian, one Levenberg-Marquardt epoch, and the time the Ceres peer needs to reach the
+// loss the in-house trainer reaches. Networks have the thesis's three_chamber architecture
+// (3 -> 35 -> 35 -> n_out, h = 2, b = 35, §5.3.4); data come from the analytical PCC finger
+// (3 actuators): n_out = 3 is N_fk (tip position), 9 the tip Jacobian (N_J), 27 the Jacobian of
+// three tracked points. Training sets have 4096 x 0.7 = 2867 samples (16^3 grid, 70 % split).
+#include "ik/pcc_kinematics.hpp"
+#include "learn/ceres_trainer.hpp"
+#include "learn/lm_trainer.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <random>
+
+namespace softkin {
+namespace {
+
+// `n` random actuations and the PCC outputs: tip (n_out = 3) or the first n_out / 3 rows of J.
+SampleSet PccData(int n, int n_out, unsigned seed) {
+  PccKinematics pcc;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, pcc.params().max_pull);
+  SampleSet s;
+  s.X.resize(n, 3);
+  s.Y.resize(n, n_out);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d c(u(rng), u(rng), u(rng));
+    const KinematicsEval e = pcc.Evaluate(c, n_out > 3);
+    s.X.row(i) = c.transpose();
+    if (n_out == 3) {
+      s.Y.row(i) = e.p.row(0);
+    } else {
+      const Eigen::MatrixXd Jr = e.J.topRows(n_out / 3);  // (n_out/3) x 3, flattened row by row
+      for (int r = 0; r < Jr.rows(); ++r) s.Y.block(i, 3 * r, 1, 3) = Jr.row(r);
+    }
+  }
+  return s;
+}
+
+Fnn ThreeChamberNet(const SampleSet& data, int n_out) {
+  Fnn net({3, 35, 35, n_out});
+  net.FitNormalization(data.X, data.Y);
+  net.InitializeNguyenWidrow(1);
+  return net;
+}
+
+void BM_FnnForwardOne(benchmark::State& state) {
+  const SampleSet data = PccData(64, 3, 1);
+  const Fnn net = ThreeChamberNet(data, 3);
+  FnnWorkspace ws;
+  Eigen::VectorXd y(3);
+  Eigen::VectorXd x = data.X.row(5).transpose();
+  for (auto _ : state) {
+    net.Forward(x, ws, y);
+    benchmark::DoNotOptimize(y.data());
+  }
+}
+BENCHMARK(BM_FnnForwardOne)->Unit(benchmark::kMicrosecond);
+
+void BM_FnnForwardBatch(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const SampleSet data = PccData(n, 3, 2);
+  const Fnn net = ThreeChamberNet(data, 3);
+  for (auto _ : state) {
+    Eigen::MatrixXd Y = net.ForwardBatch(data.X);
+    benchmark::DoNotOptimize(Y.data());
+  }
+  state.SetItemsProcessed(state.iterations() * n);
+}
+BENCHMARK(BM_FnnForwardBatch)->Arg(4096)->Unit(benchmark::kMicrosecond);
+
+void BM_FnnInputJacobian(benchmark::State& state) {
+  const int n_out = static_cast<int>(state.range(0));
+  const SampleSet data = PccData(64, n_out, 3);
+  const Fnn net = ThreeChamberNet(data, n_out);
+  FnnWorkspace ws;
+  Eigen::VectorXd y(n_out);
+  Eigen::MatrixXd J(n_out, 3);
+  const Eigen::VectorXd x = data.X.row(7).transpose();
+  for (auto _ : state) {
+    net.InputJacobian(x, ws, y, J);
+    benchmark::DoNotOptimize(J.data());
+  }
+}
+BENCHMARK(BM_FnnInputJacobian)->Arg(3)->Arg(9)->Unit(benchmark::kMicrosecond);
+
+// One LM epoch (accumulate J^T J and J^T e, then as many Cholesky solves as mu needs) after the
+// initial loss evaluation. Args: n_out, threads.
+void BM_LmEpoch(benchmark::State& state) {
+  const int n_out = static_cast<int>(state.range(0));
+  const int threads = static_cast<int>(state.range(1));
+  const SampleSet data = PccData(2867, n_out, 4);
+  LmOptions o;
+  o.max_epochs = 1;
+  o.num_threads = threads;
+  LmSummary s;
+  for (auto _ : state) {
+    Fnn net({3, 35, 35, n_out});
+    s = TrainLevenbergMarquardt(net, data, nullptr, o);
+    benchmark::DoNotOptimize(s.train_mse.data());
+  }
+  state.counters["W"] = s.num_parameters;
+  state.counters["solves"] = s.accepted_steps + s.rejected_steps;
+  state.counters["threads"] = s.num_threads;
+  state.SetLabel("3-35-35-" + std::to_string(n_out) + ", 2867 samples");
+}
+BENCHMARK(BM_LmEpoch)
+    ->Args({3, 1})
+    ->Args({3, 2})
+    ->Args({9, 2})
+    ->Args({27, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(2);
+
+// Time to the same training loss: the in-house trainer runs `epochs` epochs (range 0) on N_fk
+// data; Ceres (dense normal Cholesky, 2 threads) starts from the same network and stops at the
+// loss LM reached. Counters: both times (set-up included), their ratio, the losses.
+void BM_PeerTimeToLoss(benchmark::State& state) {
+  const int epochs = static_cast<int>(state.range(0));
+  const SampleSet data = PccData(2867, 3, 5);
+  for (auto _ : state) {
+    Fnn lm_net({3, 35, 35, 3});
+    LmOptions lo;
+    lo.max_epochs = epochs;
+    lo.num_threads = 2;
+    lo.min_grad = 0.0;
+    const LmSummary ls = TrainLevenbergMarquardt(lm_net, data, nullptr, lo);
+    Fnn ceres_net({3, 35, 35, 3});
+    CeresFitOptions co;
+    co.target_mse = ls.final_train_mse;
+    co.max_iterations = 20 * epochs;
+    co.num_threads = 2;
+    const CeresFitSummary cs = FitFnnWithCeres(ceres_net, data, co);
+    state.counters["lm_s"] = ls.total_time_s;
+    state.counters["ceres_s"] = cs.reached_target ? cs.time_to_target_s : cs.total_time_s;
+    state.counters["ratio"] = state.counters["ceres_s"] / ls.total_time_s;
+    state.counters["lm_mse"] = ls.final_train_mse;
+    state.counters["ceres_mse"] = cs.final_mse;
+    state.counters["ceres_iters"] = cs.iterations;
+    state.counters["reached"] = cs.reached_target ? 1 : 0;
+  }
+}
+BENCHMARK(BM_PeerTimeToLoss)->Arg(20)->Unit(benchmark::kSecond)->Iterations(1);
+
+}  // namespace
+}  // namespace softkin
+
+BENCHMARK_MAIN();
