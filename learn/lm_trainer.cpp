@@ -1,6 +1,7 @@
 #include "learn/lm_trainer.hpp"
 
-#include <Eigen/Cholesky>
+#include "learn/tiled_cholesky.hpp"
+
 #include <omp.h>
 
 #include <algorithm>
@@ -17,6 +18,7 @@ namespace {
 
 constexpr int kSubBlock = 16;     // samples per parallel Jacobian task (fixed: results do not depend on threads)
 constexpr int kTile = 64;         // columns of H per parallel product task
+constexpr int kCholeskyTile = 128;  // tile of the damped normal matrix's factorisation
 constexpr double kMuMin = 1e-20;  // trainlm's floor on mu
 
 using Clock = std::chrono::steady_clock;
@@ -222,7 +224,6 @@ LmSummary TrainLevenbergMarquardt(Fnn& net, const SampleSet& train, const Sample
   Eigen::VectorXd g(W), delta(W);
   Eigen::MatrixXd Jt(W, static_cast<Eigen::Index>(bs) * nL);
   Eigen::MatrixXd Zb(nL, bs);
-  Eigen::LLT<Eigen::MatrixXd> llt(W);
   const int ntiles = (W + kTile - 1) / kTile;
 
   auto progress = [&](int epoch, bool force) {
@@ -291,9 +292,9 @@ LmSummary TrainLevenbergMarquardt(Fnn& net, const SampleSet& train, const Sample
     while (mu <= options.mu_max) {
       A.triangularView<Eigen::Lower>() = H.triangularView<Eigen::Lower>();
       A.diagonal().array() += mu;
-      llt.compute(A);
-      if (llt.info() == Eigen::Success) {
-        delta = llt.solve(g);
+      if (TiledCholeskyInPlace(A, kCholeskyTile, nt)) {
+        delta = g;
+        TiledCholeskySolveInPlace(A, delta);
         trial.set_parameters(w + delta);
         const double trial_loss = mse_of(trial, tr);
         if (std::isfinite(trial_loss) && trial_loss < loss) {

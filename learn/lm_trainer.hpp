@@ -9,7 +9,8 @@
 /// whatever its unit (trainlm's default measures errors in target units instead).
 ///
 /// One epoch (as trainlm): with J = dz/dw over all training samples (N n_L x W) and e = t - z,
-/// accumulate H = J^T J and g = J^T e; then repeat { solve (H + mu I) delta = g (Cholesky);
+/// accumulate H = J^T J and g = J^T e; then repeat { solve (H + mu I) delta = g (tiled Cholesky,
+/// learn/tiled_cholesky.hpp);
 /// evaluate mse(w + delta); if it is lower, accept, mu *= mu_dec, end the epoch; else mu *= mu_inc }
 /// until mu > mu_max. The training loss therefore never increases: it is recorded per epoch in
 /// LmSummary::train_mse.
