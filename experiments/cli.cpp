@@ -1,6 +1,7 @@
 #include "experiments/cli.hpp"
 
 #include "experiments/cli_args.hpp"
+#include "experiments/cli_dataset.hpp"
 #include "experiments/cli_ik.hpp"
 #include "experiments/results.hpp"
 #include "experiments/runner.hpp"
@@ -147,6 +148,10 @@ int RunCli(int argc, char** argv) {
   // ik (experiments/cli_ik.cpp)
   IkCommandArgs ik_args;
   auto* ik_cmd = AddIkCommand(&app, &ik_args);
+
+  // dataset (experiments/cli_dataset.cpp)
+  DatasetCommandArgs ds_args;
+  auto* ds_cmd = AddDatasetCommand(&app, &ds_args);
 
   try {
     app.parse(argc, argv);
@@ -303,6 +308,11 @@ int RunCli(int argc, char** argv) {
       return 0;
     }
     if (ik_cmd->parsed()) return RunIkCommand(ik_args);
+    if (ds_cmd->parsed()) {
+      std::string command_line;
+      for (int i = 0; i < argc; ++i) command_line += (i ? " " : "") + std::string(argv[i]);
+      return RunDatasetCommand(ds_args, command_line);
+    }
     if (run->parsed()) {
       ropt.plot = !no_plot;
       RunExperiment(config, ropt);

@@ -163,7 +163,7 @@ constexpr double kThreeRadius = 24.0, kThreeLength = 136.0;
 constexpr double kChamberRadius = 7.0, kChamberOffset = 13.0, kChamberY0 = 8.0, kChamberY1 = 128.0;
 constexpr double kChamberAngle0 = 180.0;  // degrees, chamber 0 (c1)
 
-Scene MakeThreeChamber(int res) {
+Scene MakeThreeChamber(int res, double chamber_radius) {
   DiskExtrusion p;
   p.radius = kThreeRadius;
   p.rings = res;
@@ -177,11 +177,11 @@ Scene MakeThreeChamber(int res) {
     const double a = (kChamberAngle0 + 120.0 * k) * pi / 180.0;
     centre[k] = kChamberOffset * Eigen::Vector2d(std::cos(a), std::sin(a));
   }
-  auto region = [&centre](const DiskElementInfo& e) {
+  auto region = [&centre, chamber_radius](const DiskElementInfo& e) {
     const Eigen::Vector3d& c = e.canonical_centroid;
     if (c.y() < kChamberY0 || c.y() > kChamberY1) return 0;
     for (int k = 0; k < 3; ++k)
-      if ((Eigen::Vector2d(c.x(), c.z()) - centre[k]).norm() <= kChamberRadius)
+      if ((Eigen::Vector2d(c.x(), c.z()) - centre[k]).norm() <= chamber_radius)
         return 1 + (k + e.sector) % 3;
     return 0;
   };
@@ -888,7 +888,9 @@ struct RobotEntry {
 };
 
 Scene MakePneumaticFingerP(int res, const RobotParams&) { return MakePneumaticFinger(res); }
-Scene MakeThreeChamberP(int res, const RobotParams&) { return MakeThreeChamber(res); }
+Scene MakeThreeChamberP(int res, const RobotParams& P) {
+  return MakeThreeChamber(res, P.at("chamber_radius"));
+}
 Scene MakeCableFingerP(int res, const RobotParams&) { return MakeCableFinger(res); }
 
 const std::vector<RobotEntry>& Registry() {
@@ -914,7 +916,10 @@ const std::vector<RobotEntry>& Registry() {
         "(top face y = 136).",
         kThreeDefaultRes,
         "number of concentric rings of the cross-section disk (radial spacing 24/res mm; layers "
-        "along y of about the same size), integer in [3, 16]; ~102 res^3 tets", {}},
+        "along y of about the same size), integer in [3, 16]; ~102 res^3 tets",
+        {{"chamber_radius", kChamberRadius, 5.0, 9.0,
+          "chamber radius, mm (the outer wall is 24 - 13 - radius thick: 4 mm at the default 7); "
+          "chamber elements are the tets whose centroid lies within it"}}},
        kThreeMinRes, kThreeMaxRes, &MakeThreeChamberP},
       {{"cable_finger",
         "Cable-driven finger (thesis Fig. 2.8, Fig. 4.1): 120 x 25 x 25 mm, four teeth on a 5 mm "

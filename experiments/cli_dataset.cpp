@@ -1,0 +1,210 @@
+#include "experiments/cli_dataset.hpp"
+
+#include "experiments/cli_args.hpp"
+#include "experiments/results.hpp"
+#include "ik/simulator_kinematics.hpp"
+#include "learn/dataset.hpp"
+#include "learn/twin.hpp"
+#include "solver/robots.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+namespace softkin {
+
+CLI::App* AddDatasetCommand(CLI::App* app, DatasetCommandArgs* a) {
+  auto* ds = app->add_subcommand(
+      "dataset",
+      "Generate a learning dataset (thesis Sec. 5.3.2): evaluate a robot's simulator, or a "
+      "'hardware' twin, on a grid of N^m actuations visited in serpentine order (each sample one "
+      "grid step from the previous, so the simulator warm-starts next to its answer) or on seeded "
+      "random actuations. Writes a CSV (index, status, c0.., <point>_x/_y/_z, J_<point>_<coord>_c<a> "
+      "with --jacobian, message), one line per sample as it is computed, and a sidecar FILE.json "
+      "(robot, res, params, points, sampling, git commit; twin label). Running the same command "
+      "again on a partial file resumes it; --shard k/n computes the k-th of n contiguous slices; "
+      "--merge joins the shards. Exit 0 when every sample succeeded, 1 when some were recorded as "
+      "failed, 2 for bad input. Units: mm. See docs/datasets.md");
+  auto* o_robot = ds->add_option("--robot", a->robot, "Embedded robot name (see `softkin robots`)");
+  auto* o_twin = ds->add_option("--twin", a->twin,
+                                "A 'hardware' twin (docs/twins.md): " + [] {
+                                  std::string s;
+                                  for (const auto& n : TwinNames()) s += (s.empty() ? "" : ", ") + n;
+                                  return s;
+                                }());
+  o_robot->excludes(o_twin);
+  ds->add_option("--res", a->res, "Robot resolution (default: the robot's own)");
+  ds->add_option("--param", a->params,
+                 "Robot design parameter NAME=VALUE (repeatable; see `softkin robots`)")
+      ->needs(o_robot);
+  auto* o_grid = ds->add_option("--grid", a->grid, "N samples per actuator: a grid of N^m (default 16)");
+  auto* o_random = ds->add_option("--random", a->random, "Number of uniform random samples");
+  o_grid->excludes(o_random);
+  ds->add_option("--seed", a->seed, "Seed of --random (required with it)")->needs(o_random);
+  ds->add_option("--block", a->block,
+                 "Warm-start block: the simulator restarts from rest every this many samples, so "
+                 "a resumed or sharded run equals an uninterrupted one bit for bit (default 64)");
+  ds->add_option("--points", a->points,
+                 "Tracked points, comma-separated markers (or marker[i]) of the robot (default tip)");
+  ds->add_option("--jacobian", a->jacobian,
+                 "Record J = dp/dc too: none (default), implicit (exact, cheapest), fd, fd-warm "
+                 "(a twin has none)");
+  ds->add_option("--shard", a->shard, "Compute shard k of n (k = 0..n-1): a contiguous slice of "
+                                      "the serpentine order, into its own --out file");
+  ds->add_option("--gradient-tolerance", a->gradient_tolerance,
+                 "Forward solves stop when the energy gradient falls below this fraction of its "
+                 "starting value (default: the scene's)");
+  ds->add_option("--merge", a->merge, "Merge these complete shard files (all n of them) into --out")
+      ->expected(1, -1);
+  ds->add_option("--out", a->out, "Output CSV (its sidecar is FILE.json)")->required();
+  ds->add_flag("--quiet", a->quiet, "No progress on stderr");
+  return ds;
+}
+
+namespace {
+
+std::vector<std::string> SplitComma(const std::string& s, const std::string& option) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (item.empty()) throw std::invalid_argument(option + ": empty item in '" + s + "'");
+    else out.push_back(item);
+  if (out.empty() || s.back() == ',') throw std::invalid_argument(option + ": expected comma-separated names, got '" + s + "'");
+  return out;
+}
+
+int DefaultResolution(const std::string& robot) {
+  for (const auto& r : ListRobots())
+    if (r.name == robot) return r.default_resolution;
+  return 0;
+}
+
+}  // namespace
+
+int RunDatasetCommand(const DatasetCommandArgs& a, const std::string& command_line) {
+  if (!a.merge.empty()) {
+    if (!a.robot.empty() || !a.twin.empty() || !a.shard.empty())
+      throw std::invalid_argument("--merge: give only the shard files and --out");
+    const long long n = MergeDatasets(a.merge, a.out);
+    if (!a.quiet)
+      std::cerr << "softkin dataset: merged " << a.merge.size() << " shard(s), " << n
+                << " samples, into " << a.out << "\n";
+    return 0;
+  }
+  if (a.robot.empty() == a.twin.empty())
+    throw std::invalid_argument("dataset: give exactly one of --robot NAME or --twin NAME");
+  if (a.res < 0) throw std::invalid_argument("--res: expected a positive integer");
+  DatasetSampling sampling;
+  if (a.random != 0) {
+    if (a.random < 1)
+      throw std::invalid_argument("--random: expected a number of samples >= 1, got " + std::to_string(a.random));
+    if (a.seed < 0) throw std::invalid_argument("--seed: required with --random (an integer >= 0)");
+    sampling.kind = DatasetSampling::Kind::kRandom;
+    sampling.random = a.random;
+    sampling.seed = static_cast<std::uint64_t>(a.seed);
+  } else {
+    sampling.grid = a.grid == 0 ? 16 : a.grid;
+    if (sampling.grid < 2 || sampling.grid > 1000)
+      throw std::invalid_argument("--grid: expected N in [2, 1000] samples per actuator, got " +
+                                  std::to_string(sampling.grid));
+  }
+  if (a.block < 1) throw std::invalid_argument("--block: expected an integer >= 1, got " + std::to_string(a.block));
+  sampling.block = a.block;
+  const bool with_j = a.jacobian != "none";
+  SimulatorKinematicsOptions ko;
+  if (with_j && !JacobianModeFromString(a.jacobian, &ko.jacobian))
+    throw std::invalid_argument("--jacobian: unknown mode '" + a.jacobian +
+                                "' (expected none, " + JacobianModeNames() + ")");
+  if (!a.twin.empty() && with_j)
+    throw std::invalid_argument("--jacobian: a twin gives positions only (hardware has no "
+                                "Jacobian); use --jacobian none with --twin");
+  if (a.gradient_tolerance < 0 || !std::isfinite(a.gradient_tolerance))
+    throw std::invalid_argument("--gradient-tolerance: expected a fraction > 0");
+  DatasetRunOptions run;
+  run.out = a.out;
+  run.jacobian = with_j;
+  run.progress = !a.quiet;
+  if (!a.shard.empty()) {
+    int k = -1, n = -1;
+    char tail = 0;
+    if (std::sscanf(a.shard.c_str(), "%d/%d%c", &k, &n, &tail) != 2 || n < 1 || k < 0 || k >= n)
+      throw std::invalid_argument("--shard: expected k/n with integers 0 <= k < n, got '" + a.shard + "'");
+    run.shard = k;
+    run.shards = n;
+  }
+  const std::vector<std::string> points = SplitComma(a.points, "--points");
+
+  std::unique_ptr<Kinematics> kin;
+  nlohmann::json source;
+  if (!a.robot.empty()) {
+    const RobotParams params = ParseRobotParams(a.params);
+    const Scene scene = MakeRobot(a.robot, a.res, params);
+    FkOptions fk = scene.solver;
+    if (a.gradient_tolerance > 0) fk.gradient_tolerance = a.gradient_tolerance;
+    std::string why;
+    if (!fk.IsValid(&why)) throw std::invalid_argument("--gradient-tolerance: " + why);
+    ko.points = points;
+    std::unique_ptr<SimulatorKinematics> sim;
+    try {
+      sim = std::make_unique<SimulatorKinematics>(scene, ko, &fk);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("--points / --jacobian: ") + e.what());
+    }
+    SimulatorKinematics* raw = sim.get();
+    run.reset = [raw] { raw->Reset(); };
+    nlohmann::json pj = nlohmann::json::object();
+    for (const auto& [k, v] : params) pj[k] = v;
+    source = {{"kind", "robot"}, {"robot", a.robot},
+              {"res", a.res > 0 ? a.res : DefaultResolution(a.robot)}, {"params", pj},
+              {"fk_solver", fk.solver}, {"gradient_tolerance", fk.gradient_tolerance},
+              {"jacobian_mode", with_j ? a.jacobian : "none"}};
+    kin = std::move(sim);
+  } else {
+    const TwinSpec spec = GetTwinSpec(a.twin);
+    TwinOptions to;
+    to.res = a.res;
+    to.points = points;
+    if (a.gradient_tolerance > 0)
+      throw std::invalid_argument("--gradient-tolerance: not supported with --twin (the twin "
+                                  "solves with its robot's own settings)");
+    std::unique_ptr<TwinKinematics> twin;
+    try {
+      twin = std::make_unique<TwinKinematics>(spec, to);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("--twin / --points: ") + e.what());
+    }
+    TwinKinematics* raw = twin.get();
+    run.reset = [raw] { raw->Reset(); };
+    source = {{"kind", "twin"}, {"twin", "twin:" + spec.name}, {"robot", spec.robot},
+              {"res", a.res > 0 ? a.res : DefaultResolution(spec.robot)},
+              {"twin_doc", spec.doc}, {"noise_sigma_mm", spec.noise_sigma_mm},
+              {"noise_seed", spec.noise_seed}};
+    kin = std::move(twin);
+  }
+  run.source = source;
+  run.provenance = {{"git_commit", GitCommit()}, {"command", command_line}};
+
+  const long long total = DatasetSize(sampling, kin->num_actuators());
+  if (!a.quiet)
+    std::cerr << "softkin dataset: " << kin->name() << " of "
+              << (a.robot.empty() ? a.twin : a.robot) << ", " << total << " samples"
+              << (run.shards > 1 ? " (shard " + a.shard + ")" : "") << ", points " << a.points
+              << ", jacobian " << a.jacobian << " -> " << a.out << "\n";
+  const DatasetRunSummary s = GenerateDataset(*kin, sampling, run);
+  if (!a.quiet) {
+    char line[300];
+    std::snprintf(line, sizeof line,
+                  "softkin dataset: samples [%lld, %lld): %lld already in the file, %lld written "
+                  "(%lld failed) in %.1f s (%.1f ms/sample, %lld forward solves)\n",
+                  s.first, s.first + s.count, s.already, s.written, s.failed, s.time_s,
+                  s.written > 0 ? 1e3 * s.time_s / s.written : 0.0, s.fk_solves);
+    std::cerr << line;
+  }
+  return s.failed > 0 ? 1 : 0;
+}
+
+}  // namespace softkin
