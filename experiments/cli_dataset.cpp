@@ -168,9 +168,7 @@ int RunDatasetCommand(const DatasetCommandArgs& a, const std::string& command_li
     TwinOptions to;
     to.res = a.res;
     to.points = points;
-    if (a.gradient_tolerance > 0)
-      throw std::invalid_argument("--gradient-tolerance: not supported with --twin (the twin "
-                                  "solves with its robot's own settings)");
+    to.gradient_tolerance = a.gradient_tolerance;
     std::unique_ptr<TwinKinematics> twin;
     try {
       twin = std::make_unique<TwinKinematics>(spec, to);
@@ -182,6 +180,7 @@ int RunDatasetCommand(const DatasetCommandArgs& a, const std::string& command_li
     source = {{"kind", "twin"}, {"twin", "twin:" + spec.name}, {"robot", spec.robot},
               {"res", a.res > 0 ? a.res : DefaultResolution(spec.robot)},
               {"twin_doc", spec.doc}, {"noise_sigma_mm", spec.noise_sigma_mm},
+              {"gradient_tolerance", twin->simulator().fk_options().gradient_tolerance},
               {"noise_seed", spec.noise_seed}};
     kin = std::move(twin);
   }

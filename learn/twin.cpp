@@ -110,7 +110,12 @@ TwinKinematics::TwinKinematics(const TwinSpec& spec, const TwinOptions& options)
   SimulatorKinematicsOptions ko;
   ko.points = options.points;
   ko.jacobian = JacobianMode::kFdWarm;  // never used: a twin gives no Jacobian
-  sim_ = std::make_unique<SimulatorKinematics>(MakeTwinScene(spec, options.res), ko);
+  const Scene scene = MakeTwinScene(spec, options.res);
+  FkOptions fk = scene.solver;
+  if (options.gradient_tolerance > 0) fk.gradient_tolerance = options.gradient_tolerance;
+  std::string why;
+  if (!fk.IsValid(&why)) throw std::invalid_argument("twin " + spec.name + ": gradient_tolerance: " + why);
+  sim_ = std::make_unique<SimulatorKinematics>(scene, ko, &fk);
 }
 
 double TwinKinematics::Noise(const Eigen::Ref<const Eigen::VectorXd>& c, int q, int d) const {

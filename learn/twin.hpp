@@ -54,6 +54,8 @@ struct TwinOptions {
   std::vector<std::string> points;
   bool noise = true;                ///< add the measurement noise (false: for calibration checks)
   bool offset = true;               ///< add the marker offset
+  /// Forward-solve gradient tolerance (FkOptions::gradient_tolerance; 0: the robot's own).
+  double gradient_tolerance = 0.0;
 };
 
 class TwinKinematics : public Kinematics {
