@@ -164,7 +164,12 @@ int RunDatasetCommand(const DatasetCommandArgs& a, const std::string& command_li
               {"jacobian_mode", with_j ? a.jacobian : "none"}};
     kin = std::move(sim);
   } else {
-    const TwinSpec spec = GetTwinSpec(a.twin);
+    TwinSpec spec;
+    try {
+      spec = GetTwinSpec(a.twin);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("--twin: ") + e.what());
+    }
     TwinOptions to;
     to.res = a.res;
     to.points = points;

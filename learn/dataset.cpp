@@ -167,20 +167,27 @@ void WriteSidecar(const std::string& csv, const nlohmann::json& j) {
   fs::rename(tmp, path);
 }
 
-/// First key path where a and b differ ("" if equal).
-std::string FirstDifference(const nlohmann::json& a, const nlohmann::json& b, const std::string& at) {
+/// Key paths where a and b differ, comma-separated ("" if equal).
+void Differences(const nlohmann::json& a, const nlohmann::json& b, const std::string& at,
+                 std::vector<std::string>* out) {
+  auto key = [&](const std::string& k) { return at.empty() ? k : at + "." + k; };
   if (a.is_object() && b.is_object()) {
     for (auto it = a.begin(); it != a.end(); ++it) {
-      const std::string key = at.empty() ? it.key() : at + "." + it.key();
-      if (!b.contains(it.key())) return key;
-      const std::string d = FirstDifference(it.value(), b[it.key()], key);
-      if (!d.empty()) return d;
+      if (!b.contains(it.key())) out->push_back(key(it.key()));
+      else Differences(it.value(), b[it.key()], key(it.key()), out);
     }
     for (auto it = b.begin(); it != b.end(); ++it)
-      if (!a.contains(it.key())) return at.empty() ? it.key() : at + "." + it.key();
-    return "";
+      if (!a.contains(it.key())) out->push_back(key(it.key()));
+  } else if (a != b) {
+    out->push_back(at.empty() ? "(root)" : at);
   }
-  return a == b ? "" : (at.empty() ? "(root)" : at);
+}
+std::string KeyDifferences(const nlohmann::json& a, const nlohmann::json& b, const std::string& at) {
+  std::vector<std::string> d;
+  Differences(a, b, at, &d);
+  std::string s;
+  for (const auto& k : d) s += (s.empty() ? "" : "', '") + k;
+  return s;
 }
 
 /// The complete sample lines of a dataset CSV whose header must be `header`; their indices must
@@ -374,8 +381,8 @@ DatasetRunSummary GenerateDataset(Kinematics& kin, const DatasetSampling& sampli
   bool fresh = true;
   if (fs::exists(opt.out)) {
     const nlohmann::json side = ReadSidecar(opt.out);
-    std::string d = FirstDifference(config, side["config"], "config");
-    if (d.empty()) d = FirstDifference(shard, side["shard"], "shard");
+    std::string d = KeyDifferences(config, side["config"], "config");
+    if (d.empty()) d = KeyDifferences(shard, side["shard"], "shard");
     if (!d.empty())
       throw std::invalid_argument(
           opt.out + " exists and was made with another configuration (its sidecar " +
@@ -449,7 +456,7 @@ long long MergeDatasets(const std::vector<std::string>& shards, const std::strin
       config = side["config"];
       n = side["shard"].value("n", 0);
     } else {
-      const std::string d = FirstDifference(config, side["config"], "config");
+      const std::string d = KeyDifferences(config, side["config"], "config");
       if (!d.empty())
         throw std::invalid_argument("merge: " + f + " has another configuration than " +
                                     shards.front() + " (sidecars differ at '" + d + "')");
@@ -590,37 +597,24 @@ Dataset LoadDataset(const std::string& path) {
   return ds;
 }
 
-// ---- split ----
+// ---- samples and split ----
 
-DatasetSplit SplitTrainTest(long long n, double train_fraction, std::uint64_t seed) {
-  if (n < 0) throw std::invalid_argument("split: expected n >= 0 samples");
-  if (!(train_fraction >= 0.0 && train_fraction <= 1.0))
-    throw std::invalid_argument("split: train fraction must lie in [0, 1]");
-  std::vector<long long> perm(static_cast<size_t>(n));
-  for (long long i = 0; i < n; ++i) perm[i] = i;
-  // Fisher-Yates with the counter-based generator (std::shuffle differs between libraries).
-  std::uint64_t state = Mix(seed ^ 0x5EEDULL);
-  for (long long i = n - 1; i > 0; --i) {
-    state = Mix(state);
-    const long long j = static_cast<long long>(Unit(state) * static_cast<double>(i + 1));
-    std::swap(perm[i], perm[std::min(j, i)]);
-  }
-  const long long nt = std::llround(train_fraction * static_cast<double>(n));
-  DatasetSplit s;
-  s.train.assign(perm.begin(), perm.begin() + nt);
-  s.test.assign(perm.begin() + nt, perm.end());
-  std::sort(s.train.begin(), s.train.end());
-  std::sort(s.test.begin(), s.test.end());
-  return s;
+SampleSet PositionSamples(const Dataset& d) { return SampleSet{d.inputs, d.positions}; }
+
+SampleSet JacobianSamples(const Dataset& d) {
+  if (d.jacobians.cols() == 0)
+    throw std::invalid_argument("dataset has no Jacobian columns (generate it with --jacobian)");
+  return SampleSet{d.inputs, d.jacobians};
 }
 
-Eigen::MatrixXd SelectRows(const Eigen::MatrixXd& m, const std::vector<long long>& rows) {
-  Eigen::MatrixXd out(static_cast<Eigen::Index>(rows.size()), m.cols());
-  for (size_t i = 0; i < rows.size(); ++i) {
-    assert(rows[i] >= 0 && rows[i] < m.rows());
-    out.row(static_cast<Eigen::Index>(i)) = m.row(rows[i]);
-  }
-  return out;
+TrainTestSets SplitTrainTest(const SampleSet& s, std::uint64_t seed, double train_fraction) {
+  const SplitIndices idx = RandomSplit(s.size(), train_fraction, seed);
+  TrainTestSets t;
+  t.train_rows = idx.first;
+  t.test_rows = idx.second;
+  t.train = SelectRows(s, idx.first);
+  t.test = SelectRows(s, idx.second);
+  return t;
 }
 
 }  // namespace softkin

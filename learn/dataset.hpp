@@ -33,6 +33,7 @@
 /// actuator bounds, sampling, jacobian, block) and must match on resume and merge; `provenance`
 /// (git commit, command, ...) is recorded only.
 #include "ik/kinematics.hpp"
+#include "learn/sample_set.hpp"
 
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
@@ -132,15 +133,20 @@ struct Dataset {
 /// indices not strictly increasing, a last line without '\n').
 Dataset LoadDataset(const std::string& path);
 
-/// A seeded train/test split of n samples.
-struct DatasetSplit {
-  std::vector<long long> train, test;  ///< disjoint, together 0..n-1, each sorted ascending
-};
-/// round(train_fraction n) samples for training chosen by a seeded shuffle (the same seed gives the
-/// same split on every platform), the rest for testing. train_fraction in [0, 1].
-DatasetSplit SplitTrainTest(long long n, double train_fraction, std::uint64_t seed);
+/// The dataset as network samples (learn/sample_set.hpp): X = inputs (n x m), Y = positions
+/// (n x 3P, for N_fk).
+SampleSet PositionSamples(const Dataset& d);
+/// X = inputs, Y = flattened Jacobians (n x 3Pm, for N_J). Throws std::invalid_argument if the
+/// dataset has no Jacobian columns.
+SampleSet JacobianSamples(const Dataset& d);
 
-/// Rows `rows` of m (rows.size() x m.cols()).
-Eigen::MatrixXd SelectRows(const Eigen::MatrixXd& m, const std::vector<long long>& rows);
+/// A train/test split of a sample set.
+struct TrainTestSets {
+  SampleSet train, test;
+  std::vector<int> train_rows, test_rows;  ///< rows of the input set, ascending, disjoint
+};
+/// The seeded split of Sec. 5.3.3 (70/30 by default): RandomSplit(s.size(), train_fraction, seed).
+/// The same seed gives the same split on every platform.
+TrainTestSets SplitTrainTest(const SampleSet& s, std::uint64_t seed, double train_fraction = 0.7);
 
 }  // namespace softkin

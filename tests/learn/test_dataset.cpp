@@ -341,24 +341,24 @@ TEST_F(DatasetTest, CorruptFilesAreRejectedWithFileAndLine) {
 }
 
 TEST(DatasetSplit, SeededDisjointAndComplete) {
-  const DatasetSplit a = SplitTrainTest(1000, 0.7, 5), b = SplitTrainTest(1000, 0.7, 5);
-  const DatasetSplit c = SplitTrainTest(1000, 0.7, 6);
-  EXPECT_EQ(a.train, b.train);
-  EXPECT_EQ(a.test, b.test);
-  EXPECT_NE(a.train, c.train);
-  EXPECT_EQ(a.train.size(), 700u);
-  EXPECT_EQ(a.test.size(), 300u);
-  std::set<long long> all(a.train.begin(), a.train.end());
-  for (long long i : a.test) EXPECT_TRUE(all.insert(i).second) << i << " in both";
-  EXPECT_EQ(all.size(), 1000u);
-  EXPECT_EQ(*all.rbegin(), 999);
-  // Not a prefix: the shuffle mixes the order.
-  EXPECT_NE(a.train.back(), 699);
-  EXPECT_EQ(SplitTrainTest(7, 0.7, 1).train.size(), 5u);
-  EXPECT_THROW(SplitTrainTest(10, 1.5, 1), std::invalid_argument);
-  const Eigen::MatrixXd m = Eigen::MatrixXd::Random(10, 2);
-  const Eigen::MatrixXd s = SelectRows(m, {3, 7});
-  EXPECT_EQ(Eigen::MatrixXd(s.row(1)), Eigen::MatrixXd(m.row(7)));
+  SampleSet all;
+  all.X = Eigen::VectorXd::LinSpaced(1000, 0.0, 999.0);  // row i holds i
+  all.Y = 2.0 * all.X;
+  const TrainTestSets a = SplitTrainTest(all, 5), b = SplitTrainTest(all, 5), c = SplitTrainTest(all, 6);
+  EXPECT_EQ(a.train_rows, b.train_rows);
+  EXPECT_EQ(a.train.X, b.train.X);
+  EXPECT_NE(a.train_rows, c.train_rows);
+  EXPECT_EQ(a.train.size(), 700);
+  EXPECT_EQ(a.test.size(), 300);
+  std::set<int> seen;
+  for (int i = 0; i < a.train.size(); ++i) {
+    EXPECT_EQ(a.train.X(i, 0), a.train_rows[i]);  // the rows travel with their samples
+    EXPECT_EQ(a.train.Y(i, 0), 2.0 * a.train_rows[i]);
+    seen.insert(a.train_rows[i]);
+  }
+  for (int r : a.test_rows) EXPECT_TRUE(seen.insert(r).second) << r << " in both";
+  EXPECT_EQ(seen.size(), 1000u);
+  EXPECT_NE(a.train_rows.back(), 699);  // shuffled, not a prefix
 }
 
 }  // namespace
