@@ -2,11 +2,26 @@
 // IK overhead itself, since each model evaluation costs well under a microsecond. Two starts: cold
 // (the middle of the box, as after the configuration-space sample) and warm (the previous
 // waypoint of a smooth path, 1.6 mm away). Counters: evaluations, Jacobian evaluations and the
-// final error per waypoint. Simulator-backed cases (ik/simulator_kinematics.hpp) belong here too.
+// final error per waypoint.
+//
+// BM_SimulatorWaypoint: one waypoint with the simulator in the loop (SimulatorKinematics, implicit
+// Jacobian, lg-aa with gradient tolerance 1e-4 as `softkin ik --gradient-tolerance 1e-4`) on
+// three_chamber, lambda = 0.2 mm. The target is the tip at c_true = (1.78, 1.26, 1); the waypoint
+// starts from the previous waypoint's solution c_prev = (1.66, 1.22, 1) (4.5 mm away), with the
+// kinematics' state at c_prev, as in trajectory following (Algorithm 4). Before each timed solve
+// the kinematics replays the previous waypoint (untimed): J at c_pp = (1.54, 1.18, 1), then p at
+// c_prev, so its warm state, prediction and Jacobian guess are those a path would leave. range(0): method (enum order), range(1): resolution (7 is the
+// robot's default). Counters: fk_solves, evaluations, err_mm.
 #include "ik/ik_solver.hpp"
 #include "ik/pcc_kinematics.hpp"
+#include "ik/simulator_kinematics.hpp"
+#include "solver/robots.hpp"
 
 #include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <map>
+#include <memory>
 
 namespace softkin {
 namespace {
@@ -49,6 +64,79 @@ void AllMethods(benchmark::internal::Benchmark* b) {
 }
 
 BENCHMARK(BM_IkWaypoint)->Apply(AllMethods)->Unit(benchmark::kMicrosecond);
+
+struct SimFixture {
+  std::unique_ptr<SimulatorKinematics> kin;
+  Eigen::VectorXd c_pp, c_prev;
+  Eigen::Vector3d target;
+};
+
+SimFixture& GetSimFixture(int res) {
+  static std::map<int, std::unique_ptr<SimFixture>> cache;
+  auto it = cache.find(res);
+  if (it != cache.end()) return *it->second;
+  auto f = std::make_unique<SimFixture>();
+  const Scene scene = MakeRobot("three_chamber", res);
+  FkOptions fk = scene.solver;
+  fk.gradient_tolerance = 1e-4;
+  SimulatorKinematicsOptions o;
+  o.jacobian = JacobianMode::kImplicit;
+  o.points = {"tip"};
+  f->kin = std::make_unique<SimulatorKinematics>(scene, o, &fk);
+  f->c_pp = Eigen::Vector3d(1.54, 1.18, 1.0);
+  f->c_prev = Eigen::Vector3d(1.66, 1.22, 1.0);
+  const KinematicsEval e = f->kin->Evaluate(Eigen::Vector3d(1.78, 1.26, 1.0), false);
+  f->target = e.ok ? Eigen::Vector3d(e.p.row(0).transpose()) : Eigen::Vector3d::Zero();
+  return *cache.emplace(res, std::move(f)).first->second;
+}
+
+void BM_SimulatorWaypoint(benchmark::State& state) {
+  const IkMethod method = AllIkMethods()[state.range(0)];
+  SimFixture& f = GetSimFixture(static_cast<int>(state.range(1)));
+  const PointTrackingObjective objective(f.kin->point_names(), "tip", f.target);
+  IkOptions opt;
+  opt.method = method;
+  opt.lambda = 0.04;  // (0.2 mm)^2
+  IkResult r;
+  long long solves = 0;
+  for (auto _ : state) {
+    // The previous waypoint, untimed: J where it started, p where it ended.
+    if (!f.kin->Evaluate(f.c_pp, true).ok || !f.kin->Evaluate(f.c_prev, false).ok) {
+      state.SkipWithError("forward solve or Jacobian of the previous waypoint failed");
+      return;
+    }
+    const long long before = f.kin->total_fk_solves();
+    const auto t0 = std::chrono::steady_clock::now();
+    r = SolveIk(*f.kin, objective, f.c_prev, opt);
+    state.SetIterationTime(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    solves = f.kin->total_fk_solves() - before;
+  }
+  state.SetLabel(IkMethodToString(method) + " res " + std::to_string(state.range(1)) + " " +
+                 IkTerminationToString(r.summary.termination));
+  state.counters["fk_solves"] = static_cast<double>(solves);
+  state.counters["evals"] = r.summary.evaluations;
+  state.counters["jac_evals"] = r.summary.jacobian_evaluations;
+  state.counters["err_mm"] = std::sqrt(r.objective);
+}
+
+void SimulatorCases(benchmark::internal::Benchmark* b) {
+  const auto& all = AllIkMethods();
+  auto index = [&](IkMethod m) {
+    for (size_t i = 0; i < all.size(); ++i)
+      if (all[i] == m) return static_cast<int>(i);
+    return 0;
+  };
+  for (IkMethod m : {IkMethod::kSoftLineSearch, IkMethod::kNloptSlsqp, IkMethod::kGaussNewton})
+    b->Args({index(m), 4});
+  b->Args({index(IkMethod::kGaussNewton), 7});
+}
+
+BENCHMARK(BM_SimulatorWaypoint)
+    ->Apply(SimulatorCases)
+    ->Iterations(2)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace softkin

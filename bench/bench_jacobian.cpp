@@ -13,7 +13,13 @@
 //                    per fixture, median of 5) -- the target for implicit is <= 1
 //   gmres_its        implicit only: GMRES iterations summed over the columns
 //   fk_iterations    BM_WarmFk: local-global iterations of the warm solve
-// Run with OMP_NUM_THREADS=2 on a quiet machine (docs/kinematics.md).
+// BM_Jacobian's implicit case starts its Krylov solves from 0 (jacobian_initial_guess off), as the
+// first Jacobian of a path does. BM_ImplicitSolve calls ComputeEquilibriumJacobian directly at c:
+//   range(1) = 1: all columns in lockstep (batched products), 0: column by column;
+//   range(2) = 1: Krylov solves start from dX/dc at c0 (as along an IK path), 0: from 0.
+// BM_PredictedFk: the forward solve c0 -> c from the first-order prediction X0 + dX/dc(c0) (c - c0)
+// (SimulatorKinematicsOptions::predict_warm_start) instead of X0.
+// Run with OMP_NUM_THREADS=1 (or 2 on a quiet machine; docs/kinematics.md).
 #include "ik/simulator_kinematics.hpp"
 #include "solver/robots.hpp"
 
@@ -35,6 +41,8 @@ struct Fixture {
   std::shared_ptr<const Model> model;
   Eigen::VectorXd c0, c;
   Eigen::MatrixX3d X0;       ///< converged state at c0
+  Eigen::MatrixX3d Xc;       ///< converged state at c (warm from X0)
+  Eigen::MatrixXd dXdc0;     ///< implicit dX/dc at c0 (3 #V x #actuators)
   double warm_fk_s = 0.0;    ///< median time of the warm solve c0 -> c
   int warm_fk_iterations = 0;
 };
@@ -69,6 +77,8 @@ const Fixture& GetFixture(int robot) {
   }
   std::sort(t.begin(), t.end());
   f->warm_fk_s = t[t.size() / 2];
+  f->Xc = solver->Solve(f->c, &f->X0).positions;
+  f->dXdc0 = ComputeEquilibriumJacobian(*f->model, f->X0, f->c0).dXdc;
   return *cache.emplace(robot, std::move(f)).first->second;
 }
 
@@ -91,6 +101,7 @@ void BM_Jacobian(benchmark::State& state) {
   const JacobianMode mode = static_cast<JacobianMode>(state.range(1));
   SimulatorKinematicsOptions o;
   o.jacobian = mode;
+  o.jacobian_initial_guess = false;  // every timed call starts from 0, as a path's first J does
   SimulatorKinematics k(f.model, o);
   // Prime: converged at c0, then at c (warm from c0).
   if (!k.Evaluate(f.c0, false).ok || !k.Evaluate(f.c, false).ok) {
@@ -121,7 +132,59 @@ void BM_Jacobian(benchmark::State& state) {
   if (mode == JacobianMode::kImplicit) state.counters["gmres_its"] = gmres;
 }
 
+void BM_ImplicitSolve(benchmark::State& state) {
+  const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
+  EquilibriumJacobianOptions o;
+  o.lockstep = state.range(1) == 1;
+  const bool guess = state.range(2) == 1;
+  if (f.dXdc0.size() == 0) {
+    state.SkipWithError("implicit Jacobian at c0 failed");
+    return;
+  }
+  EquilibriumJacobianResult r;
+  for (auto _ : state) {
+    r = ComputeEquilibriumJacobian(*f.model, f.Xc, f.c, {}, o, guess ? &f.dXdc0 : nullptr);
+    if (!r.ok) {
+      state.SkipWithError(r.message.c_str());
+      return;
+    }
+    benchmark::DoNotOptimize(r.dXdc.data());
+  }
+  int products = 0;
+  for (int its : r.iterations) products += its;
+  state.SetLabel(std::string(kRobots[state.range(0)]) + (o.lockstep ? " lockstep" : " by column") +
+                 (guess ? " guess" : " zero"));
+  state.counters["products"] = products;
+  state.counters["rounds"] = r.rounds;
+  state.counters["ratio_warm_fk"] = r.time_s / f.warm_fk_s;
+}
+
+void BM_PredictedFk(benchmark::State& state) {
+  const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
+  auto solver = MakeFkSolver(f.model, f.model->scene().solver);
+  Eigen::MatrixX3d start = f.X0;
+  const Eigen::VectorXd dx = f.dXdc0 * (f.c - f.c0);
+  for (int v = 0; v < start.rows(); ++v)
+    for (int d = 0; d < 3; ++d) start(v, d) += dx[3 * v + d];
+  FkResult r;
+  for (auto _ : state) {
+    r = solver->Solve(f.c, &start);
+    benchmark::DoNotOptimize(r.positions.data());
+  }
+  state.SetLabel(kRobots[state.range(0)]);
+  state.counters["fk_iterations"] = r.iterations;
+  state.counters["ratio_warm_fk"] = r.time_s / f.warm_fk_s;
+  // How far the predicted start and the converged state at c are from each other (mm, max).
+  state.counters["start_err_mm"] = (start - r.positions).rowwise().norm().maxCoeff();
+  state.counters["warm_start_err_mm"] = (f.X0 - r.positions).rowwise().norm().maxCoeff();
+}
+
 BENCHMARK(BM_WarmFk)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_PredictedFk)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ImplicitSolve)
+    ->ArgsProduct({{0, 1}, {0, 1}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(BM_Jacobian)
     ->ArgsProduct({{0, 1},
                    {static_cast<int>(JacobianMode::kFd), static_cast<int>(JacobianMode::kFdWarm),

@@ -123,13 +123,23 @@ IkResult SolveGaussNewton(Kinematics& kin, const Objective& objective,
       S.history.push_back(o_trial);
       break;
     }
+    // The trial already gave O at c: decide whether to stop before paying for J there (on the
+    // simulator a Jacobian costs about one forward solve). The loop's stopping tests see the
+    // same value, since the kinematics at the same c give the same p.
+    if (o_trial > options.lambda && P.Stalled(o_prev, o_trial, step, &S)) {
+      S.history.push_back(o_trial);
+      break;
+    }
+    if (o_trial <= options.lambda || S.iterations >= options.max_iterations) {
+      S.history.push_back(o_trial);
+      cur.value = o_trial;
+      continue;  // converged or i_max: reported at the top of the loop
+    }
     if (!evaluate_at(c, &cur, "at an accepted point: ")) {
       S.history.push_back(o_trial);
       break;
     }
     S.history.push_back(cur.value);
-    if (cur.value <= options.lambda) continue;
-    if (P.Stalled(o_prev, cur.value, step, &S)) break;
   }
   return P.Finish(c0, S);
 }

@@ -136,6 +136,9 @@ void SimulatorKinematics::Reset() {
   last_X_.resize(0, 3);
   last_c_.resize(0);
   last_start_.resize(0, 3);
+  jac_dXdc_.resize(0, 0);
+  jac_c_.resize(0);
+  jac_columns_.clear();
 }
 
 double SimulatorKinematics::fd_step(int a) const {
@@ -205,8 +208,28 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
     centre_start = last_start_;  // where the reused state was solved from
   } else {
     FkResult r;
-    const std::string err = Solve(c, start, &r, &note);
-    ++ev.fk_solves;
+    // First-order prediction from the previous state and its implicit Jacobian.
+    Eigen::MatrixX3d predicted;
+    if (have_last && options_.jacobian == JacobianMode::kImplicit && options_.predict_warm_start &&
+        jac_c_.size() == c.size() && jac_c_ == last_c_ && jac_dXdc_.rows() == 3 * last_X_.rows()) {
+      const int nv = static_cast<int>(last_X_.rows());
+      Eigen::VectorXd dc(jac_columns_.size());
+      for (size_t j = 0; j < jac_columns_.size(); ++j) dc[j] = c[jac_columns_[j]] - last_c_[jac_columns_[j]];
+      const Eigen::VectorXd dx = jac_dXdc_ * dc;
+      predicted = last_X_ + Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(
+                                dx.data(), nv, 3);
+      if (!predicted.allFinite()) predicted.resize(0, 3);
+    }
+    std::string err;
+    if (predicted.rows() > 0) {
+      err = Solve(c, &predicted, &r, &note);
+      ++ev.fk_solves;
+      if (err.empty()) centre_start = predicted;
+    }
+    if (predicted.rows() == 0 || !err.empty()) {
+      err = Solve(c, start, &r, &note);
+      ++ev.fk_solves;
+    }
     if (!err.empty()) {
       ev.message = err;
       return finish();
@@ -292,11 +315,17 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
     (act.is_signed() && c[a] == 0.0 ? kinked : smooth).push_back(a);
   }
   if (!smooth.empty()) {
-    last_implicit_ = ComputeEquilibriumJacobian(*model_, X, c, smooth, options_.implicit);
+    const bool guess = options_.jacobian_initial_guess && jac_columns_ == smooth &&
+                       jac_dXdc_.rows() == 3 * X.rows();
+    last_implicit_ = ComputeEquilibriumJacobian(*model_, X, c, smooth, options_.implicit,
+                                                guess ? &jac_dXdc_ : nullptr);
     if (!last_implicit_.ok) {
       ev.message = last_implicit_.message;
       return finish();
     }
+    jac_dXdc_ = last_implicit_.dXdc;
+    jac_c_ = c;
+    jac_columns_ = smooth;
     for (size_t j = 0; j < smooth.size(); ++j)
       for (int q = 0; q < np; ++q)
         for (int t = offset_[q]; t < offset_[q + 1]; ++t)

@@ -19,7 +19,10 @@
 /// equals the previous successful c exactly, its state is reused without a solve (fk_solves = 0):
 /// IK often asks for p(c) and then J(c) at the same c. `fd` probes start from the state the
 /// centre solve started from (so each probe is solved exactly as a plain p solve would have been
-/// in its place); `fd-warm` probes start from the converged state at c.
+/// in its place); `fd-warm` probes start from the converged state at c. With `implicit`, a p solve
+/// starts from the first-order prediction of the previous state when its Jacobian is known
+/// (predict_warm_start), and each Jacobian's linear solves start from the previous one
+/// (jacobian_initial_guess).
 ///
 /// A forward solve that does not converge (status iteration_cap, diverged, time_limit) makes the
 /// evaluation fail (ok = false, message with the FK status and the actuation), unless
@@ -59,6 +62,15 @@ struct SimulatorKinematicsOptions {
   bool warm_start = true;
   /// Accept forward solves that stop at the iteration cap (message says so); else ok = false.
   bool accept_iteration_cap = false;
+  /// implicit only: start a p solve from the first-order prediction X + dX/dc (c - c_prev) of the
+  /// previous state, when the last implicit Jacobian was taken at that state (IK takes J at the
+  /// current iterate and then solves at the next one). The converged state is the same fixed
+  /// point; only the start is closer (fewer iterations). A prediction whose solve fails is retried
+  /// from the plain warm start (both solves are counted).
+  bool predict_warm_start = true;
+  /// implicit only: start each Jacobian's Krylov solves from the previous implicit Jacobian
+  /// (dX/dc changes slowly along a path). The tolerance stays relative to the right-hand side.
+  bool jacobian_initial_guess = true;
   /// Options of the implicit mode's linear solve.
   EquilibriumJacobianOptions implicit;
   bool IsValid(std::string* why) const;
@@ -120,6 +132,10 @@ class SimulatorKinematics : public Kinematics {
   Eigen::MatrixX3d last_X_;
   Eigen::MatrixX3d last_start_;  ///< where last_X_ was solved from (empty: rest shape)
   Eigen::VectorXd last_c_;
+  /// The last implicit dX/dc (3 #V x #columns), the actuation it was taken at and its columns.
+  Eigen::MatrixXd jac_dXdc_;
+  Eigen::VectorXd jac_c_;
+  std::vector<int> jac_columns_;
   long long total_fk_solves_ = 0;
   EquilibriumJacobianResult last_implicit_;
 };

@@ -5,6 +5,7 @@
 #include "solver/targets.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -93,8 +94,8 @@ bool EquilibriumLinearization::Setup(const Model& model, const Eigen::Ref<const 
   measure_.assign(ne, 0.0);
   measure_active_.assign(ne, 0);
   if (static_cast<int>(measure_grad_.size()) != ne) measure_grad_.resize(ne);
-  dratio_.assign(ne, 0.0);
-  if (static_cast<int>(weighted_.size()) != ne) weighted_.resize(ne);
+  if (static_cast<int>(rows_.size()) != ne) rows_.resize(ne);
+  if (static_cast<int>(vol_grad_.size()) != ne) vol_grad_.resize(ne);
 
   // Groups: current measures and the normalisation of ComputeLocalRatios.
   groups_.assign(model.num_groups(), GroupCache());
@@ -149,6 +150,7 @@ bool EquilibriumLinearization::Setup(const Model& model, const Eigen::Ref<const 
       bad = std::max(bad, i);
       continue;
     }
+    if (e.role != ElementRole::Body || e.r_omega < 1.0) rows_[i] = D;
     if (e.role == ElementRole::Body && e.r_omega < 1.0) {
       const double vd = RowsVolume(D, e.k);
       ec.vol = vd;
@@ -156,6 +158,7 @@ bool EquilibriumLinearization::Setup(const Model& model, const Eigen::Ref<const 
         const double s = std::cbrt(e.rest_volume / vd);
         ec.s = std::min(s, 10.0);
         ec.s_active = s < 10.0;
+        if (ec.s_active) vol_grad_[i] = RowsVolumeGradient(D, e.k);
       } else {
         ec.s = 1.0;  // as ElementTarget: a collapsed or inverted element keeps s = 1
         ec.s_active = false;
@@ -175,88 +178,124 @@ bool EquilibriumLinearization::Setup(const Model& model, const Eigen::Ref<const 
 void EquilibriumLinearization::ApplyRhsDerivative(const Eigen::Ref<const Eigen::MatrixX3d>& dX,
                                                   const Eigen::Ref<const Eigen::VectorXd>& dc,
                                                   Eigen::MatrixX3d* dB) {
+  const Eigen::MatrixXd dXm = dX, dcm = dc;
+  Eigen::MatrixXd out;
+  ApplyRhsDerivativeBatch(dXm, dcm, &out);
+  *dB = out;
+}
+
+void EquilibriumLinearization::ApplyRhsDerivativeBatch(const Eigen::Ref<const Eigen::MatrixXd>& dX,
+                                                       const Eigen::Ref<const Eigen::MatrixXd>& dc,
+                                                       Eigen::MatrixXd* dB) {
   const Model& model = *model_;
   const auto& els = model.elements();
   const int ne = static_cast<int>(els.size());
+  const int nv = model.num_vertices();
+  const int m = static_cast<int>(dc.cols());
+  assert(dX.rows() == nv && dX.cols() == 3 * m && dc.rows() == model.num_actuators());
+  dratio_.assign(static_cast<size_t>(ne) * m, 0.0);
+  if (weighted_.size() != static_cast<size_t>(ne) * m) weighted_.resize(static_cast<size_t>(ne) * m);
+  // Rows of element e in direction j, centred.
+  auto gather = [&](const ModelElement& e, int j, ElemRows* D) {
+    for (int q = 0; q < e.k; ++q)
+      for (int d = 0; d < 3; ++d) (*D)(q, d) = dX(e.v[q], 3 * j + d);
+    CenterRows(*D, e.k);
+  };
 
   // Pass 1: ratio derivatives, group by group (the rank-one coupling through sum_j m_j).
   for (int g = 0; g < model.num_groups(); ++g) {
     const GroupCache& gc = groups_[g];
     const auto& ids = model.group_elements(g);
-    if (gc.vented) {
-      for (int i : ids) dratio_[i] = 0.0;
-      continue;
-    }
-    double dMd = 0.0;
-    for (int i : ids) {
-      double dm = 0.0;
-      if (measure_active_[i]) {
-        ElemRows dD;
-        Gather(els[i], dX, &dD);
-        dm = measure_grad_[i].topRows(els[i].k).cwiseProduct(dD.topRows(els[i].k)).sum();
-      }
-      dratio_[i] = dm;  // holds dm_i until the group's dsigma is known
-      dMd += dm;
-    }
+    if (gc.vented) continue;  // dratio_ stays 0
     const double M = model.group_rest_measure(g), LR = model.group_offset(g);
-    const double drho = gc.drho * dc[model.group_actuator(g)];
-    const double dsigma = -gc.sigma * dMd / gc.Md + (gc.num_active ? (M + LR) * drho / gc.Md : 0.0);
-    for (int i : ids)
-      dratio_[i] = (gc.sigma * dratio_[i] + measure_[i] * dsigma) / els[i].measure0;
+    for (int j = 0; j < m; ++j) {
+      double dMd = 0.0;
+      for (int i : ids) {
+        double dm = 0.0;
+        if (measure_active_[i]) {
+          ElemRows dD;
+          gather(els[i], j, &dD);
+          dm = measure_grad_[i].topRows(els[i].k).cwiseProduct(dD.topRows(els[i].k)).sum();
+        }
+        dratio_[static_cast<size_t>(i) * m + j] = dm;  // holds dm_i until dsigma is known
+        dMd += dm;
+      }
+      const double drho = gc.drho * dc(model.group_actuator(g), j);
+      const double dsigma =
+          -gc.sigma * dMd / gc.Md + (gc.num_active ? (M + LR) * drho / gc.Md : 0.0);
+      for (int i : ids) {
+        double& r = dratio_[static_cast<size_t>(i) * m + j];
+        r = (gc.sigma * r + measure_[i] * dsigma) / els[i].measure0;
+      }
+    }
   }
 
-  // Pass 2: per-element target derivatives dT (already in the current frame, centred). Products
-  // use the fixed 6 x 3 row blocks: rows k..5 of the rest and centred rows are zero, so the
-  // fixed-size kernels give the same result without dynamic-size overhead.
+  // Pass 2: per-element target derivatives dT (already in the current frame, centred), every
+  // direction while the element's cached data is at hand. Products use the fixed 6 x 3 row
+  // blocks: rows k..5 of the rest and centred rows are zero.
   const int nt = threads_ > 0 ? threads_ : omp_get_max_threads();
 #pragma omp parallel for schedule(static) num_threads(nt)
   for (int i = 0; i < ne; ++i) {
     const ModelElement& e = els[i];
     const ElementCache& ec = cache_[i];
-    const int k = e.k;
     const double r = ratios_[i];
-    ElemRows dD, dT;
-    Gather(e, dX, &dD);
     const ElemRows& P = e.rest;
-    if (e.role != ElementRole::Body && r == kVented) {
-      dT = dD;  // vented: T = D
-    } else if (e.role == ElementRole::Body) {
-      const Eigen::Matrix3d dM = dD.transpose() * P;
-      const Eigen::Matrix3d W = PolarDerivativeW(ec.R, ec.Sinv, dM);
-      // T = r_w P R^T + (1 - r_w) s D; d(P R^T) = P dR^T = -P W R^T.
-      const Eigen::Matrix3d WRt = W * ec.R.transpose();
-      dT.noalias() = (-e.r_omega) * (P * WRt);
-      if (e.r_omega < 1.0) {
-        ElemRows D;
-        Gather(e, X_, &D);
-        double ds = 0.0;
-        if (ec.s_active) {
-          const double dvol = RowsVolumeGradient(D, k).cwiseProduct(dD).sum();
-          ds = -(ec.s / 3.0) * dvol / ec.vol;
-        }
-        dT += (1.0 - e.r_omega) * (ds * D + ec.s * dD);
-      }
-    } else if (e.role == ElementRole::Pneumatic) {
-      // T = q P R^T, q = cbrt(r).
-      const double q = std::cbrt(r), dq = q * dratio_[i] / (3.0 * r);
-      const Eigen::Matrix3d dM = dD.transpose() * P;
-      const Eigen::Matrix3d W = PolarDerivativeW(ec.R, ec.Sinv, dM);
-      const Eigen::Matrix3d G = dq * ec.R.transpose() - q * (W * ec.R.transpose());
-      dT.noalias() = P * G;
-    } else {
-      // Cable / DEA: T = Ps R^T, Ps = P S(r)^T, R = polar(D^T Ps).
-      ElemRows D;
-      Gather(e, X_, &D);
-      const Eigen::Matrix3d Sr = ActuationShape(e, r);
-      const Eigen::Matrix3d dSr = dratio_[i] * ActuationShapeDerivative(e, r);
-      const ElemRows Ps = P * Sr.transpose(), dPs = P * dSr.transpose();
-      const Eigen::Matrix3d dM = dD.transpose() * Ps + D.transpose() * dPs;
-      const Eigen::Matrix3d W = PolarDerivativeW(ec.R, ec.Sinv, dM);
-      dT.noalias() = dPs * ec.R.transpose() - Ps * (W * ec.R.transpose());
+    const bool vented = e.role != ElementRole::Body && r == kVented;
+    // Cable / DEA: T = Ps R^T, Ps = P S(r)^T, R = polar(D^T Ps).
+    ElemRows Ps, dPs0;
+    if (!vented && (e.role == ElementRole::Cable || e.role == ElementRole::Dea)) {
+      Ps.noalias() = P * ActuationShape(e, r).transpose();
+      dPs0.noalias() = P * ActuationShapeDerivative(e, r).transpose();
     }
-    weighted_[i] = e.wv * dT;
+    const Eigen::Matrix3d Rt = ec.R.transpose();
+    for (int j = 0; j < m; ++j) {
+      ElemRows dD, dT;
+      gather(e, j, &dD);
+      const double dr = dratio_[static_cast<size_t>(i) * m + j];
+      if (vented) {
+        dT = dD;  // vented: T = D
+      } else if (e.role == ElementRole::Body) {
+        const Eigen::Matrix3d dM = dD.transpose() * P;
+        const Eigen::Matrix3d W = PolarDerivativeW(ec.R, ec.Sinv, dM);
+        // T = r_w P R^T + (1 - r_w) s D; d(P R^T) = P dR^T = -P W R^T.
+        const Eigen::Matrix3d WRt = W * Rt;
+        dT.noalias() = (-e.r_omega) * (P * WRt);
+        if (e.r_omega < 1.0) {
+          const ElemRows& D = rows_[i];
+          double ds = 0.0;
+          if (ec.s_active) ds = -(ec.s / 3.0) * vol_grad_[i].cwiseProduct(dD).sum() / ec.vol;
+          dT += (1.0 - e.r_omega) * (ds * D + ec.s * dD);
+        }
+      } else if (e.role == ElementRole::Pneumatic) {
+        // T = q P R^T, q = cbrt(r).
+        const double q = std::cbrt(r), dq = q * dr / (3.0 * r);
+        const Eigen::Matrix3d dM = dD.transpose() * P;
+        const Eigen::Matrix3d W = PolarDerivativeW(ec.R, ec.Sinv, dM);
+        const Eigen::Matrix3d G = dq * Rt - q * (W * Rt);
+        dT.noalias() = P * G;
+      } else {
+        const ElemRows& D = rows_[i];
+        const ElemRows dPs = dr * dPs0;
+        const Eigen::Matrix3d dM = dD.transpose() * Ps + D.transpose() * dPs;
+        const Eigen::Matrix3d W = PolarDerivativeW(ec.R, ec.Sinv, dM);
+        dT.noalias() = dPs * Rt - Ps * (W * Rt);
+      }
+      weighted_[static_cast<size_t>(i) * m + j] = e.wv * dT;
+    }
   }
-  AssembleRhs(model, weighted_, dB, threads_);
+  // Gather sum_i w_i Vol_i S_i^T dT_i per vertex and direction (AssembleRhs, batched).
+  dB->resize(nv, 3 * m);
+  const auto& off = model.incidence_offset();
+  const auto& inc = model.incidence();
+#pragma omp parallel for schedule(static) num_threads(nt)
+  for (int v = 0; v < nv; ++v) {
+    for (int j = 0; j < m; ++j) {
+      Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
+      for (int q = off[v]; q < off[v + 1]; ++q)
+        sum += weighted_[static_cast<size_t>(inc[q] / 6) * m + j].row(inc[q] % 6);
+      for (int d = 0; d < 3; ++d) (*dB)(v, 3 * j + d) = sum[d];
+    }
+  }
 }
 
 Eigen::MatrixX3d PrescribedDerivative(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& c,
@@ -278,123 +317,247 @@ Eigen::MatrixX3d PrescribedDerivative(const Model& model, const Eigen::Ref<const
 
 namespace {
 
-/// The Krylov basis V (n x (m + 1)) and Hessenberg matrix Hbar ((m + 1) x m, before the Givens
-/// rotations) of the last GMRES cycle: prec(op(V_m)) = V_{m+1} Hbar. Kept to start the next column.
-struct KrylovMemory {
-  Eigen::MatrixXd V, Hbar;
-  int m = 0;
+/// The operator of the linear solve on the free coordinates, applied to a block of vectors:
+/// Apply(Y) = H Y = A_ff Y - (K Y)_f (Y: #free x k, every other coordinate zero), and
+/// Precondition(V) = A_ff^-1 V with the model's CHOLMOD factors, all columns in one solve.
+class FreeOperator {
+ public:
+  FreeOperator(const Model& model, EquilibriumLinearization* lin)
+      : model_(model), lin_(lin), zero_c_(Eigen::MatrixXd::Zero(model.num_actuators(), 1)) {}
+
+  /// Free coordinates x (#free) of the #V x 3 block X.
+  void Gather(const Eigen::Ref<const Eigen::MatrixXd>& X, Eigen::Ref<Eigen::VectorXd> x) const {
+    for (int d = 0; d < 3; ++d) {
+      const auto& fv = model_.free_vertices(d);
+      const int o = model_.free_offset(d);
+      for (size_t i = 0; i < fv.size(); ++i) x[o + static_cast<int>(i)] = X(fv[i], d);
+    }
+  }
+  /// Writes x (#free) into the free coordinates of the #V x 3 block X.
+  void Scatter(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::MatrixXd> X) const {
+    for (int d = 0; d < 3; ++d) {
+      const auto& fv = model_.free_vertices(d);
+      const int o = model_.free_offset(d);
+      for (size_t i = 0; i < fv.size(); ++i) X(fv[i], d) = x[o + static_cast<int>(i)];
+    }
+  }
+
+  Eigen::MatrixXd Apply(const Eigen::MatrixXd& Y) {
+    const int k = static_cast<int>(Y.cols()), nv = model_.num_vertices();
+    Yx_.setZero(nv, 3 * k);
+    for (int j = 0; j < k; ++j) Scatter(Y.col(j), Yx_.middleCols(3 * j, 3));
+    if (zero_c_.cols() != k) zero_c_.setZero(model_.num_actuators(), k);
+    lin_->ApplyRhsDerivativeBatch(Yx_, zero_c_, &dB_);
+    AY_.noalias() = model_.A() * Yx_;
+    AY_ -= dB_;
+    Eigen::MatrixXd out(Y.rows(), k);
+    for (int j = 0; j < k; ++j) Gather(AY_.middleCols(3 * j, 3), out.col(j));
+    return out;
+  }
+
+  Eigen::MatrixXd Precondition(const Eigen::MatrixXd& V) const {
+    const int k = static_cast<int>(V.cols());
+    Eigen::MatrixXd out(V.rows(), k);
+    if (model_.factor_of_axis(0) == model_.factor_of_axis(1) &&
+        model_.factor_of_axis(1) == model_.factor_of_axis(2)) {
+      // One factor: every axis of every column is one right-hand side of one solve.
+      const int n0 = model_.free_offset(1);
+      Eigen::Map<const Eigen::MatrixXd> B(V.data(), n0, 3 * k);
+      Eigen::Map<Eigen::MatrixXd> Y(out.data(), n0, 3 * k);
+      Y = model_.factorization(model_.factor_of_axis(0)).solve(B);
+      return out;
+    }
+    for (int d = 0; d < 3; ++d) {
+      const int o = model_.free_offset(d), n = model_.free_offset(d + 1) - o;
+      out.middleRows(o, n) =
+          model_.factorization(model_.factor_of_axis(d)).solve(V.middleRows(o, n).eval());
+    }
+    return out;
+  }
+
+ private:
+  const Model& model_;
+  EquilibriumLinearization* lin_;
+  Eigen::MatrixXd zero_c_, Yx_, dB_, AY_;
 };
 
-/// Restarted GMRES for op(y) = rhs, left-preconditioned by prec (y and rhs of size n).
-/// Start: y = 0, or, when `memory` holds the last cycle of a previous solve with the same
-/// operator, the minimiser of the preconditioned residual over that cycle's Krylov space (no
-/// operator product: prec(op(V_m z)) = V_{m+1} Hbar z). The columns of J share their slow (soft)
-/// modes, so later columns start with those already resolved. Returns the number of operator
-/// products; *rel receives the final preconditioned residual relative to ||prec(rhs)||.
-template <class Op, class Prec>
-int Gmres(const Op& op, const Prec& prec, const Eigen::VectorXd& rhs, int restart, int max_it,
-          double tol, Eigen::VectorXd* y, double* rel, KrylovMemory* memory) {
-  const int n = static_cast<int>(rhs.size());
-  y->setZero(n);
-  const Eigen::VectorXd b = prec(rhs);
-  const double beta0 = b.norm();
-  *rel = 0.0;
-  if (!(beta0 > 0.0)) return 0;
-  Eigen::VectorXd r = b;
-  if (memory && memory->m > 0) {
-    const int pm = memory->m;
-    const Eigen::VectorXd t = memory->V.leftCols(pm + 1).transpose() * b;
-    const Eigen::VectorXd z = memory->Hbar.topLeftCorner(pm + 1, pm).colPivHouseholderQr().solve(t);
-    if (z.allFinite()) {
-      *y = memory->V.leftCols(pm) * z;
-      r = b - memory->V.leftCols(pm + 1) * (memory->Hbar.topLeftCorner(pm + 1, pm) * z);
+/// GMRES state of one column (left-preconditioned, restarted, from a given start), advanced one
+/// operator product at a time so that several columns can share batched products. The basis is
+/// orthogonalised by classical Gram-Schmidt with one re-orthogonalisation (CGS2: as stable as
+/// modified Gram-Schmidt, with matrix-vector products).
+class GmresColumn {
+ public:
+  /// b = prec(rhs) (#free), y0 the start (#free), restart/max_it/tol as the options.
+  GmresColumn(Eigen::VectorXd b, Eigen::VectorXd y0, int restart, int max_it, double tol)
+      : b_(std::move(b)), y_(std::move(y0)), m_(std::max(1, std::min(restart, max_it))),
+        max_it_(max_it), tol_(tol) {
+    beta0_ = b_.norm();
+    if (!(beta0_ > 0.0)) {
+      done_ = true;  // rhs = 0: y = 0 exactly
+      y_.setZero();
+      rel_ = 0.0;
+      return;
+    }
+    if (y_.squaredNorm() > 0.0) {
+      want_residual_ = true;  // the start's residual costs a product
+    } else {
+      StartCycle(b_);
     }
   }
-  const int m = std::max(1, std::min(restart, max_it));
-  Eigen::MatrixXd V(n, m + 1);
-  Eigen::MatrixXd Hh = Eigen::MatrixXd::Zero(m + 1, m), Hraw(m + 1, m);
-  Eigen::VectorXd g(m + 1), cs(m), sn(m), w(n);
-  int total = 0, last_m = 0;
-  double beta = r.norm();
-  bool first = true;
-  while (true) {
-    if (!first) {
-      r = prec(rhs - op(*y));
-      beta = r.norm();
-    }
-    first = false;
-    *rel = beta / beta0;
-    if (*rel <= tol || total >= max_it || !(beta > 0.0)) break;
-    V.col(0) = r / beta;
-    g.setZero();
-    g(0) = beta;
-    Hh.setZero();
-    Hraw.setZero();
-    int j_end = 0;
-    for (int j = 0; j < m && total < max_it; ++j) {
-      w = prec(op(V.col(j)));
-      ++total;
-      for (int i = 0; i <= j; ++i) {  // modified Gram-Schmidt
-        Hh(i, j) = w.dot(V.col(i));
-        w -= Hh(i, j) * V.col(i);
-      }
-      Hh(j + 1, j) = w.norm();
-      Hraw.col(j) = Hh.col(j);
-      if (Hh(j + 1, j) > 0.0) V.col(j + 1) = w / Hh(j + 1, j);
-      for (int i = 0; i < j; ++i) {  // previous Givens rotations
-        const double t = cs(i) * Hh(i, j) + sn(i) * Hh(i + 1, j);
-        Hh(i + 1, j) = -sn(i) * Hh(i, j) + cs(i) * Hh(i + 1, j);
-        Hh(i, j) = t;
-      }
-      const double den = std::hypot(Hh(j, j), Hh(j + 1, j));
-      cs(j) = den > 0.0 ? Hh(j, j) / den : 1.0;
-      sn(j) = den > 0.0 ? Hh(j + 1, j) / den : 0.0;
-      Hh(j, j) = den;
-      Hh(j + 1, j) = 0.0;
-      g(j + 1) = -sn(j) * g(j);
-      g(j) = cs(j) * g(j);
-      j_end = j + 1;
-      if (std::abs(g(j + 1)) <= tol * beta0 || !(den > 0.0) || !(Hraw(j + 1, j) > 0.0)) break;
-    }
-    if (j_end == 0) break;
-    const Eigen::VectorXd z = Hh.topLeftCorner(j_end, j_end)
-                                  .triangularView<Eigen::Upper>()
-                                  .solve(g.head(j_end));
-    *y += V.leftCols(j_end) * z;
-    last_m = Hraw(j_end, j_end - 1) > 0.0 ? j_end : 0;  // a breakdown leaves no usable relation
-    if (!y->allFinite()) break;
+
+  bool done() const { return done_; }
+  int products() const { return products_; }
+  double rel() const { return rel_; }
+  const Eigen::VectorXd& y() const { return y_; }
+  /// The vector the next product is applied to.
+  const Eigen::VectorXd& Request() {
+    if (want_residual_) return y_;
+    next_ = V_.col(j_);
+    return next_;
   }
-  if (memory && last_m > 0) {
-    memory->V.swap(V);
-    memory->Hbar = Hraw;
-    memory->m = last_m;
+  /// Feeds w = prec(op(Request())).
+  void Consume(const Eigen::VectorXd& w) {
+    ++products_;
+    if (want_residual_) {
+      want_residual_ = false;
+      StartCycle(b_ - w);
+      return;
+    }
+    const int j = j_;
+    // CGS2 against the j + 1 basis vectors.
+    Eigen::VectorXd v = w;
+    Eigen::VectorXd h = V_.leftCols(j + 1).transpose() * v;
+    v.noalias() -= V_.leftCols(j + 1) * h;
+    const Eigen::VectorXd h2 = V_.leftCols(j + 1).transpose() * v;
+    v.noalias() -= V_.leftCols(j + 1) * h2;
+    h += h2;
+    const double hn = v.norm();
+    Hh_.col(j).head(j + 1) = h;
+    Hh_(j + 1, j) = hn;
+    const bool breakdown = !(hn > 1e-14 * w.norm());
+    if (!breakdown) {
+      if (V_.cols() < j + 2) Grow(j + 2);
+      V_.col(j + 1) = v / hn;
+    }
+    for (int i = 0; i < j; ++i) {  // previous Givens rotations
+      const double t = cs_(i) * Hh_(i, j) + sn_(i) * Hh_(i + 1, j);
+      Hh_(i + 1, j) = -sn_(i) * Hh_(i, j) + cs_(i) * Hh_(i + 1, j);
+      Hh_(i, j) = t;
+    }
+    const double den = std::hypot(Hh_(j, j), Hh_(j + 1, j));
+    cs_(j) = den > 0.0 ? Hh_(j, j) / den : 1.0;
+    sn_(j) = den > 0.0 ? Hh_(j + 1, j) / den : 0.0;
+    Hh_(j, j) = den;
+    Hh_(j + 1, j) = 0.0;
+    g_(j + 1) = -sn_(j) * g_(j);
+    g_(j) = cs_(j) * g_(j);
+    j_ = j + 1;
+    const bool end = std::abs(g_(j + 1)) <= tol_ * beta0_ || breakdown || !(den > 0.0) ||
+                     j_ >= m_ || products_ >= max_it_;
+    if (!end) return;
+    const Eigen::VectorXd z =
+        Hh_.topLeftCorner(j_, j_).triangularView<Eigen::Upper>().solve(g_.head(j_));
+    y_.noalias() += V_.leftCols(j_) * z;
+    if (!y_.allFinite()) {
+      done_ = true;
+      rel_ = std::numeric_limits<double>::infinity();
+      return;
+    }
+    if (products_ >= max_it_) {
+      // No budget for the true residual: report the estimate of the cycle.
+      rel_ = std::abs(g_(j_)) / beta0_;
+      done_ = true;
+      return;
+    }
+    want_residual_ = true;  // recompute the residual from scratch (next product)
   }
-  return total;
+
+ private:
+  void Grow(int cols) {
+    const int n = static_cast<int>(b_.size());
+    const int want = std::min(m_ + 1, std::max(cols, 2 * static_cast<int>(V_.cols())));
+    V_.conservativeResize(n, want);
+  }
+  void StartCycle(const Eigen::VectorXd& r) {
+    const double beta = r.norm();
+    rel_ = beta / beta0_;
+    if (rel_ <= tol_ || products_ >= max_it_ || !(beta > 0.0)) {
+      done_ = true;
+      return;
+    }
+    if (V_.cols() < 1) Grow(16);
+    V_.col(0) = r / beta;
+    Hh_.setZero(m_ + 1, m_);
+    g_.setZero(m_ + 1);
+    g_(0) = beta;
+    cs_.setZero(m_);
+    sn_.setZero(m_);
+    j_ = 0;
+  }
+
+  Eigen::VectorXd b_, y_, next_;
+  int m_, max_it_;
+  double tol_, beta0_ = 0.0, rel_ = 1.0;
+  Eigen::MatrixXd V_, Hh_;
+  Eigen::VectorXd g_, cs_, sn_;
+  int j_ = 0, products_ = 0;
+  bool done_ = false, want_residual_ = false;
+};
+
+/// Runs the columns' GMRES solves, batching the products of every column still running (all of
+/// them together with lockstep, else one column after the other). Returns the number of batched
+/// products.
+int RunGmres(FreeOperator* op, std::vector<GmresColumn>* cols, bool lockstep) {
+  int rounds = 0;
+  const int n = static_cast<int>(cols->size());
+  for (int first = 0; first < n; first = lockstep ? n : first + 1) {
+    const int last = lockstep ? n : first + 1;
+    while (true) {
+      std::vector<int> active;
+      for (int j = first; j < last; ++j)
+        if (!(*cols)[j].done()) active.push_back(j);
+      if (active.empty()) break;
+      Eigen::MatrixXd V((*cols)[active[0]].Request().size(), active.size());
+      for (size_t q = 0; q < active.size(); ++q) V.col(q) = (*cols)[active[q]].Request();
+      const Eigen::MatrixXd W = op->Precondition(op->Apply(V));
+      ++rounds;
+      for (size_t q = 0; q < active.size(); ++q) (*cols)[active[q]].Consume(W.col(q));
+    }
+  }
+  return rounds;
 }
 
-/// BiCGSTAB for op(y) = rhs, left-preconditioned by prec, from y = 0: two operator products per
-/// iteration and no stored basis (GMRES's orthogonalisation reads its whole basis every step).
-/// Returns the number of operator products; *rel receives the final preconditioned relative
-/// residual (recomputed from scratch at the end).
-template <class Op, class Prec>
-int BiCgStab(const Op& op, const Prec& prec, const Eigen::VectorXd& rhs, int max_it, double tol,
+/// BiCGSTAB for op(y) = rhs, left-preconditioned, from y0: two operator products per iteration
+/// and no stored basis. Returns the number of operator products; *rel receives the final
+/// preconditioned relative residual (recomputed from scratch at the end).
+int BiCgStab(FreeOperator* op, const Eigen::VectorXd& rhs, int max_it, double tol,
              Eigen::VectorXd* y, double* rel) {
+  auto pop = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
+    return op->Precondition(op->Apply(v));
+  };
   const int n = static_cast<int>(rhs.size());
-  y->setZero(n);
-  Eigen::VectorXd r = prec(rhs);
-  const double beta0 = r.norm();
+  const Eigen::VectorXd b = op->Precondition(rhs);
+  const double beta0 = b.norm();
   *rel = 0.0;
-  if (!(beta0 > 0.0)) return 0;
+  if (!(beta0 > 0.0)) {
+    y->setZero(n);
+    return 0;
+  }
+  int total = 0;
+  Eigen::VectorXd r = b;
+  if (y->squaredNorm() > 0.0) {
+    r = b - pop(*y);
+    ++total;
+  }
   const Eigen::VectorXd r0 = r;
   Eigen::VectorXd p = Eigen::VectorXd::Zero(n), v = Eigen::VectorXd::Zero(n), s(n), t(n);
   double rho = 1.0, alpha = 1.0, omega = 1.0;
-  int total = 0;
-  while (total + 2 <= max_it) {
+  while (total + 2 <= max_it && r.norm() > tol * beta0) {
     const double rho_new = r0.dot(r);
     if (!(std::abs(rho_new) > 0.0)) break;  // breakdown
     const double beta = (rho_new / rho) * (alpha / omega);
     p = r + beta * (p - omega * v);
-    v = prec(op(p));
+    v = pop(p);
     ++total;
     const double r0v = r0.dot(v);
     if (!(std::abs(r0v) > 0.0)) break;
@@ -405,7 +568,7 @@ int BiCgStab(const Op& op, const Prec& prec, const Eigen::VectorXd& rhs, int max
       r = s;
       break;
     }
-    t = prec(op(s));
+    t = pop(s);
     ++total;
     const double tt = t.squaredNorm();
     if (!(tt > 0.0)) break;
@@ -413,9 +576,9 @@ int BiCgStab(const Op& op, const Prec& prec, const Eigen::VectorXd& rhs, int max
     *y += alpha * p + omega * s;
     r = s - omega * t;
     rho = rho_new;
-    if (r.norm() <= tol * beta0 || !(std::abs(omega) > 0.0)) break;
+    if (!(std::abs(omega) > 0.0)) break;
   }
-  *rel = (prec(rhs) - prec(op(*y))).norm() / beta0;
+  *rel = (b - pop(*y)).norm() / beta0;
   ++total;
   return total;
 }
@@ -426,7 +589,8 @@ EquilibriumJacobianResult ComputeEquilibriumJacobian(const Model& model,
                                                      const Eigen::Ref<const Eigen::MatrixX3d>& X,
                                                      const Eigen::Ref<const Eigen::VectorXd>& c,
                                                      const std::vector<int>& columns_in,
-                                                     const EquilibriumJacobianOptions& options) {
+                                                     const EquilibriumJacobianOptions& options,
+                                                     const Eigen::MatrixXd* initial_guess) {
   const auto t0 = std::chrono::steady_clock::now();
   EquilibriumJacobianResult res;
   auto finish = [&]() {
@@ -452,6 +616,9 @@ EquilibriumJacobianResult ComputeEquilibriumJacobian(const Model& model,
       res.message = "ComputeEquilibriumJacobian: column " + std::to_string(a) + " is not an actuator";
       return finish();
     }
+  const int nc = static_cast<int>(columns.size());
+  const bool use_guess = initial_guess && initial_guess->rows() == 3 * nv &&
+                         initial_guess->cols() == nc && initial_guess->allFinite();
 
   EquilibriumLinearization lin;
   if (!lin.Setup(model, X, c, &why, options.threads)) {
@@ -459,55 +626,77 @@ EquilibriumJacobianResult ComputeEquilibriumJacobian(const Model& model,
     return finish();
   }
   const int nf = model.num_free_dofs();
-  Eigen::MatrixX3d Y(nv, 3), dB(nv, 3);
-  Eigen::VectorXd AY, KY;
-  const Eigen::VectorXd zero_c = Eigen::VectorXd::Zero(na);
-  // H y = A_ff y - (K Y)_f with Y = y on the free coordinates, 0 elsewhere.
-  auto op = [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
-    Y.setZero();
-    model.ScatterFree(y, &Y);
-    lin.ApplyRhsDerivative(Y, zero_c, &dB);
-    model.GatherFree(model.A() * Y, &AY);
-    model.GatherFree(dB, &KY);
-    return AY - KY;
-  };
-  auto prec = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd { return model.SolveFree(v); };
+  FreeOperator op(model, &lin);
 
-  res.dXdc.setZero(3 * nv, static_cast<Eigen::Index>(columns.size()));
-  Eigen::VectorXd rhs, y, Ac;
-  KrylovMemory memory;
-  for (size_t j = 0; j < columns.size(); ++j) {
+  // Right-hand sides, all columns in one pass: dB/dc_a + (K_fc - A_fc) dx_c/dc_a.
+  std::vector<Eigen::MatrixX3d> dXc(nc);
+  Eigen::MatrixXd dXcb(nv, 3 * nc), dcb = Eigen::MatrixXd::Zero(na, nc), dBb;
+  for (int j = 0; j < nc; ++j) {
+    dXc[j] = PrescribedDerivative(model, c, columns[j]);
+    dXcb.middleCols(3 * j, 3) = dXc[j];
+    dcb(columns[j], j) = 1.0;
+  }
+  lin.ApplyRhsDerivativeBatch(dXcb, dcb, &dBb);
+  dBb.noalias() -= model.A() * dXcb;
+  Eigen::MatrixXd rhs(nf, nc), Y0 = Eigen::MatrixXd::Zero(nf, nc), Yf(nf, nc);
+  for (int j = 0; j < nc; ++j) {
+    op.Gather(dBb.middleCols(3 * j, 3), rhs.col(j));
+    if (use_guess) {
+      Eigen::MatrixX3d G(nv, 3);
+      for (int v = 0; v < nv; ++v)
+        for (int d = 0; d < 3; ++d) G(v, d) = (*initial_guess)(3 * v + d, j);
+      op.Gather(G, Y0.col(j));
+    }
+  }
+
+  std::vector<double> rels(nc, 0.0);
+  res.iterations.assign(nc, 0);
+  if (options.krylov == "bicgstab") {
+    for (int j = 0; j < nc; ++j) {
+      Eigen::VectorXd y = Y0.col(j);
+      res.iterations[j] =
+          BiCgStab(&op, rhs.col(j), options.max_iterations, options.tolerance, &y, &rels[j]);
+      res.rounds += res.iterations[j];
+      Yf.col(j) = y;
+    }
+  } else {
+    const Eigen::MatrixXd B = op.Precondition(rhs);
+    std::vector<GmresColumn> cols;
+    cols.reserve(nc);
+    for (int j = 0; j < nc; ++j)
+      cols.emplace_back(B.col(j), Y0.col(j), options.restart, options.max_iterations,
+                        options.tolerance);
+    res.rounds = RunGmres(&op, &cols, options.lockstep);
+    for (int j = 0; j < nc; ++j) {
+      Yf.col(j) = cols[j].y();
+      rels[j] = cols[j].rel();
+      res.iterations[j] = cols[j].products();
+    }
+  }
+  // The unpreconditioned residuals, for the report (one batched product).
+  const Eigen::MatrixXd HY = op.Apply(Yf);
+  for (int j = 0; j < nc; ++j) {
+    const double rn = rhs.col(j).norm();
+    res.residuals.push_back(rn > 0 ? (HY.col(j) - rhs.col(j)).norm() / rn : 0.0);
+  }
+  res.dXdc.setZero(3 * nv, nc);
+  for (int j = 0; j < nc; ++j) {
     const int a = columns[j];
-    const Eigen::MatrixX3d dXc = PrescribedDerivative(model, c, a);
-    Eigen::VectorXd dc = zero_c;
-    dc[a] = 1.0;
-    lin.ApplyRhsDerivative(dXc, dc, &dB);
-    model.GatherFree(dB - model.A() * dXc, &rhs);
-    double rel = 0.0;
-    const int its =
-        options.krylov == "bicgstab"
-            ? BiCgStab(op, prec, rhs, options.max_iterations, options.tolerance, &y, &rel)
-            : Gmres(op, prec, rhs, options.restart, options.max_iterations, options.tolerance, &y,
-                    &rel, options.recycle ? &memory : nullptr);
-    res.iterations.push_back(its);
-    const double rn = rhs.norm();
-    const double true_rel = rn > 0 ? (op(y) - rhs).norm() / rn : 0.0;
-    res.residuals.push_back(true_rel);
-    if (!y.allFinite() || !(rel <= options.tolerance)) {
+    if (!Yf.col(j).allFinite() || !(rels[j] <= options.tolerance)) {
       std::ostringstream s;
-      s << "implicit Jacobian: GMRES for actuator '" << model.scene().actuators[a].name
-        << "' stopped at relative residual " << rel << " after " << its
+      s << "implicit Jacobian: " << (options.krylov == "bicgstab" ? "BiCGSTAB" : "GMRES")
+        << " for actuator '" << model.scene().actuators[a].name
+        << "' stopped at relative residual " << rels[j] << " after " << res.iterations[j]
         << " iterations (tolerance " << options.tolerance << ")";
       res.message = s.str();
       res.dXdc.resize(0, 0);
       return finish();
     }
-    Eigen::MatrixX3d dX = dXc;
-    model.ScatterFree(y, &dX);
+    Eigen::MatrixX3d dX = dXc[j];
+    op.Scatter(Yf.col(j), dX);
     for (int v = 0; v < nv; ++v)
-      for (int d = 0; d < 3; ++d) res.dXdc(3 * v + d, static_cast<Eigen::Index>(j)) = dX(v, d);
+      for (int d = 0; d < 3; ++d) res.dXdc(3 * v + d, j) = dX(v, d);
   }
-  (void)nf;
   res.ok = true;
   return finish();
 }

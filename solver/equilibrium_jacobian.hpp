@@ -21,7 +21,8 @@
 ///     dr_i = (sigma dm_i + m_i dsigma) / mu_i with dsigma = -sigma d(sum m_j) / sum m_j +
 ///     (M + L_R) drho / sum m_j: a per-group rank-one coupling, applied as such.
 /// H is not symmetric in general (the blended and ratio-coupled targets are not minimisers of one
-/// energy), so the linear solve is restarted GMRES, left-preconditioned by A_ff^-1 with the
+/// energy), so the linear solve is restarted GMRES (all columns in lockstep, one batched product per
+/// round), left-preconditioned by A_ff^-1 with the
 /// model's prefactored CHOLMOD factor (Model::SolveFree): the preconditioned operator is
 /// I - A_ff^-1 K_ff, the identity minus the Jacobian of the local-global map, whose spectrum the
 /// local-global iteration itself contracts; GMRES needs far fewer products than that iteration.
@@ -42,17 +43,21 @@ namespace softkin {
 struct EquilibriumJacobianOptions {
   /// Krylov method: "gmres" (restarted, see restart) or "bicgstab" (no stored basis).
   std::string krylov = "gmres";
-  /// Stop GMRES when the preconditioned residual has dropped by this factor.
+  /// Stop GMRES when the preconditioned residual has dropped by this factor (relative to the
+  /// preconditioned right-hand side, whatever the starting guess).
   double tolerance = 1e-8;
   /// Krylov iterations (operator products) allowed per column, over all restarts.
   int max_iterations = 1000;
-  /// GMRES restart length (Krylov basis size; memory 2 x #free dofs x (restart + 1) doubles).
-  /// Restarting loses the slow modes and costs far more products (cable_finger res 5 to 1e-8:
-  /// 732 products with restart 80, ~480 without restart), so it is large.
+  /// GMRES restart length (Krylov basis size; the basis grows as needed, up to 8 x #free dofs x
+  /// (restart + 1) bytes per column). Restarting loses the slow modes and costs far more products
+  /// (cable_finger res 5 to 1e-8: 732 products with restart 80, ~480 without restart), so it is
+  /// large.
   int restart = 300;
-  /// Start each column from the best combination of the previous column's Krylov space. Off by
-  /// default: on cable_finger (res 5) it did not reduce the total products (430 vs 425 to 1e-8).
-  bool recycle = false;
+  /// GMRES only: solve all columns in lockstep, each in its own Krylov space but with one batched
+  /// operator product per round (one pass over the elements for every column, and one CHOLMOD
+  /// solve with 3 x #columns right-hand sides). Same iterates as column by column, in about half
+  /// the time on three_chamber (docs/kinematics.md). false: one column after the other.
+  bool lockstep = true;
   /// OpenMP threads for the per-element products (0 = library default).
   int threads = 0;
   bool IsValid(std::string* why) const;
@@ -75,6 +80,11 @@ class EquilibriumLinearization {
   /// coordinate, prescribed ones included) and actuation dc (#actuators). Exact up to round-off.
   void ApplyRhsDerivative(const Eigen::Ref<const Eigen::MatrixX3d>& dX,
                           const Eigen::Ref<const Eigen::VectorXd>& dc, Eigen::MatrixX3d* dB);
+  /// ApplyRhsDerivative for m directions at once, in one pass over the elements: dX is #V x 3m
+  /// (direction j in columns 3j..3j+2, mm), dc is #actuators x m, dB receives #V x 3m. Column
+  /// block j equals ApplyRhsDerivative(dX block j, dc.col(j)) to round-off.
+  void ApplyRhsDerivativeBatch(const Eigen::Ref<const Eigen::MatrixXd>& dX,
+                               const Eigen::Ref<const Eigen::MatrixXd>& dc, Eigen::MatrixXd* dB);
   const Model& model() const { return *model_; }
 
  private:
@@ -96,11 +106,13 @@ class EquilibriumLinearization {
   std::vector<double> ratios_;
   std::vector<ElementCache> cache_;
   std::vector<GroupCache> groups_;
+  std::vector<ElemRows> rows_;         ///< centred current rows D (blended bodies, cable, DEA)
+  std::vector<ElemRows> vol_grad_;     ///< d Vol / dD of blended bodies with an active scale
   std::vector<double> measure_;        ///< m_i (floored) of actuation elements
   std::vector<char> measure_active_;   ///< m_i above its floor
   std::vector<ElemRows> measure_grad_; ///< dm_i/dD of actuation elements (others unused)
-  std::vector<double> dratio_;         ///< scratch: dr_i
-  std::vector<ElemRows> weighted_;     ///< scratch: w_i Vol_i dT_i
+  std::vector<double> dratio_;         ///< scratch: dr_i per direction (#E x m)
+  std::vector<ElemRows> weighted_;     ///< scratch: w_i Vol_i dT_i per direction (#E x m)
   int threads_ = 0;
 };
 
@@ -111,19 +123,27 @@ struct EquilibriumJacobianResult {
   /// 3 #V x #columns: dX/dc (row 3 v + d: coordinate d of vertex v), mm per unit of actuation;
   /// column j is actuator columns[j].
   Eigen::MatrixXd dXdc;
-  std::vector<int> iterations;    ///< GMRES iterations (operator products) per column
+  /// Operator products per column (GMRES / BiCGSTAB iterations plus the residual checks).
+  std::vector<int> iterations;
   std::vector<double> residuals;  ///< final ||H y - rhs|| / ||rhs|| per column (unpreconditioned)
+  /// Batched operator applications (lockstep rounds; equals the sum of iterations without lockstep).
+  int rounds = 0;
   double time_s = 0.0;
 };
 
 /// dX/dc at the equilibrium X (#V x 3, a converged local-global state for actuation c) for the
-/// actuators in `columns` (empty: all, in order). ok = false with a message for unsupported
-/// elements, degenerate elements or a GMRES solve that does not reach options.tolerance within
-/// options.max_iterations (never NaN). Uses Model::SolveFree, so not concurrently on one Model.
+/// actuators in `columns` (empty: all, in order). `initial_guess` (optional, 3 #V x #columns in the
+/// layout of dXdc, e.g. the previous Jacobian of a path) starts each Krylov solve from its free
+/// coordinates instead of 0; the tolerance stays relative to the right-hand side, so a close guess
+/// saves products without loosening the result. ok = false with a message for unsupported
+/// elements, degenerate elements or a Krylov solve that does not reach options.tolerance within
+/// options.max_iterations (never NaN). Uses the model's CHOLMOD factors, so not concurrently on
+/// one Model.
 EquilibriumJacobianResult ComputeEquilibriumJacobian(
     const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
     const Eigen::Ref<const Eigen::VectorXd>& c, const std::vector<int>& columns = {},
-    const EquilibriumJacobianOptions& options = EquilibriumJacobianOptions());
+    const EquilibriumJacobianOptions& options = EquilibriumJacobianOptions(),
+    const Eigen::MatrixXd* initial_guess = nullptr);
 
 /// d(prescribed coordinates)/dc[a] (#V x 3, zero on free coordinates): nonzero only for motion
 /// actuators (their vertices' rigid motion), computed by a central difference of

@@ -195,6 +195,25 @@ TEST(IkSolver, AFailingKinematicsStopsEveryMethodWithItsMessage) {
   }
 }
 
+// Gauss-Newton takes J only where it will step from: at c0 and at each accepted point it goes on
+// from, never at the point where it stops (on the simulator a Jacobian costs about a forward
+// solve). The evaluations are then one per iteration with J plus the trials.
+TEST(IkSolver, GaussNewtonTakesNoJacobianWhereItStops) {
+  PccKinematics pcc;
+  for (const Eigen::Vector3d c_true : {Eigen::Vector3d(5, 5, 9), Eigen::Vector3d(12, 3, 7)}) {
+    PointTrackingObjective o(pcc.point_names(), "tip", pcc.Evaluate(c_true, false).p.row(0).transpose());
+    IkOptions opt;
+    opt.method = IkMethod::kGaussNewton;
+    const IkResult r = SolveIk(pcc, o, pcc.rest(), opt);
+    ASSERT_TRUE(r.summary.converged()) << r.summary.BriefReport();
+    ASSERT_GT(r.summary.iterations, 0);
+    EXPECT_EQ(r.summary.jacobian_evaluations, r.summary.iterations);
+    EXPECT_EQ(r.summary.history.size(), static_cast<size_t>(r.summary.iterations) + 1);
+    EXPECT_LE(r.objective, opt.lambda);
+    EXPECT_EQ(r.objective, r.summary.history.back());
+  }
+}
+
 TEST(IkSolver, BriefReportSaysWhatHappened) {
   PccKinematics pcc;
   PointTrackingObjective o(pcc.point_names(), "tip", pcc.Evaluate(Eigen::Vector3d(5, 5, 9), false).p.row(0).transpose());

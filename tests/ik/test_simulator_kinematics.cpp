@@ -194,6 +194,36 @@ TEST(Kinematics, FkSolveCountsAndStateReuse) {
   }
 }
 
+// implicit along a path: the p solve starts from the first-order prediction of the previous state
+// and the Jacobian's Krylov solves from the previous Jacobian. Both are only starting points: p
+// and J agree with a kinematics that uses neither, to the FK and Krylov tolerances, and the
+// Jacobian takes fewer products.
+TEST(Kinematics, PredictedStartsKeepPAndJ) {
+  const Scene s = MakeRobot("three_chamber", 3);
+  auto model = std::make_shared<const Model>(s);
+  const FkOptions fk = Fk(1e-8, 1e-9);
+  SimulatorKinematicsOptions with = Mode(JacobianMode::kImplicit), without = with;
+  without.predict_warm_start = false;
+  without.jacobian_initial_guess = false;
+  SimulatorKinematics a(model, with, &fk), b(model, without, &fk);
+  const std::vector<Eigen::VectorXd> path = {Vec({1.5, 1.2, 1.0}), Vec({1.56, 1.25, 1.02}),
+                                             Vec({1.62, 1.3, 1.04})};
+  int pa = 0, pb = 0;
+  for (size_t i = 0; i < path.size(); ++i) {
+    SCOPED_TRACE(i);
+    const KinematicsEval ea = a.Evaluate(path[i], true), eb = b.Evaluate(path[i], true);
+    ASSERT_TRUE(ea.ok) << ea.message;
+    ASSERT_TRUE(eb.ok) << eb.message;
+    EXPECT_EQ(ea.fk_solves, 1);  // the predicted start converged: no retry
+    EXPECT_LT((ea.p - eb.p).norm(), 1e-5 * model->size());
+    EXPECT_LT(RelErr(ea.J, eb.J), 1e-5);
+    if (i == 0) continue;  // the first Jacobian has no guess
+    for (int its : a.last_implicit().iterations) pa += its;
+    for (int its : b.last_implicit().iterations) pb += its;
+  }
+  EXPECT_LT(pa, pb);
+}
+
 // At a bound the differences are one-sided (probes stay in the box) and still agree with implicit.
 TEST(Kinematics, OneSidedDifferencesAtTheBounds) {
   const Scene s = MakeRobot("three_chamber", 3);
