@@ -200,7 +200,7 @@ TEST(IkSolver, AFailingKinematicsStopsEveryMethodWithItsMessage) {
 // solve). The evaluations are then one per iteration with J plus the trials.
 TEST(IkSolver, GaussNewtonTakesNoJacobianWhereItStops) {
   PccKinematics pcc;
-  for (const Eigen::Vector3d c_true : {Eigen::Vector3d(5, 5, 9), Eigen::Vector3d(12, 3, 7)}) {
+  for (const Eigen::Vector3d& c_true : {Eigen::Vector3d(5, 5, 9), Eigen::Vector3d(12, 3, 7)}) {
     PointTrackingObjective o(pcc.point_names(), "tip", pcc.Evaluate(c_true, false).p.row(0).transpose());
     IkOptions opt;
     opt.method = IkMethod::kGaussNewton;
