@@ -2,6 +2,7 @@
 
 #include "experiments/cli_args.hpp"
 #include "experiments/cli_dataset.hpp"
+#include "experiments/cli_train.hpp"
 #include "experiments/cli_ik.hpp"
 #include "experiments/results.hpp"
 #include "experiments/runner.hpp"
@@ -152,6 +153,10 @@ int RunCli(int argc, char** argv) {
   // dataset (experiments/cli_dataset.cpp)
   DatasetCommandArgs ds_args;
   auto* ds_cmd = AddDatasetCommand(&app, &ds_args);
+
+  // train (experiments/cli_train.cpp)
+  TrainCommandArgs train_args;
+  auto* train_cmd = AddTrainCommand(&app, &train_args);
 
   try {
     app.parse(argc, argv);
@@ -312,6 +317,11 @@ int RunCli(int argc, char** argv) {
       std::string command_line;
       for (int i = 0; i < argc; ++i) command_line += (i ? " " : "") + std::string(argv[i]);
       return RunDatasetCommand(ds_args, command_line);
+    }
+    if (train_cmd->parsed()) {
+      std::string command_line;
+      for (int i = 0; i < argc; ++i) command_line += (i ? " " : "") + std::string(argv[i]);
+      return RunTrainCommand(train_args, command_line);
     }
     if (run->parsed()) {
       ropt.plot = !no_plot;

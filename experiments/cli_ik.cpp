@@ -5,9 +5,12 @@
 #include "ik/simulator_kinematics.hpp"
 #include "ik/trajectory.hpp"
 #include "ik/trajectory_io.hpp"
+#include "learn/net_kinematics.hpp"
 #include "solver/robots.hpp"
 #include "solver/scene_json.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -49,7 +52,10 @@ CLI::App* AddIkCommand(CLI::App* app, IkCommandArgs* a) {
                  "Tracked point: a marker of the scene (its vertices' mean), or 'marker[i]' for its "
                  "vertex i (default tip)");
   ik->add_option("--method", a->method,
-                 "IK method: " + IkMethodNames() + " (default softls, thesis Algorithm 3)");
+                 "IK method: " + IkMethodNames() +
+                     " (default softls, thesis Algorithm 3); with --nets also 'learned' "
+                     "(gauss-newton on the networks, Eq. 5.4-5.6) and 'direct' (the direct-IK "
+                     "network N_ik, Table 5.1's baseline)");
   ik->add_option("--jacobian", a->jacobian,
                  "How the simulator's Jacobian dp/dc is computed: fd (central differences, "
                  "Eq. 4.2), fd-warm (differences started from the converged state), implicit "
@@ -72,7 +78,20 @@ CLI::App* AddIkCommand(CLI::App* app, IkCommandArgs* a) {
   ik->add_option("--cache", a->cache,
                  "CSV cache of the configuration-space samples: loaded if it was built for the "
                  "same robot, point, Jacobian mode and grid, else (re)built and written");
-  ik->add_option("--out", a->out, "Output CSV, one row per waypoint")->required();
+  ik->add_option("--out", a->out, "Output CSV, one row per waypoint (required unless --interactive)");
+  ik->add_option("--nets", a->nets,
+                 "Network directory from `softkin train`: IK on the learned kinematics instead of "
+                 "the simulator (no --robot/--scene; the reached point is the networks' "
+                 "prediction)");
+  ik->add_option("--jacobian-source", a->jacobian_source,
+                 "With --nets: network (the learned Jacobian N_J, Eq. 5.3; default) or "
+                 "fk-derivative (the analytic derivative of N_fk)");
+  ik->add_flag("--s2r", a->s2r,
+               "With --nets: use the sim-to-real layer, p = N_s2r(N_fk(c)) (Eq. 5.4)");
+  ik->add_flag("--interactive", a->interactive,
+               "With --nets: read targets 'x y z' (or x,y,z) from stdin, one per line, and print "
+               "one CSV row per target to stdout (actuation and predicted point); each target "
+               "starts from the previous answer; 'quit' or end of input stops (Fig. 5.13)");
   ik->add_flag("--resume", a->resume,
                "Continue an interrupted run: keep the complete rows already in --out (they must "
                "be for the same waypoints) and solve the rest, warm-started from the last row's "
@@ -129,23 +148,12 @@ size_t CheckResumeRows(const std::string& out, const Eigen::MatrixX3d& waypoints
   return pos;
 }
 
-}  // namespace
-
-int RunIkCommand(const IkCommandArgs& a) {
-  // ---- options ----
-  if (a.robot.empty() == a.scene.empty())
-    throw std::invalid_argument("ik: give exactly one of --robot NAME or --scene FILE");
-  if (a.target.empty() == a.trajectory.empty())
-    throw std::invalid_argument("ik: give exactly one of --target x,y,z or --trajectory FILE");
-  if (a.res < 0) throw std::invalid_argument("--res: expected a positive integer");
+/// The per-waypoint IK options shared by the simulator and the learned kinematics.
+IkOptions ParseIkOptions(const IkCommandArgs& a, const std::string& method) {
   IkOptions ik;
-  if (!StringToIkMethod(a.method, &ik.method))
-    throw std::invalid_argument("--method: unknown method '" + a.method + "' (expected one of " +
-                                IkMethodNames() + ")");
-  SimulatorKinematicsOptions ko;
-  if (!JacobianModeFromString(a.jacobian, &ko.jacobian))
-    throw std::invalid_argument("--jacobian: unknown mode '" + a.jacobian + "' (expected one of " +
-                                JacobianModeNames() + ")");
+  if (!StringToIkMethod(method, &ik.method))
+    throw std::invalid_argument("--method: unknown method '" + method + "' (expected one of " +
+                                IkMethodNames() + (a.nets.empty() ? "" : ", learned, direct") + ")");
   if (!(a.lambda_mm >= 0) || !std::isfinite(a.lambda_mm))
     throw std::invalid_argument("--lambda: expected a distance >= 0 mm, got " + std::to_string(a.lambda_mm));
   if (a.max_iterations < 1)
@@ -157,18 +165,41 @@ int RunIkCommand(const IkCommandArgs& a) {
   if (a.samples != 0 && (a.samples < 2 || a.samples > 50))
     throw std::invalid_argument("--samples: expected 0 (start at rest) or an integer in [2, 50], got " +
                                 std::to_string(a.samples));
-  if (a.point.find("[*]") != std::string::npos)
-    throw std::invalid_argument("--point: expected one point (a marker or 'marker[i]'), got the group '" +
-                                a.point + "'");
   if (!(a.max_time_s > 0) || !std::isfinite(a.max_time_s))
     throw std::invalid_argument("--max-time: expected a time > 0 s, got " + std::to_string(a.max_time_s));
-  if (a.gradient_tolerance < 0 || !std::isfinite(a.gradient_tolerance))
-    throw std::invalid_argument("--gradient-tolerance: expected a fraction > 0, got " +
-                                std::to_string(a.gradient_tolerance));
   ik.max_time_s = a.max_time_s;
   ik.lambda = a.lambda_mm * a.lambda_mm;
   ik.max_iterations = a.max_iterations;
   ik.max_evaluations = a.max_evaluations;
+  return ik;
+}
+
+}  // namespace
+
+int RunLearnedIk(const IkCommandArgs& a);
+
+int RunIkCommand(const IkCommandArgs& a) {
+  if (!a.nets.empty() || a.method == "learned" || a.method == "direct") return RunLearnedIk(a);
+  if (a.interactive) throw std::invalid_argument("--interactive: needs --nets DIR (learned kinematics)");
+  if (a.s2r) throw std::invalid_argument("--s2r: needs --nets DIR (learned kinematics)");
+  if (a.out.empty()) throw std::invalid_argument("--out: required (the output CSV)");
+  // ---- options ----
+  if (a.robot.empty() == a.scene.empty())
+    throw std::invalid_argument("ik: give exactly one of --robot NAME or --scene FILE");
+  if (a.target.empty() == a.trajectory.empty())
+    throw std::invalid_argument("ik: give exactly one of --target x,y,z or --trajectory FILE");
+  if (a.res < 0) throw std::invalid_argument("--res: expected a positive integer");
+  IkOptions ik = ParseIkOptions(a, a.method);
+  SimulatorKinematicsOptions ko;
+  if (!JacobianModeFromString(a.jacobian, &ko.jacobian))
+    throw std::invalid_argument("--jacobian: unknown mode '" + a.jacobian + "' (expected one of " +
+                                JacobianModeNames() + ")");
+  if (a.point.find("[*]") != std::string::npos)
+    throw std::invalid_argument("--point: expected one point (a marker or 'marker[i]'), got the group '" +
+                                a.point + "'");
+  if (a.gradient_tolerance < 0 || !std::isfinite(a.gradient_tolerance))
+    throw std::invalid_argument("--gradient-tolerance: expected a fraction > 0, got " +
+                                std::to_string(a.gradient_tolerance));
 
   // ---- waypoints ----
   Eigen::MatrixX3d waypoints;
@@ -291,6 +322,176 @@ int RunIkCommand(const IkCommandArgs& a) {
               << " s; wrote " << a.out << "\n";
   }
   return failed > 0 ? 1 : 0;
+}
+
+namespace {
+
+Eigen::MatrixX3d ReadTargets(const IkCommandArgs& a, std::string* source) {
+  if (!a.target.empty()) {
+    const Eigen::VectorXd t = ParseNumberList(a.target, "--target");
+    if (t.size() != 3)
+      throw std::invalid_argument("--target: expected x,y,z (3 numbers, mm), got " +
+                                  std::to_string(t.size()) + " number(s) in '" + a.target + "'");
+    *source = "--target";
+    return t.transpose();
+  }
+  *source = a.trajectory;
+  return ReadWaypoints(a.trajectory);
+}
+
+/// One target with the direct-IK network: c = N_ik(t), the point predicted by the kinematics.
+WaypointResult DirectWaypoint(const LearnedNets& nets, NetKinematics& kin, int index,
+                              const Eigen::Vector3d& target, const Eigen::VectorXd& previous,
+                              const Eigen::VectorXd& range) {
+  const auto t0 = std::chrono::steady_clock::now();
+  WaypointResult w;
+  w.index = index;
+  w.target = target;
+  w.c = DirectIk(nets, target);
+  const KinematicsEval e = kin.Evaluate(w.c, false);
+  w.reached = e.p.row(0).transpose();
+  w.error_mm = (w.reached - target).norm();
+  w.objective = w.error_mm * w.error_mm;
+  w.converged = true;
+  w.termination = IkTermination::kConverged;
+  w.message = "direct";
+  w.evaluations = 1;
+  w.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (previous.size() == w.c.size()) {
+    w.jump = (w.c - previous).cwiseAbs().maxCoeff();
+    w.jump_fraction = (w.c - previous).cwiseAbs().cwiseQuotient(range).maxCoeff();
+  }
+  return w;
+}
+
+}  // namespace
+
+int RunLearnedIk(const IkCommandArgs& a) {
+  if (a.nets.empty())
+    throw std::invalid_argument("--method " + a.method + ": needs --nets DIR (from `softkin train`)");
+  if (!a.robot.empty() || !a.scene.empty())
+    throw std::invalid_argument("--nets: the networks replace the simulator; drop --robot/--scene");
+  const int given = !a.target.empty() + !a.trajectory.empty() + a.interactive;
+  if (given != 1)
+    throw std::invalid_argument("ik --nets: give exactly one of --target x,y,z, --trajectory FILE or --interactive");
+  if (!a.interactive && a.out.empty()) throw std::invalid_argument("--out: required (the output CSV)");
+  if (a.resume) throw std::invalid_argument("--resume: not supported with --nets (learned IK takes milliseconds)");
+  JacobianSource source;
+  if (!JacobianSourceFromString(a.jacobian_source, &source))
+    throw std::invalid_argument("--jacobian-source: unknown source '" + a.jacobian_source +
+                                "' (expected network or fk-derivative)");
+  const bool direct = a.method == "direct";
+  const std::string method = a.method == "learned" || direct ? "gauss-newton" : a.method;
+  IkOptions ik = ParseIkOptions(a, method);
+  const LearnedNets nets = LearnedNets::Load(a.nets);
+  if (direct && !nets.has_ik())
+    throw std::invalid_argument("--method direct: " + a.nets + " has no ik network (train it with --what fk,ik)");
+  if (!direct && source == JacobianSource::kNetwork && !nets.has_jac())
+    throw std::invalid_argument("--jacobian-source network: " + a.nets +
+                                " has no jac network; train one (--what fk,jac) or use "
+                                "--jacobian-source fk-derivative");
+  if (a.s2r && !nets.has_s2r())
+    throw std::invalid_argument("--s2r: " + a.nets + " has no s2r network (train it with `softkin train --s2r`)");
+  if (a.point != "tip" && a.point != nets.points.front())
+    throw std::invalid_argument("--point: the networks track '" + nets.points.front() + "' first; got '" + a.point + "'");
+  NetKinematics kin(nets, source, a.s2r);
+  const int n = kin.num_actuators();
+  const Eigen::VectorXd range = kin.upper() - kin.lower();
+
+  TrajectoryOptions to;
+  to.point = nets.points.front();
+  to.ik = ik;
+  to.sampling.samples_per_axis = a.samples == 0 ? 2 : a.samples;
+  if (a.samples == 0) to.warm_start = kin.rest();
+
+  if (a.interactive) {
+    std::cout << WaypointCsvHeader(n) << "\n" << std::flush;
+    if (!a.quiet)
+      std::cerr << "softkin ik: " << kin.name() << " from " << a.nets
+                << "; type a target 'x y z' (mm) per line, 'quit' to stop\n";
+    Eigen::VectorXd previous;
+    std::string line;
+    int index = 0, lineno = 0;
+    while (std::getline(std::cin, line)) {
+      ++lineno;
+      const size_t b = line.find_first_not_of(" \t\r");
+      if (b == std::string::npos || line[b] == '#') continue;
+      if (line.compare(b, 4, "quit") == 0 || line.compare(b, 4, "exit") == 0) break;
+      std::string norm = line;
+      for (char& ch : norm)
+        if (ch == ',' || ch == '\t') ch = ' ';
+      std::istringstream ss(norm);
+      Eigen::Vector3d t;
+      std::string extra;
+      if (!(ss >> t.x() >> t.y() >> t.z()) || (ss >> extra) || !t.allFinite()) {
+        std::cerr << "softkin ik: stdin:" << lineno << ": expected a target 'x y z' (3 finite numbers, mm), got '"
+                  << line << "'\n";
+        continue;
+      }
+      WaypointResult w;
+      if (direct) {
+        w = DirectWaypoint(nets, kin, index, t, previous, range);
+      } else {
+        TrajectoryOptions one = to;
+        if (previous.size() == n) one.warm_start = previous;
+        const TrajectoryResult r = FollowTrajectory(kin, t.transpose(), one);
+        w = r.waypoints.front();
+        w.index = index;
+        if (previous.size() == n) {
+          w.jump = (w.c - previous).cwiseAbs().maxCoeff();
+          w.jump_fraction = (w.c - previous).cwiseAbs().cwiseQuotient(range).maxCoeff();
+        }
+      }
+      previous = w.c;
+      ++index;
+      std::cout << WaypointCsvRow(w) << "\n" << std::flush;
+    }
+    return 0;
+  }
+
+  std::string source_name;
+  const Eigen::MatrixX3d waypoints = ReadTargets(a, &source_name);
+  std::ofstream csv(a.out);
+  if (!csv) throw std::runtime_error("cannot write " + a.out);
+  csv << WaypointCsvHeader(n) << "\n";
+  if (!a.quiet)
+    std::cerr << "softkin ik: " << kin.name() << " from " << a.nets << ", "
+              << (direct ? std::string("direct") : method) << ", " << waypoints.rows()
+              << " waypoint(s) from " << source_name << "\n";
+  double sum = 0, worst = 0, total_time = 0, max_jump = 0;
+  int converged = 0;
+  if (direct) {
+    Eigen::VectorXd previous;
+    for (int i = 0; i < waypoints.rows(); ++i) {
+      const WaypointResult w = DirectWaypoint(nets, kin, i, waypoints.row(i).transpose(), previous, range);
+      previous = w.c;
+      csv << WaypointCsvRow(w) << "\n";
+      sum += w.error_mm;
+      worst = std::max(worst, w.error_mm);
+      total_time += w.time_s;
+      max_jump = std::max(max_jump, w.jump);
+      converged += w.error_mm * w.error_mm <= ik.lambda;
+    }
+  } else {
+    const TrajectoryResult r = FollowTrajectory(kin, waypoints, to, [&](const WaypointResult& w) {
+      csv << WaypointCsvRow(w) << "\n";
+    });
+    for (const auto& w : r.waypoints) sum += std::max(0.0, w.error_mm);
+    worst = r.max_error_mm;
+    total_time = r.total_time_s;
+    max_jump = r.max_jump;
+    converged = r.converged;
+  }
+  csv.flush();
+  if (!csv) throw std::runtime_error("error while writing " + a.out);
+  if (!a.quiet) {
+    const double N = static_cast<double>(waypoints.rows());
+    std::cerr << "softkin ik: " << converged << " of " << waypoints.rows()
+              << " waypoint(s) within lambda (predicted); error mean " << sum / N << " mm, max "
+              << worst << " mm; largest actuation jump " << max_jump << "; "
+              << 1e3 * total_time / N << " ms per waypoint; wrote " << a.out << "\n";
+  }
+  return 0;
 }
 
 }  // namespace softkin

@@ -29,6 +29,11 @@ struct IkCommandArgs {
   std::string out;
   bool resume = false;
   bool quiet = false;
+  // ---- learned kinematics (thesis Ch. 5; docs/learning.md) ----
+  std::string nets;                        ///< network directory from `softkin train`
+  std::string jacobian_source = "network"; ///< network (N_J) or fk-derivative (dN_fk/dc)
+  bool s2r = false;                        ///< drive the sim-to-real corrected kinematics
+  bool interactive = false;                ///< targets from stdin, rows to stdout (Fig. 5.13)
 };
 
 /// Adds the `ik` subcommand to `app`, bound to *args; returns it.
