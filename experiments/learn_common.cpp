@@ -1,0 +1,153 @@
+#include "experiments/learn_common.hpp"
+
+#include "experiments/results.hpp"
+#include "ik/simulator_kinematics.hpp"
+#include "learn/twin.hpp"
+#include "solver/robots.hpp"
+
+#include <filesystem>
+#include <iostream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace softkin {
+
+namespace fs = std::filesystem;
+
+std::string DatasetSpec::Tag() const {
+  std::ostringstream s;
+  s << (twin.empty() ? robot : "twin_" + twin) << "_r" << res << "_";
+  if (sampling.kind == DatasetSampling::Kind::kGrid) s << "g" << sampling.grid;
+  else s << "rnd" << sampling.random << "s" << sampling.seed;
+  s << "_b" << sampling.block << (jacobian ? "_J" : "") << "_gt" << gradient_tolerance;
+  for (const auto& p : points) s << "_" << p;
+  std::string t = s.str();
+  for (char& c : t)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-' && c != '.') c = '-';
+  return t;
+}
+
+nlohmann::json DatasetSpec::Json() const {
+  return {{"robot", robot}, {"twin", twin}, {"res", res}, {"points", points},
+          {"sampling", sampling.ToJson()}, {"jacobian", jacobian},
+          {"gradient_tolerance", gradient_tolerance}};
+}
+
+DatasetSpec ParseDatasetSpec(const nlohmann::json& j, const std::string& where) {
+  auto bad = [&where](const std::string& key, const std::string& what) {
+    return std::invalid_argument(where + "." + key + ": expected " + what);
+  };
+  if (!j.is_object()) throw std::invalid_argument(where + ": expected a dataset object {\"robot\", \"grid\", ...}");
+  const std::set<std::string> known = {"robot", "twin", "res", "points", "grid", "random", "seed",
+                                       "jacobian", "gradient_tolerance", "block"};
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (!known.count(it.key())) throw std::invalid_argument(where + "." + it.key() + ": unknown key");
+  DatasetSpec s;
+  if (j.contains("twin")) {
+    if (!j["twin"].is_string()) throw bad("twin", "a twin name");
+    s.twin = j["twin"].get<std::string>();
+    try {
+      s.robot = GetTwinSpec(s.twin).robot;
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(where + ".twin: " + e.what());
+    }
+    if (j.contains("robot")) throw std::invalid_argument(where + ": give robot or twin, not both");
+  } else {
+    if (!j.contains("robot") || !j["robot"].is_string()) throw bad("robot", "an embedded robot name");
+    s.robot = j["robot"].get<std::string>();
+  }
+  if (j.contains("res")) {
+    if (!j["res"].is_number_integer()) throw bad("res", "an integer");
+    s.res = j["res"].get<int>();
+  }
+  if (j.contains("points")) {
+    if (!j["points"].is_array() || j["points"].empty()) throw bad("points", "a non-empty array of marker names");
+    s.points.clear();
+    for (const auto& p : j["points"]) {
+      if (!p.is_string()) throw bad("points", "marker names");
+      s.points.push_back(p.get<std::string>());
+    }
+  }
+  if (j.contains("random")) {
+    if (!j["random"].is_number_integer() || j["random"].get<long long>() < 1) throw bad("random", "a sample count >= 1");
+    if (!j.contains("seed") || !j["seed"].is_number_integer()) throw bad("seed", "an integer seed (required with random)");
+    s.sampling.kind = DatasetSampling::Kind::kRandom;
+    s.sampling.random = j["random"].get<long long>();
+    s.sampling.seed = j["seed"].get<std::uint64_t>();
+    if (j.contains("grid")) throw std::invalid_argument(where + ": give grid or random, not both");
+  } else {
+    if (!j.contains("grid") || !j["grid"].is_number_integer()) throw bad("grid", "an integer N >= 2 (N^m samples)");
+    s.sampling.grid = j["grid"].get<int>();
+  }
+  if (j.contains("block")) {
+    if (!j["block"].is_number_integer()) throw bad("block", "an integer >= 1");
+    s.sampling.block = j["block"].get<int>();
+  }
+  if (j.contains("jacobian")) {
+    if (!j["jacobian"].is_boolean()) throw bad("jacobian", "true or false");
+    s.jacobian = j["jacobian"].get<bool>();
+  }
+  if (j.contains("gradient_tolerance")) {
+    if (!j["gradient_tolerance"].is_number() || !(j["gradient_tolerance"].get<double>() > 0))
+      throw bad("gradient_tolerance", "a number > 0");
+    s.gradient_tolerance = j["gradient_tolerance"].get<double>();
+  }
+  std::string why;
+  if (!s.sampling.IsValid(&why)) throw std::invalid_argument(where + ": " + why);
+  if (!s.twin.empty() && s.jacobian) throw std::invalid_argument(where + ".jacobian: a twin has no Jacobian");
+  return s;
+}
+
+std::unique_ptr<Kinematics> MakeSpecKinematics(const DatasetSpec& spec) {
+  if (!spec.twin.empty()) {
+    TwinOptions to;
+    to.res = spec.res;
+    to.points = spec.points;
+    to.gradient_tolerance = spec.gradient_tolerance;
+    return std::make_unique<TwinKinematics>(GetTwinSpec(spec.twin), to);
+  }
+  const Scene scene = MakeRobot(spec.robot, spec.res);
+  FkOptions fk = scene.solver;
+  fk.gradient_tolerance = spec.gradient_tolerance;
+  SimulatorKinematicsOptions ko;
+  ko.points = spec.points;
+  ko.jacobian = JacobianMode::kImplicit;
+  return std::make_unique<SimulatorKinematics>(scene, ko, &fk);
+}
+
+std::string DatasetCacheDir(const std::string& result_dir) {
+  return (fs::path(result_dir).parent_path() / "_datasets").string();
+}
+
+Dataset CachedDataset(const DatasetSpec& spec, const std::string& cache_dir, bool verbose,
+                      nlohmann::json* info) {
+  fs::create_directories(cache_dir);
+  const std::string path = (fs::path(cache_dir) / (spec.Tag() + ".csv")).string();
+  std::unique_ptr<Kinematics> kin = MakeSpecKinematics(spec);
+  DatasetRunOptions run;
+  run.out = path;
+  run.jacobian = spec.jacobian;
+  run.source = spec.Json();
+  run.source["kind"] = spec.twin.empty() ? "robot" : "twin";
+  if (!spec.twin.empty()) run.source["twin"] = "twin:" + spec.twin;
+  run.provenance = {{"git_commit", GitCommit()}, {"command", "softkin run (experiment dataset cache)"}};
+  Kinematics* raw = kin.get();
+  run.reset = [raw] {
+    if (auto* t = dynamic_cast<TwinKinematics*>(raw)) t->Reset();
+    else if (auto* s = dynamic_cast<SimulatorKinematics*>(raw)) s->Reset();
+  };
+  run.progress = verbose;
+  if (verbose) std::cerr << "  dataset " << path << " (" << kin->name() << ")\n";
+  const DatasetRunSummary s = GenerateDataset(*kin, spec.sampling, run);
+  Dataset d = LoadDataset(path);
+  if (info) {
+    *info = {{"path", path}, {"spec", spec.Json()}, {"samples", d.inputs.rows()},
+             {"failed", d.failed}, {"generated_now", s.written}, {"already_cached", s.already},
+             {"time_s", s.time_s},
+             {"ms_per_sample", s.written > 0 ? 1e3 * s.time_s / s.written : 0.0}};
+  }
+  return d;
+}
+
+}  // namespace softkin

@@ -1,0 +1,49 @@
+#pragma once
+/// \file
+/// What the Chapter 5 experiments share: dataset specs read from a config, generated once into a
+/// cache beside the results (resumable: an interrupted run continues where it stopped, and a
+/// finished dataset is reused by every experiment that asks for the same one), and the kinematics
+/// they come from (a robot's simulator, or a labelled "hardware" twin).
+
+#include "experiments/config.hpp"
+#include "ik/kinematics.hpp"
+#include "learn/dataset.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace softkin {
+
+struct DatasetSpec {
+  std::string robot;                       ///< embedded robot (always set; a twin's nominal robot)
+  std::string twin;                        ///< "" or a twin name (learn/twin.hpp)
+  int res = 0;                             ///< resolution (<= 0: the robot's default)
+  std::vector<std::string> points = {"tip"};
+  DatasetSampling sampling;                ///< grid N^m or seeded random
+  bool jacobian = false;                   ///< record J (implicit differentiation)
+  double gradient_tolerance = 1e-4;        ///< forward-solve stopping ratio
+  /// A file-name-safe key of everything above (the cache file's name).
+  std::string Tag() const;
+  nlohmann::json Json() const;
+};
+
+/// Parses a dataset object {"robot" | "twin", "res", "grid" | "random" + "seed", "points",
+/// "jacobian", "gradient_tolerance", "block"}; `where` names it in errors ("cfg.json: dataset").
+/// Unknown keys and wrong types throw std::invalid_argument naming where.key.
+DatasetSpec ParseDatasetSpec(const nlohmann::json& j, const std::string& where);
+
+/// The kinematics a spec samples (SimulatorKinematics or TwinKinematics).
+std::unique_ptr<Kinematics> MakeSpecKinematics(const DatasetSpec& spec);
+
+/// The shared cache directory of an experiment's result dir: <dir>/../_datasets.
+std::string DatasetCacheDir(const std::string& result_dir);
+
+/// Generates (or resumes, or reuses) the spec's dataset at <cache_dir>/<tag>.csv and loads it.
+/// *info (if given) receives {path, samples, generated_now, time_s, ms_per_sample}.
+Dataset CachedDataset(const DatasetSpec& spec, const std::string& cache_dir, bool verbose,
+                      nlohmann::json* info = nullptr);
+
+}  // namespace softkin
