@@ -38,6 +38,8 @@ const Entry kExperiments[] = {
     {"ik_trajectory", &RunIkTrajectory},
     {"ik_methods", &RunIkMethods},
     {"ik_pick_and_place", &RunIkPickAndPlace},
+    {"learn_architecture", &RunLearnArchitecture},
+    {"learn_ik_methods", &RunLearnIkMethods},
 };
 }  // namespace
 

@@ -1,0 +1,262 @@
+// Thesis Chapter 5 on three_chamber and finger_manipulator: the network architecture sweep
+// (Fig. 5.5), the IK methods compared (Table 5.1) and, with ik/pcc_chamber_kinematics, the
+// simulator against the analytical PCC model as the data source of sim-to-real (Fig. 5.14).
+#include "experiments/learn_common.hpp"
+#include "experiments/results.hpp"
+#include "experiments/runner.hpp"
+#include "ik/ik_solver.hpp"
+#include "ik/objectives.hpp"
+#include "ik/trajectory.hpp"
+#include "learn/net_kinematics.hpp"
+#include "learn/train_nets.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <random>
+
+namespace softkin {
+
+namespace {
+
+double Seconds(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+nlohmann::json Vec(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+
+LmOptions ReadLm(const Config& cfg) {
+  LmOptions lm;
+  lm.max_epochs = cfg.Int("epochs", 1000);
+  lm.num_threads = cfg.Int("threads", 0);
+  lm.max_time_s = cfg.Number("max_train_time_s", 0.0);
+  lm.seed = cfg.seed();
+  if (lm.max_epochs < 1) cfg.Fail("epochs", "an integer >= 1");
+  if (lm.num_threads < 0) cfg.Fail("threads", "an integer >= 0 (0: OpenMP's default)");
+  if (!(lm.max_time_s >= 0)) cfg.Fail("max_train_time_s", "a time >= 0 s (0: none)");
+  return lm;
+}
+
+std::vector<int> Layers(const Config& cfg, const std::string& key, const std::vector<int>& def) {
+  const std::vector<int> v = cfg.IntList(key, def);
+  if (v.empty()) cfg.Fail(key, "a non-empty list of neuron counts");
+  for (int b : v)
+    if (b < 1) cfg.Fail(key, "neuron counts >= 1");
+  return v;
+}
+
+DatasetSpec SpecFromConfig(const Config& cfg, const std::string& key) {
+  const nlohmann::json j = cfg.Raw(key);
+  if (j.is_null()) cfg.Fail(key, "a dataset object {\"robot\", \"res\", \"grid\", ...}");
+  return ParseDatasetSpec(j, cfg.path() + ": " + key);
+}
+
+}  // namespace
+
+// ---- Fig. 5.5: test error against the number of hidden layers h and neurons per layer b ----
+nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, bool verbose) {
+  const nlohmann::json robots = cfg.Raw("datasets");
+  const std::vector<int> layers = cfg.IntList("layers", {1, 2, 3, 4});
+  const std::vector<int> neurons = cfg.IntList("neurons", {10, 20, 35, 50});
+  const bool jac = cfg.Bool("jacobian_network", true);
+  const LmOptions lm = ReadLm(cfg);
+  cfg.CheckNoUnknownKeys();
+  if (!robots.is_array() || robots.empty()) cfg.Fail("datasets", "a non-empty array of dataset objects");
+  for (int h : layers)
+    if (h < 1 || h > 8) cfg.Fail("layers", "hidden-layer counts in [1, 8]");
+  for (int b : neurons)
+    if (b < 1) cfg.Fail("neurons", "neuron counts >= 1");
+
+  CsvWriter csv(dir + "/architecture.csv",
+                {"robot", "net", "h", "b", "parameters", "test_mean", "test_max", "test_mean_pct",
+                 "test_max_pct", "epochs", "time_s"});
+  nlohmann::json rows = nlohmann::json::array(), datasets = nlohmann::json::array();
+  for (size_t r = 0; r < robots.size(); ++r) {
+    const DatasetSpec spec = ParseDatasetSpec(robots[r], cfg.path() + ": datasets[" + std::to_string(r) + "]");
+    nlohmann::json dinfo;
+    const Dataset d = CachedDataset(spec, DatasetCacheDir(dir), verbose, &dinfo);
+    const SampleSet pos = PositionSamples(d);
+    const TrainTestSets split = SplitTrainTest(pos, cfg.seed());
+    const double width = WorkspaceWidth(pos.Y);
+    dinfo["workspace_width_mm"] = width;
+    datasets.push_back(dinfo);
+    const bool with_j = jac && d.jacobians.cols() > 0;
+    SampleSet js;
+    if (with_j) js = JacobianSamples(d);
+    // The Jacobian's error is quoted as the tip displacement error of a step of 1/10 of the
+    // actuation range (the finite-difference step of Sec. 5.2.1), as % of the workspace width.
+    double range = 0;
+    for (const auto& b : d.meta["config"]["actuator_bounds"]) range = std::max(range, b[1].get<double>() - b[0].get<double>());
+    for (const std::string net : {"fk", "jac"}) {
+      if (net == "jac" && !with_j) continue;
+      const SampleSet& s = net == "fk" ? pos : js;
+      const SampleSet train = SelectRows(s, split.train_rows), test = SelectRows(s, split.test_rows);
+      for (int h : layers)
+        for (int b : neurons) {
+          NetTrainOptions o;
+          o.hidden.assign(h, b);
+          o.lm = lm;
+          o.split_seed = cfg.seed();
+          const NetTrainResult t = TrainNet(train, test, o);
+          const double scale = net == "fk" ? 100.0 / width : 100.0 * 0.1 * range / width;
+          nlohmann::json row = {{"robot", spec.robot}, {"net", net}, {"h", h}, {"b", b},
+                                {"parameters", t.net.num_parameters()},
+                                {"test_mean", t.test.mean_dist}, {"test_max", t.test.max_dist},
+                                {"test_mean_pct", scale * t.test.mean_dist},
+                                {"test_max_pct", scale * t.test.max_dist},
+                                {"relative", t.test.relative}, {"epochs", t.lm.epochs},
+                                {"time_s", t.lm.total_time_s}};
+          csv.RowStrings({spec.robot, net, std::to_string(h), std::to_string(b),
+                          std::to_string(t.net.num_parameters()), std::to_string(t.test.mean_dist),
+                          std::to_string(t.test.max_dist), std::to_string(scale * t.test.mean_dist),
+                          std::to_string(scale * t.test.max_dist), std::to_string(t.lm.epochs),
+                          std::to_string(t.lm.total_time_s)});
+          rows.push_back(row);
+          if (verbose)
+            std::fprintf(stderr, "  %s N_%s h=%d b=%d: test mean %.4f%% (max %.4f%%) of %.1f mm, %d epochs, %.1f s\n",
+                         spec.robot.c_str(), net.c_str(), h, b, scale * t.test.mean_dist,
+                         scale * t.test.max_dist, width, t.lm.epochs, t.lm.total_time_s);
+        }
+    }
+  }
+  return {{"rows", rows}, {"datasets", datasets},
+          {"jacobian_error_note",
+           "N_J errors are |dJ| x (range/10) (the tip error of a 1/10-range step), as % of the workspace width"},
+          {"thesis", {{"three_chamber", {{"fk", {{"h", 2}, {"b", 35}, {"test_mean_mm", 0.17}, {"test_mean_pct", 0.34}}}}},
+                      {"finger_manipulator", {{"fk", {{"h", 3}, {"b", 30}, {"test_mean_pct", 0.58}}},
+                                              {"jac", {{"h", 2}, {"b", 64}}}}}}}};
+}
+
+// ---- Table 5.1: IK time per waypoint and error, measured by the simulator, per method ----
+nlohmann::json RunLearnIkMethods(const Config& cfg, const std::string& dir, bool verbose) {
+  const DatasetSpec spec = SpecFromConfig(cfg, "dataset");
+  NetsFromDatasetOptions no;
+  no.fk_options.hidden = Layers(cfg, "fk_hidden", {35, 35});
+  no.jac_options.hidden = Layers(cfg, "jac_hidden", {64, 64});
+  no.ik_options.hidden = Layers(cfg, "ik_hidden", {35, 35});
+  no.fk_options.lm = no.jac_options.lm = no.ik_options.lm = ReadLm(cfg);
+  no.split_seed = no.fk_options.split_seed = no.jac_options.split_seed = no.ik_options.split_seed = cfg.seed();
+  const int n_targets = cfg.Int("targets", 50);
+  const int n_numerical = cfg.Int("numerical_targets", 5);
+  const double eps_pct = cfg.Number("lambda_pct_width", 0.1);
+  const int max_iter = cfg.Int("max_iterations", 30);
+  const std::vector<std::string> methods =
+      cfg.StringList("methods", {"numerical", "direct", "learned"});
+  cfg.CheckNoUnknownKeys();
+  if (!spec.jacobian) cfg.Fail("dataset.jacobian", "true (N_J is trained on the recorded Jacobians)");
+  if (n_targets < 1) cfg.Fail("targets", "an integer >= 1");
+  if (n_numerical < 0) cfg.Fail("numerical_targets", "an integer >= 0");
+  if (!(eps_pct > 0)) cfg.Fail("lambda_pct_width", "a percentage > 0");
+  for (const auto& m : methods)
+    if (m != "numerical" && m != "direct" && m != "learned")
+      cfg.Fail("methods", "names out of numerical, direct, learned ('" + m + "' is not)");
+
+  // Data and networks.
+  nlohmann::json dinfo;
+  const Dataset d = CachedDataset(spec, DatasetCacheDir(dir), verbose, &dinfo);
+  if (verbose) std::fprintf(stderr, "  training N_fk, N_J, N_ik on %lld samples\n", static_cast<long long>(d.inputs.rows()));
+  const auto t_train = std::chrono::steady_clock::now();
+  LearnedNets nets = TrainNetsFromDataset(d, dinfo["path"].get<std::string>(), no);
+  const double train_s = Seconds(t_train);
+  nets.Save(dir + "/nets");
+  const double width = nets.info["dataset"]["workspace_width_mm"].get<double>();
+  const double eps_mm = eps_pct / 100.0 * width;
+
+  // The truth: the simulator the data came from; targets it reaches at seeded random actuations.
+  std::unique_ptr<Kinematics> truth = MakeSpecKinematics(spec);
+  const int m = truth->num_actuators();
+  std::mt19937_64 rng(cfg.seed());
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  Eigen::MatrixXd c_true(n_targets, m);
+  Eigen::MatrixX3d targets(n_targets, 3);
+  for (int i = 0; i < n_targets; ++i) {
+    for (int a = 0; a < m; ++a)
+      c_true(i, a) = truth->lower()[a] + u(rng) * (truth->upper()[a] - truth->lower()[a]);
+    const KinematicsEval e = truth->Evaluate(c_true.row(i).transpose(), false);
+    if (!e.ok) throw std::runtime_error("the simulator failed at a target actuation: " + e.message);
+    targets.row(i) = e.p.row(0);
+  }
+  auto true_error = [&](const Eigen::VectorXd& c, int i) {
+    const KinematicsEval e = truth->Evaluate(c, false);
+    return e.ok ? (e.p.row(0) - targets.row(i)).norm() : -1.0;
+  };
+
+  IkOptions io;
+  io.method = IkMethod::kGaussNewton;
+  io.lambda = eps_mm * eps_mm;
+  io.max_iterations = max_iter;
+  CsvWriter csv(dir + "/targets.csv", {"method", "i", "target_x", "target_y", "target_z", "err_mm",
+                                        "predicted_err_mm", "time_ms", "iterations"});
+  nlohmann::json rows = nlohmann::json::array();
+  const std::map<std::string, std::pair<double, double>> thesis = {
+      {"pcc", {12.6, 8.2}}, {"numerical", {138000.0, 4.7}}, {"direct", {3.2, 0.97}}, {"learned", {28.0, 0.78}}};
+  const std::map<std::string, std::string> label = {
+      {"pcc", "PCC analytical"}, {"numerical", "simulation-in-the-loop (implicit J)"},
+      {"direct", "direct IK learning"}, {"learned", "learned Jacobian"}};
+  for (const auto& method : methods) {
+    std::unique_ptr<Kinematics> model;
+    nlohmann::json extra = nlohmann::json::object();
+    if (method == "learned") {
+      model = std::make_unique<NetKinematics>(nets, JacobianSource::kNetwork, false);
+    } else if (method == "numerical") {
+      model = MakeSpecKinematics(spec);
+    }
+    ConfigurationSamples samples;
+    if (model) {
+      SamplingOptions so;
+      so.samples_per_axis = 5;
+      samples = SampleConfigurationSpace(*model, model->point_names().front(), so);
+      extra["sampling_time_s"] = samples.time_s;
+    }
+    const int n = method == "numerical" ? std::min(n_numerical, n_targets) : n_targets;
+    double sum = 0, worst = 0, time = 0;
+    int ok = 0;
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector3d t = targets.row(i).transpose();
+      Eigen::VectorXd c;
+      double pred = 0;
+      int iters = 0;
+      const auto t0 = std::chrono::steady_clock::now();
+      if (method == "direct") {
+        c = DirectIk(nets, t);
+      } else {
+        const Eigen::VectorXd c0 = samples.c.row(ClosestSample(samples, t)).transpose();
+        PointTrackingObjective obj(model->point_names(), model->point_names().front(), t);
+        const IkResult r = SolveIk(*model, obj, c0, io);
+        c = r.c;
+        pred = std::sqrt(r.objective);
+        iters = r.summary.iterations;
+      }
+      const double dt = Seconds(t0);
+      const double err = true_error(c, i);
+      csv.RowStrings({method, std::to_string(i), std::to_string(t.x()), std::to_string(t.y()),
+                      std::to_string(t.z()), std::to_string(err), std::to_string(pred),
+                      std::to_string(1e3 * dt), std::to_string(iters)});
+      if (err < 0) continue;
+      ++ok;
+      sum += err;
+      worst = std::max(worst, err);
+      time += dt;
+      if (verbose && method == "numerical")
+        std::fprintf(stderr, "  numerical target %d/%d: %.3f mm, %.2f s\n", i + 1, n, err, dt);
+    }
+    nlohmann::json row = {{"method", method}, {"label", label.at(method)}, {"targets", n},
+                          {"evaluated", ok},
+                          {"ms_per_waypoint", ok ? 1e3 * time / ok : 0.0},
+                          {"mean_err_mm", ok ? sum / ok : 0.0}, {"max_err_mm", worst},
+                          {"mean_err_pct_width", ok ? 100.0 * sum / ok / width : 0.0},
+                          {"thesis_ms_per_waypoint", thesis.at(method).first},
+                          {"thesis_mean_err_mm", thesis.at(method).second}};
+    row.update(extra);
+    rows.push_back(row);
+    if (verbose)
+      std::fprintf(stderr, "  %-10s %3d targets: %.3f ms per waypoint, error mean %.3f mm, max %.3f mm (thesis %.1f ms, %.2f mm)\n",
+                   method.c_str(), ok, row["ms_per_waypoint"].get<double>(), row["mean_err_mm"].get<double>(),
+                   worst, thesis.at(method).first, thesis.at(method).second);
+  }
+  return {{"rows", rows}, {"dataset", dinfo}, {"networks", nets.info}, {"training_time_s", train_s},
+          {"workspace_width_mm", width}, {"lambda_mm", eps_mm},
+          {"errors_note", "every error is measured by the simulator at the method's actuation, on seeded random targets the simulator reaches (not on the training grid)"}};
+}
+
+}  // namespace softkin
