@@ -6,6 +6,7 @@
 #include "experiments/runner.hpp"
 #include "ik/ik_solver.hpp"
 #include "ik/objectives.hpp"
+#include "ik/pcc_chamber_kinematics.hpp"
 #include "ik/trajectory.hpp"
 #include "learn/net_kinematics.hpp"
 #include "learn/train_nets.hpp"
@@ -49,6 +50,25 @@ DatasetSpec SpecFromConfig(const Config& cfg, const std::string& key) {
   const nlohmann::json j = cfg.Raw(key);
   if (j.is_null()) cfg.Fail(key, "a dataset object {\"robot\", \"res\", \"grid\", ...}");
   return ParseDatasetSpec(j, cfg.path() + ": " + key);
+}
+
+/// The PCC baseline of three_chamber calibrated on a dataset's tip positions (gain, chamber
+/// offset and cap length fitted; the thesis calibrates its PCC model on measurements likewise).
+std::unique_ptr<PccChamberKinematics> FitPccBaseline(const Dataset& d, nlohmann::json* info) {
+  if (d.num_actuators != 3)
+    throw std::invalid_argument("the PCC baseline models three_chamber (3 actuators), the dataset has " +
+                                std::to_string(d.num_actuators));
+  PccChamberParams start;
+  if (d.meta.is_object() && d.meta.contains("config") && d.meta["config"].contains("actuator_bounds")) {
+    start.lower = d.meta["config"]["actuator_bounds"][0][0].get<double>();
+    start.upper = d.meta["config"]["actuator_bounds"][0][1].get<double>();
+    start.rest = start.lower;
+  }
+  const PccFitResult f = FitPccChamber(d.inputs, d.positions.leftCols(3), start);
+  if (info)
+    *info = {{"gain", f.params.gain}, {"offset_mm", f.params.offset}, {"cap_mm", f.params.cap},
+             {"fit_rms_mm", f.rms_mm}, {"start_rms_mm", f.rms_start_mm}, {"fit_samples", d.inputs.rows()}};
+  return std::make_unique<PccChamberKinematics>(f.params);
 }
 
 }  // namespace
@@ -141,15 +161,15 @@ nlohmann::json RunLearnIkMethods(const Config& cfg, const std::string& dir, bool
   const double eps_pct = cfg.Number("lambda_pct_width", 0.1);
   const int max_iter = cfg.Int("max_iterations", 30);
   const std::vector<std::string> methods =
-      cfg.StringList("methods", {"numerical", "direct", "learned"});
+      cfg.StringList("methods", {"pcc", "numerical", "direct", "learned"});
   cfg.CheckNoUnknownKeys();
   if (!spec.jacobian) cfg.Fail("dataset.jacobian", "true (N_J is trained on the recorded Jacobians)");
   if (n_targets < 1) cfg.Fail("targets", "an integer >= 1");
   if (n_numerical < 0) cfg.Fail("numerical_targets", "an integer >= 0");
   if (!(eps_pct > 0)) cfg.Fail("lambda_pct_width", "a percentage > 0");
   for (const auto& m : methods)
-    if (m != "numerical" && m != "direct" && m != "learned")
-      cfg.Fail("methods", "names out of numerical, direct, learned ('" + m + "' is not)");
+    if (m != "pcc" && m != "numerical" && m != "direct" && m != "learned")
+      cfg.Fail("methods", "names out of pcc, numerical, direct, learned ('" + m + "' is not)");
 
   // Data and networks.
   nlohmann::json dinfo;
@@ -200,6 +220,10 @@ nlohmann::json RunLearnIkMethods(const Config& cfg, const std::string& dir, bool
       model = std::make_unique<NetKinematics>(nets, JacobianSource::kNetwork, false);
     } else if (method == "numerical") {
       model = MakeSpecKinematics(spec);
+    } else if (method == "pcc") {
+      nlohmann::json fit;
+      model = FitPccBaseline(d, &fit);
+      extra["pcc_fit"] = fit;
     }
     ConfigurationSamples samples;
     if (model) {
@@ -257,6 +281,101 @@ nlohmann::json RunLearnIkMethods(const Config& cfg, const std::string& dir, bool
   return {{"rows", rows}, {"dataset", dinfo}, {"networks", nets.info}, {"training_time_s", train_s},
           {"workspace_width_mm", width}, {"lambda_mm", eps_mm},
           {"errors_note", "every error is measured by the simulator at the method's actuation, on seeded random targets the simulator reaches (not on the training grid)"}};
+}
+
+// ---- Fig. 5.14: sim-to-real on networks learned from the simulator or from the PCC model ----
+nlohmann::json RunLearnDataSource(const Config& cfg, const std::string& dir, bool verbose) {
+  const DatasetSpec sim_spec = SpecFromConfig(cfg, "dataset");
+  const DatasetSpec twin_spec = SpecFromConfig(cfg, "twin_dataset");
+  const std::vector<int> sizes = cfg.IntList("s2r_samples", {50, 100, 200, 300, 500, 1000});
+  const double eta = cfg.Number("eta", 0.25);
+  const int test_n = cfg.Int("test_samples", 200);
+  const std::vector<int> fk_hidden = Layers(cfg, "fk_hidden", {35, 35});
+  const LmOptions lm = ReadLm(cfg);
+  cfg.CheckNoUnknownKeys();
+  if (twin_spec.twin.empty()) cfg.Fail("twin_dataset", "a dataset object with \"twin\"");
+  if (twin_spec.robot != "three_chamber" || sim_spec.robot != "three_chamber")
+    cfg.Fail("dataset", "three_chamber datasets (the PCC model is of three_chamber)");
+  if (!(eta > 0)) cfg.Fail("eta", "a number > 0");
+  if (test_n < 10) cfg.Fail("test_samples", "an integer >= 10");
+  for (int s : sizes)
+    if (s < 10) cfg.Fail("s2r_samples", "sample counts >= 10");
+
+  nlohmann::json sim_info, twin_info;
+  const Dataset sim = CachedDataset(sim_spec, DatasetCacheDir(dir), verbose, &sim_info);
+  const Dataset twin = CachedDataset(twin_spec, DatasetCacheDir(dir), verbose, &twin_info);
+  const int max_train = *std::max_element(sizes.begin(), sizes.end());
+  if (twin.inputs.rows() < max_train + test_n)
+    cfg.Fail("twin_dataset", "at least max(s2r_samples) + test_samples = " + std::to_string(max_train + test_n) +
+                                 " twin samples (it has " + std::to_string(twin.inputs.rows()) + ")");
+  // The twin's last test_n samples are the test set; the s2r training sets are nested prefixes.
+  const Eigen::MatrixXd c_test = twin.inputs.bottomRows(test_n), p_test = twin.positions.bottomRows(test_n).leftCols(3);
+  const double width = WorkspaceWidth(twin.positions.leftCols(3));
+
+  // The analytical data: the PCC model calibrated on the simulator's data, sampled on the same
+  // actuations, so both networks see the same inputs.
+  nlohmann::json fit;
+  const std::unique_ptr<PccChamberKinematics> pcc = FitPccBaseline(sim, &fit);
+  Dataset ana = sim;
+  ana.jacobians.resize(ana.inputs.rows(), 0);
+  ana.point_names = {"tip"};
+  ana.positions.resize(ana.inputs.rows(), 3);
+  for (int i = 0; i < ana.inputs.rows(); ++i)
+    ana.positions.row(i) = PccChamberKinematics::Tip(pcc->params(), ana.inputs.row(i).transpose()).transpose();
+  Dataset simd = sim;
+  simd.jacobians.resize(simd.inputs.rows(), 0);
+  simd.positions = sim.positions.leftCols(3).eval();
+  simd.point_names = {"tip"};
+
+  CsvWriter csv(dir + "/errors.csv", {"source", "ts", "sample", "err_mm", "err_pct"});
+  nlohmann::json rows = nlohmann::json::array(), sources = nlohmann::json::array();
+  for (const std::string source : {"simulator", "pcc"}) {
+    NetsFromDatasetOptions o;
+    o.jac = o.ik = false;
+    o.fk_options.hidden = fk_hidden;
+    o.fk_options.lm = lm;
+    o.split_seed = o.fk_options.split_seed = cfg.seed();
+    const LearnedNets base = TrainNetsFromDataset(source == "simulator" ? simd : ana, source, o);
+    // Without s2r: N_fk against the twin.
+    const Eigen::MatrixXd pred0 = base.fk.ForwardBatch(c_test);
+    const double err0 = (pred0 - p_test).rowwise().norm().mean();
+    sources.push_back({{"source", source}, {"fk_test_pct_width", base.info["fk"]["test_mean_pct_width"]},
+                       {"twin_mean_err_without_s2r_mm", err0}});
+    if (verbose) std::fprintf(stderr, "  N_fk from %s: %.3f mm mean error on the twin without s2r\n", source.c_str(), err0);
+    for (int ts : sizes) {
+      LearnedNets nets = base;
+      Dataset part = twin;
+      part.inputs = twin.inputs.topRows(ts);
+      part.positions = twin.positions.topRows(ts).leftCols(3);
+      part.jacobians.resize(ts, 0);
+      part.point_names = {"tip"};
+      // All ts samples train (the fixed held-out twin test set measures); 15 % of them validate.
+      NetTrainOptions so;
+      so.hidden = {S2rNeurons(eta, ts)};
+      so.lm = lm;
+      so.split_seed = cfg.seed();
+      const NetTrainResult r = TrainNet(S2rSamples(nets.fk, part.inputs, part.positions), SampleSet{}, so);
+      const Eigen::MatrixXd pred = r.net.ForwardBatch(nets.fk.ForwardBatch(c_test));
+      const Eigen::VectorXd e = (pred - p_test).rowwise().norm();
+      int within = 0;
+      for (int i = 0; i < e.size(); ++i) {
+        within += e[i] <= 0.01 * width;
+        csv.RowStrings({source, std::to_string(ts), std::to_string(i), std::to_string(e[i]),
+                        std::to_string(100.0 * e[i] / width)});
+      }
+      rows.push_back({{"source", source}, {"ts", ts}, {"s2r_neurons", so.hidden[0]},
+                      {"mean_err_mm", e.mean()}, {"max_err_mm", e.maxCoeff()},
+                      {"mean_err_pct", 100.0 * e.mean() / width},
+                      {"within_1pct", static_cast<double>(within) / e.size()}});
+      if (verbose)
+        std::fprintf(stderr, "  %s + s2r(TS#=%d): mean %.3f mm (%.2f %%), %.0f %% of test points within 1 %%\n",
+                     source.c_str(), ts, e.mean(), 100.0 * e.mean() / width, 100.0 * within / e.size());
+    }
+  }
+  return {{"rows", rows}, {"sources", sources}, {"pcc_fit", fit}, {"dataset", sim_info},
+          {"twin_dataset", twin_info}, {"twin_label", "twin data (simulated hardware, docs/twins.md)"},
+          {"workspace_width_mm", width}, {"test_samples", test_n}, {"eta", eta},
+          {"thesis", {{"within_1pct_at_ts", {{"simulator", 300}, {"pcc", 1000}}}}}};
 }
 
 }  // namespace softkin

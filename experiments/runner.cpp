@@ -40,6 +40,7 @@ const Entry kExperiments[] = {
     {"ik_pick_and_place", &RunIkPickAndPlace},
     {"learn_architecture", &RunLearnArchitecture},
     {"learn_ik_methods", &RunLearnIkMethods},
+    {"learn_data_source", &RunLearnDataSource},
 };
 }  // namespace
 

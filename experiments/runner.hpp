@@ -55,5 +55,6 @@ nlohmann::json RunIkPickAndPlace(const Config& cfg, const std::string& dir, bool
 // Chapter 5 (experiments/exp_learn.cpp).
 nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunLearnIkMethods(const Config& cfg, const std::string& dir, bool verbose);
+nlohmann::json RunLearnDataSource(const Config& cfg, const std::string& dir, bool verbose);
 
 }  // namespace softkin
