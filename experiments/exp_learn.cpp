@@ -1,6 +1,7 @@
 // Thesis Chapter 5 on three_chamber and finger_manipulator: the network architecture sweep
 // (Fig. 5.5), the IK methods compared (Table 5.1) and, with ik/pcc_chamber_kinematics, the
 // simulator against the analytical PCC model as the data source of sim-to-real (Fig. 5.14).
+#include "experiments/ik_config.hpp"
 #include "experiments/learn_common.hpp"
 #include "experiments/results.hpp"
 #include "experiments/runner.hpp"
@@ -10,6 +11,8 @@
 #include "ik/trajectory.hpp"
 #include "learn/net_kinematics.hpp"
 #include "learn/train_nets.hpp"
+#include "learn/twin.hpp"
+#include "ik/trajectory_io.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -376,6 +379,180 @@ nlohmann::json RunLearnDataSource(const Config& cfg, const std::string& dir, boo
           {"twin_dataset", twin_info}, {"twin_label", "twin data (simulated hardware, docs/twins.md)"},
           {"workspace_width_mm", width}, {"test_samples", test_n}, {"eta", eta},
           {"thesis", {{"within_1pct_at_ts", {{"simulator", 300}, {"pcc", 1000}}}}}};
+}
+
+namespace {
+
+std::vector<DatasetSpec> TwinSpecs(const Config& cfg, const std::string& key) {
+  const nlohmann::json j = cfg.Raw(key);
+  if (!j.is_array() || j.empty()) cfg.Fail(key, "a non-empty array of twin dataset objects {\"twin\", ...}");
+  std::vector<DatasetSpec> out;
+  for (size_t i = 0; i < j.size(); ++i) {
+    out.push_back(ParseDatasetSpec(j[i], cfg.path() + ": " + key + "[" + std::to_string(i) + "]"));
+    if (out.back().twin.empty()) cfg.Fail(key + "[" + std::to_string(i) + "]", "a dataset object with \"twin\"");
+  }
+  return out;
+}
+
+/// Mean tip distance between rows of A and B (first 3 columns).
+double MeanDist(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
+  return (A.leftCols(3) - B.leftCols(3)).rowwise().norm().mean();
+}
+
+}  // namespace
+
+// ---- Fig. 5.6: s2r error against eta and against the number of twin samples ----
+nlohmann::json RunLearnS2rSweep(const Config& cfg, const std::string& dir, bool verbose) {
+  const DatasetSpec sim_spec = SpecFromConfig(cfg, "dataset");
+  const std::vector<DatasetSpec> twins = TwinSpecs(cfg, "twin_datasets");
+  const std::vector<double> etas = cfg.NumberList("etas", {1.0 / 16, 1.0 / 8, 0.25, 0.5, 1.0});
+  const std::vector<int> sizes = cfg.IntList("sizes", {64, 125, 216, 343, 620});
+  const int eta_size = cfg.Int("eta_sweep_samples", 343);
+  const double size_eta = cfg.Number("size_sweep_eta", 0.25);
+  const int test_n = cfg.Int("test_samples", 200);
+  const std::vector<int> fk_hidden = Layers(cfg, "fk_hidden", {35, 35});
+  const LmOptions lm = ReadLm(cfg);
+  cfg.CheckNoUnknownKeys();
+  for (double e : etas)
+    if (!(e > 0)) cfg.Fail("etas", "numbers > 0");
+  int need = eta_size;
+  for (int n : sizes) {
+    if (n < 10) cfg.Fail("sizes", "sample counts >= 10");
+    need = std::max(need, n);
+  }
+  nlohmann::json sim_info;
+  const Dataset sim = CachedDataset(sim_spec, DatasetCacheDir(dir), verbose, &sim_info);
+  NetsFromDatasetOptions o;
+  o.jac = o.ik = false;
+  o.fk_options.hidden = fk_hidden;
+  o.fk_options.lm = lm;
+  o.split_seed = o.fk_options.split_seed = cfg.seed();
+  const LearnedNets nets = TrainNetsFromDataset(sim, sim_info["path"].get<std::string>(), o);
+
+  CsvWriter csv(dir + "/s2r_sweep.csv", {"twin", "sweep", "eta", "samples", "neurons", "train_mm",
+                                         "test_mm", "without_mm"});
+  nlohmann::json rows = nlohmann::json::array(), tinfo = nlohmann::json::array();
+  for (const DatasetSpec& ts : twins) {
+    nlohmann::json info;
+    const Dataset twin = CachedDataset(ts, DatasetCacheDir(dir), verbose, &info);
+    if (twin.inputs.rows() < need + test_n)
+      cfg.Fail("twin_datasets", "at least " + std::to_string(need + test_n) + " samples per twin (" + ts.twin +
+                                    " has " + std::to_string(twin.inputs.rows()) + ")");
+    tinfo.push_back(info);
+    const SampleSet all = S2rSamples(nets.fk, twin.inputs, twin.positions.leftCols(3));
+    const int n = all.size();
+    std::vector<int> test_rows, train_rows;
+    for (int i = n - test_n; i < n; ++i) test_rows.push_back(i);
+    const SampleSet test = SelectRows(all, test_rows);
+    const double without = MeanDist(test.X, test.Y);
+    auto run = [&](const std::string& sweep, double eta, int samples) {
+      std::vector<int> rows_k;
+      for (int i = 0; i < samples; ++i) rows_k.push_back(i);
+      NetTrainOptions so;
+      so.hidden = {S2rNeurons(eta, samples)};
+      so.lm = lm;
+      so.split_seed = cfg.seed();
+      const NetTrainResult r = TrainNet(SelectRows(all, rows_k), test, so);
+      rows.push_back({{"twin", ts.twin}, {"sweep", sweep}, {"eta", eta}, {"samples", samples},
+                      {"neurons", so.hidden[0]}, {"train_mm", r.train.mean_dist},
+                      {"test_mm", r.test.mean_dist}, {"test_max_mm", r.test.max_dist},
+                      {"without_mm", without}});
+      csv.RowStrings({ts.twin, sweep, std::to_string(eta), std::to_string(samples),
+                      std::to_string(so.hidden[0]), std::to_string(r.train.mean_dist),
+                      std::to_string(r.test.mean_dist), std::to_string(without)});
+      if (verbose)
+        std::fprintf(stderr, "  %s eta %.4g, %d samples (%d neurons): train %.3f mm, test %.3f mm (without s2r %.3f mm)\n",
+                     ts.twin.c_str(), eta, samples, so.hidden[0], r.train.mean_dist, r.test.mean_dist, without);
+    };
+    for (double eta : etas) run("eta", eta, eta_size);
+    for (int size : sizes) run("samples", size_eta, size);
+  }
+  return {{"rows", rows}, {"dataset", sim_info}, {"twin_datasets", tinfo},
+          {"fk", nets.info["fk"]}, {"twin_label", "twin data (simulated hardware, docs/twins.md)"},
+          {"thesis", {{"eta", 0.25}, {"twin_samples", {343, 620}}}}};
+}
+
+// ---- Fig. 5.7 / 5.8: path following on the twins, learned Jacobian IK with and without s2r ----
+nlohmann::json RunLearnS2rPaths(const Config& cfg, const std::string& dir, bool verbose) {
+  const DatasetSpec sim_spec = SpecFromConfig(cfg, "dataset");
+  const std::vector<DatasetSpec> twins = TwinSpecs(cfg, "twin_datasets");
+  const nlohmann::json path_spec = cfg.Raw("path");
+  const double eta = cfg.Number("eta", 0.25);
+  const double eps_pct = cfg.Number("lambda_pct_width", 0.1);
+  NetsFromDatasetOptions no;
+  no.ik = false;
+  no.fk_options.hidden = Layers(cfg, "fk_hidden", {35, 35});
+  no.jac_options.hidden = Layers(cfg, "jac_hidden", {64, 64});
+  no.fk_options.lm = no.jac_options.lm = ReadLm(cfg);
+  no.split_seed = no.fk_options.split_seed = no.jac_options.split_seed = cfg.seed();
+  const LmOptions lm = no.fk_options.lm;
+  cfg.CheckNoUnknownKeys();
+  if (!sim_spec.jacobian) cfg.Fail("dataset.jacobian", "true (N_J is trained on the recorded Jacobians)");
+  if (!(eta > 0)) cfg.Fail("eta", "a number > 0");
+  if (!(eps_pct > 0)) cfg.Fail("lambda_pct_width", "a percentage > 0");
+
+  nlohmann::json sim_info;
+  const Dataset sim = CachedDataset(sim_spec, DatasetCacheDir(dir), verbose, &sim_info);
+  const LearnedNets nominal = TrainNetsFromDataset(sim, sim_info["path"].get<std::string>(), no);
+  const double width = nominal.info["dataset"]["workspace_width_mm"].get<double>();
+  NetKinematics nominal_kin(nominal, JacobianSource::kNetwork, false);
+  SamplingOptions so;
+  so.samples_per_axis = 5;
+  const ConfigurationSamples samples = SampleConfigurationSpace(nominal_kin, "tip", so);
+  const IkPath path = MakeIkPath(path_spec, cfg.path() + ": path", nominal_kin, samples);
+
+  TrajectoryOptions to;
+  to.ik.method = IkMethod::kGaussNewton;
+  to.ik.lambda = std::pow(eps_pct / 100.0 * width, 2);
+  to.ik.max_iterations = 30;
+  to.sampling = so;
+
+  nlohmann::json rows = nlohmann::json::array(), tinfo = nlohmann::json::array();
+  for (const DatasetSpec& ts : twins) {
+    nlohmann::json info;
+    const Dataset twin = CachedDataset(ts, DatasetCacheDir(dir), verbose, &info);
+    tinfo.push_back(info);
+    LearnedNets nets = nominal;
+    TrainS2r(nets, twin, info["path"].get<std::string>(), eta, lm, cfg.seed());
+    // The twin measures the answer without its measurement noise (its systematic gap remains).
+    TwinOptions mo;
+    mo.res = ts.res;
+    mo.noise = false;
+    mo.gradient_tolerance = ts.gradient_tolerance;
+    TwinKinematics measure(GetTwinSpec(ts.twin), mo);
+    for (bool with_s2r : {false, true}) {
+      NetKinematics kin(nets, JacobianSource::kNetwork, with_s2r);
+      const TrajectoryResult r = FollowTrajectory(kin, path.waypoints, to);
+      const std::string tag = ts.twin.substr(ts.twin.find('/') + 1) + (with_s2r ? "_s2r" : "_nominal");
+      CsvWriter csv(dir + "/path_" + tag + ".csv", {"i", "target_x", "target_y", "target_z", "x", "y", "z",
+                                                     "err_mm", "predicted_err_mm", "time_ms"});
+      double sum = 0, worst = 0, time = 0;
+      int ok = 0;
+      for (const WaypointResult& w : r.waypoints) {
+        const KinematicsEval e = measure.Evaluate(w.c, false);
+        if (!e.ok) continue;
+        const Eigen::Vector3d p = e.p.row(0).transpose();
+        const double err = (p - w.target).norm();
+        csv.Row({static_cast<double>(w.index), w.target.x(), w.target.y(), w.target.z(), p.x(), p.y(), p.z(),
+                 err, w.error_mm, 1e3 * w.time_s});
+        ++ok;
+        sum += err;
+        worst = std::max(worst, err);
+        time += w.time_s;
+      }
+      rows.push_back({{"twin", ts.twin}, {"s2r", with_s2r}, {"waypoints", path.waypoints.rows()},
+                      {"measured", ok}, {"mean_err_mm", ok ? sum / ok : 0.0}, {"max_err_mm", worst},
+                      {"ms_per_waypoint", ok ? 1e3 * time / ok : 0.0}, {"max_jump", r.max_jump},
+                      {"csv", "path_" + tag + ".csv"}});
+      if (verbose)
+        std::fprintf(stderr, "  %s %s: error on the twin mean %.3f mm, max %.3f mm, %.2f ms per waypoint\n",
+                     ts.twin.c_str(), with_s2r ? "with s2r" : "without s2r", ok ? sum / ok : 0.0, worst,
+                     ok ? 1e3 * time / ok : 0.0);
+    }
+  }
+  return {{"rows", rows}, {"path", path.info}, {"thesis", path.thesis}, {"dataset", sim_info},
+          {"twin_datasets", tinfo}, {"networks", nominal.info}, {"workspace_width_mm", width},
+          {"twin_label", "errors are measured on the twin (simulated hardware, docs/twins.md) without its measurement noise"}};
 }
 
 }  // namespace softkin

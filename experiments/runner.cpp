@@ -41,6 +41,8 @@ const Entry kExperiments[] = {
     {"learn_architecture", &RunLearnArchitecture},
     {"learn_ik_methods", &RunLearnIkMethods},
     {"learn_data_source", &RunLearnDataSource},
+    {"learn_s2r_sweep", &RunLearnS2rSweep},
+    {"learn_s2r_paths", &RunLearnS2rPaths},
 };
 }  // namespace
 

@@ -56,5 +56,7 @@ nlohmann::json RunIkPickAndPlace(const Config& cfg, const std::string& dir, bool
 nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunLearnIkMethods(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunLearnDataSource(const Config& cfg, const std::string& dir, bool verbose);
+nlohmann::json RunLearnS2rSweep(const Config& cfg, const std::string& dir, bool verbose);
+nlohmann::json RunLearnS2rPaths(const Config& cfg, const std::string& dir, bool verbose);
 
 }  // namespace softkin
