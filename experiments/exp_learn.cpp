@@ -82,6 +82,8 @@ nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, b
   const std::vector<int> layers = cfg.IntList("layers", {1, 2, 3, 4});
   const std::vector<int> neurons = cfg.IntList("neurons", {10, 20, 35, 50});
   const bool jac = cfg.Bool("jacobian_network", true);
+  const std::vector<int> jac_layers = cfg.IntList("jac_layers", layers);
+  const std::vector<int> jac_neurons = cfg.IntList("jac_neurons", neurons);
   const LmOptions lm = ReadLm(cfg);
   cfg.CheckNoUnknownKeys();
   if (!robots.is_array() || robots.empty()) cfg.Fail("datasets", "a non-empty array of dataset objects");
@@ -114,8 +116,8 @@ nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, b
       if (net == "jac" && !with_j) continue;
       const SampleSet& s = net == "fk" ? pos : js;
       const SampleSet train = SelectRows(s, split.train_rows), test = SelectRows(s, split.test_rows);
-      for (int h : layers)
-        for (int b : neurons) {
+      for (int h : net == "fk" ? layers : jac_layers)
+        for (int b : net == "fk" ? neurons : jac_neurons) {
           NetTrainOptions o;
           o.hidden.assign(h, b);
           o.lm = lm;
@@ -179,7 +181,7 @@ nlohmann::json RunLearnIkMethods(const Config& cfg, const std::string& dir, bool
   const Dataset d = CachedDataset(spec, DatasetCacheDir(dir), verbose, &dinfo);
   if (verbose) std::fprintf(stderr, "  training N_fk, N_J, N_ik on %lld samples\n", static_cast<long long>(d.inputs.rows()));
   const auto t_train = std::chrono::steady_clock::now();
-  LearnedNets nets = TrainNetsFromDataset(d, dinfo["path"].get<std::string>(), no);
+  LearnedNets nets = CachedNets(d, dinfo["path"].get<std::string>(), spec.Tag(), no, NetsCacheDir(dir), verbose);
   const double train_s = Seconds(t_train);
   nets.Save(dir + "/nets");
   const double width = nets.info["dataset"]["workspace_width_mm"].get<double>();
@@ -338,7 +340,9 @@ nlohmann::json RunLearnDataSource(const Config& cfg, const std::string& dir, boo
     o.fk_options.hidden = fk_hidden;
     o.fk_options.lm = lm;
     o.split_seed = o.fk_options.split_seed = cfg.seed();
-    const LearnedNets base = TrainNetsFromDataset(source == "simulator" ? simd : ana, source, o);
+    const LearnedNets base = CachedNets(source == "simulator" ? simd : ana, source,
+                                        (source == "simulator" ? "" : "pccfit-") + sim_spec.Tag(), o,
+                                        NetsCacheDir(dir), verbose);
     // Without s2r: N_fk against the twin.
     const Eigen::MatrixXd pred0 = base.fk.ForwardBatch(c_test);
     const double err0 = (pred0 - p_test).rowwise().norm().mean();
@@ -427,7 +431,8 @@ nlohmann::json RunLearnS2rSweep(const Config& cfg, const std::string& dir, bool 
   o.fk_options.hidden = fk_hidden;
   o.fk_options.lm = lm;
   o.split_seed = o.fk_options.split_seed = cfg.seed();
-  const LearnedNets nets = TrainNetsFromDataset(sim, sim_info["path"].get<std::string>(), o);
+  const LearnedNets nets = CachedNets(sim, sim_info["path"].get<std::string>(), sim_spec.Tag(), o,
+                                     NetsCacheDir(dir), verbose);
 
   CsvWriter csv(dir + "/s2r_sweep.csv", {"twin", "sweep", "eta", "samples", "neurons", "train_mm",
                                          "test_mm", "without_mm"});
@@ -493,7 +498,8 @@ nlohmann::json RunLearnS2rPaths(const Config& cfg, const std::string& dir, bool 
 
   nlohmann::json sim_info;
   const Dataset sim = CachedDataset(sim_spec, DatasetCacheDir(dir), verbose, &sim_info);
-  const LearnedNets nominal = TrainNetsFromDataset(sim, sim_info["path"].get<std::string>(), no);
+  const LearnedNets nominal = CachedNets(sim, sim_info["path"].get<std::string>(), sim_spec.Tag(), no,
+                                        NetsCacheDir(dir), verbose);
   const double width = nominal.info["dataset"]["workspace_width_mm"].get<double>();
   NetKinematics nominal_kin(nominal, JacobianSource::kNetwork, false);
   SamplingOptions so;

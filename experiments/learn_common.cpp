@@ -6,6 +6,7 @@
 #include "solver/robots.hpp"
 
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <set>
 #include <sstream>
@@ -148,6 +149,96 @@ Dataset CachedDataset(const DatasetSpec& spec, const std::string& cache_dir, boo
              {"ms_per_sample", s.written > 0 ? 1e3 * s.time_s / s.written : 0.0}};
   }
   return d;
+}
+
+}  // namespace softkin
+
+#include "learn/train_nets.hpp"
+
+namespace softkin {
+
+std::string NetsCacheDir(const std::string& result_dir) {
+  return (fs::path(result_dir).parent_path() / "_nets").string();
+}
+
+namespace {
+
+std::string LayersTag(const std::vector<int>& v) {
+  std::string s;
+  for (int b : v) s += (s.empty() ? "" : "x") + std::to_string(b);
+  return s;
+}
+
+std::string NetTag(const char* name, bool on, const NetTrainOptions& o) {
+  if (!on) return "";
+  std::ostringstream s;
+  s << "_" << name << LayersTag(o.hidden) << "e" << o.lm.max_epochs << "s" << o.lm.seed << "v"
+    << o.validation_fraction << "q" << o.split_seed;
+  if (o.lm.max_time_s > 0) s << "t" << o.lm.max_time_s;
+  return s.str();
+}
+
+}  // namespace
+
+LearnedNets CachedNets(const Dataset& d, const std::string& dataset_path, const std::string& dataset_tag,
+                       const NetsFromDatasetOptions& opt, const std::string& cache_dir, bool verbose,
+                       bool* cached) {
+  std::ostringstream key;
+  key << dataset_tag << "_n" << d.inputs.rows() << "_split" << opt.split_seed << "f" << opt.train_fraction;
+  const fs::path dir = fs::path(cache_dir) / key.str();
+  fs::create_directories(dir);
+  // Bounds, points and the split's record, without training anything.
+  NetsFromDatasetOptions none = opt;
+  none.fk = none.jac = none.ik = false;
+  LearnedNets out = TrainNetsFromDataset(d, dataset_path, none);
+  NetsFromDatasetOptions missing = none;
+  struct Item {
+    const char* name;
+    bool want;
+    const NetTrainOptions* o;
+    Fnn* net;
+    bool* miss;
+  } items[3] = {{"fk", opt.fk, &opt.fk_options, &out.fk, &missing.fk},
+                {"jac", opt.jac, &opt.jac_options, &out.jac, &missing.jac},
+                {"ik", opt.ik, &opt.ik_options, &out.ik, &missing.ik}};
+  bool all_cached = true;
+  for (Item& it : items) {
+    if (!it.want) continue;
+    const std::string base = (dir / NetTag(it.name, true, *it.o).substr(1)).string();
+    try {
+      if (fs::exists(base + ".fnn") && fs::exists(base + ".json")) {
+        Fnn f = Fnn::Load(base + ".fnn");
+        std::ifstream in(base + ".json");
+        const nlohmann::json info = nlohmann::json::parse(in);
+        *it.net = std::move(f);
+        out.info[it.name] = info;
+        if (verbose) std::cerr << "  N_" << it.name << " from the cache " << base << ".fnn\n";
+        continue;
+      }
+    } catch (const std::exception& e) {
+      if (verbose) std::cerr << "  ignoring the unreadable cached network " << base << ": " << e.what() << "\n";
+    }
+    *it.miss = true;
+    all_cached = false;
+  }
+  if (!all_cached) {
+    if (verbose)
+      std::cerr << "  training" << (missing.fk ? " N_fk" : "") << (missing.jac ? " N_J" : "")
+                << (missing.ik ? " N_ik" : "") << " on " << d.inputs.rows() << " samples\n";
+    LearnedNets trained = TrainNetsFromDataset(d, dataset_path, missing);
+    Fnn* from[3] = {&trained.fk, &trained.jac, &trained.ik};
+    for (int k = 0; k < 3; ++k) {
+      if (!*items[k].miss) continue;
+      const std::string base = (dir / NetTag(items[k].name, true, *items[k].o).substr(1)).string();
+      *items[k].net = *from[k];
+      out.info[items[k].name] = trained.info[items[k].name];
+      out.info[items[k].name]["git_commit"] = GitCommit();
+      from[k]->Save(base + ".fnn");
+      WriteJson(base + ".json", out.info[items[k].name]);
+    }
+  }
+  if (cached) *cached = all_cached;
+  return out;
 }
 
 }  // namespace softkin

@@ -47,3 +47,21 @@ Dataset CachedDataset(const DatasetSpec& spec, const std::string& cache_dir, boo
                       nlohmann::json* info = nullptr);
 
 }  // namespace softkin
+
+namespace softkin {
+
+struct NetsFromDatasetOptions;
+struct LearnedNets;
+
+/// Trains the networks of `opt` on `d` (TrainNetsFromDataset), or loads them from
+/// <cache_dir>/<key> when a run with the same dataset, architectures, epochs, split and seed
+/// saved them there (training N_J on thousands of Jacobians takes minutes; several experiments
+/// share the same networks). *cached says which happened.
+LearnedNets CachedNets(const Dataset& d, const std::string& dataset_path, const std::string& dataset_tag,
+                       const NetsFromDatasetOptions& opt, const std::string& cache_dir, bool verbose,
+                       bool* cached = nullptr);
+
+/// The shared network cache directory of an experiment's result dir: <dir>/../_nets.
+std::string NetsCacheDir(const std::string& result_dir);
+
+}  // namespace softkin
