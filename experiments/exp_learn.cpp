@@ -561,4 +561,146 @@ nlohmann::json RunLearnS2rPaths(const Config& cfg, const std::string& dir, bool 
           {"twin_label", "errors are measured on the twin (simulated hardware, docs/twins.md) without its measurement noise"}};
 }
 
+// ---- Fig. 5.10 / 5.12: the redundant finger_manipulator on a path, learned Jacobian vs direct IK ----
+namespace {
+
+/// A figure '8' (lemniscate of Gerono) of n waypoints in the plane of axes (au, av) around
+/// centre: u = half_u sin t, v = half_v sin t cos t, t = 2 pi i / n.
+Eigen::MatrixX3d EightPath(const nlohmann::json& spec, const std::string& where) {
+  auto num = [&](const char* k) {
+    if (!spec.contains(k) || !spec[k].is_number()) throw std::invalid_argument(where + "." + k + ": expected a number");
+    return spec[k].get<double>();
+  };
+  for (auto it = spec.begin(); it != spec.end(); ++it)
+    if (it.key() != "name" && it.key() != "type" && it.key() != "center" && it.key() != "half_u" &&
+        it.key() != "half_v" && it.key() != "axes" && it.key() != "n" && it.key() != "thesis")
+      throw std::invalid_argument(where + "." + it.key() + ": unknown key (expected name, type, center, half_u, half_v, axes, n, thesis)");
+  if (!spec.contains("center") || !spec["center"].is_array() || spec["center"].size() != 3)
+    throw std::invalid_argument(where + ".center: expected [x, y, z] in mm");
+  Eigen::Vector3d c;
+  for (int d = 0; d < 3; ++d) c[d] = spec["center"][d].get<double>();
+  int au = 1, av = 0;
+  if (spec.contains("axes")) {
+    au = spec["axes"][0].get<int>();
+    av = spec["axes"][1].get<int>();
+  }
+  if (au < 0 || au > 2 || av < 0 || av > 2 || au == av) throw std::invalid_argument(where + ".axes: expected two different axes out of 0, 1, 2");
+  if (!spec.contains("n") || !spec["n"].is_number_integer() || spec["n"].get<int>() < 4)
+    throw std::invalid_argument(where + ".n: expected an integer >= 4");
+  const int n = spec["n"].get<int>();
+  const double hu = num("half_u"), hv = num("half_v");
+  Eigen::MatrixX3d w(n, 3);
+  for (int i = 0; i < n; ++i) {
+    const double t = 2.0 * 3.14159265358979323846 * i / n;
+    Eigen::Vector3d p = c;
+    p[au] += hu * std::sin(t);
+    p[av] += hv * std::sin(t) * std::cos(t);
+    w.row(i) = p.transpose();
+  }
+  return w;
+}
+
+}  // namespace
+
+nlohmann::json RunLearnRedundantPath(const Config& cfg, const std::string& dir, bool verbose) {
+  const DatasetSpec spec = SpecFromConfig(cfg, "dataset");
+  const nlohmann::json path_spec = cfg.Raw("path");
+  const double eps_pct = cfg.Number("lambda_pct_width", 0.1);
+  NetsFromDatasetOptions no;
+  no.fk_options.hidden = Layers(cfg, "fk_hidden", {30, 30, 30});
+  no.jac_options.hidden = Layers(cfg, "jac_hidden", {30, 30});
+  no.ik_options.hidden = Layers(cfg, "ik_hidden", {30, 30});
+  no.fk_options.lm = no.jac_options.lm = no.ik_options.lm = ReadLm(cfg);
+  no.split_seed = no.fk_options.split_seed = no.jac_options.split_seed = no.ik_options.split_seed = cfg.seed();
+  const int max_iter = cfg.Int("max_iterations", 30);
+  cfg.CheckNoUnknownKeys();
+  if (!spec.jacobian) cfg.Fail("dataset.jacobian", "true (N_J is trained on the recorded Jacobians)");
+  if (!path_spec.is_object()) cfg.Fail("path", "a path object");
+
+  nlohmann::json dinfo;
+  const Dataset d = CachedDataset(spec, DatasetCacheDir(dir), verbose, &dinfo);
+  LearnedNets nets = CachedNets(d, dinfo["path"].get<std::string>(), spec.Tag(), no, NetsCacheDir(dir), verbose);
+  const double width = nets.info["dataset"]["workspace_width_mm"].get<double>();
+  NetKinematics kin(nets, JacobianSource::kNetwork, false);
+  SamplingOptions so;
+  so.samples_per_axis = 5;
+  const ConfigurationSamples samples = SampleConfigurationSpace(kin, nets.points.front(), so);
+  Eigen::MatrixX3d waypoints;
+  nlohmann::json pinfo = path_spec;
+  if (path_spec.value("type", "") == "eight") {
+    waypoints = EightPath(path_spec, cfg.path() + ": path");
+  } else {
+    const IkPath p = MakeIkPath(path_spec, cfg.path() + ": path", kin, samples);
+    waypoints = p.waypoints;
+    pinfo = p.info;
+  }
+  std::unique_ptr<Kinematics> truth = MakeSpecKinematics(spec);
+  const Eigen::VectorXd range = truth->upper() - truth->lower();
+
+  TrajectoryOptions to;
+  to.point = nets.points.front();
+  to.ik.method = IkMethod::kGaussNewton;
+  to.ik.lambda = std::pow(eps_pct / 100.0 * width, 2);
+  to.ik.max_iterations = max_iter;
+  to.sampling = so;
+  nlohmann::json rows = nlohmann::json::array();
+  for (const std::string method : {"learned", "direct"}) {
+    std::vector<Eigen::VectorXd> cs;
+    std::vector<double> times;
+    if (method == "learned") {
+      const TrajectoryResult r = FollowTrajectory(kin, waypoints, to);
+      for (const auto& w : r.waypoints) {
+        cs.push_back(w.c);
+        times.push_back(w.time_s);
+      }
+    } else {
+      for (int i = 0; i < waypoints.rows(); ++i) {
+        const auto t0 = std::chrono::steady_clock::now();
+        cs.push_back(DirectIk(nets, waypoints.row(i).transpose()));
+        times.push_back(Seconds(t0));
+      }
+    }
+    std::vector<std::string> head = {"i", "target_x", "target_y", "target_z", "x", "y", "z", "err_mm", "time_ms", "jump"};
+    for (int a = 0; a < truth->num_actuators(); ++a) head.push_back("c" + std::to_string(a));
+    CsvWriter csv(dir + "/path_" + method + ".csv", head);
+    double sum = 0, worst = 0, time = 0, max_jump = 0, max_jump_frac = 0;
+    int ok = 0;
+    for (size_t i = 0; i < cs.size(); ++i) {
+      const KinematicsEval e = truth->Evaluate(cs[i], false);  // warm-started along the path
+      double jump = 0;
+      if (i > 0) {
+        jump = (cs[i] - cs[i - 1]).cwiseAbs().maxCoeff();
+        max_jump = std::max(max_jump, jump);
+        max_jump_frac = std::max(max_jump_frac, (cs[i] - cs[i - 1]).cwiseAbs().cwiseQuotient(range).maxCoeff());
+      }
+      if (!e.ok) continue;
+      const Eigen::Vector3d p = e.p.row(0).transpose(), t = waypoints.row(i).transpose();
+      const double err = (p - t).norm();
+      std::vector<double> row = {static_cast<double>(i), t.x(), t.y(), t.z(), p.x(), p.y(), p.z(), err,
+                                 1e3 * times[i], jump};
+      for (int a = 0; a < cs[i].size(); ++a) row.push_back(cs[i][a]);
+      csv.Row(row);
+      ++ok;
+      sum += err;
+      worst = std::max(worst, err);
+      time += times[i];
+      if (verbose && (i + 1) % 20 == 0)
+        std::fprintf(stderr, "  %s: %zu/%zu waypoints measured by the simulator\n", method.c_str(), i + 1, cs.size());
+    }
+    rows.push_back({{"method", method}, {"waypoints", cs.size()}, {"measured", ok},
+                    {"mean_err_mm", ok ? sum / ok : 0.0}, {"max_err_mm", worst},
+                    {"mean_err_pct", ok ? 100.0 * sum / ok / width : 0.0}, {"max_err_pct", 100.0 * worst / width},
+                    {"ms_per_waypoint", ok ? 1e3 * time / ok : 0.0}, {"max_jump", max_jump},
+                    {"max_jump_fraction", max_jump_frac}});
+    if (verbose)
+      std::fprintf(stderr, "  %s: error mean %.3f mm (%.3f %%), max %.3f mm (%.3f %%), largest jump %.3f (%.1f %% of the range), %.3f ms per waypoint\n",
+                   method.c_str(), ok ? sum / ok : 0.0, ok ? 100.0 * sum / ok / width : 0.0, worst, 100.0 * worst / width,
+                   max_jump, 100.0 * max_jump_frac, ok ? 1e3 * time / ok : 0.0);
+  }
+  return {{"rows", rows}, {"path", pinfo}, {"dataset", dinfo}, {"networks", nets.info},
+          {"workspace_width_mm", width},
+          {"errors_note", "errors are measured by the simulator at each method's actuation"},
+          {"thesis", path_spec.value("thesis", nlohmann::json::object())}};
+}
+
 }  // namespace softkin

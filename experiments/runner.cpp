@@ -43,6 +43,7 @@ const Entry kExperiments[] = {
     {"learn_data_source", &RunLearnDataSource},
     {"learn_s2r_sweep", &RunLearnS2rSweep},
     {"learn_s2r_paths", &RunLearnS2rPaths},
+    {"learn_redundant_path", &RunLearnRedundantPath},
 };
 }  // namespace
 

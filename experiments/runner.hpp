@@ -58,5 +58,6 @@ nlohmann::json RunLearnIkMethods(const Config& cfg, const std::string& dir, bool
 nlohmann::json RunLearnDataSource(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunLearnS2rSweep(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunLearnS2rPaths(const Config& cfg, const std::string& dir, bool verbose);
+nlohmann::json RunLearnRedundantPath(const Config& cfg, const std::string& dir, bool verbose);
 
 }  // namespace softkin
