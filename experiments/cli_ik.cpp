@@ -383,7 +383,12 @@ int RunLearnedIk(const IkCommandArgs& a) {
   const bool direct = a.method == "direct";
   const std::string method = a.method == "learned" || direct ? "gauss-newton" : a.method;
   IkOptions ik = ParseIkOptions(a, method);
-  const LearnedNets nets = LearnedNets::Load(a.nets);
+  LearnedNets nets;
+  try {
+    nets = LearnedNets::Load(a.nets);
+  } catch (const std::runtime_error& e) {
+    throw std::invalid_argument(std::string("--nets: ") + e.what());
+  }
   if (direct && !nets.has_ik())
     throw std::invalid_argument("--method direct: " + a.nets + " has no ik network (train it with --what fk,ik)");
   if (!direct && source == JacobianSource::kNetwork && !nets.has_jac())

@@ -109,7 +109,12 @@ int RunTrainCommand(const TrainCommandArgs& a, const std::string& command_line) 
   lm.progress_every = 10;
 
   if (!a.s2r.empty()) {
-    LearnedNets nets = LearnedNets::Load(a.out);
+    LearnedNets nets;
+    try {
+      nets = LearnedNets::Load(a.out);
+    } catch (const std::runtime_error& e) {
+      throw std::invalid_argument(std::string("--out (the networks to add N_s2r to): ") + e.what());
+    }
     const Dataset twin = LoadDataset(a.s2r);
     if (!a.quiet)
       std::cerr << "softkin train: sim-to-real layer from " << a.s2r << " (" << twin.inputs.rows()

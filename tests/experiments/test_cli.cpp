@@ -36,7 +36,7 @@ std::string TempDir(const std::string& name) {
 
 TEST(Cli, HelpOnEveryCommand) {
   for (const char* c : {"--help", "robots --help", "fk --help", "run --help", "scene --help",
-                        "calibrate --help"}) {
+                        "calibrate --help", "train --help", "dataset --help", "ik --help"}) {
     const CliRun r = Cli(c);
     EXPECT_EQ(r.code, 0) << c << "\n" << r.out;
     EXPECT_NE(r.out.find("Usage"), std::string::npos) << c;
@@ -395,3 +395,58 @@ TEST(Cli, IkExperimentsRunTinyConfigsAndRejectBadPaths) {
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("place_offset"), std::string::npos) << r.out;
 }
+
+namespace {
+
+TEST(Cli, TrainAndLearnedIkFromADataset) {
+  const std::string dir = TempDir("learn");
+  // 27 samples of the coarse three_chamber with implicit Jacobians, loose forward solves.
+  CliRun r = Cli("dataset --robot three_chamber --res 3 --grid 3 --jacobian implicit --gradient-tolerance 1e-3 --quiet --out " +
+                 dir + "/d.csv");
+  ASSERT_EQ(r.code, 0) << r.out;
+  r = Cli("train --dataset " + dir + "/d.csv --out " + dir + "/nets --hidden 6 --hidden-jac 6 --hidden-ik 6 --epochs 40 --threads 1 --quiet");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("% of the"), std::string::npos) << r.out;  // N_fk error as % of the workspace
+  for (const char* f : {"nets.json", "fk.fnn", "jac.fnn", "ik.fnn"})
+    EXPECT_TRUE(std::filesystem::exists(dir + "/nets/" + f)) << f;
+  std::ifstream nj(dir + "/nets/nets.json");
+  const auto info = nlohmann::json::parse(nj);
+  EXPECT_EQ(info["format"], "softkin-nets");
+  EXPECT_EQ(info["info"]["dataset"]["samples"], 27);
+  EXPECT_EQ(info["rest"], nlohmann::json::array({1.0, 1.0, 1.0}));
+
+  // One target (the rest tip region), learned and direct.
+  for (const char* method : {"learned", "direct"}) {
+    r = Cli(std::string("ik --nets ") + dir + "/nets --method " + method + " --target 0,136,0 --quiet --out " + dir + "/ik.csv");
+    ASSERT_EQ(r.code, 0) << method << "\n" << r.out;
+    const std::string text = ReadText(dir + "/ik.csv");
+    EXPECT_EQ(CountLines(text), 2) << text;
+    EXPECT_EQ(text.find("nan"), std::string::npos) << text;
+  }
+  // Interactive: rows on stdout for good lines, a message naming the line for a bad one, 'quit' stops.
+  std::ofstream(dir + "/in.txt") << "2 140 -3\nnot a point\n-4,138,2\nquit\n5 5 5\n";
+  r = Cli("ik --nets " + dir + "/nets --method learned --interactive --quiet < " + dir + "/in.txt");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("stdin:2: expected a target"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("\n2,"), std::string::npos) << r.out;  // nothing after 'quit'
+  EXPECT_NE(r.out.find("\n0,2,140,-3,"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\n1,-4,138,2,"), std::string::npos) << r.out;
+
+  // Bad input: exit 2 with the option named.
+  r = Cli("ik --nets " + dir + "/missing --method learned --target 0,136,0 --out " + dir + "/x.csv");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("--nets"), std::string::npos) << r.out;
+  r = Cli("ik --nets " + dir + "/nets --method learned --s2r --target 0,136,0 --out " + dir + "/x.csv");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("no s2r network"), std::string::npos) << r.out;
+  r = Cli("ik --method learned --target 0,136,0 --out " + dir + "/x.csv");
+  EXPECT_EQ(r.code, 2) << r.out;
+  r = Cli("train --dataset " + dir + "/d.csv --out " + dir + "/n2 --what fk,xyz");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("--what"), std::string::npos) << r.out;
+  r = Cli("train --s2r " + dir + "/d.csv --out " + dir + "/none");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("nets.json"), std::string::npos) << r.out;
+}
+
+}  // namespace
