@@ -164,6 +164,7 @@ nlohmann::json RunLearnIkMethods(const Config& cfg, const std::string& dir, bool
   const int n_targets = cfg.Int("targets", 50);
   const int n_numerical = cfg.Int("numerical_targets", 5);
   const double eps_pct = cfg.Number("lambda_pct_width", 0.1);
+  const double net_eps_pct = cfg.Number("network_lambda_pct_width", 0.01);
   const int max_iter = cfg.Int("max_iterations", 30);
   const std::vector<std::string> methods =
       cfg.StringList("methods", {"pcc", "numerical", "direct", "learned"});
@@ -172,6 +173,7 @@ nlohmann::json RunLearnIkMethods(const Config& cfg, const std::string& dir, bool
   if (n_targets < 1) cfg.Fail("targets", "an integer >= 1");
   if (n_numerical < 0) cfg.Fail("numerical_targets", "an integer >= 0");
   if (!(eps_pct > 0)) cfg.Fail("lambda_pct_width", "a percentage > 0");
+  if (!(net_eps_pct > 0)) cfg.Fail("network_lambda_pct_width", "a percentage > 0");
   for (const auto& m : methods)
     if (m != "pcc" && m != "numerical" && m != "direct" && m != "learned")
       cfg.Fail("methods", "names out of pcc, numerical, direct, learned ('" + m + "' is not)");
@@ -251,7 +253,9 @@ nlohmann::json RunLearnIkMethods(const Config& cfg, const std::string& dir, bool
       } else {
         const Eigen::VectorXd c0 = samples.c.row(ClosestSample(samples, t)).transpose();
         PointTrackingObjective obj(model->point_names(), model->point_names().front(), t);
-        const IkResult r = SolveIk(*model, obj, c0, io);
+        IkOptions mo = io;
+        if (method != "numerical") mo.lambda = std::pow(net_eps_pct / 100.0 * width, 2);  // models are cheap
+        const IkResult r = SolveIk(*model, obj, c0, mo);
         c = r.c;
         pred = std::sqrt(r.objective);
         iters = r.summary.iterations;
@@ -285,6 +289,7 @@ nlohmann::json RunLearnIkMethods(const Config& cfg, const std::string& dir, bool
   }
   return {{"rows", rows}, {"dataset", dinfo}, {"networks", nets.info}, {"training_time_s", train_s},
           {"workspace_width_mm", width}, {"lambda_mm", eps_mm},
+          {"model_lambda_mm", net_eps_pct / 100.0 * width},
           {"errors_note", "every error is measured by the simulator at the method's actuation, on seeded random targets the simulator reaches (not on the training grid)"}};
 }
 
