@@ -4,7 +4,13 @@
 // (3 -> 35 -> 35 -> n_out, h = 2, b = 35, §5.3.4); data come from the analytical PCC finger
 // (3 actuators): n_out = 3 is N_fk (tip position), 9 the tip Jacobian (N_J), 27 the Jacobian of
 // three tracked points. Training sets have 4096 x 0.7 = 2867 samples (16^3 grid, 70 % split).
+#include "ik/ik_solver.hpp"
+#include "ik/objectives.hpp"
+#include "ik/pcc_chamber_kinematics.hpp"
 #include "ik/pcc_kinematics.hpp"
+#include "ik/trajectory.hpp"
+#include "learn/net_kinematics.hpp"
+#include "learn/train_nets.hpp"
 #include "learn/ceres_trainer.hpp"
 #include "learn/lm_trainer.hpp"
 
@@ -141,6 +147,66 @@ void BM_PeerTimeToLoss(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_PeerTimeToLoss)->Arg(20)->Unit(benchmark::kSecond)->Iterations(1);
+
+// One learned-IK waypoint (Table 5.1's "learned Jacobian", Eq. 5.4-5.6): damped Gauss-Newton on
+// N_fk (h = 2, b = 35) and N_J (h = 2, b = 30) trained on 8^3 samples of the three_chamber PCC
+// model (setup, not timed), from the closest of 5^3 network samples to a target off the grid,
+// stopping at 0.01 % of the workspace width. Arg 1: with the sim-to-real layer (Eq. 5.4).
+void BM_LearnedIkWaypoint(benchmark::State& state) {
+  static LearnedNets nets = [] {
+    PccChamberKinematics pcc;
+    Dataset d;
+    d.point_names = {"tip"};
+    d.num_actuators = 3;
+    const int N = 8;
+    d.inputs.resize(N * N * N, 3);
+    d.positions.resize(N * N * N, 3);
+    d.jacobians.resize(N * N * N, 9);
+    for (int i = 0; i < N * N * N; ++i) {
+      const Eigen::Vector3d c(1 + 2.0 * (i % N) / (N - 1), 1 + 2.0 * (i / N % N) / (N - 1), 1 + 2.0 * (i / (N * N)) / (N - 1));
+      const KinematicsEval e = pcc.Evaluate(c, true);
+      d.inputs.row(i) = c.transpose();
+      d.positions.row(i) = e.p.row(0);
+      for (int r = 0; r < 3; ++r) d.jacobians.block(i, 3 * r, 1, 3) = e.J.row(r);
+    }
+    NetsFromDatasetOptions o;
+    o.ik = false;
+    o.jac_options.hidden = {30, 30};
+    o.fk_options.lm.max_epochs = o.jac_options.lm.max_epochs = 100;
+    LearnedNets n = TrainNetsFromDataset(d, "pcc-chamber-8^3", o);
+    // An s2r layer from a "hardware" PCC with another gain and offset (for Arg 1).
+    PccChamberParams hw;
+    hw.gain = 0.27;
+    hw.offset = 14.0;
+    Dataset t = d;
+    t.jacobians.resize(t.inputs.rows(), 0);
+    for (int i = 0; i < t.inputs.rows(); ++i)
+      t.positions.row(i) = PccChamberKinematics::Tip(hw, t.inputs.row(i).transpose()).transpose();
+    LmOptions lm;
+    lm.max_epochs = 100;
+    TrainS2r(n, t, "pcc-hardware", 0.25, lm);
+    return n;
+  }();
+  NetKinematics kin(nets, JacobianSource::kNetwork, state.range(0) != 0);
+  SamplingOptions so;
+  so.samples_per_axis = 5;
+  const ConfigurationSamples samples = SampleConfigurationSpace(kin, "tip", so);
+  const double width = nets.info["dataset"]["workspace_width_mm"].get<double>();
+  IkOptions io;
+  io.method = IkMethod::kGaussNewton;
+  io.lambda = std::pow(1e-4 * width, 2);
+  const Eigen::Vector3d target = kin.Evaluate(Eigen::Vector3d(2.37, 1.42, 1.11), false).p.row(0).transpose();
+  const Eigen::VectorXd c0 = samples.c.row(ClosestSample(samples, target)).transpose();
+  PointTrackingObjective obj(kin.point_names(), "tip", target);
+  double err = 0;
+  for (auto _ : state) {
+    const IkResult r = SolveIk(kin, obj, c0, io);
+    err = std::sqrt(r.objective);
+    benchmark::DoNotOptimize(r.c.data());
+  }
+  state.counters["err_mm"] = err;
+}
+BENCHMARK(BM_LearnedIkWaypoint)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace softkin
