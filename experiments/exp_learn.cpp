@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <fstream>
 #include <random>
 
 namespace softkin {
@@ -26,8 +27,6 @@ namespace {
 double Seconds(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
-
-nlohmann::json Vec(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
 
 LmOptions ReadLm(const Config& cfg) {
   LmOptions lm;
@@ -92,6 +91,30 @@ nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, b
   for (int b : neurons)
     if (b < 1) cfg.Fail("neurons", "neuron counts >= 1");
 
+  // Resume: every finished network is appended to architecture.jsonl with the settings that
+  // produced it; a rerun reuses the rows whose settings match and trains only the others.
+  const std::string journal_path = dir + "/architecture.jsonl";
+  std::vector<nlohmann::json> journal;
+  {
+    std::ifstream in(journal_path);
+    std::string line;
+    int lineno = 0;
+    while (std::getline(in, line)) {
+      ++lineno;
+      if (line.empty()) continue;
+      try {
+        nlohmann::json j = nlohmann::json::parse(line);
+        if (j.contains("key") && j.contains("row")) journal.push_back(std::move(j));
+      } catch (const nlohmann::json::exception&) {
+        std::fprintf(stderr, "  %s:%d: not a complete JSON record (an interrupted write?); that network is trained again\n",
+                     journal_path.c_str(), lineno);
+      }
+    }
+  }
+  std::ofstream journal_out(journal_path, std::ios::app);
+  if (!journal_out) throw std::runtime_error("cannot write " + journal_path);
+  int reused = 0;
+
   CsvWriter csv(dir + "/architecture.csv",
                 {"robot", "net", "h", "b", "parameters", "test_mean", "test_max", "test_mean_pct",
                  "test_max_pct", "epochs", "time_s"});
@@ -118,33 +141,53 @@ nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, b
       const SampleSet train = SelectRows(s, split.train_rows), test = SelectRows(s, split.test_rows);
       for (int h : net == "fk" ? layers : jac_layers)
         for (int b : net == "fk" ? neurons : jac_neurons) {
-          NetTrainOptions o;
-          o.hidden.assign(h, b);
-          o.lm = lm;
-          o.split_seed = cfg.seed();
-          const NetTrainResult t = TrainNet(train, test, o);
+          const nlohmann::json key = {{"dataset", robots[r]}, {"net", net}, {"h", h}, {"b", b},
+                                      {"seed", cfg.seed()}, {"epochs", lm.max_epochs},
+                                      {"max_train_time_s", lm.max_time_s}};
+          nlohmann::json row;
+          bool found = false;
+          for (const auto& rec : journal)
+            if (rec["key"] == key) {
+              row = rec["row"];
+              found = true;
+            }
           const double scale = net == "fk" ? 100.0 / width : 100.0 * 0.1 * range / width;
-          nlohmann::json row = {{"robot", spec.robot}, {"net", net}, {"h", h}, {"b", b},
-                                {"parameters", t.net.num_parameters()},
-                                {"test_mean", t.test.mean_dist}, {"test_max", t.test.max_dist},
-                                {"test_mean_pct", scale * t.test.mean_dist},
-                                {"test_max_pct", scale * t.test.max_dist},
-                                {"relative", t.test.relative}, {"epochs", t.lm.epochs},
-                                {"time_s", t.lm.total_time_s}};
+          if (found) {
+            ++reused;
+          } else {
+            NetTrainOptions o;
+            o.hidden.assign(h, b);
+            o.lm = lm;
+            o.split_seed = cfg.seed();
+            const NetTrainResult t = TrainNet(train, test, o);
+            row = {{"robot", spec.robot}, {"net", net}, {"h", h}, {"b", b},
+                   {"parameters", t.net.num_parameters()},
+                   {"test_mean", t.test.mean_dist}, {"test_max", t.test.max_dist},
+                   {"test_mean_pct", scale * t.test.mean_dist},
+                   {"test_max_pct", scale * t.test.max_dist},
+                   {"relative", t.test.relative}, {"epochs", t.lm.epochs},
+                   {"time_s", t.lm.total_time_s}};
+            journal_out << nlohmann::json{{"key", key}, {"row", row}}.dump() << "\n";
+            journal_out.flush();
+          }
           csv.RowStrings({spec.robot, net, std::to_string(h), std::to_string(b),
-                          std::to_string(t.net.num_parameters()), std::to_string(t.test.mean_dist),
-                          std::to_string(t.test.max_dist), std::to_string(scale * t.test.mean_dist),
-                          std::to_string(scale * t.test.max_dist), std::to_string(t.lm.epochs),
-                          std::to_string(t.lm.total_time_s)});
+                          std::to_string(row["parameters"].get<long long>()),
+                          std::to_string(row["test_mean"].get<double>()),
+                          std::to_string(row["test_max"].get<double>()),
+                          std::to_string(row["test_mean_pct"].get<double>()),
+                          std::to_string(row["test_max_pct"].get<double>()),
+                          std::to_string(row["epochs"].get<int>()),
+                          std::to_string(row["time_s"].get<double>())});
           rows.push_back(row);
           if (verbose)
-            std::fprintf(stderr, "  %s N_%s h=%d b=%d: test mean %.4f%% (max %.4f%%) of %.1f mm, %d epochs, %.1f s\n",
-                         spec.robot.c_str(), net.c_str(), h, b, scale * t.test.mean_dist,
-                         scale * t.test.max_dist, width, t.lm.epochs, t.lm.total_time_s);
+            std::fprintf(stderr, "  %s N_%s h=%d b=%d: test mean %.4f%% (max %.4f%%) of %.1f mm, %d epochs, %.1f s%s\n",
+                         spec.robot.c_str(), net.c_str(), h, b, row["test_mean_pct"].get<double>(),
+                         row["test_max_pct"].get<double>(), width, row["epochs"].get<int>(),
+                         row["time_s"].get<double>(), found ? " (resumed from architecture.jsonl)" : "");
         }
     }
   }
-  return {{"rows", rows}, {"datasets", datasets},
+  return {{"rows", rows}, {"datasets", datasets}, {"resumed_rows", reused},
           {"jacobian_error_note",
            "N_J errors are |dJ| x (range/10) (the tip error of a 1/10-range step), as % of the workspace width"},
           {"thesis", {{"three_chamber", {{"fk", {{"h", 2}, {"b", 35}, {"test_mean_mm", 0.17}, {"test_mean_pct", 0.34}}}}},

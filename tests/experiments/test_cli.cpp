@@ -449,4 +449,46 @@ TEST(Cli, TrainAndLearnedIkFromADataset) {
   EXPECT_NE(r.out.find("nets.json"), std::string::npos) << r.out;
 }
 
+TEST(Cli, ArchitectureSweepResumesFinishedNetworks) {
+  const std::string dir = TempDir("arch");
+  const std::string cfg = dir + "/arch.json";
+  std::ofstream(cfg) << R"({"name": "tiny_arch", "experiment": "learn_architecture", "seed": 3,
+    "datasets": [{"robot": "three_chamber", "res": 3, "grid": 3, "gradient_tolerance": 1e-3}],
+    "layers": [1], "neurons": [3, 5], "jacobian_network": false, "epochs": 15, "threads": 1})";
+  CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  auto summary = [&] {
+    std::ifstream f(dir + "/tiny_arch/summary.json");
+    return nlohmann::json::parse(f);
+  };
+  const auto first = summary();
+  ASSERT_EQ(first["rows"].size(), 2u);
+  EXPECT_EQ(first["resumed_rows"], 0);
+  // A rerun trains nothing and reports the same rows.
+  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto second = summary();
+  EXPECT_EQ(second["resumed_rows"], 2);
+  EXPECT_EQ(second["rows"], first["rows"]);
+  // An interrupted journal (the last record cut mid-write) and a changed setting: the cut record
+  // and the rows of other settings are trained again, the intact record is reused.
+  std::string journal = ReadText(dir + "/tiny_arch/architecture.jsonl");
+  ASSERT_EQ(CountLines(journal), 2) << journal;
+  const size_t second_line = journal.find('\n') + 1;
+  std::ofstream(dir + "/tiny_arch/architecture.jsonl") << journal.substr(0, second_line + 20);
+  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("architecture.jsonl:2: not a complete JSON record"), std::string::npos) << r.out;
+  const auto third = summary();
+  EXPECT_EQ(third["resumed_rows"], 1);
+  EXPECT_EQ(third["rows"][0], first["rows"][0]);
+  EXPECT_EQ(third["rows"][1]["b"], 5);
+  std::ofstream(cfg) << R"({"name": "tiny_arch", "experiment": "learn_architecture", "seed": 3,
+    "datasets": [{"robot": "three_chamber", "res": 3, "grid": 3, "gradient_tolerance": 1e-3}],
+    "layers": [1], "neurons": [3, 5], "jacobian_network": false, "epochs": 16, "threads": 1})";
+  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(summary()["resumed_rows"], 0);
+}
+
 }  // namespace
