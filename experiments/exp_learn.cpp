@@ -117,7 +117,7 @@ nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, b
 
   CsvWriter csv(dir + "/architecture.csv",
                 {"robot", "net", "h", "b", "parameters", "test_mean", "test_max", "test_mean_pct",
-                 "test_max_pct", "epochs", "time_s"});
+                 "test_max_pct", "epochs", "time_s", "termination"});
   nlohmann::json rows = nlohmann::json::array(), datasets = nlohmann::json::array();
   for (size_t r = 0; r < robots.size(); ++r) {
     const DatasetSpec spec = ParseDatasetSpec(robots[r], cfg.path() + ": datasets[" + std::to_string(r) + "]");
@@ -166,7 +166,8 @@ nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, b
                    {"test_mean_pct", scale * t.test.mean_dist},
                    {"test_max_pct", scale * t.test.max_dist},
                    {"relative", t.test.relative}, {"epochs", t.lm.epochs},
-                   {"time_s", t.lm.total_time_s}};
+                   {"time_s", t.lm.total_time_s},
+                   {"termination", LmTerminationToString(t.lm.termination)}};
             journal_out << nlohmann::json{{"key", key}, {"row", row}}.dump() << "\n";
             journal_out.flush();
           }
@@ -177,7 +178,8 @@ nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, b
                           std::to_string(row["test_mean_pct"].get<double>()),
                           std::to_string(row["test_max_pct"].get<double>()),
                           std::to_string(row["epochs"].get<int>()),
-                          std::to_string(row["time_s"].get<double>())});
+                          std::to_string(row["time_s"].get<double>()),
+                          row.value("termination", std::string("?"))});
           rows.push_back(row);
           if (verbose)
             std::fprintf(stderr, "  %s N_%s h=%d b=%d: test mean %.4f%% (max %.4f%%) of %.1f mm, %d epochs, %.1f s%s\n",
