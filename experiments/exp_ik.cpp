@@ -268,17 +268,38 @@ nlohmann::json RunIkMethods(const Config& cfg, const std::string& dir, bool verb
                                        "mean_err_mm", "max_err_mm", "fk_calls", "fk_calls_per_waypoint",
                                        "evaluations", "mean_iterations", "failures"});
   nlohmann::json rows = nlohmann::json::array();
+  // Resume: each finished method x Jacobian row is journaled with every setting that produced it
+  // (the config but its method and Jacobian lists); a rerun reuses matching rows.
+  ResumeJournal journal(dir + "/methods.jsonl");
+  nlohmann::json settings = cfg.json();
+  for (const char* k : {"methods", "jacobians", "description", "name"}) settings.erase(k);
+  settings["quick"] = cfg.quick();
   for (IkMethod m : methods) {
     // BOBYQA never asks for J: one run, whatever the mode.
     const bool derivative_free = m == IkMethod::kNloptBobyqa;
     for (size_t k = 0; k < jmodes.size(); ++k) {
       if (derivative_free && k > 0) break;
+      const std::string jname = derivative_free ? "none" : JacobianModeToString(jmodes[k]);
+      const nlohmann::json key = {{"settings", settings}, {"method", IkMethodToString(m)}, {"jacobian", jname}};
+      if (const nlohmann::json* done = journal.Find(key)) {
+        journal.CountReuse();
+        rows.push_back(*done);
+        const nlohmann::json& d = *done;
+        csv.RowStrings({d["method"].get<std::string>(), jname, std::to_string(d["waypoints"].get<int>()),
+                        std::to_string(d["converged"].get<int>()), std::to_string(d["ms_per_waypoint"].get<double>()),
+                        std::to_string(d["mean_err_mm"].get<double>()), std::to_string(d["max_err_mm"].get<double>()),
+                        std::to_string(d["fk_calls"].get<long long>()),
+                        std::to_string(d["fk_calls_per_waypoint"].get<double>()),
+                        std::to_string(d["evaluations"].get<long long>()),
+                        std::to_string(d["mean_iterations"].get<double>()), std::to_string(d["failures"].get<int>())});
+        if (verbose) std::fprintf(stderr, "  %s/%s: resumed from methods.jsonl\n", d["method"].get<std::string>().c_str(), jname.c_str());
+        continue;
+      }
       SimulatorKinematicsOptions ko = s.KinematicsFor({s.point});
       ko.jacobian = jmodes[k];
       SimulatorKinematics kin(model, ko, &s.fk);
       IkOptions ik = s.ik;
       ik.method = m;
-      const std::string jname = derivative_free ? "none" : JacobianModeToString(jmodes[k]);
       const std::string label = IkMethodToString(m) + "/" + jname;
       const TrajectoryResult r = Follow(kin, path.waypoints, guess, s, ik,
                                         dir + "/path_" + IkMethodToString(m) + "_" + jname + ".csv",
@@ -297,6 +318,7 @@ nlohmann::json RunIkMethods(const Config& cfg, const std::string& dir, bool verb
                       {"evaluations", st.evals},
                       {"mean_iterations", st.mean_iter},
                       {"failures", st.failed}});
+      journal.Append(key, rows.back());
       csv.RowStrings({IkMethodToString(m), jname, std::to_string(st.n), std::to_string(st.converged),
                       std::to_string(ms), std::to_string(st.mean_err), std::to_string(st.max_err),
                       std::to_string(st.fk), std::to_string(st.n ? double(st.fk) / st.n : 0.0),
@@ -314,6 +336,7 @@ nlohmann::json RunIkMethods(const Config& cfg, const std::string& dir, bool verb
   j["initial_guess"] = Vec(guess);
   j["samples"] = SamplesJson(samples);
   j["rows"] = rows;
+  j["resumed_rows"] = journal.reused();
   return j;
 }
 

@@ -17,7 +17,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <random>
 
 namespace softkin {
@@ -93,27 +92,7 @@ nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, b
 
   // Resume: every finished network is appended to architecture.jsonl with the settings that
   // produced it; a rerun reuses the rows whose settings match and trains only the others.
-  const std::string journal_path = dir + "/architecture.jsonl";
-  std::vector<nlohmann::json> journal;
-  {
-    std::ifstream in(journal_path);
-    std::string line;
-    int lineno = 0;
-    while (std::getline(in, line)) {
-      ++lineno;
-      if (line.empty()) continue;
-      try {
-        nlohmann::json j = nlohmann::json::parse(line);
-        if (j.contains("key") && j.contains("row")) journal.push_back(std::move(j));
-      } catch (const nlohmann::json::exception&) {
-        std::fprintf(stderr, "  %s:%d: not a complete JSON record (an interrupted write?); that network is trained again\n",
-                     journal_path.c_str(), lineno);
-      }
-    }
-  }
-  std::ofstream journal_out(journal_path, std::ios::app);
-  if (!journal_out) throw std::runtime_error("cannot write " + journal_path);
-  int reused = 0;
+  ResumeJournal journal(dir + "/architecture.jsonl");
 
   CsvWriter csv(dir + "/architecture.csv",
                 {"robot", "net", "h", "b", "parameters", "test_mean", "test_max", "test_mean_pct",
@@ -145,15 +124,12 @@ nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, b
                                       {"seed", cfg.seed()}, {"epochs", lm.max_epochs},
                                       {"max_train_time_s", lm.max_time_s}};
           nlohmann::json row;
-          bool found = false;
-          for (const auto& rec : journal)
-            if (rec["key"] == key) {
-              row = rec["row"];
-              found = true;
-            }
+          const nlohmann::json* done = journal.Find(key);
+          const bool found = done != nullptr;
+          if (found) row = *done;
           const double scale = net == "fk" ? 100.0 / width : 100.0 * 0.1 * range / width;
           if (found) {
-            ++reused;
+            journal.CountReuse();
           } else {
             NetTrainOptions o;
             o.hidden.assign(h, b);
@@ -168,8 +144,7 @@ nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, b
                    {"relative", t.test.relative}, {"epochs", t.lm.epochs},
                    {"time_s", t.lm.total_time_s},
                    {"termination", LmTerminationToString(t.lm.termination)}};
-            journal_out << nlohmann::json{{"key", key}, {"row", row}}.dump() << "\n";
-            journal_out.flush();
+            journal.Append(key, row);
           }
           csv.RowStrings({spec.robot, net, std::to_string(h), std::to_string(b),
                           std::to_string(row["parameters"].get<long long>()),
@@ -189,7 +164,7 @@ nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, b
         }
     }
   }
-  return {{"rows", rows}, {"datasets", datasets}, {"resumed_rows", reused},
+  return {{"rows", rows}, {"datasets", datasets}, {"resumed_rows", journal.reused()},
           {"jacobian_error_note",
            "N_J errors are |dJ| x (range/10) (the tip error of a 1/10-range step), as % of the workspace width"},
           {"thesis", {{"three_chamber", {{"fk", {{"h", 2}, {"b", 35}, {"test_mean_mm", 0.17}, {"test_mean_pct", 0.34}}}}},

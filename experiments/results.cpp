@@ -98,4 +98,41 @@ void CsvWriter::RowStrings(const std::vector<std::string>& values) {
   out_.flush();
 }
 
+ResumeJournal::ResumeJournal(const std::string& path) : path_(path) {
+  {
+    std::ifstream in(path);
+    std::string line;
+    int lineno = 0;
+    while (std::getline(in, line)) {
+      ++lineno;
+      if (line.empty()) continue;
+      try {
+        nlohmann::json j = nlohmann::json::parse(line);
+        if (j.is_object() && j.contains("key") && j.contains("row")) {
+          records_.push_back(std::move(j));
+          continue;
+        }
+      } catch (const nlohmann::json::exception&) {
+      }
+      std::fprintf(stderr, "  %s:%d: not a complete JSON record (an interrupted write?); that unit is computed again\n",
+                   path.c_str(), lineno);
+    }
+  }
+  out_.open(path, std::ios::app);
+  if (!out_) throw std::runtime_error("cannot write " + path);
+}
+
+const nlohmann::json* ResumeJournal::Find(const nlohmann::json& key) const {
+  for (auto it = records_.rbegin(); it != records_.rend(); ++it)
+    if ((*it)["key"] == key) return &(*it)["row"];
+  return nullptr;
+}
+
+void ResumeJournal::Append(const nlohmann::json& key, const nlohmann::json& row) {
+  out_ << nlohmann::json{{"key", key}, {"row", row}}.dump() << "\n";
+  out_.flush();
+  if (!out_) throw std::runtime_error("cannot write " + path_);
+  records_.push_back({{"key", key}, {"row", row}});
+}
+
 }  // namespace softkin

@@ -32,4 +32,25 @@ class CsvWriter {
   size_t cols_;
 };
 
+/// A journal of finished units of a long sweep, for resuming it: one JSON record per line,
+/// {"key": ..., "row": ...}, appended and flushed as each unit finishes. The key holds every setting
+/// that determines the row; a rerun reuses the rows whose key matches exactly and recomputes the
+/// rest. A line that does not parse (a write cut by a crash) is reported on stderr and skipped.
+class ResumeJournal {
+ public:
+  explicit ResumeJournal(const std::string& path);
+  /// The row recorded for `key` (the last one if several), or nullptr.
+  const nlohmann::json* Find(const nlohmann::json& key) const;
+  void Append(const nlohmann::json& key, const nlohmann::json& row);
+  int reused() const { return reused_; }
+  void CountReuse() { ++reused_; }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  std::vector<nlohmann::json> records_;
+  std::ofstream out_;
+  int reused_ = 0;
+};
+
 }  // namespace softkin

@@ -376,6 +376,21 @@ TEST(Cli, IkExperimentsRunTinyConfigsAndRejectBadPaths) {
     EXPECT_TRUE(std::filesystem::exists(dir + "/tiny_traj/path_seg.csv"));
     EXPECT_TRUE(std::filesystem::exists(dir + "/tiny_traj/samples.csv"));
   }
+  // ik_methods journals each method x Jacobian row; a rerun reuses it.
+  std::ofstream(cfg) << R"({"name": "tiny_methods", "experiment": "ik_methods", "seed": 2,
+    "robot": "cable_finger", "res": 5, "solver": {"gradient_tolerance": 1e-3}, "samples_per_axis": 2,
+    "methods": ["gauss-newton"], "jacobians": ["implicit"], "max_evaluations": 6,
+    "path": {"name": "seg", "type": "polyline", "n": 2, "vertices": [[119.5, 12.5, 16.0], [119.0, 12.5, 18.0]]}})";
+  for (int run = 0; run < 2; ++run) {
+    r = Cli("run " + cfg + " --no-plot --results " + dir);
+    ASSERT_EQ(r.code, 0) << r.out;
+    std::ifstream f(dir + "/tiny_methods/summary.json");
+    const auto j = nlohmann::json::parse(f);
+    ASSERT_EQ(j["rows"].size(), 1u);
+    EXPECT_EQ(j["rows"][0]["method"], "gauss-newton");
+    EXPECT_EQ(j["rows"][0]["waypoints"], 2);
+    EXPECT_EQ(j["resumed_rows"], run) << "run " << run;
+  }
   // A path of an unknown type, a file path with a bad stride, a bad method: exit 2 with the key.
   std::ofstream(cfg) << R"({"name": "tiny_traj", "experiment": "ik_trajectory", "seed": 2,
     "robot": "cable_finger", "res": 5, "samples_per_axis": 2, "solver": {"gradient_tolerance": 1e-3},
