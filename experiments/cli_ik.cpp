@@ -70,8 +70,10 @@ CLI::App* AddIkCommand(CLI::App* app, IkCommandArgs* a) {
   ik->add_option("--max-time", a->max_time_s, "Wall-time limit per waypoint, s (default 600)");
   ik->add_option("--gradient-tolerance", a->gradient_tolerance,
                  "Forward solves stop when the energy gradient falls below this fraction of its "
-                 "starting value (default: the scene's, 1e-6); 1e-4 moves the tip by "
-                 "micrometres and saves about two thirds of the iterations");
+                 "starting value (default: the scene's, 1e-6). 1e-4 saves about half the iterations "
+                 "but its error depends on the robot: micrometres on cable_finger, ~0.1 mm on "
+                 "three_chamber, up to 4 mm on finger_manipulator (a soft lateral mode); check "
+                 "yours against a tight solve first");
   ik->add_option("--samples", a->samples,
                  "Configuration-space samples per actuator for the first waypoint's initial guess "
                  "(default 5: 5^3 = 125 for three actuators); 0 starts from the rest actuation");
