@@ -281,18 +281,10 @@ nlohmann::json RunIkMethods(const Config& cfg, const std::string& dir, bool verb
       if (derivative_free && k > 0) break;
       const std::string jname = derivative_free ? "none" : JacobianModeToString(jmodes[k]);
       const nlohmann::json key = {{"settings", settings}, {"method", IkMethodToString(m)}, {"jacobian", jname}};
-      if (const nlohmann::json* done = journal.Find(key)) {
-        journal.CountReuse();
+      if (const nlohmann::json* done = journal.Reuse(key)) {
         rows.push_back(*done);
-        const nlohmann::json& d = *done;
-        csv.RowStrings({d["method"].get<std::string>(), jname, std::to_string(d["waypoints"].get<int>()),
-                        std::to_string(d["converged"].get<int>()), std::to_string(d["ms_per_waypoint"].get<double>()),
-                        std::to_string(d["mean_err_mm"].get<double>()), std::to_string(d["max_err_mm"].get<double>()),
-                        std::to_string(d["fk_calls"].get<long long>()),
-                        std::to_string(d["fk_calls_per_waypoint"].get<double>()),
-                        std::to_string(d["evaluations"].get<long long>()),
-                        std::to_string(d["mean_iterations"].get<double>()), std::to_string(d["failures"].get<int>())});
-        if (verbose) std::fprintf(stderr, "  %s/%s: resumed from methods.jsonl\n", d["method"].get<std::string>().c_str(), jname.c_str());
+        csv.RowJson(*done);
+        if (verbose) std::fprintf(stderr, "  %s/%s: resumed from methods.jsonl\n", IkMethodToString(m).c_str(), jname.c_str());
         continue;
       }
       SimulatorKinematicsOptions ko = s.KinematicsFor({s.point});
@@ -319,10 +311,7 @@ nlohmann::json RunIkMethods(const Config& cfg, const std::string& dir, bool verb
                       {"mean_iterations", st.mean_iter},
                       {"failures", st.failed}});
       journal.Append(key, rows.back());
-      csv.RowStrings({IkMethodToString(m), jname, std::to_string(st.n), std::to_string(st.converged),
-                      std::to_string(ms), std::to_string(st.mean_err), std::to_string(st.max_err),
-                      std::to_string(st.fk), std::to_string(st.n ? double(st.fk) / st.n : 0.0),
-                      std::to_string(st.evals), std::to_string(st.mean_iter), std::to_string(st.failed)});
+      csv.RowJson(rows.back());
       if (verbose)
         std::fprintf(stderr, "  %s: %d/%d converged, %.1f ms/waypoint, mean %.3f mm, max %.3f mm, %lld FK\n",
                      label.c_str(), st.converged, st.n, ms, st.mean_err, st.max_err, st.fk);

@@ -123,13 +123,11 @@ nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, b
           const nlohmann::json key = {{"dataset", robots[r]}, {"net", net}, {"h", h}, {"b", b},
                                       {"seed", cfg.seed()}, {"epochs", lm.max_epochs},
                                       {"max_train_time_s", lm.max_time_s}};
-          nlohmann::json row;
-          const nlohmann::json* done = journal.Find(key);
-          const bool found = done != nullptr;
-          if (found) row = *done;
           const double scale = net == "fk" ? 100.0 / width : 100.0 * 0.1 * range / width;
-          if (found) {
-            journal.CountReuse();
+          const nlohmann::json* done = journal.Reuse(key);
+          nlohmann::json row;
+          if (done) {
+            row = *done;
           } else {
             NetTrainOptions o;
             o.hidden.assign(h, b);
@@ -146,21 +144,13 @@ nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, b
                    {"termination", LmTerminationToString(t.lm.termination)}};
             journal.Append(key, row);
           }
-          csv.RowStrings({spec.robot, net, std::to_string(h), std::to_string(b),
-                          std::to_string(row["parameters"].get<long long>()),
-                          std::to_string(row["test_mean"].get<double>()),
-                          std::to_string(row["test_max"].get<double>()),
-                          std::to_string(row["test_mean_pct"].get<double>()),
-                          std::to_string(row["test_max_pct"].get<double>()),
-                          std::to_string(row["epochs"].get<int>()),
-                          std::to_string(row["time_s"].get<double>()),
-                          row.value("termination", std::string("?"))});
+          csv.RowJson(row);
           rows.push_back(row);
           if (verbose)
             std::fprintf(stderr, "  %s N_%s h=%d b=%d: test mean %.4f%% (max %.4f%%) of %.1f mm, %d epochs, %.1f s%s\n",
                          spec.robot.c_str(), net.c_str(), h, b, row["test_mean_pct"].get<double>(),
                          row["test_max_pct"].get<double>(), width, row["epochs"].get<int>(),
-                         row["time_s"].get<double>(), found ? " (resumed from architecture.jsonl)" : "");
+                         row["time_s"].get<double>(), done ? " (resumed from architecture.jsonl)" : "");
         }
     }
   }

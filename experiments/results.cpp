@@ -73,7 +73,7 @@ void WriteJson(const std::string& path, const nlohmann::json& j) {
 }
 
 CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& header)
-    : path_(path), out_(path), cols_(header.size()) {
+    : path_(path), header_(header), out_(path), cols_(header.size()) {
   if (!out_) throw std::runtime_error("cannot write " + path);
   RowStrings(header);
 }
@@ -85,6 +85,26 @@ void CsvWriter::Row(const std::vector<double>& values) {
     std::ostringstream os;
     os << std::setprecision(10) << v;
     s.push_back(os.str());
+  }
+  RowStrings(s);
+}
+
+void CsvWriter::RowJson(const nlohmann::json& row) {
+  std::vector<std::string> s;
+  s.reserve(header_.size());
+  for (const auto& k : header_) {
+    const auto it = row.find(k);
+    if (it == row.end() || it->is_null()) {
+      s.emplace_back();
+    } else if (it->is_string()) {
+      s.push_back(it->get<std::string>());
+    } else if (it->is_number_integer() || it->is_boolean()) {
+      s.push_back(it->dump());
+    } else {
+      std::ostringstream os;
+      os << std::setprecision(10) << it->get<double>();
+      s.push_back(os.str());
+    }
   }
   RowStrings(s);
 }
@@ -122,9 +142,12 @@ ResumeJournal::ResumeJournal(const std::string& path) : path_(path) {
   if (!out_) throw std::runtime_error("cannot write " + path);
 }
 
-const nlohmann::json* ResumeJournal::Find(const nlohmann::json& key) const {
+const nlohmann::json* ResumeJournal::Reuse(const nlohmann::json& key) {
   for (auto it = records_.rbegin(); it != records_.rend(); ++it)
-    if ((*it)["key"] == key) return &(*it)["row"];
+    if ((*it)["key"] == key) {
+      ++reused_;
+      return &(*it)["row"];
+    }
   return nullptr;
 }
 

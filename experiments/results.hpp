@@ -24,10 +24,14 @@ class CsvWriter {
   CsvWriter(const std::string& path, const std::vector<std::string>& header);
   void Row(const std::vector<double>& values);
   void RowStrings(const std::vector<std::string>& values);
+  /// One row from a JSON object: the value of each header name (numbers as by Row, strings as is,
+  /// a missing key as empty).
+  void RowJson(const nlohmann::json& row);
   const std::string& path() const { return path_; }
 
  private:
   std::string path_;
+  std::vector<std::string> header_;
   std::ofstream out_;
   size_t cols_;
 };
@@ -39,11 +43,11 @@ class CsvWriter {
 class ResumeJournal {
  public:
   explicit ResumeJournal(const std::string& path);
-  /// The row recorded for `key` (the last one if several), or nullptr.
-  const nlohmann::json* Find(const nlohmann::json& key) const;
+  /// The row recorded for `key` (the last one if several), counted as reused; or nullptr.
+  const nlohmann::json* Reuse(const nlohmann::json& key);
   void Append(const nlohmann::json& key, const nlohmann::json& row);
+  /// Rows returned by Reuse so far.
   int reused() const { return reused_; }
-  void CountReuse() { ++reused_; }
   const std::string& path() const { return path_; }
 
  private:
