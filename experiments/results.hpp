@@ -40,6 +40,8 @@ class CsvWriter {
 /// {"key": ..., "row": ...}, appended and flushed as each unit finishes. The key holds every setting
 /// that determines the row; a rerun reuses the rows whose key matches exactly and recomputes the
 /// rest. A line that does not parse (a write cut by a crash) is reported on stderr and skipped.
+/// The key does not identify the code: after changing the code, delete the journal to recompute
+/// (summaries report how many rows were reused, as "resumed_rows").
 class ResumeJournal {
  public:
   explicit ResumeJournal(const std::string& path);
