@@ -118,9 +118,9 @@ TrajectoryResult Follow(SimulatorKinematics& kin, const Eigen::MatrixX3d& waypoi
   auto cb = [&](const WaypointResult& w) {
     csv << WaypointCsvRow(w) << "\n" << std::flush;
     if (verbose)
-      std::fprintf(stderr, "  [%s %d/%d] error %.3f mm, %s, %d it, %lld FK, %.2f s\n", label.c_str(),
+      std::fprintf(stderr, "  [%s %d/%d] error %.3f mm, %s, %d it, %lld FK, %.2f s%s%s\n", label.c_str(),
                    w.index + 1, total, w.error_mm, IkTerminationToString(w.termination).c_str(),
-                   w.iterations, w.fk_solves, w.time_s);
+                   w.iterations, w.fk_solves, w.time_s, w.message.empty() ? "" : ": ", w.message.c_str());
   };
   (void)s;
   return FollowTrajectory(kin, waypoints, to, cb);
