@@ -73,7 +73,7 @@ void WriteJson(const std::string& path, const nlohmann::json& j) {
 }
 
 CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& header)
-    : path_(path), header_(header), out_(path), cols_(header.size()) {
+    : path_(path), header_(header), out_(path) {
   if (!out_) throw std::runtime_error("cannot write " + path);
   RowStrings(header);
 }
@@ -110,9 +110,9 @@ void CsvWriter::RowJson(const nlohmann::json& row) {
 }
 
 void CsvWriter::RowStrings(const std::vector<std::string>& values) {
-  if (values.size() != cols_)
+  if (values.size() != header_.size())
     throw std::logic_error(path_ + ": row has " + std::to_string(values.size()) +
-                           " values, header has " + std::to_string(cols_));
+                           " values, header has " + std::to_string(header_.size()));
   for (size_t i = 0; i < values.size(); ++i) out_ << (i ? "," : "") << values[i];
   out_ << "\n";
   out_.flush();

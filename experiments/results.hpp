@@ -33,7 +33,6 @@ class CsvWriter {
   std::string path_;
   std::vector<std::string> header_;
   std::ofstream out_;
-  size_t cols_;
 };
 
 /// A journal of finished units of a long sweep, for resuming it: one JSON record per line,
@@ -45,12 +44,12 @@ class CsvWriter {
 class ResumeJournal {
  public:
   explicit ResumeJournal(const std::string& path);
-  /// The row recorded for `key` (the last one if several), counted as reused; or nullptr.
+  /// The row recorded for `key` (the last one if several), counted as reused; or nullptr. The
+  /// pointer is valid until the next Append.
   const nlohmann::json* Reuse(const nlohmann::json& key);
   void Append(const nlohmann::json& key, const nlohmann::json& row);
   /// Rows returned by Reuse so far.
   int reused() const { return reused_; }
-  const std::string& path() const { return path_; }
 
  private:
   std::string path_;
