@@ -10,8 +10,10 @@
 // starts from the previous waypoint's solution c_prev = (1.66, 1.22, 1) (4.5 mm away), with the
 // kinematics' state at c_prev, as in trajectory following (Algorithm 4). Before each timed solve
 // the kinematics replays the previous waypoint (untimed): J at c_pp = (1.54, 1.18, 1), then p at
-// c_prev, so its warm state, prediction and Jacobian guess are those a path would leave. range(0): method (enum order), range(1): resolution (7 is the
-// robot's default). Counters: fk_solves, evaluations, err_mm.
+// c_prev, so its warm state, prediction and Jacobian guess are those a path would leave; broyden
+// is handed the J taken at c_pp, as FollowTrajectory hands on the previous waypoint's.
+// range(0): method (enum order), range(1): resolution (7 is the robot's default). Counters:
+// fk_solves, evaluations, jac_evals, err_mm.
 #include "ik/ik_solver.hpp"
 #include "ik/pcc_kinematics.hpp"
 #include "ik/simulator_kinematics.hpp"
@@ -100,11 +102,14 @@ void BM_SimulatorWaypoint(benchmark::State& state) {
   IkResult r;
   long long solves = 0;
   for (auto _ : state) {
-    // The previous waypoint, untimed: J where it started, p where it ended.
-    if (!f.kin->Evaluate(f.c_pp, true).ok || !f.kin->Evaluate(f.c_prev, false).ok) {
+    // The previous waypoint, untimed: J where it started, p where it ended. broyden gets that J
+    // handed over (as FollowTrajectory does with the previous waypoint's).
+    const KinematicsEval pp = f.kin->Evaluate(f.c_pp, true);
+    if (!pp.ok || !f.kin->Evaluate(f.c_prev, false).ok) {
       state.SkipWithError("forward solve or Jacobian of the previous waypoint failed");
       return;
     }
+    if (method == IkMethod::kBroyden) opt.initial_jacobian = pp.J;
     const long long before = f.kin->total_fk_solves();
     const auto t0 = std::chrono::steady_clock::now();
     r = SolveIk(*f.kin, objective, f.c_prev, opt);
@@ -127,9 +132,11 @@ void SimulatorCases(benchmark::internal::Benchmark* b) {
       if (all[i] == m) return static_cast<int>(i);
     return 0;
   };
-  for (IkMethod m : {IkMethod::kSoftLineSearch, IkMethod::kNloptSlsqp, IkMethod::kGaussNewton})
+  for (IkMethod m : {IkMethod::kSoftLineSearch, IkMethod::kNloptSlsqp, IkMethod::kGaussNewton,
+                     IkMethod::kBroyden})
     b->Args({index(m), 4});
   b->Args({index(IkMethod::kGaussNewton), 7});
+  b->Args({index(IkMethod::kBroyden), 7});
 }
 
 BENCHMARK(BM_SimulatorWaypoint)

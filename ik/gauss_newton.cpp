@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 
+#include <cmath>
 #include <limits>
 #include <sstream>
 
@@ -36,10 +37,42 @@ IkResult SolveGaussNewton(Kinematics& kin, const Objective& objective,
     return true;
   };
 
+  // broyden: J of `cur` is secant-updated (not fresh) until a step fails with it.
+  const bool broyden = options.method == IkMethod::kBroyden;
+  bool fresh = true;
+  // cur.J -> r, dr_dc without a new evaluation (broyden's updated J); false with S filled.
+  auto residuals_of = [&](const IkPoint& pt, const char* where) {
+    try {
+      P.Residuals(pt, &r, &dr_dc);
+    } catch (const ObjectiveError& e) {
+      S.termination = IkTermination::kObjectiveFailure;
+      S.message = std::string(where) + objective.name() + ": " + e.what();
+      return false;
+    }
+    return true;
+  };
+
   IkPoint cur;
-  if (!evaluate_at(c0, &cur, "at c0: ")) return P.Finish(c0, S);
-  S.history.push_back(cur.value);
   Eigen::VectorXd c = c0;
+  auto finish = [&]() {
+    IkResult res = P.Finish(c0, S);
+    if (broyden && cur.J.size() > 0 && res.c == c) res.J = cur.J;
+    return res;
+  };
+  if (broyden && options.initial_jacobian.size() > 0) {
+    cur = P.Evaluate(c0, false);
+    if (!cur.ok) {
+      S.termination = cur.failure;
+      S.message = "at c0: " + cur.message;
+      return finish();
+    }
+    cur.J = options.initial_jacobian;
+    fresh = false;
+    if (!residuals_of(cur, "at c0: ")) return finish();
+  } else if (!evaluate_at(c0, &cur, "at c0: ")) {
+    return finish();
+  }
+  S.history.push_back(cur.value);
   double mu = -1.0;
 
   while (true) {
@@ -77,9 +110,10 @@ IkResult SolveGaussNewton(Kinematics& kin, const Objective& objective,
       gf[i] = g[free[i]];
       for (int j = 0; j < nf; ++j) Hf(i, j) = H(free[i], free[j]);
     }
-    bool accepted = false, budget = true;
+    bool accepted = false, budget = true, refresh = false;
     double o_trial = 0.0;
     Eigen::VectorXd c_trial;
+    Eigen::MatrixX3d p_trial;
     while (mu <= options.max_damping) {
       const Eigen::VectorXd duf =
           (Hf + mu * Eigen::MatrixXd::Identity(nf, nf)).ldlt().solve(-gf);
@@ -100,12 +134,27 @@ IkResult SolveGaussNewton(Kinematics& kin, const Objective& objective,
       if (t.ok && t.value < cur.value) {
         accepted = true;
         o_trial = t.value;
+        p_trial = t.p;
         mu = std::max(mu / 10.0, 1e-300);
+        break;
+      }
+      if (broyden && !fresh) {  // the updated J may be what failed: evaluate J before damping
+        refresh = true;
         break;
       }
       mu *= 10.0;
     }
     if (!budget) break;
+    if (refresh) {
+      std::string msg;
+      if (P.OutOfBudget(&S.termination, &msg)) {
+        S.message = msg;
+        break;
+      }
+      if (!evaluate_at(c, &cur, "re-evaluating J after a failed secant step: ")) break;
+      fresh = true;
+      continue;
+    }
     if (!accepted) {
       S.termination = IkTermination::kNoProgress;
       S.message = "no decrease with damping up to max_damping";
@@ -115,6 +164,26 @@ IkResult SolveGaussNewton(Kinematics& kin, const Objective& objective,
                              range.cwiseMax(std::numeric_limits<double>::min())))
                             .maxCoeff();
     const double o_prev = cur.value;
+    const bool step_had_fresh_j = fresh;
+    if (broyden) {
+      // Broyden's update in the scaled coordinates u (minimal change of J diag(range) in the
+      // Frobenius norm): J += (dp - J dc) w^T / (dc^T w), w = dc / range^2.
+      const Eigen::VectorXd dc = c_trial - c;
+      const Eigen::VectorXd w =
+          dc.cwiseQuotient(range.cwiseMax(std::numeric_limits<double>::min()).cwiseAbs2());
+      const double den = dc.dot(w);
+      const int np = static_cast<int>(p_trial.rows());
+      Eigen::VectorXd dp(3 * np);
+      for (int q = 0; q < np; ++q)
+        for (int d = 0; d < 3; ++d) dp[3 * q + d] = p_trial(q, d) - cur.p(q, d);
+      if (den > 0.0 && std::isfinite(den)) {
+        cur.J += (dp - cur.J * dc) * (w.transpose() / den);
+        ++S.secant_updates;
+      }
+      cur.p = p_trial;
+      cur.value = o_trial;
+      fresh = false;
+    }
     c = c_trial;
     ++S.iterations;
     std::string msg;
@@ -127,8 +196,26 @@ IkResult SolveGaussNewton(Kinematics& kin, const Objective& objective,
     // simulator a Jacobian costs about one forward solve). The loop's stopping tests see the
     // same value, since the kinematics at the same c give the same p.
     if (o_trial > options.lambda && P.Stalled(o_prev, o_trial, step, &S)) {
+      if (broyden && !step_had_fresh_j) {
+        // A stall with a secant-updated J may be the update's fault: evaluate J at c and go on.
+        S.termination = IkTermination::kSolverFailure;
+        S.message.clear();
+        S.history.push_back(o_trial);
+        if (P.OutOfBudget(&S.termination, &msg)) {
+          S.message = msg;
+          break;
+        }
+        if (!evaluate_at(c, &cur, "at an accepted point: ")) break;
+        fresh = true;
+        continue;
+      }
       S.history.push_back(o_trial);
       break;
+    }
+    if (broyden) {
+      S.history.push_back(o_trial);
+      if (!residuals_of(cur, "at an accepted point: ")) break;
+      continue;  // converged / i_max are reported at the top of the loop
     }
     if (o_trial <= options.lambda || S.iterations >= options.max_iterations) {
       S.history.push_back(o_trial);
@@ -141,7 +228,7 @@ IkResult SolveGaussNewton(Kinematics& kin, const Objective& objective,
     }
     S.history.push_back(cur.value);
   }
-  return P.Finish(c0, S);
+  return finish();
 }
 
 }  // namespace softkin

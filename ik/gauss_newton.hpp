@@ -13,12 +13,21 @@
 /// mu starts at initial_damping times the largest diagonal entry of A^T A. Stopping: O <= lambda,
 /// i_max accepted steps, function / parameter tolerance, budget. Only decreases are accepted.
 /// Each iteration evaluates the Jacobian once, at the accepted point.
+///
+/// `broyden` (IkMethod::kBroyden) takes the same steps but evaluates J only at c0 (not even there
+/// when IkOptions::initial_jacobian is given, e.g. the previous waypoint's IkResult::J) and after
+/// a step made with an updated J fails (a trial without decrease, or a stall). After each accepted
+/// step, J gets Broyden's rank-one secant update in the scaled coordinates:
+///     J += (dp - J dc) w^T / (dc^T w),   w_a = dc_a / range_a^2,
+/// so that J dc = dp holds for the step just taken and J changes least in the Frobenius norm of
+/// J diag(range). On the simulator a Jacobian costs one to two forward solves, and along a smooth
+/// path J barely changes between waypoints: a warm waypoint then costs its trial solves only.
 
 #include "ik/ik_solver.hpp"
 
 namespace softkin {
 
-/// The gauss-newton method of SolveIk (which checks the inputs; call that instead). The objective
+/// The gauss-newton and broyden methods of SolveIk (which checks the inputs; call that instead). The objective
 /// must have num_residuals() > 0.
 IkResult SolveGaussNewton(Kinematics& kin, const Objective& objective,
                           const Eigen::Ref<const Eigen::VectorXd>& c0, const IkOptions& options);

@@ -18,7 +18,7 @@ const std::vector<std::pair<IkMethod, const char*>>& MethodNames() {
       {IkMethod::kSoftLineSearch, "softls"},     {IkMethod::kNloptMma, "nlopt-mma"},
       {IkMethod::kNloptLbfgs, "nlopt-lbfgs"},    {IkMethod::kNloptSlsqp, "nlopt-slsqp"},
       {IkMethod::kNloptCcsaq, "nlopt-ccsaq"},    {IkMethod::kNloptBobyqa, "nlopt-bobyqa"},
-      {IkMethod::kGaussNewton, "gauss-newton"}};
+      {IkMethod::kGaussNewton, "gauss-newton"},  {IkMethod::kBroyden, "broyden"}};
   return names;
 }
 
@@ -111,6 +111,7 @@ bool IkOptions::IsValid(std::string* why) const {
     s << "initial_damping must be > 0, got " << initial_damping;
   else if (!(finite(max_damping) && max_damping > initial_damping))
     s << "max_damping must be > initial_damping, got " << max_damping;
+  else if (!initial_jacobian.allFinite()) s << "initial_jacobian has a non-finite entry";
   if (why) *why = s.str();
   return s.str().empty();
 }
@@ -120,8 +121,9 @@ std::string IkSummary::BriefReport() const {
   s << IkMethodToString(method) << " (" << IkGradientToString(gradient)
     << "): " << IkTerminationToString(termination) << ", O " << std::setprecision(4)
     << initial_objective << " -> " << final_objective << " in " << iterations << " iterations, "
-    << evaluations << " evaluations (" << jacobian_evaluations << " with J), " << fk_solves
-    << " FK solves, " << std::setprecision(3) << time_s * 1e3 << " ms";
+    << evaluations << " evaluations (" << jacobian_evaluations << " with J";
+  if (secant_updates > 0) s << ", " << secant_updates << " secant updates";
+  s << "), " << fk_solves << " FK solves, " << std::setprecision(3) << time_s * 1e3 << " ms";
   if (!message.empty()) s << "; " << message;
   return s.str();
 }
@@ -140,9 +142,18 @@ IkResult SolveIk(Kinematics& kin, const Objective& objective,
     case IkMethod::kSoftLineSearch:
       return SolveSoftLineSearch(kin, objective, c0, options);
     case IkMethod::kGaussNewton:
+    case IkMethod::kBroyden:
       if (objective.num_residuals() == 0)
-        throw std::invalid_argument("IK: gauss-newton needs a least-squares objective; " +
-                                    objective.name() + " has none");
+        throw std::invalid_argument("IK: " + IkMethodToString(options.method) +
+                                    " needs a least-squares objective; " + objective.name() +
+                                    " has none");
+      if (options.method == IkMethod::kBroyden && options.initial_jacobian.size() > 0 &&
+          (options.initial_jacobian.rows() != 3 * kin.num_points() ||
+           options.initial_jacobian.cols() != kin.num_actuators()))
+        throw std::invalid_argument(
+            "IK: initial_jacobian is " + std::to_string(options.initial_jacobian.rows()) + " x " +
+            std::to_string(options.initial_jacobian.cols()) + ", expected 3 #points x #actuators = " +
+            std::to_string(3 * kin.num_points()) + " x " + std::to_string(kin.num_actuators()));
       return SolveGaussNewton(kin, objective, c0, options);
     default:
       return SolveNlopt(kin, objective, c0, options);

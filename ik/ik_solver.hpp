@@ -5,7 +5,10 @@
 ///  - `softls`: Algorithm 3, gradient descent with the soft line search (ik/soft_line_search.hpp);
 ///  - `nlopt-mma`, `nlopt-lbfgs`, `nlopt-slsqp`, `nlopt-ccsaq`, `nlopt-bobyqa`: NLopt's LD_MMA,
 ///    LD_LBFGS, LD_SLSQP, LD_CCSAQ and (derivative-free) LN_BOBYQA with bounds (ik/nlopt_ik.hpp);
-///  - `gauss-newton`: damped least squares on the residual Jacobian (ik/gauss_newton.hpp).
+///  - `gauss-newton`: damped least squares on the residual Jacobian (ik/gauss_newton.hpp);
+///  - `broyden`: the same steps with J from the Kinematics only at the start (none when one is
+///    handed over in IkOptions::initial_jacobian) and after a failed step, and Broyden's secant
+///    update in between (ik/gauss_newton.hpp).
 /// Options follow the Ceres pattern (IsValid), results come with an IkSummary (termination type,
 /// message, iterations, objective history, evaluation and FK counts, time, BriefReport()).
 
@@ -27,6 +30,7 @@ enum class IkMethod {
   kNloptCcsaq,      ///< "nlopt-ccsaq" (LD_CCSAQ)
   kNloptBobyqa,     ///< "nlopt-bobyqa" (LN_BOBYQA, derivative-free)
   kGaussNewton,     ///< "gauss-newton"
+  kBroyden,         ///< "broyden" (gauss-newton with secant-updated J)
 };
 std::string IkMethodToString(IkMethod m);
 /// false (and *m untouched) for an unknown name.
@@ -80,6 +84,12 @@ struct IkOptions {
   double initial_damping = 1e-3;  ///< Levenberg mu at the start, relative to max diag(J^T J) (> 0)
   double max_damping = 1e12;      ///< give up when mu exceeds this (> initial_damping)
 
+  // ---- broyden ----
+  /// dp/dc at c0 (3 #points x #actuators, e.g. IkResult::J of the previous waypoint), used instead
+  /// of evaluating J there. Empty: J is evaluated at c0. Ignored by the other methods. Must be
+  /// finite; its size is checked against the kinematics.
+  Eigen::MatrixXd initial_jacobian;
+
   /// True if every field is in range; else false and *why (if given) names the field.
   bool IsValid(std::string* why) const;
 };
@@ -109,6 +119,7 @@ struct IkSummary {
   std::vector<double> history;
   int evaluations = 0;           ///< Kinematics::Evaluate calls
   int jacobian_evaluations = 0;  ///< of which with the Jacobian
+  int secant_updates = 0;        ///< broyden: rank-one updates of J (0 for the other methods)
   long long fk_solves = 0;       ///< forward solves they took (Kinematics::total_fk_solves delta)
   double time_s = 0.0;           ///< wall time
   double initial_objective = 0.0;
@@ -122,6 +133,9 @@ struct IkResult {
   Eigen::VectorXd c;    ///< #actuators, the best actuation found (within the box)
   Eigen::MatrixX3d p;   ///< #points x 3, the tracked points at c, mm
   double objective = 0.0;  ///< O(p(c))
+  /// broyden only: its dp/dc at c (evaluated or secant-updated), to hand to the next solve as
+  /// IkOptions::initial_jacobian; empty for the other methods or when c is not its last iterate.
+  Eigen::MatrixXd J;
   IkSummary summary;
 };
 

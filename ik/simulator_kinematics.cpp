@@ -1,5 +1,6 @@
 #include "ik/simulator_kinematics.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -235,6 +236,33 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
       return finish();
     }
     X = r.positions;
+    // Keep dX/dc first-order along the path: Broyden's secant update from the step just solved
+    // (scaled by the ranges, as IK's broyden), so the next prediction is still close.
+    if (have_last && options_.jacobian == JacobianMode::kImplicit && options_.secant_update &&
+        jac_c_.size() == c.size() && jac_c_ == last_c_ && jac_dXdc_.rows() == 3 * X.rows()) {
+      const int nj = static_cast<int>(jac_columns_.size());
+      Eigen::VectorXd dc(nj), w(nj);
+      for (int j = 0; j < nj; ++j) {
+        const int a = jac_columns_[j];
+        dc[j] = c[a] - last_c_[a];
+        w[j] = dc[j] / std::max(std::pow(upper_[a] - lower_[a], 2), 1e-300);
+      }
+      bool others_fixed = true;  // actuators outside the columns (kinks) must not have moved
+      for (int a = 0; a < num_actuators(); ++a)
+        if (std::find(jac_columns_.begin(), jac_columns_.end(), a) == jac_columns_.end() &&
+            c[a] != last_c_[a])
+          others_fixed = false;
+      const double den = dc.dot(w);
+      if (others_fixed && den > 0.0 && std::isfinite(den)) {
+        const Eigen::MatrixX3d dX = X - last_X_;
+        Eigen::VectorXd y(3 * X.rows());
+        for (Eigen::Index v = 0; v < X.rows(); ++v)
+          for (int d = 0; d < 3; ++d) y[3 * v + d] = dX(v, d);
+        y -= jac_dXdc_ * dc;
+        jac_dXdc_ += y * (w.transpose() / den);
+        jac_c_ = c;
+      }
+    }
     last_X_ = X;
     last_c_ = c;
     last_start_ = centre_start;

@@ -68,6 +68,12 @@ struct SimulatorKinematicsOptions {
   /// point; only the start is closer (fewer iterations). A prediction whose solve fails is retried
   /// from the plain warm start (both solves are counted).
   bool predict_warm_start = true;
+  /// implicit only: after each p solve that started from the state dX/dc belongs to, update
+  /// dX/dc by Broyden's secant rule (dX/dc += (dX - dX/dc dc) w^T / (dc^T w), w = dc / range^2)
+  /// so that it belongs to the new state. Predictions then stay first-order along a path on
+  /// which no new Jacobian is evaluated (IK's broyden method). The update is exact along the
+  /// step just taken; the converged states do not depend on it, only where solves start.
+  bool secant_update = true;
   /// implicit only: start each Jacobian's Krylov solves from the previous implicit Jacobian
   /// (dX/dc changes slowly along a path). The tolerance stays relative to the right-hand side.
   bool jacobian_initial_guess = true;

@@ -213,12 +213,17 @@ TrajectoryResult FollowTrajectory(Kinematics& kin, const Eigen::Ref<const Eigen:
   const Eigen::VectorXd range = (kin.upper() - kin.lower()).cwiseMax(1e-300);
   double err_sum = 0.0;
   int err_count = 0;
+  Eigen::MatrixXd j_prev;
   for (int w = options.first_waypoint; w < waypoints.rows(); ++w) {
     WaypointResult wr;
     wr.index = w;
     wr.target = waypoints.row(w).transpose();
     const PointTrackingObjective objective(kin.point_names(), options.point, wr.target);
-    const IkResult ik = SolveIk(kin, objective, c_prev, options.ik);
+    // broyden: hand the last waypoint's J over (it was taken or updated at c_prev).
+    IkOptions io = options.ik;
+    if (io.method == IkMethod::kBroyden && io.initial_jacobian.size() == 0) io.initial_jacobian = j_prev;
+    const IkResult ik = SolveIk(kin, objective, c_prev, io);
+    j_prev = ik.J;
     wr.c = ik.c;
     wr.termination = ik.summary.termination;
     wr.message = ik.summary.message;

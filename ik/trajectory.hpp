@@ -6,7 +6,9 @@
 ///     5^3 = 125); the first waypoint starts from the actuation of the sample whose point is
 ///     closest to it. The samples can be cached in a CSV file (see SampleConfigurationSpace).
 ///  2. Each later waypoint starts from the previous waypoint's solution (the warm start; a
-///     simulator Kinematics also keeps its own deformed state).
+///     simulator Kinematics also keeps its own deformed state). With the `broyden` method the
+///     previous waypoint's (secant-updated) Jacobian is handed over too, so a warm waypoint
+///     evaluates no Jacobian unless a step with it fails.
 ///  3. For every waypoint: the actuation, the reached point, its distance to the target (for a
 ///     waypoint outside the workspace, the distance to the closest point IK found), iterations,
 ///     evaluations, FK solves and time; and the largest actuation jump between neighbours.

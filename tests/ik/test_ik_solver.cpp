@@ -19,12 +19,13 @@ TEST(IkSolver, EnumStringsRoundTrip) {
     EXPECT_EQ(back, m);
     ++n;
   }
-  EXPECT_EQ(n, 7);
+  EXPECT_EQ(n, 8);
   IkMethod m = IkMethod::kNloptMma;
   EXPECT_FALSE(StringToIkMethod("bfgs", &m));
   EXPECT_EQ(m, IkMethod::kNloptMma);
   EXPECT_EQ(IkMethodNames(),
-            "softls, nlopt-mma, nlopt-lbfgs, nlopt-slsqp, nlopt-ccsaq, nlopt-bobyqa, gauss-newton");
+            "softls, nlopt-mma, nlopt-lbfgs, nlopt-slsqp, nlopt-ccsaq, nlopt-bobyqa, gauss-newton, "
+            "broyden");
   for (IkTermination t : {IkTermination::kConverged, IkTermination::kNoProgress,
                           IkTermination::kMaxIterations, IkTermination::kMaxEvaluations,
                           IkTermination::kMaxTime, IkTermination::kKinematicsFailure,
@@ -81,7 +82,7 @@ std::vector<Case> AllCases() {
   std::vector<Case> out;
   for (IkMethod m : AllIkMethods()) {
     out.push_back({m, IkGradient::kJacobian});
-    if (m != IkMethod::kNloptBobyqa && m != IkMethod::kGaussNewton)
+    if (m != IkMethod::kNloptBobyqa && m != IkMethod::kGaussNewton && m != IkMethod::kBroyden)
       out.push_back({m, IkGradient::kCentralDifference});
   }
   return out;
@@ -107,7 +108,7 @@ TEST(IkSolver, EveryMethodRecoversAKnownActuationOnTheLinearModel) {
     EXPECT_LE(r.summary.evaluations, opt.max_evaluations);
     ++solved;
   }
-  EXPECT_EQ(solved, 12);
+  EXPECT_EQ(solved, 13);
 }
 
 TEST(IkSolver, EveryMethodRecoversKnownActuationsOnThePccModel) {
@@ -134,7 +135,7 @@ TEST(IkSolver, EveryMethodRecoversKnownActuationsOnThePccModel) {
       EXPECT_TRUE((r.c.array() >= 0).all() && (r.c.array() <= 20).all());
       ++solved;
     }
-  EXPECT_EQ(solved, 36);
+  EXPECT_EQ(solved, 39);
 }
 
 TEST(IkSolver, ShapeMatchingRecoversTheWholeShape) {
@@ -185,7 +186,7 @@ TEST(IkSolver, AFailingKinematicsStopsEveryMethodWithItsMessage) {
     IkResult r;
     ASSERT_NO_THROW(r = SolveIk(rec, o, Eigen::Vector3d(10, 10, 10), opt)) << IkMethodToString(m);
     EXPECT_TRUE(r.c.allFinite());
-    if (m == IkMethod::kSoftLineSearch || m == IkMethod::kGaussNewton) {
+    if (m == IkMethod::kSoftLineSearch || m == IkMethod::kGaussNewton || m == IkMethod::kBroyden) {
       // Failed trials count as no decrease; the solve ends one way or another, never above O(c0).
       EXPECT_LE(r.objective, r.summary.history.front());
       continue;
@@ -212,6 +213,57 @@ TEST(IkSolver, GaussNewtonTakesNoJacobianWhereItStops) {
     EXPECT_LE(r.objective, opt.lambda);
     EXPECT_EQ(r.objective, r.summary.history.back());
   }
+}
+
+// broyden on a linear model: the secant update keeps an exact J exact (J dc = dp on every step),
+// so with J handed over it never evaluates one, and it converges like gauss-newton.
+TEST(IkSolver, BroydenWithAnExactJacobianEvaluatesNone) {
+  auto lin = test::LinearKinematics::Random(3, 7);
+  const Eigen::Vector3d c_true(2.5, 7.0, 4.0);
+  const Eigen::Vector3d target = lin.Evaluate(c_true, false).p.row(0).transpose();
+  PointTrackingObjective o(lin.point_names(), "tip", target);
+  IkOptions opt;
+  opt.method = IkMethod::kBroyden;
+  opt.lambda = 1e-10;
+  opt.initial_jacobian = lin.Evaluate(lin.rest(), true).J;
+  const IkResult r = SolveIk(lin, o, lin.rest(), opt);
+  ASSERT_TRUE(r.summary.converged()) << r.summary.BriefReport();
+  EXPECT_EQ(r.summary.jacobian_evaluations, 0);
+  EXPECT_EQ(r.summary.secant_updates, r.summary.iterations);
+  EXPECT_GT(r.summary.iterations, 0);
+  EXPECT_LT((r.c - c_true).norm(), 1e-4);
+  // The J it hands back is still the model's (constant) Jacobian.
+  EXPECT_TRUE(test::NearMatrix(r.J, opt.initial_jacobian, 1e-9, 1e-9));
+  EXPECT_NE(r.summary.BriefReport().find("secant updates"), std::string::npos);
+}
+
+// A wrong Jacobian handed over (here the negated true one, so its first step goes uphill) costs
+// one evaluated J and nothing else: broyden never accepts an increase, evaluates J where the step
+// failed, and converges. A J of the wrong size is rejected up front.
+TEST(IkSolver, BroydenRecoversFromAWrongJacobian) {
+  PccKinematics pcc;
+  const Eigen::Vector3d c0(10, 10, 10);
+  for (const Eigen::Vector3d& c_true : {Eigen::Vector3d(5, 5, 9), Eigen::Vector3d(12, 3, 7)}) {
+    PointTrackingObjective o(pcc.point_names(), "tip", pcc.Evaluate(c_true, false).p.row(0).transpose());
+    IkOptions opt;
+    opt.method = IkMethod::kBroyden;
+    opt.initial_jacobian = -pcc.Evaluate(c0, true).J;
+    const IkResult r = SolveIk(pcc, o, c0, opt);
+    ASSERT_TRUE(r.summary.converged()) << r.summary.BriefReport();
+    EXPECT_GE(r.summary.jacobian_evaluations, 1);
+    for (size_t i = 1; i < r.summary.history.size(); ++i)
+      EXPECT_LE(r.summary.history[i], r.summary.history[i - 1]);
+    EXPECT_EQ(r.J.rows(), 3 * pcc.num_points());
+    EXPECT_EQ(r.J.cols(), 3);
+    EXPECT_TRUE(r.J.allFinite());
+  }
+  PointTrackingObjective o(pcc.point_names(), "tip", Eigen::Vector3d(0, 0, 90));
+  IkOptions bad;
+  bad.method = IkMethod::kBroyden;
+  bad.initial_jacobian = Eigen::MatrixXd::Zero(2, 3);
+  EXPECT_THROW(SolveIk(pcc, o, c0, bad), std::invalid_argument);
+  bad.initial_jacobian = Eigen::MatrixXd::Constant(3, 3, std::nan(""));
+  EXPECT_THROW(SolveIk(pcc, o, c0, bad), std::invalid_argument);
 }
 
 TEST(IkSolver, BriefReportSaysWhatHappened) {

@@ -224,6 +224,35 @@ TEST(Kinematics, PredictedStartsKeepPAndJ) {
   EXPECT_LT(pa, pb);
 }
 
+// With no new Jacobian along a path (IK's broyden), dX/dc is secant-updated after each solve so
+// predictions stay first-order. That only moves where solves start: p agrees with a kinematics
+// that predicts nothing, every predicted start converges, and a Jacobian taken afterwards (its
+// Krylov solves start from the updated dX/dc) agrees too.
+TEST(Kinematics, SecantUpdatedPredictionsKeepP) {
+  const Scene s = MakeRobot("three_chamber", 3);
+  auto model = std::make_shared<const Model>(s);
+  const FkOptions fk = Fk(1e-8, 1e-9);
+  SimulatorKinematicsOptions with = Mode(JacobianMode::kImplicit), without = with;
+  without.predict_warm_start = false;
+  without.secant_update = false;
+  without.jacobian_initial_guess = false;
+  SimulatorKinematics a(model, with, &fk), b(model, without, &fk);
+  ASSERT_TRUE(a.Evaluate(Vec({1.5, 1.2, 1.0}), true).ok);
+  ASSERT_TRUE(b.Evaluate(Vec({1.5, 1.2, 1.0}), true).ok);
+  const std::vector<Eigen::VectorXd> path = {Vec({1.6, 1.25, 1.05}), Vec({1.7, 1.2, 1.1}),
+                                             Vec({1.8, 1.3, 1.1}), Vec({1.9, 1.35, 1.2})};
+  for (size_t i = 0; i < path.size(); ++i) {
+    SCOPED_TRACE(i);
+    const bool last = i + 1 == path.size();
+    const KinematicsEval ea = a.Evaluate(path[i], last), eb = b.Evaluate(path[i], last);
+    ASSERT_TRUE(ea.ok) << ea.message;
+    ASSERT_TRUE(eb.ok) << eb.message;
+    EXPECT_EQ(ea.fk_solves, 1);
+    EXPECT_LT((ea.p - eb.p).norm(), 1e-5 * model->size());
+    if (last) EXPECT_LT(RelErr(ea.J, eb.J), 1e-5);
+  }
+}
+
 // At a bound the differences are one-sided (probes stay in the box) and still agree with implicit.
 TEST(Kinematics, OneSidedDifferencesAtTheBounds) {
   const Scene s = MakeRobot("three_chamber", 3);

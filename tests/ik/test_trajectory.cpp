@@ -55,6 +55,40 @@ TEST(Trajectory, SmoothPathGivesContinuousActuation) {
   EXPECT_EQ(r.samples.cache_status, "built");
 }
 
+// broyden along a smooth path: each waypoint gets the previous one's Jacobian, so J is evaluated
+// at the first waypoint and where a secant-updated step failed, not at every waypoint as with
+// gauss-newton; the answers are as good.
+TEST(Trajectory, BroydenHandsTheJacobianOnAlongThePath) {
+  PccKinematics k;
+  const Eigen::MatrixX3d path = CirclePath(k, 40);
+  int j_gn = 0, j_br = 0;
+  for (IkMethod m : {IkMethod::kGaussNewton, IkMethod::kBroyden}) {
+    int with_j = 0;
+    struct Counting : test::RecordingKinematics {
+      using test::RecordingKinematics::RecordingKinematics;
+      int* jac = nullptr;
+      KinematicsEval Evaluate(const Eigen::Ref<const Eigen::VectorXd>& c, bool with_jacobian) override {
+        if (with_jacobian) ++*jac;
+        return test::RecordingKinematics::Evaluate(c, with_jacobian);
+      }
+    } counting(k);
+    counting.jac = &with_j;
+    TrajectoryOptions opt;
+    opt.ik.method = m;
+    opt.ik.max_iterations = 100;
+    opt.ik.max_evaluations = 2000;
+    const TrajectoryResult r = FollowTrajectory(counting, path, opt);
+    SCOPED_TRACE(IkMethodToString(m));
+    EXPECT_EQ(r.converged, 40);
+    EXPECT_LE(r.max_error_mm, 0.2);
+    EXPECT_LT(r.max_jump, 3.0);
+    (m == IkMethod::kBroyden ? j_br : j_gn) = with_j;  // the sampling takes no J
+  }
+  EXPECT_GE(j_gn, 40);       // at least one J per waypoint
+  EXPECT_LT(j_br, j_gn / 2);  // most waypoints need none
+  EXPECT_GE(j_br, 1);
+}
+
 TEST(Trajectory, FirstWaypointStartsFromTheClosestSample) {
   PccKinematics k;
   const Eigen::MatrixX3d path = CirclePath(k, 4);
