@@ -77,6 +77,11 @@ CLI::App* AddIkCommand(CLI::App* app, IkCommandArgs* a) {
   ik->add_option("--samples", a->samples,
                  "Configuration-space samples per actuator for the first waypoint's initial guess "
                  "(default 5: 5^3 = 125 for three actuators); 0 starts from the rest actuation");
+  ik->add_option("--first-starts", a->first_starts,
+                 "The first waypoint is solved from up to this many of the closest samples, "
+                 "closest first, until one converges (default 3; 1 is Algorithm 4 as written). A "
+                 "sample on a corner of the actuation box can be a stationary point no method "
+                 "leaves");
   ik->add_option("--cache", a->cache,
                  "CSV cache of the configuration-space samples: loaded if it was built for the "
                  "same robot, point, Jacobian mode and grid, else (re)built and written");
@@ -167,6 +172,9 @@ IkOptions ParseIkOptions(const IkCommandArgs& a, const std::string& method) {
   if (a.samples != 0 && (a.samples < 2 || a.samples > 50))
     throw std::invalid_argument("--samples: expected 0 (start at rest) or an integer in [2, 50], got " +
                                 std::to_string(a.samples));
+  if (a.first_starts < 1 || a.first_starts > 1000)
+    throw std::invalid_argument("--first-starts: expected an integer in [1, 1000], got " +
+                                std::to_string(a.first_starts));
   if (!(a.max_time_s > 0) || !std::isfinite(a.max_time_s))
     throw std::invalid_argument("--max-time: expected a time > 0 s, got " + std::to_string(a.max_time_s));
   ik.max_time_s = a.max_time_s;
@@ -246,6 +254,7 @@ int RunIkCommand(const IkCommandArgs& a) {
   to.point = kin->point_names().front();
   to.ik = ik;
   to.sampling.samples_per_axis = a.samples == 0 ? 2 : a.samples;
+  to.first_waypoint_starts = a.first_starts;
   to.sampling.cache_file = a.cache;
   {
     std::ostringstream key;
@@ -409,6 +418,7 @@ int RunLearnedIk(const IkCommandArgs& a) {
   to.point = nets.points.front();
   to.ik = ik;
   to.sampling.samples_per_axis = a.samples == 0 ? 2 : a.samples;
+  to.first_waypoint_starts = a.first_starts;
   if (a.samples == 0) to.warm_start = kin.rest();
 
   if (a.interactive) {

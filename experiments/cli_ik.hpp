@@ -23,6 +23,7 @@ struct IkCommandArgs {
   int max_iterations = 30;
   int max_evaluations = 300;
   int samples = 5;
+  int first_starts = 3;
   double max_time_s = 600;
   double gradient_tolerance = 0;  ///< 0: the scene's FK setting
   std::string cache;

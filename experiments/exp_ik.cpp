@@ -101,9 +101,10 @@ nlohmann::json StatsJson(const PathStats& s) {
           {"max_target_step_mm", s.max_target_step}};
 }
 
-/// Follows `waypoints` from `guess`, streaming rows into `csv_path` and progress to stderr.
+/// Follows `waypoints` from the closest of `samples` (up to s.first_waypoint_starts of them for
+/// the first waypoint), streaming rows into `csv_path` and progress to stderr.
 TrajectoryResult Follow(SimulatorKinematics& kin, const Eigen::MatrixX3d& waypoints,
-                        const Eigen::VectorXd& guess, const IkExperimentSetup& s,
+                        const ConfigurationSamples& samples, const IkExperimentSetup& s,
                         const IkOptions& ik, const std::string& csv_path, const std::string& label,
                         bool verbose) {
   std::ofstream csv(csv_path);
@@ -112,7 +113,8 @@ TrajectoryResult Follow(SimulatorKinematics& kin, const Eigen::MatrixX3d& waypoi
   TrajectoryOptions to;
   to.point = kin.point_names().front();
   to.ik = ik;
-  to.warm_start = guess;
+  to.samples = &samples;
+  to.first_waypoint_starts = s.first_waypoint_starts;
   kin.Reset();
   const int total = static_cast<int>(waypoints.rows());
   auto cb = [&](const WaypointResult& w) {
@@ -122,7 +124,6 @@ TrajectoryResult Follow(SimulatorKinematics& kin, const Eigen::MatrixX3d& waypoi
                    w.index + 1, total, w.error_mm, IkTerminationToString(w.termination).c_str(),
                    w.iterations, w.fk_solves, w.time_s, w.message.empty() ? "" : ": ", w.message.c_str());
   };
-  (void)s;
   return FollowTrajectory(kin, waypoints, to, cb);
 }
 
@@ -209,16 +210,15 @@ nlohmann::json RunIkTrajectory(const Config& cfg, const std::string& dir, bool v
   for (size_t i = 0; i < paths.size(); ++i) {
     kin.Reset();
     const IkPath path = MakeIkPath(paths[i], cfg.path() + ": paths[" + std::to_string(i) + "]", kin, samples);
-    const int closest = ClosestSample(samples, path.waypoints.row(0).transpose());
-    const Eigen::VectorXd guess = samples.c.row(closest).transpose();
-    const TrajectoryResult r = Follow(kin, path.waypoints, guess, s, s.ik,
+    const TrajectoryResult r = Follow(kin, path.waypoints, samples, s, s.ik,
                                       dir + "/path_" + path.name + ".csv", path.name, verbose);
     const PathStats st = Stats(r.waypoints, kin, s.lambda_mm);
     nlohmann::json pj = StatsJson(st);
     pj["name"] = path.name;
     pj["spec"] = path.info;
-    pj["initial_sample"] = closest;
-    pj["initial_guess"] = Vec(guess);
+    pj["initial_sample"] = r.initial_sample;
+    pj["initial_guess"] = Vec(r.initial_guess);
+    pj["initial_starts_tried"] = r.initial_starts_tried;
     pj["total_time_s"] = r.total_time_s;
     pj["total_time_with_sampling_s"] = r.total_time_s + samples.time_s;
     pj["thesis"] = path.thesis;
@@ -262,11 +262,13 @@ nlohmann::json RunIkMethods(const Config& cfg, const std::string& dir, bool verb
   const ConfigurationSamples samples = Sample(probe, s, verbose);
   probe.Reset();
   const IkPath path = MakeIkPath(path_spec, cfg.path() + ": path", probe, samples);
-  const Eigen::VectorXd guess = samples.c.row(ClosestSample(samples, path.waypoints.row(0).transpose())).transpose();
+  const Eigen::VectorXd closest =
+      samples.c.row(ClosestSample(samples, path.waypoints.row(0).transpose())).transpose();
 
   CsvWriter csv(dir + "/methods.csv", {"method", "jacobian", "waypoints", "converged", "ms_per_waypoint",
                                        "mean_err_mm", "max_err_mm", "fk_calls", "fk_calls_per_waypoint",
-                                       "evaluations", "mean_iterations", "failures"});
+                                       "evaluations", "mean_iterations", "failures", "initial_sample",
+                                       "initial_starts_tried"});
   nlohmann::json rows = nlohmann::json::array();
   // Resume: each finished method x Jacobian row is journaled with every setting that produced it
   // (the config but its method and Jacobian lists); a rerun reuses matching rows.
@@ -293,7 +295,7 @@ nlohmann::json RunIkMethods(const Config& cfg, const std::string& dir, bool verb
       IkOptions ik = s.ik;
       ik.method = m;
       const std::string label = IkMethodToString(m) + "/" + jname;
-      const TrajectoryResult r = Follow(kin, path.waypoints, guess, s, ik,
+      const TrajectoryResult r = Follow(kin, path.waypoints, samples, s, ik,
                                         dir + "/path_" + IkMethodToString(m) + "_" + jname + ".csv",
                                         label, verbose);
       const PathStats st = Stats(r.waypoints, kin, s.lambda_mm);
@@ -309,7 +311,9 @@ nlohmann::json RunIkMethods(const Config& cfg, const std::string& dir, bool verb
                       {"fk_calls_per_waypoint", st.n ? double(st.fk) / st.n : 0.0},
                       {"evaluations", st.evals},
                       {"mean_iterations", st.mean_iter},
-                      {"failures", st.failed}});
+                      {"failures", st.failed},
+                      {"initial_sample", r.initial_sample},
+                      {"initial_starts_tried", r.initial_starts_tried}});
       journal.Append(key, rows.back());
       csv.RowJson(rows.back());
       if (verbose)
@@ -322,7 +326,7 @@ nlohmann::json RunIkMethods(const Config& cfg, const std::string& dir, bool verb
   j.erase("jacobian");
   j["path"] = path.info;
   j["waypoints"] = path.waypoints.rows();
-  j["initial_guess"] = Vec(guess);
+  j["closest_sample"] = Vec(closest);
   j["samples"] = SamplesJson(samples);
   j["rows"] = rows;
   j["resumed_rows"] = journal.reused();

@@ -198,6 +198,7 @@ nlohmann::json IkExperimentSetup::Json() const {
           {"max_iterations", ik.max_iterations},
           {"max_evaluations", ik.max_evaluations},
           {"samples_per_axis", samples_per_axis},
+          {"first_waypoint_starts", first_waypoint_starts},
           {"fk_solver", fk.solver}};
 }
 
@@ -230,6 +231,9 @@ IkExperimentSetup ReadIkSetup(const Config& cfg, const std::string& default_robo
   if (!s.ik.IsValid(&why)) throw std::invalid_argument(cfg.path() + ": " + why);
   s.samples_per_axis = cfg.Int("samples_per_axis", 5);
   if (s.samples_per_axis < 2 || s.samples_per_axis > 20) cfg.Fail("samples_per_axis", "an integer in [2, 20]");
+  s.first_waypoint_starts = cfg.Int("first_waypoint_starts", 3);
+  if (s.first_waypoint_starts < 1 || s.first_waypoint_starts > 1000)
+    cfg.Fail("first_waypoint_starts", "an integer in [1, 1000]");
   if (s.scene.marker_index(s.point.substr(0, s.point.find('['))) < 0)
     cfg.Fail("point", "a marker of robot '" + s.robot + "'");
   return s;

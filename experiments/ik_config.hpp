@@ -7,7 +7,8 @@
 ///   point ("tip"), method ("softls"), jacobian ("implicit"), fd_step (1/160 of the range),
 ///   lambda_mm (0.2: stop a point-tracking waypoint within 0.2 mm, i.e. O <= 0.04 mm^2),
 ///   max_iterations (30, thesis i_max), max_evaluations (300), max_time_s (600 per
-///   waypoint or stage), samples_per_axis (5: 5^3 samples).
+///   waypoint or stage), samples_per_axis (5: 5^3 samples), first_waypoint_starts (3: the first
+///   waypoint of a path is solved from up to 3 closest samples until one converges).
 ///
 /// A path is a JSON object {"name", "type", ...}:
 ///   "polyline": "vertices" [[x,y,z],...] (mm), "n" waypoints spread evenly by arc length over the
@@ -45,6 +46,7 @@ struct IkExperimentSetup {
   IkOptions ik;
   double lambda_mm = 0.2;
   int samples_per_axis = 5;
+  int first_waypoint_starts = 3;
   /// robot, res, sizes, method, jacobian, lambda, i_max: for the summary.
   nlohmann::json Json() const;
   /// Kinematics options tracking `points`.

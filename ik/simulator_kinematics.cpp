@@ -347,13 +347,29 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
                        jac_dXdc_.rows() == 3 * X.rows();
     last_implicit_ = ComputeEquilibriumJacobian(*model_, X, c, smooth, options_.implicit,
                                                 guess ? &jac_dXdc_ : nullptr);
-    if (!last_implicit_.ok) {
+    if (!last_implicit_.ok && !options_.implicit_fallback) {
       ev.message = last_implicit_.message;
       return finish();
     }
-    jac_dXdc_ = last_implicit_.dXdc;
-    jac_c_ = c;
-    jac_columns_ = smooth;
+    if (!last_implicit_.ok) {
+      // Fall back to fd-warm for these columns, and say so. dX/dc is not known at c, so no
+      // prediction starts from it.
+      jac_c_.resize(0);
+      note += (note.empty() ? "" : "; ") + std::string("implicit Jacobian failed (") +
+              last_implicit_.message + "); its columns are fd-warm central differences instead";
+      for (int a : smooth) {
+        const std::string err = fd_column(a, true);
+        if (!err.empty()) {
+          ev.message = err;
+          return finish();
+        }
+      }
+      smooth.clear();
+    } else {
+      jac_dXdc_ = last_implicit_.dXdc;
+      jac_c_ = c;
+      jac_columns_ = smooth;
+    }
     for (size_t j = 0; j < smooth.size(); ++j)
       for (int q = 0; q < np; ++q)
         for (int t = offset_[q]; t < offset_[q + 1]; ++t)

@@ -77,6 +77,10 @@ struct SimulatorKinematicsOptions {
   /// implicit only: start each Jacobian's Krylov solves from the previous implicit Jacobian
   /// (dX/dc changes slowly along a path). The tolerance stays relative to the right-hand side.
   bool jacobian_initial_guess = true;
+  /// implicit only: when the implicit derivative fails (its Krylov solve does not converge, an
+  /// element it cannot differentiate), compute those columns as fd-warm does and say so in
+  /// `message`, instead of failing the evaluation. Collision response stays an error.
+  bool implicit_fallback = true;
   /// Options of the implicit mode's linear solve.
   EquilibriumJacobianOptions implicit;
   bool IsValid(std::string* why) const;

@@ -2,6 +2,7 @@
 
 #include "ik/objectives.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -103,6 +104,8 @@ bool TrajectoryOptions::IsValid(std::string* why) const {
   else if (!ik.IsValid(&s)) s = "ik." + s;
   else if (!sampling.IsValid(&s)) s = "sampling." + s;
   else if (first_waypoint < 0) s = "first_waypoint must be >= 0";
+  else if (first_waypoint_starts < 1)
+    s = "first_waypoint_starts must be >= 1, got " + std::to_string(first_waypoint_starts);
   if (why) *why = s;
   return s.empty();
 }
@@ -187,6 +190,19 @@ int ClosestSample(const ConfigurationSamples& samples, const Eigen::Vector3d& ta
   return best;
 }
 
+std::vector<int> ClosestSamples(const ConfigurationSamples& samples, const Eigen::Vector3d& target,
+                                int count) {
+  std::vector<std::pair<double, int>> d;
+  d.reserve(samples.p.rows());
+  for (int i = 0; i < samples.p.rows(); ++i)
+    d.emplace_back((samples.p.row(i).transpose() - target).squaredNorm(), i);
+  const size_t n = std::min(d.size(), static_cast<size_t>(std::max(count, 0)));
+  std::partial_sort(d.begin(), d.begin() + n, d.end());
+  std::vector<int> out;
+  for (size_t i = 0; i < n; ++i) out.push_back(d[i].second);
+  return out;
+}
+
 TrajectoryResult FollowTrajectory(Kinematics& kin, const Eigen::Ref<const Eigen::MatrixX3d>& waypoints,
                                   const TrajectoryOptions& options,
                                   const WaypointCallback& on_waypoint) {
@@ -203,11 +219,19 @@ TrajectoryResult FollowTrajectory(Kinematics& kin, const Eigen::Ref<const Eigen:
     why = CheckKinematicsInput(kin, options.warm_start);
     if (!why.empty()) throw std::invalid_argument("trajectory warm start: " + why);
     c_prev = options.warm_start;
-  } else if (options.first_waypoint < waypoints.rows()) {
-    res.samples = SampleConfigurationSpace(kin, options.point, options.sampling);
-    res.initial_sample = ClosestSample(res.samples, waypoints.row(options.first_waypoint).transpose());
-    c_prev = res.initial_sample >= 0 ? Eigen::VectorXd(res.samples.c.row(res.initial_sample).transpose())
-                                     : kin.rest();
+  }
+  auto sample_set = [&]() { return options.samples ? options.samples : &res.samples; };
+  std::vector<int> starts;  // samples to try for the first waypoint, closest first
+  if (options.warm_start.size() == 0 && options.first_waypoint < waypoints.rows()) {
+    if (!options.samples) res.samples = SampleConfigurationSpace(kin, options.point, options.sampling);
+    else if (options.samples->c.cols() != kin.num_actuators() ||
+             options.samples->p.rows() != options.samples->c.rows())
+      throw std::invalid_argument("trajectory samples: expected #samples x " +
+                                  std::to_string(kin.num_actuators()) + " actuations and as many points");
+    starts = ClosestSamples(*sample_set(), waypoints.row(options.first_waypoint).transpose(),
+                            options.first_waypoint_starts);
+    res.initial_sample = starts.empty() ? -1 : starts.front();
+    c_prev = starts.empty() ? kin.rest() : Eigen::VectorXd(sample_set()->c.row(starts.front()).transpose());
   }
   res.initial_guess = c_prev;
   const Eigen::VectorXd range = (kin.upper() - kin.lower()).cwiseMax(1e-300);
@@ -222,7 +246,38 @@ TrajectoryResult FollowTrajectory(Kinematics& kin, const Eigen::Ref<const Eigen:
     // broyden: hand the last waypoint's J over (it was taken or updated at c_prev).
     IkOptions io = options.ik;
     if (io.method == IkMethod::kBroyden && io.initial_jacobian.size() == 0) io.initial_jacobian = j_prev;
-    const IkResult ik = SolveIk(kin, objective, c_prev, io);
+    IkResult ik = SolveIk(kin, objective, c_prev, io);
+    if (w == options.first_waypoint && starts.size() > 1) {
+      // Further closest samples until one converges; keep the best, add up the cost.
+      res.initial_starts_tried = 1;
+      IkSummary total = ik.summary;
+      for (size_t t = 1; t < starts.size() && !ik.summary.converged(); ++t) {
+        const Eigen::VectorXd c_try = sample_set()->c.row(starts[t]).transpose();
+        IkOptions it = options.ik;
+        const IkResult again = SolveIk(kin, objective, c_try, it);
+        ++res.initial_starts_tried;
+        total.iterations += again.summary.iterations;
+        total.evaluations += again.summary.evaluations;
+        total.jacobian_evaluations += again.summary.jacobian_evaluations;
+        total.fk_solves += again.summary.fk_solves;
+        total.time_s += again.summary.time_s;
+        const bool better = again.p.rows() > k && (ik.p.rows() <= k || again.objective < ik.objective);
+        if (better) {
+          ik = again;
+          res.initial_sample = starts[t];
+          res.initial_guess = c_try;
+          c_prev = c_try;
+        }
+      }
+      const std::string tried = "; first waypoint solved from " +
+                                std::to_string(res.initial_starts_tried) + " sample(s), kept sample " +
+                                std::to_string(res.initial_sample);
+      total.termination = ik.summary.termination;
+      total.message = ik.summary.message + (res.initial_starts_tried > 1 ? tried : "");
+      ik.summary = total;
+    } else if (w == options.first_waypoint && !starts.empty()) {
+      res.initial_starts_tried = 1;
+    }
     j_prev = ik.J;
     wr.c = ik.c;
     wr.termination = ik.summary.termination;

@@ -55,6 +55,9 @@ ConfigurationSamples SampleConfigurationSpace(Kinematics& kin, const std::string
 
 /// Row of the sample whose point is closest to `target` (ties: the first), or -1 if none.
 int ClosestSample(const ConfigurationSamples& samples, const Eigen::Vector3d& target);
+/// Rows of the `count` samples closest to `target`, closest first (ties: lower row first).
+std::vector<int> ClosestSamples(const ConfigurationSamples& samples, const Eigen::Vector3d& target,
+                                int count);
 
 struct TrajectoryOptions {
   std::string point = "tip";  ///< the tracked point that follows the path
@@ -65,6 +68,15 @@ struct TrajectoryOptions {
   /// ...starting from this actuation (the solution of waypoint first_waypoint - 1). Empty: start
   /// from the closest configuration-space sample (Algorithm 4, line 2).
   Eigen::VectorXd warm_start;
+  /// Without a warm start, the first waypoint is solved from up to this many samples, closest
+  /// first, until one converges; the best answer is kept and the waypoint's counts and time add
+  /// up over the tries. A closest sample on a corner of the box can be a stationary point of the
+  /// box-constrained problem (every actuator pushed against its bound), from which no method
+  /// moves. >= 1; 1 is Algorithm 4 as written.
+  int first_waypoint_starts = 3;
+  /// Without a warm start: samples to use instead of sampling (e.g. shared by several runs on
+  /// one robot); must outlive the call. nullptr: sample with `sampling`.
+  const ConfigurationSamples* samples = nullptr;
   bool IsValid(std::string* why) const;
 };
 
@@ -97,9 +109,11 @@ struct TrajectoryResult {
   int max_jump_index = -1;         ///< the waypoint where it happened (-1: fewer than 2 waypoints)
   int converged = 0;               ///< waypoints with O <= lambda
   double mean_error_mm = 0.0, max_error_mm = 0.0;  ///< over the waypoints with a reached point
-  int initial_sample = -1;         ///< sample used for the first waypoint (-1: warm start given)
-  Eigen::VectorXd initial_guess;   ///< the actuation the first waypoint started from
-  ConfigurationSamples samples;    ///< empty when a warm start was given
+  /// Sample the kept answer of the first waypoint started from (-1: warm start given).
+  int initial_sample = -1;
+  int initial_starts_tried = 0;    ///< samples the first waypoint was solved from (0: warm start)
+  Eigen::VectorXd initial_guess;   ///< the actuation the kept first-waypoint answer started from
+  ConfigurationSamples samples;    ///< empty when a warm start or TrajectoryOptions::samples was given
   double total_time_s = 0.0;       ///< including the sampling
 };
 

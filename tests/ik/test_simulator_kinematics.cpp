@@ -331,6 +331,27 @@ TEST(Kinematics, FailedForwardSolvesAndUnsupportedScenesGiveReasons) {
   EXPECT_NE(ec.message.find("collision"), std::string::npos) << ec.message;
   EXPECT_TRUE(kc.Evaluate(Vec({1.5, 1.0, 1.0}), false).ok);  // p alone is fine
 
+  // An implicit derivative whose Krylov solve cannot converge (capped at 2 products here, as
+  // GMRES at cable_finger's slack-cable bound) falls back to fd-warm columns and says so; without
+  // the fallback the evaluation fails with the Krylov message.
+  const FkOptions tight = Fk(1e-8, 1e-9);
+  SimulatorKinematicsOptions starved = Mode(JacobianMode::kImplicit);
+  starved.implicit.max_iterations = 2;
+  SimulatorKinematics kf(model, starved, &tight);
+  SimulatorKinematics kw(model, Mode(JacobianMode::kFdWarm), &tight);
+  const KinematicsEval ef = kf.Evaluate(Vec({1.5, 1.2, 1.0}), true);
+  const KinematicsEval ew = kw.Evaluate(Vec({1.5, 1.2, 1.0}), true);
+  ASSERT_TRUE(ef.ok) << ef.message;
+  ASSERT_TRUE(ew.ok) << ew.message;
+  EXPECT_NE(ef.message.find("fd-warm"), std::string::npos) << ef.message;
+  EXPECT_EQ(ef.fk_solves, 1 + 2 * 3);
+  EXPECT_LT(RelErr(ef.J, ew.J), 1e-9);
+  starved.implicit_fallback = false;
+  SimulatorKinematics kn(model, starved, &tight);
+  const KinematicsEval en = kn.Evaluate(Vec({1.5, 1.2, 1.0}), true);
+  EXPECT_FALSE(en.ok);
+  EXPECT_FALSE(en.message.empty());
+
   FkOptions nlp = Fk(1e-5, 1e-6);
   nlp.solver = "ceres";
   EXPECT_THROW(SimulatorKinematics(model, Mode(JacobianMode::kImplicit), &nlp),

@@ -89,6 +89,50 @@ TEST(Trajectory, BroydenHandsTheJacobianOnAlongThePath) {
   EXPECT_GE(j_br, 1);
 }
 
+// When the first waypoint does not converge from the closest sample (here the kinematics fails
+// around it, as a forward solve that does not converge would), the next closest samples are tried
+// in order; the kept answer, its start and the summed cost are reported. With one start allowed
+// (Algorithm 4 as written) the waypoint fails.
+TEST(Trajectory, FirstWaypointTriesTheNextClosestSamples) {
+  PccKinematics k;
+  const Eigen::MatrixX3d path = CirclePath(k, 3);
+  SamplingOptions so;
+  const ConfigurationSamples all = SampleConfigurationSpace(k, "tip", so);
+  const std::vector<int> order = ClosestSamples(all, path.row(0).transpose(), 125);
+  ASSERT_EQ(order.size(), 125u);
+  for (size_t i = 1; i < order.size(); ++i)
+    EXPECT_LE((all.p.row(order[i - 1]) - path.row(0)).norm(), (all.p.row(order[i]) - path.row(0)).norm());
+  EXPECT_EQ(order.front(), ClosestSample(all, path.row(0).transpose()));
+  const Eigen::VectorXd bad = all.c.row(order[0]).transpose();
+  for (int starts : {1, 3}) {
+    SCOPED_TRACE(starts);
+    test::RecordingKinematics rec(k);
+    // The 125 sampling evaluations see no failure; the solve from the closest sample fails at
+    // its start.
+    rec.fail_if = [&](const Eigen::VectorXd& c) { return rec.calls.size() > 125 && (c - bad).norm() < 1e-9; };
+    TrajectoryOptions opt;
+    opt.ik.method = IkMethod::kGaussNewton;
+    opt.first_waypoint_starts = starts;
+    const TrajectoryResult r = FollowTrajectory(rec, path, opt);
+    ASSERT_EQ(r.waypoints.size(), 3u);
+    if (starts == 1) {
+      EXPECT_FALSE(r.waypoints[0].converged);
+      EXPECT_EQ(r.initial_sample, order[0]);
+      EXPECT_EQ(r.initial_starts_tried, 1);
+      continue;
+    }
+    EXPECT_TRUE(r.waypoints[0].converged) << r.waypoints[0].message;
+    EXPECT_EQ(r.initial_starts_tried, 2);
+    EXPECT_EQ(r.initial_sample, order[1]);
+    EXPECT_TRUE(r.initial_guess.isApprox(all.c.row(order[1]).transpose()));
+    EXPECT_NE(r.waypoints[0].message.find("2 sample(s)"), std::string::npos) << r.waypoints[0].message;
+    EXPECT_EQ(r.converged, 3);
+  }
+  TrajectoryOptions zero;
+  zero.first_waypoint_starts = 0;
+  EXPECT_THROW(FollowTrajectory(k, path, zero), std::invalid_argument);
+}
+
 TEST(Trajectory, FirstWaypointStartsFromTheClosestSample) {
   PccKinematics k;
   const Eigen::MatrixX3d path = CirclePath(k, 4);
