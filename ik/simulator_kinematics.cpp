@@ -346,7 +346,7 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
     const bool guess = options_.jacobian_initial_guess && jac_columns_ == smooth &&
                        jac_dXdc_.rows() == 3 * X.rows();
     last_implicit_ = ComputeEquilibriumJacobian(*model_, X, c, smooth, options_.implicit,
-                                                guess ? &jac_dXdc_ : nullptr);
+                                                guess ? &jac_dXdc_ : nullptr, workspace_.get());
     if (!last_implicit_.ok && !options_.implicit_fallback) {
       ev.message = last_implicit_.message;
       return finish();

@@ -148,6 +148,8 @@ class SimulatorKinematics : public Kinematics {
   std::vector<int> jac_columns_;
   long long total_fk_solves_ = 0;
   EquilibriumJacobianResult last_implicit_;
+  /// The implicit mode's preconditioner pattern, symbolic analysis and factor, kept along a path.
+  std::unique_ptr<EquilibriumJacobianWorkspace> workspace_ = std::make_unique<EquilibriumJacobianWorkspace>();
 };
 
 }  // namespace softkin

@@ -35,10 +35,34 @@
 /// their true one-sided derivative.
 #include "solver/model.hpp"
 
+#include <Eigen/CholmodSupport>
+
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace softkin {
+
+/// The CHOLMOD factor of the "local" preconditioner (EquilibriumJacobianOptions::preconditioner).
+using LocalPreconditioner = Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
+/// One element's block of K_local (3k x 3k, k <= 6 vertices).
+using LocalBlock = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 18, 18>;
+
+/// What the "local" preconditioner keeps from one Jacobian to the next of the same model: the
+/// sparsity pattern of A_ff - sym(K_local) and CHOLMOD's symbolic analysis (ordering, supernodes),
+/// so later Jacobians only assemble and factor numerically. Not thread-safe; one per caller.
+class EquilibriumJacobianWorkspace {
+ public:
+  EquilibriumJacobianWorkspace();
+  ~EquilibriumJacobianWorkspace();
+  EquilibriumJacobianWorkspace(const EquilibriumJacobianWorkspace&) = delete;
+  EquilibriumJacobianWorkspace& operator=(const EquilibriumJacobianWorkspace&) = delete;
+  /// Numeric factorisations done with this workspace.
+  int factorizations() const;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 struct EquilibriumJacobianOptions {
   /// Krylov method: "gmres" (restarted, see restart) or "bicgstab" (no stored basis).
@@ -60,6 +84,18 @@ struct EquilibriumJacobianOptions {
   bool lockstep = true;
   /// OpenMP threads for the per-element products (0 = library default).
   int threads = 0;
+  /// "A_ff": precondition by the global step's prefactored matrix (no setup cost). "local"
+  /// (default): factor A_ff - sym(K_local) (K_local: the per-element blocks of K,
+  /// LocalStiffness) with CHOLMOD's supernodal Cholesky, closer to H (for rigid bodies it is the
+  /// ARAP Hessian; only the groups' rank-one coupling and the skew part are left to GMRES) but a
+  /// factorisation of 3 #V unknowns; falls back to A_ff if it is not positive definite
+  /// (docs/kinematics.md).
+  std::string preconditioner = "local";
+  /// "local" with a workspace: use the workspace's factor of an earlier state instead of
+  /// factoring again, while it still works (GMRES converges within max(2 n, n + 10) rounds, n the
+  /// rounds right after it was factored; past that it is refactored at the next Jacobian, and at
+  /// once if GMRES did not converge). Along an IK path the state changes slowly.
+  bool reuse_preconditioner = true;
   bool IsValid(std::string* why) const;
 };
 
@@ -85,9 +121,23 @@ class EquilibriumLinearization {
   /// block j equals ApplyRhsDerivative(dX block j, dc.col(j)) to round-off.
   void ApplyRhsDerivativeBatch(const Eigen::Ref<const Eigen::MatrixXd>& dX,
                                const Eigen::Ref<const Eigen::MatrixXd>& dc, Eigen::MatrixXd* dB);
+  /// Calls f(i, Kb, thread) for every element i, in parallel (thread: the OpenMP thread number,
+  /// for per-thread accumulation), with Kb its (3k x 3k) block of K_local (row and column 3 q + d:
+  /// coordinate d of the element's vertex q), as LocalStiffness assembles them.
+  void ForEachLocalBlock(
+      const std::function<void(int element, const LocalBlock& block, int thread)>& f) const;
+  /// The per-element part of K = dB/dX as a sparse 3 #V x 3 #V matrix (row and column 3 v + d):
+  /// each element's exact block (rotation, blend scale, and the ratio's dependence on the
+  /// element's own measure), without the groups' rank-one coupling through their total measure.
+  /// For rigid bodies A - K is then the ARAP Hessian. Used to build a preconditioner.
+  Eigen::SparseMatrix<double> LocalStiffness() const;
   const Model& model() const { return *model_; }
 
  private:
+  /// dT of element i for a centred change dD of its rows and dr of its ratio; Ps / dPs0 are the
+  /// cable / DEA reshaped rest rows and their ratio derivative (unused otherwise).
+  void ElementTargetDerivative(int i, bool vented, const ElemRows& dD, double dr,
+                               const ElemRows& Ps, const ElemRows& dPs0, ElemRows* dT) const;
   struct ElementCache {
     Eigen::Matrix3d R;     ///< best rotation of the element's target
     Eigen::Matrix3d Sinv;  ///< (tr(S) I - S)^-1, S = R^T M
@@ -129,6 +179,8 @@ struct EquilibriumJacobianResult {
   /// Batched operator applications (lockstep rounds; equals the sum of iterations without lockstep).
   int rounds = 0;
   double time_s = 0.0;
+  std::string preconditioner;         ///< what preconditioned the solve (and why, on a fallback)
+  double preconditioner_time_s = 0.0; ///< assembling and factoring it ("local")
 };
 
 /// dX/dc at the equilibrium X (#V x 3, a converged local-global state for actuation c) for the
@@ -138,12 +190,14 @@ struct EquilibriumJacobianResult {
 /// saves products without loosening the result. ok = false with a message for unsupported
 /// elements, degenerate elements or a Krylov solve that does not reach options.tolerance within
 /// options.max_iterations (never NaN). Uses the model's CHOLMOD factors, so not concurrently on
-/// one Model.
+/// one Model. `workspace` (optional) keeps the "local" preconditioner's pattern and symbolic
+/// analysis between calls on the same model.
 EquilibriumJacobianResult ComputeEquilibriumJacobian(
     const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
     const Eigen::Ref<const Eigen::VectorXd>& c, const std::vector<int>& columns = {},
     const EquilibriumJacobianOptions& options = EquilibriumJacobianOptions(),
-    const Eigen::MatrixXd* initial_guess = nullptr);
+    const Eigen::MatrixXd* initial_guess = nullptr,
+    EquilibriumJacobianWorkspace* workspace = nullptr);
 
 /// d(prescribed coordinates)/dc[a] (#V x 3, zero on free coordinates): nonzero only for motion
 /// actuators (their vertices' rigid motion), computed by a central difference of
