@@ -1,5 +1,8 @@
 #include "ik/simulator_kinematics.hpp"
 
+#include "solver/energy.hpp"
+#include "solver/mesh.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -170,6 +173,37 @@ std::string SimulatorKinematics::Solve(const Eigen::VectorXd& c, const Eigen::Ma
   return s.str();
 }
 
+bool SimulatorKinematics::PredictionIsSafe(const Eigen::MatrixX3d& from,
+                                           const Eigen::MatrixX3d& predicted,
+                                           const Eigen::VectorXd& c) {
+  // A linear extrapolation over a long step (a line search's first trial, the jump to another
+  // sample) can fold elements over; the local-global iterations then converge from there to
+  // another, folded equilibrium (cable_finger res 6: the tip 60 mm off) instead of the one the
+  // plain warm start reaches. Start from the prediction only if it inverts no element the state
+  // it extrapolates from has upright, and if it is closer to equilibrium at c than that state:
+  // its local-global residual ||2 (A X - B(X))|| must be smaller.
+  const Mesh& mesh = model_->mesh();
+  for (const Element& e : mesh.elements)
+    if (SignedVolume(e, predicted) <= 0.0 && SignedVolume(e, from) > 0.0) {
+      ++rejected_predictions_;
+      return false;
+    }
+  auto residual = [&](const Eigen::MatrixX3d& X) {
+    Eigen::MatrixX3d g;
+    FrozenTargetGradient(*model_, X, c, &g);
+    double s = 0.0;  // over the free coordinates only (fixed rows carry the reactions)
+    for (int d = 0; d < 3; ++d)
+      for (int v : model_->free_vertices(d)) s += g(v, d) * g(v, d);
+    return std::sqrt(s);
+  };
+  const double r_pred = residual(predicted), r_from = residual(from);
+  if (!(r_pred < r_from)) {
+    ++rejected_predictions_;
+    return false;
+  }
+  return true;
+}
+
 KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::VectorXd>& c_in,
                                              bool with_jacobian) {
   const auto t0 = Clock::now();
@@ -219,7 +253,7 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
       const Eigen::VectorXd dx = jac_dXdc_ * dc;
       predicted = last_X_ + Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(
                                 dx.data(), nv, 3);
-      if (!predicted.allFinite()) predicted.resize(0, 3);
+      if (!predicted.allFinite() || !PredictionIsSafe(last_X_, predicted, c)) predicted.resize(0, 3);
     }
     std::string err;
     if (predicted.rows() > 0) {
@@ -253,7 +287,10 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
             c[a] != last_c_[a])
           others_fixed = false;
       const double den = dc.dot(w);
-      if (others_fixed && den > 0.0 && std::isfinite(den)) {
+      // A step below the differences' own scale (fd_step of the ranges) is mostly the forward
+      // solves' tolerance: dividing that noise by |dc| would wreck dX/dc (a line search that
+      // shrinks its steps to 1e-7 made the next prediction fold the finger over). Skip those.
+      if (others_fixed && std::isfinite(den) && std::sqrt(den) >= options_.fd_step) {
         const Eigen::MatrixX3d dX = X - last_X_;
         Eigen::VectorXd y(3 * X.rows());
         for (Eigen::Index v = 0; v < X.rows(); ++v)

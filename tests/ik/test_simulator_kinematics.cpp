@@ -253,6 +253,50 @@ TEST(Kinematics, SecantUpdatedPredictionsKeepP) {
   }
 }
 
+// A long jump (IK moving to another sample) extrapolated linearly folds cable_finger's elements
+// over; the guard keeps that prediction out, so the jump is one plain warm-started solve that
+// reaches the same state as a fresh one. (Without the guard the predicted solve ran into the
+// iteration cap for 19 s before the retry, or converged to a folded finger.)
+TEST(Kinematics, PredictionsThatFoldElementsAreNotUsed) {
+  const Scene s = MakeRobot("cable_finger", 6);
+  auto model = std::make_shared<const Model>(s);
+  FkOptions fk = s.solver;  // as ik_methods runs it
+  fk.threads = 1;
+  fk.gradient_tolerance = 1e-4;
+  SimulatorKinematicsOptions o = Mode(JacobianMode::kImplicit);
+  o.points = {"tip"};
+  SimulatorKinematics k(model, o, &fk), fresh(model, o, &fk);
+  const KinematicsEval start = k.Evaluate(Vec({1.0, 0.508, 1.0}), true);
+  ASSERT_TRUE(start.ok) << start.message;
+  const KinematicsEval jump = k.Evaluate(Vec({1.0, 0.75, 0.75}), false);
+  const KinematicsEval ref = fresh.Evaluate(Vec({1.0, 0.75, 0.75}), false);
+  ASSERT_TRUE(jump.ok) << jump.message;
+  ASSERT_TRUE(ref.ok) << ref.message;
+  EXPECT_EQ(k.rejected_predictions(), 1);
+  EXPECT_EQ(jump.fk_solves, 1);  // no failed predicted solve before it
+  EXPECT_LT((jump.p - ref.p).norm(), 0.05) << jump.p << " vs " << ref.p;  // mm
+}
+
+// Steps far below the differences' scale (a line search's shrinking trials) are FK noise over a
+// tiny |dc|: the secant update must skip them, so a later ordinary step is still predicted well
+// (the prediction is used, and the solve from it needs few iterations).
+TEST(Kinematics, TinyStepsLeaveTheSecantJacobianAlone) {
+  const Scene s = MakeRobot("three_chamber", 3);
+  auto model = std::make_shared<const Model>(s);
+  const FkOptions fk = Fk(1e-8, 1e-4);
+  SimulatorKinematics k(model, Mode(JacobianMode::kImplicit), &fk);
+  const Eigen::VectorXd c0 = Vec({1.5, 1.2, 1.0});
+  ASSERT_TRUE(k.Evaluate(c0, true).ok);
+  for (int i = 1; i <= 6; ++i) {
+    SCOPED_TRACE(i);
+    ASSERT_TRUE(k.Evaluate(c0 + Vec({1e-9, -1e-9, 1e-9}) * i, false).ok);
+  }
+  const KinematicsEval step = k.Evaluate(c0 + Vec({0.1, 0.08, 0.05}), false);
+  ASSERT_TRUE(step.ok) << step.message;
+  EXPECT_EQ(k.rejected_predictions(), 0);
+  EXPECT_EQ(step.fk_solves, 1);
+}
+
 // At a bound the differences are one-sided (probes stay in the box) and still agree with implicit.
 TEST(Kinematics, OneSidedDifferencesAtTheBounds) {
   const Scene s = MakeRobot("three_chamber", 3);
