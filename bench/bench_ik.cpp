@@ -13,7 +13,8 @@
 // c_prev, so its warm state, prediction and Jacobian guess are those a path would leave; broyden
 // is handed the J taken at c_pp, as FollowTrajectory hands on the previous waypoint's.
 // range(0): method (enum order), range(1): resolution (7 is the robot's default). Counters:
-// fk_solves, evaluations, jac_evals, err_mm.
+// fk_solves, rejected_predictions (first-order starts kept out by the guard), evaluations,
+// jac_evals, err_mm.
 #include "ik/ik_solver.hpp"
 #include "ik/pcc_kinematics.hpp"
 #include "ik/simulator_kinematics.hpp"
@@ -100,7 +101,7 @@ void BM_SimulatorWaypoint(benchmark::State& state) {
   opt.method = method;
   opt.lambda = 0.04;  // (0.2 mm)^2
   IkResult r;
-  long long solves = 0;
+  long long solves = 0, rejected = 0;
   for (auto _ : state) {
     // The previous waypoint, untimed: J where it started, p where it ended. broyden gets that J
     // handed over (as FollowTrajectory does with the previous waypoint's).
@@ -111,15 +112,18 @@ void BM_SimulatorWaypoint(benchmark::State& state) {
     }
     if (method == IkMethod::kBroyden) opt.initial_jacobian = pp.J;
     const long long before = f.kin->total_fk_solves();
+    const long long rejected_before = f.kin->rejected_predictions();
     const auto t0 = std::chrono::steady_clock::now();
     r = SolveIk(*f.kin, objective, f.c_prev, opt);
     state.SetIterationTime(
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     solves = f.kin->total_fk_solves() - before;
+    rejected = f.kin->rejected_predictions() - rejected_before;
   }
   state.SetLabel(IkMethodToString(method) + " res " + std::to_string(state.range(1)) + " " +
                  IkTerminationToString(r.summary.termination));
   state.counters["fk_solves"] = static_cast<double>(solves);
+  state.counters["rejected_predictions"] = static_cast<double>(rejected);
   state.counters["evals"] = r.summary.evaluations;
   state.counters["jac_evals"] = r.summary.jacobian_evaluations;
   state.counters["err_mm"] = std::sqrt(r.objective);

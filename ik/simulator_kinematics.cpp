@@ -1,6 +1,5 @@
 #include "ik/simulator_kinematics.hpp"
 
-#include "solver/energy.hpp"
 #include "solver/mesh.hpp"
 
 #include <algorithm>
@@ -35,6 +34,8 @@ bool SimulatorKinematicsOptions::IsValid(std::string* why) const {
   auto bad = [&](const std::string& m) { if (why) *why = m; return false; };
   if (!(fd_step > 0.0 && fd_step <= 0.25))
     return bad("fd_step: expected a fraction of the actuator range in (0, 0.25]");
+  if (!(predict_max_step > 0.0) || std::isnan(predict_max_step))
+    return bad("predict_max_step: expected a range-scaled step length > 0");
   if (!implicit.IsValid(why)) return false;
   return true;
 }
@@ -174,33 +175,22 @@ std::string SimulatorKinematics::Solve(const Eigen::VectorXd& c, const Eigen::Ma
 }
 
 bool SimulatorKinematics::PredictionIsSafe(const Eigen::MatrixX3d& from,
-                                           const Eigen::MatrixX3d& predicted,
-                                           const Eigen::VectorXd& c) {
+                                           const Eigen::MatrixX3d& predicted, double step) {
   // A linear extrapolation over a long step (a line search's first trial, the jump to another
-  // sample) can fold elements over; the local-global iterations then converge from there to
-  // another, folded equilibrium (cable_finger res 6: the tip 60 mm off) instead of the one the
-  // plain warm start reaches. Start from the prediction only if it inverts no element the state
-  // it extrapolates from has upright, and if it is closer to equilibrium at c than that state:
-  // its local-global residual ||2 (A X - B(X))|| must be smaller.
-  const Mesh& mesh = model_->mesh();
-  for (const Element& e : mesh.elements)
+  // sample) can fold elements over: the local-global iterations then converge from there to
+  // another, folded equilibrium (cable_finger res 6: the tip 60 mm off) or take thousands of
+  // iterations (14 s where the plain warm start took 0.2 s). Trust the linear model only within
+  // predict_max_step of the state it belongs to, and never when it inverts an element that is
+  // upright there.
+  if (!(step <= options_.predict_max_step)) {
+    ++rejected_predictions_;
+    return false;
+  }
+  for (const Element& e : model_->mesh().elements)
     if (SignedVolume(e, predicted) <= 0.0 && SignedVolume(e, from) > 0.0) {
       ++rejected_predictions_;
       return false;
     }
-  auto residual = [&](const Eigen::MatrixX3d& X) {
-    Eigen::MatrixX3d g;
-    FrozenTargetGradient(*model_, X, c, &g);
-    double s = 0.0;  // over the free coordinates only (fixed rows carry the reactions)
-    for (int d = 0; d < 3; ++d)
-      for (int v : model_->free_vertices(d)) s += g(v, d) * g(v, d);
-    return std::sqrt(s);
-  };
-  const double r_pred = residual(predicted), r_from = residual(from);
-  if (!(r_pred < r_from)) {
-    ++rejected_predictions_;
-    return false;
-  }
   return true;
 }
 
@@ -249,11 +239,17 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
         jac_c_.size() == c.size() && jac_c_ == last_c_ && jac_dXdc_.rows() == 3 * last_X_.rows()) {
       const int nv = static_cast<int>(last_X_.rows());
       Eigen::VectorXd dc(jac_columns_.size());
-      for (size_t j = 0; j < jac_columns_.size(); ++j) dc[j] = c[jac_columns_[j]] - last_c_[jac_columns_[j]];
+      double step2 = 0.0;  // range-scaled length of the step
+      for (size_t j = 0; j < jac_columns_.size(); ++j) {
+        const int a = jac_columns_[j];
+        dc[j] = c[a] - last_c_[a];
+        step2 += std::pow(dc[j] / std::max(upper_[a] - lower_[a], 1e-300), 2);
+      }
       const Eigen::VectorXd dx = jac_dXdc_ * dc;
       predicted = last_X_ + Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(
                                 dx.data(), nv, 3);
-      if (!predicted.allFinite() || !PredictionIsSafe(last_X_, predicted, c)) predicted.resize(0, 3);
+      if (!predicted.allFinite() || !PredictionIsSafe(last_X_, predicted, std::sqrt(step2)))
+        predicted.resize(0, 3);
     }
     std::string err;
     if (predicted.rows() > 0) {
@@ -289,14 +285,18 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
       const double den = dc.dot(w);
       // A step below the differences' own scale (fd_step of the ranges) is mostly the forward
       // solves' tolerance: dividing that noise by |dc| would wreck dX/dc (a line search that
-      // shrinks its steps to 1e-7 made the next prediction fold the finger over). Skip those.
-      if (others_fixed && std::isfinite(den) && std::sqrt(den) >= options_.fd_step) {
-        const Eigen::MatrixX3d dX = X - last_X_;
-        Eigen::VectorXd y(3 * X.rows());
-        for (Eigen::Index v = 0; v < X.rows(); ++v)
-          for (int d = 0; d < 3; ++d) y[3 * v + d] = dX(v, d);
-        y -= jac_dXdc_ * dc;
-        jac_dXdc_ += y * (w.transpose() / den);
+      // shrinks its steps to 1e-7 made the next prediction fold the finger over). Over such a
+      // step dX/dc is carried to the new state unchanged (first-order the same); longer steps
+      // update it.
+      if (others_fixed && std::isfinite(den) && den > 0.0) {
+        if (std::sqrt(den) >= options_.fd_step) {
+          const Eigen::MatrixX3d dX = X - last_X_;
+          Eigen::VectorXd y(3 * X.rows());
+          for (Eigen::Index v = 0; v < X.rows(); ++v)
+            for (int d = 0; d < 3; ++d) y[3 * v + d] = dX(v, d);
+          y -= jac_dXdc_ * dc;
+          jac_dXdc_ += y * (w.transpose() / den);
+        }
         jac_c_ = c;
       }
     }

@@ -67,18 +67,24 @@ struct SimulatorKinematicsOptions {
   /// current iterate and then solves at the next one). Near the previous state the solve
   /// converges to the same equilibrium from a closer start (fewer iterations). The energy can have
   /// several equilibria, though, and a long extrapolation can fold elements over and land in
-  /// another (cable_finger: a folded finger, the tip 60 mm off). So the prediction is used only if
-  /// it inverts no element that is upright in the previous state and its local-global residual
-  /// at c is below the previous state's (rejected_predictions() counts the others). A prediction
-  /// whose solve fails is retried from the plain warm start (both solves are counted).
+  /// another (cable_finger: a folded finger, the tip 60 mm off) or need thousands of iterations.
+  /// So the prediction is used only within predict_max_step and when it inverts no element that
+  /// is upright in the previous state (rejected_predictions() counts the others, which start
+  /// from the previous state). A prediction whose solve fails is retried from the plain warm
+  /// start (both solves are counted).
   bool predict_warm_start = true;
+  /// implicit only: the longest step the prediction is trusted over, as the Euclidean norm of
+  /// the step divided by each actuator's range (the cable_finger jumps that went wrong were 0.35;
+  /// the steps of IK along a path are a few hundredths). > 0.
+  double predict_max_step = 0.1;
   /// implicit only: after each p solve that started from the state dX/dc belongs to, update
   /// dX/dc by Broyden's secant rule (dX/dc += (dX - dX/dc dc) w^T / (dc^T w), w = dc / range^2)
   /// so that it belongs to the new state. Predictions then stay first-order along a path on
   /// which no new Jacobian is evaluated (IK's broyden method). The update is exact along the
-  /// step just taken; the converged states do not depend on it, only where solves start. Steps
-  /// shorter than fd_step (in range-scaled norm) are skipped: there the change of the state is
-  /// mostly the forward solves' tolerance, not the derivative.
+  /// step just taken; the converged states do not depend on it, only where solves start. Over
+  /// steps shorter than fd_step (in range-scaled norm) dX/dc is carried to the new state
+  /// unchanged: there the change of the state is mostly the forward solves' tolerance, not the
+  /// derivative.
   bool secant_update = true;
   /// implicit only: start each Jacobian's Krylov solves from the previous implicit Jacobian
   /// (dX/dc changes slowly along a path). The tolerance stays relative to the right-hand side.
@@ -125,8 +131,8 @@ class SimulatorKinematics : public Kinematics {
   double fd_step(int a) const;
   /// Positions (#V x 3) of the last successful p solve (empty before the first).
   const Eigen::MatrixX3d& last_positions() const { return last_X_; }
-  /// implicit: first-order predictions not used as a start because they would invert an element
-  /// or are further from equilibrium than the plain warm start (PredictionIsSafe).
+  /// implicit: first-order predictions not used as a start, because the step was longer than
+  /// predict_max_step or the prediction would invert an element (PredictionIsSafe).
   long long rejected_predictions() const { return rejected_predictions_; }
   /// Diagnostics of the last implicit Jacobian (GMRES iterations and residuals per column).
   const EquilibriumJacobianResult& last_implicit() const { return last_implicit_; }
@@ -138,11 +144,11 @@ class SimulatorKinematics : public Kinematics {
   /// One forward solve from `start` (nullptr: rest); "" or the failure message. Counts the solve.
   std::string Solve(const Eigen::VectorXd& c, const Eigen::MatrixX3d* start, FkResult* r,
                     std::string* note);
-  /// Whether `predicted` (extrapolated from `from`) is a safe start at c: it inverts no element
-  /// upright in `from`, and its local-global residual at c is below that of `from`. Counts
+  /// Whether `predicted` (extrapolated from `from` over a range-scaled step of length `step`) is
+  /// a safe start: step <= predict_max_step, and it inverts no element upright in `from`. Counts
   /// rejections.
   bool PredictionIsSafe(const Eigen::MatrixX3d& from, const Eigen::MatrixX3d& predicted,
-                        const Eigen::VectorXd& c);
+                        double step);
 
   std::shared_ptr<const Model> model_;
   SimulatorKinematicsOptions options_;

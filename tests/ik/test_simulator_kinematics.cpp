@@ -249,37 +249,50 @@ TEST(Kinematics, SecantUpdatedPredictionsKeepP) {
     ASSERT_TRUE(eb.ok) << eb.message;
     EXPECT_EQ(ea.fk_solves, 1);
     EXPECT_LT((ea.p - eb.p).norm(), 1e-5 * model->size());
-    if (last) EXPECT_LT(RelErr(ea.J, eb.J), 1e-5);
+    if (last) {
+      EXPECT_LT(RelErr(ea.J, eb.J), 1e-5);
+    }
   }
 }
 
 // A long jump (IK moving to another sample) extrapolated linearly folds cable_finger's elements
-// over; the guard keeps that prediction out, so the jump is one plain warm-started solve that
-// reaches the same state as a fresh one. (Without the guard the predicted solve ran into the
-// iteration cap for 19 s before the retry, or converged to a folded finger.)
+// over. The prediction is kept out, by its length (predict_max_step) and, with the length allowed,
+// by the inverted elements; the jump is then one plain warm-started solve that reaches the same
+// state as a fresh one. (Without the guard the predicted solve ran into the iteration cap for
+// 19 s before the retry, or converged to a folded finger.)
 TEST(Kinematics, PredictionsThatFoldElementsAreNotUsed) {
   const Scene s = MakeRobot("cable_finger", 6);
   auto model = std::make_shared<const Model>(s);
   FkOptions fk = s.solver;  // as ik_methods runs it
   fk.threads = 1;
   fk.gradient_tolerance = 1e-4;
-  SimulatorKinematicsOptions o = Mode(JacobianMode::kImplicit);
-  o.points = {"tip"};
-  SimulatorKinematics k(model, o, &fk), fresh(model, o, &fk);
-  const KinematicsEval start = k.Evaluate(Vec({1.0, 0.508, 1.0}), true);
-  ASSERT_TRUE(start.ok) << start.message;
-  const KinematicsEval jump = k.Evaluate(Vec({1.0, 0.75, 0.75}), false);
-  const KinematicsEval ref = fresh.Evaluate(Vec({1.0, 0.75, 0.75}), false);
-  ASSERT_TRUE(jump.ok) << jump.message;
-  ASSERT_TRUE(ref.ok) << ref.message;
-  EXPECT_EQ(k.rejected_predictions(), 1);
-  EXPECT_EQ(jump.fk_solves, 1);  // no failed predicted solve before it
-  EXPECT_LT((jump.p - ref.p).norm(), 0.05) << jump.p << " vs " << ref.p;  // mm
+  for (double max_step : {0.1, 1.0}) {
+    SCOPED_TRACE(max_step);
+    SimulatorKinematicsOptions o = Mode(JacobianMode::kImplicit);
+    o.points = {"tip"};
+    o.predict_max_step = max_step;  // the jump is 0.35 of the ranges long
+    SimulatorKinematics k(model, o, &fk), fresh(model, o, &fk);
+    const KinematicsEval start = k.Evaluate(Vec({1.0, 0.508, 1.0}), true);
+    ASSERT_TRUE(start.ok) << start.message;
+    const KinematicsEval jump = k.Evaluate(Vec({1.0, 0.75, 0.75}), false);
+    const KinematicsEval ref = fresh.Evaluate(Vec({1.0, 0.75, 0.75}), false);
+    ASSERT_TRUE(jump.ok) << jump.message;
+    ASSERT_TRUE(ref.ok) << ref.message;
+    EXPECT_EQ(k.rejected_predictions(), 1);
+    EXPECT_EQ(jump.fk_solves, 1);  // no failed predicted solve before it
+    EXPECT_LT((jump.p - ref.p).norm(), 0.05) << jump.p << " vs " << ref.p;  // mm
+  }
+  SimulatorKinematicsOptions bad = Mode(JacobianMode::kImplicit);
+  bad.predict_max_step = 0.0;
+  std::string why;
+  EXPECT_FALSE(bad.IsValid(&why));
+  EXPECT_NE(why.find("predict_max_step"), std::string::npos) << why;
 }
 
 // Steps far below the differences' scale (a line search's shrinking trials) are FK noise over a
-// tiny |dc|: the secant update must skip them, so a later ordinary step is still predicted well
-// (the prediction is used, and the solve from it needs few iterations).
+// tiny |dc|: the secant update must skip them (carrying dX/dc over), so a later ordinary step is
+// still predicted and the prediction used. Updating from them made that prediction invert an
+// element (and the guard reject it).
 TEST(Kinematics, TinyStepsLeaveTheSecantJacobianAlone) {
   const Scene s = MakeRobot("three_chamber", 3);
   auto model = std::make_shared<const Model>(s);
