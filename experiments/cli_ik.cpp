@@ -104,6 +104,9 @@ CLI::App* AddIkCommand(CLI::App* app, IkCommandArgs* a) {
                "be for the same waypoints) and solve the rest, warm-started from the last row's "
                "actuation");
   ik->add_flag("--quiet", a->quiet, "No progress on stderr");
+  ik->add_flag("--trace-fk", a->trace_fk,
+               "One stderr line per forward solve (start: predicted, warm or probe; c; status; "
+               "iterations; time), to see where a waypoint's time goes");
   return ik;
 }
 
@@ -201,6 +204,7 @@ int RunIkCommand(const IkCommandArgs& a) {
   if (a.res < 0) throw std::invalid_argument("--res: expected a positive integer");
   IkOptions ik = ParseIkOptions(a, a.method);
   SimulatorKinematicsOptions ko;
+  ko.trace = a.trace_fk;
   if (!JacobianModeFromString(a.jacobian, &ko.jacobian))
     throw std::invalid_argument("--jacobian: unknown mode '" + a.jacobian + "' (expected one of " +
                                 JacobianModeNames() + ")");

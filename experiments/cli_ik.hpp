@@ -30,6 +30,7 @@ struct IkCommandArgs {
   std::string out;
   bool resume = false;
   bool quiet = false;
+  bool trace_fk = false;
   // ---- learned kinematics (thesis Ch. 5; docs/learning.md) ----
   std::string nets;                        ///< network directory from `softkin train`
   std::string jacobian_source = "network"; ///< network (N_J) or fk-derivative (dN_fk/dc)

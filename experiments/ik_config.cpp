@@ -218,6 +218,7 @@ IkExperimentSetup ReadIkSetup(const Config& cfg, const std::string& default_robo
   const std::string jac = cfg.String("jacobian", "implicit");
   if (!JacobianModeFromString(jac, &s.kin.jacobian)) cfg.Fail("jacobian", "one of " + JacobianModeNames());
   s.kin.fd_step = cfg.Number("fd_step", s.kin.fd_step);
+  s.kin.trace = cfg.Bool("trace_fk", false);  // one stderr line per forward solve
   std::string why;
   if (!s.kin.IsValid(&why)) cfg.Fail("fd_step", "a valid step (" + why + ")");
   const std::string method = cfg.String("method", "softls");

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 
@@ -34,6 +35,8 @@ bool SimulatorKinematicsOptions::IsValid(std::string* why) const {
   auto bad = [&](const std::string& m) { if (why) *why = m; return false; };
   if (!(fd_step > 0.0 && fd_step <= 0.25))
     return bad("fd_step: expected a fraction of the actuator range in (0, 0.25]");
+  if (warm_max_iterations < 0)
+    return bad("warm_max_iterations: expected >= 0 (0: the solver's max_iterations)");
   if (!(predict_max_step > 0.0) || std::isnan(predict_max_step))
     return bad("predict_max_step: expected a range-scaled step length > 0");
   if (!implicit.IsValid(why)) return false;
@@ -73,6 +76,12 @@ void SimulatorKinematics::Init(const SimulatorKinematicsOptions& options, const 
         "jacobian 'implicit' differentiates the local-global equilibrium; it needs solver lg or "
         "lg-aa, got '" + fk_.solver + "' (use fd or fd-warm with other solvers)");
   solver_ = MakeFkSolver(model_, fk_);
+  warm_solver_.reset();
+  if (options_.warm_max_iterations > 0 && options_.warm_max_iterations < fk_.max_iterations) {
+    FkOptions warm = fk_;
+    warm.max_iterations = options_.warm_max_iterations;
+    warm_solver_ = MakeFkSolver(model_, warm);  // shares the model (and its factor)
+  }
 
   // Tracked points.
   std::vector<std::string> spec = options_.points;
@@ -159,9 +168,31 @@ Eigen::MatrixX3d SimulatorKinematics::Points(const Eigen::Ref<const Eigen::Matri
 }
 
 std::string SimulatorKinematics::Solve(const Eigen::VectorXd& c, const Eigen::MatrixX3d* start,
-                                       FkResult* r, std::string* note) {
-  *r = solver_->Solve(c, start);
-  ++total_fk_solves_;
+                                       FkResult* r, std::string* note, const char* kind,
+                                       int* solves, bool* from_rest) {
+  auto run = [&](FkSolver& solver, const Eigen::MatrixX3d* from, const char* what) {
+    *r = solver.Solve(c, from);
+    ++total_fk_solves_;
+    if (solves) ++*solves;
+    if (options_.trace) {
+      std::ostringstream t;
+      t << "fk #" << total_fk_solves_ << " " << what << (from ? "" : " (from rest)") << " c = ("
+        << c.transpose() << "): " << FkStatusToString(r->status) << ", " << r->iterations
+        << " iterations, " << r->time_s << " s\n";
+      std::fputs(t.str().c_str(), stderr);
+    }
+  };
+  if (from_rest) *from_rest = start == nullptr;
+  run(start && warm_solver_ ? *warm_solver_ : *solver_, start, kind);
+  // A stored state can sit where the iterations crawl (cable_finger: 10000 lg-aa iterations
+  // without converging from a neighbouring sample's state, 79 from rest; plain lg needed
+  // 15804): give such a start warm_max_iterations, then solve c as a cold FK solve would.
+  if (start && options_.retry_from_rest &&
+      (r->status == FkStatus::IterationCap || r->status == FkStatus::Diverged)) {
+    ++rest_retries_;
+    if (from_rest) *from_rest = true;
+    run(*solver_, nullptr, "rest retry");
+  }
   if (r->status == FkStatus::Converged) return "";
   std::ostringstream s;
   s << "forward solve at c = (" << c.transpose() << ") ended with status "
@@ -252,14 +283,18 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
         predicted.resize(0, 3);
     }
     std::string err;
+    bool from_rest = false;
     if (predicted.rows() > 0) {
-      err = Solve(c, &predicted, &r, &note);
-      ++ev.fk_solves;
-      if (err.empty()) centre_start = predicted;
+      err = Solve(c, &predicted, &r, &note, "predicted", &ev.fk_solves, &from_rest);
+      if (err.empty()) {
+        if (from_rest) centre_start.resize(0, 3);  // fd probes start where the centre did
+        else centre_start = predicted;
+      }
     }
-    if (predicted.rows() == 0 || !err.empty()) {
-      err = Solve(c, start, &r, &note);
-      ++ev.fk_solves;
+    // A failed prediction is retried from the plain warm start, unless a cold solve already failed.
+    if (predicted.rows() == 0 || (!err.empty() && !from_rest)) {
+      err = Solve(c, start, &r, &note, "warm", &ev.fk_solves, &from_rest);
+      if (err.empty() && from_rest) centre_start.resize(0, 3);
     }
     if (!err.empty()) {
       ev.message = err;
@@ -329,8 +364,7 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
       Eigen::VectorXd cp = c;
       cp[a] = std::min(upper_[a], std::max(lower_[a], c[a] + delta));
       FkResult r;
-      const std::string err = Solve(cp, probe_start, &r, &note);
-      ++ev.fk_solves;
+      const std::string err = Solve(cp, probe_start, &r, &note, "probe", &ev.fk_solves);
       if (!err.empty())
         return "probe of actuator '" + model_->scene().actuators[a].name + "': " + err;
       *p = flatten(Points(r.positions));

@@ -24,8 +24,9 @@
 /// (predict_warm_start), and each Jacobian's linear solves start from the previous one
 /// (jacobian_initial_guess).
 ///
-/// A forward solve that does not converge (status iteration_cap, diverged, time_limit) makes the
-/// evaluation fail (ok = false, message with the FK status and the actuation), unless
+/// A solve from a stored or predicted state gets warm_max_iterations; if it does not converge, c
+/// is solved again from the rest shape (retry_from_rest). A forward solve that does not converge
+/// (status iteration_cap, diverged, time_limit) from there makes the evaluation fail (ok = false, message with the FK status and the actuation), unless
 /// accept_iteration_cap is set, in which case an iteration_cap result is used and `message` says
 /// so. p and J are never NaN when ok.
 #include "ik/kinematics.hpp"
@@ -93,6 +94,19 @@ struct SimulatorKinematicsOptions {
   /// element it cannot differentiate), compute those columns as fd-warm does and say so in
   /// `message`, instead of failing the evaluation. Collision response stays an error.
   bool implicit_fallback = true;
+  /// Iteration cap of the solves that start from a stored state, a prediction or (fd) the centre
+  /// state, below the solver's own max_iterations; 0: the solver's. Such starts converge in tens
+  /// to hundreds of iterations, or crawl: cable_finger went 10000 lg-aa iterations without
+  /// converging from a neighbouring sample's state, where a solve from rest took 79.
+  int warm_max_iterations = 2000;
+  /// When a solve from a start fails (iteration cap, divergence), solve c again from the rest
+  /// shape with the solver's full cap; the evaluation fails only if that fails too.
+  /// rest_retries() counts them.
+  bool retry_from_rest = true;
+  /// Print one line per forward solve to stderr: its number, the start (predicted, warm, probe;
+  /// "from rest" without a state), c, the status, the iterations and the time. For finding the
+  /// solves an IK run spends its time in (softkin ik --trace-fk).
+  bool trace = false;
   /// Options of the implicit mode's linear solve.
   EquilibriumJacobianOptions implicit;
   bool IsValid(std::string* why) const;
@@ -134,6 +148,8 @@ class SimulatorKinematics : public Kinematics {
   /// implicit: first-order predictions not used as a start, because the step was longer than
   /// predict_max_step or the prediction would invert an element (PredictionIsSafe).
   long long rejected_predictions() const { return rejected_predictions_; }
+  /// Solves from a start that failed and were solved again from the rest shape (retry_from_rest).
+  long long rest_retries() const { return rest_retries_; }
   /// Diagnostics of the last implicit Jacobian (GMRES iterations and residuals per column).
   const EquilibriumJacobianResult& last_implicit() const { return last_implicit_; }
 
@@ -142,8 +158,11 @@ class SimulatorKinematics : public Kinematics {
   /// Tracked points for positions X (#points x 3).
   Eigen::MatrixX3d Points(const Eigen::Ref<const Eigen::MatrixX3d>& X) const;
   /// One forward solve from `start` (nullptr: rest); "" or the failure message. Counts the solve.
+  /// With a start, the solve gets warm_max_iterations and, if it fails, c is solved again from
+  /// the rest shape (retry_from_rest). Adds the solves made to *solves; *from_rest: the result
+  /// came from a solve started at the rest shape. `kind` names the start for the trace.
   std::string Solve(const Eigen::VectorXd& c, const Eigen::MatrixX3d* start, FkResult* r,
-                    std::string* note);
+                    std::string* note, const char* kind, int* solves, bool* from_rest = nullptr);
   /// Whether `predicted` (extrapolated from `from` over a range-scaled step of length `step`) is
   /// a safe start: step <= predict_max_step, and it inverts no element upright in `from`. Counts
   /// rejections.
@@ -154,6 +173,7 @@ class SimulatorKinematics : public Kinematics {
   SimulatorKinematicsOptions options_;
   FkOptions fk_;
   std::unique_ptr<FkSolver> solver_;
+  std::unique_ptr<FkSolver> warm_solver_;  ///< solver_ with warm_max_iterations (null: none lower)
   std::vector<std::string> names_;
   /// Point q = sum over [offset_[q], offset_[q+1]) of weight_ * X.row(vertex_).
   std::vector<int> offset_, vertex_;
@@ -168,6 +188,7 @@ class SimulatorKinematics : public Kinematics {
   std::vector<int> jac_columns_;
   long long total_fk_solves_ = 0;
   long long rejected_predictions_ = 0;
+  long long rest_retries_ = 0;
   EquilibriumJacobianResult last_implicit_;
   /// The implicit mode's preconditioner pattern, symbolic analysis and factor, kept along a path.
   std::unique_ptr<EquilibriumJacobianWorkspace> workspace_ = std::make_unique<EquilibriumJacobianWorkspace>();

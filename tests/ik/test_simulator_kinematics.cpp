@@ -289,6 +289,48 @@ TEST(Kinematics, PredictionsThatFoldElementsAreNotUsed) {
   EXPECT_NE(why.find("predict_max_step"), std::string::npos) << why;
 }
 
+// From the state a few samples leave behind, lg-aa crawls at (0.97, 0.50, 0.93) on cable_finger
+// (10000 iterations without converging; from rest it takes about 100). The warm attempt gets
+// warm_max_iterations, then c is solved from rest: the same point as a cold solve. Without the
+// retry the evaluation fails.
+TEST(Kinematics, AStartThatCrawlsIsSolvedAgainFromRest) {
+  const Scene s = MakeRobot("cable_finger", 6);
+  auto model = std::make_shared<const Model>(s);
+  FkOptions fk = s.solver;
+  fk.threads = 1;
+  fk.gradient_tolerance = 1e-4;
+  const std::vector<Eigen::VectorXd> path = {Vec({1, 0.5, 1}), Vec({1, 1, 0.5}), Vec({0.5, 0.5, 0.5}),
+                                             Vec({0.746491, 0.5, 0.514275})};
+  const Eigen::VectorXd c = Vec({0.974649, 0.501302, 0.926934});
+  SimulatorKinematicsOptions o = Mode(JacobianMode::kFdWarm);
+  o.points = {"tip"};
+  o.warm_max_iterations = 500;
+  SimulatorKinematics cold(model, o, &fk);
+  const KinematicsEval ref = cold.Evaluate(c, false);
+  ASSERT_TRUE(ref.ok) << ref.message;
+  for (bool retry : {true, false}) {
+    SCOPED_TRACE(retry);
+    o.retry_from_rest = retry;
+    SimulatorKinematics k(model, o, &fk);
+    for (const auto& ci : path) ASSERT_TRUE(k.Evaluate(ci, false).ok);
+    const KinematicsEval e = k.Evaluate(c, false);
+    if (retry) {
+      ASSERT_TRUE(e.ok) << e.message;
+      EXPECT_EQ(e.fk_solves, 2);
+      EXPECT_EQ(k.rest_retries(), 1);
+      EXPECT_LT((e.p - ref.p).norm(), 1e-6) << e.p << " vs " << ref.p;  // the cold solve itself
+    } else {
+      EXPECT_FALSE(e.ok);
+      EXPECT_NE(e.message.find("iteration_cap"), std::string::npos) << e.message;
+      EXPECT_EQ(k.rest_retries(), 0);
+    }
+  }
+  o.warm_max_iterations = -1;
+  std::string why;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("warm_max_iterations"), std::string::npos) << why;
+}
+
 // Steps far below the differences' scale (a line search's shrinking trials) are FK noise over a
 // tiny |dc|: the secant update must skip them (carrying dX/dc over), so a later ordinary step is
 // still predicted and the prediction used. Updating from them made that prediction invert an

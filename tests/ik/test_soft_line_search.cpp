@@ -93,6 +93,50 @@ TEST(SoftLineSearch, FailedTrialsAreTreatedAsNoDecrease) {
   EXPECT_GT(failed, 0);  // the guarded case really happened
 }
 
+// Forwards to another Kinematics with J negated: -grad then points uphill everywhere.
+class UphillKinematics : public Kinematics {
+ public:
+  explicit UphillKinematics(Kinematics& inner) : inner_(inner) {}
+  std::string name() const override { return "uphill"; }
+  int num_actuators() const override { return inner_.num_actuators(); }
+  const std::vector<std::string>& point_names() const override { return inner_.point_names(); }
+  const Eigen::VectorXd& lower() const override { return inner_.lower(); }
+  const Eigen::VectorXd& upper() const override { return inner_.upper(); }
+  Eigen::VectorXd rest() const override { return inner_.rest(); }
+  KinematicsEval Evaluate(const Eigen::Ref<const Eigen::VectorXd>& c, bool with_jacobian) override {
+    KinematicsEval e = inner_.Evaluate(c, with_jacobian);
+    if (e.ok && with_jacobian) e.J = -e.J;
+    return e;
+  }
+  long long total_fk_solves() const override { return inner_.total_fk_solves(); }
+
+ private:
+  Kinematics& inner_;
+};
+
+// With no descent along -grad the shrinking stops at steps of parameter_tolerance (of the
+// ranges), not after max_shrinks: each smaller trial would be a forward solve spent on noise.
+TEST(SoftLineSearch, ShrinkingStopsBelowTheParameterTolerance) {
+  PccKinematics pcc;
+  UphillKinematics up(pcc);
+  test::RecordingKinematics rec(up);
+  const Eigen::VectorXd c0 = (pcc.lower() + pcc.upper()) / 2;
+  PointTrackingObjective o(rec.point_names(), "tip",
+                           pcc.Evaluate(pcc.upper() * 0.9, false).p.row(0).transpose());
+  IkOptions opt;
+  opt.parameter_tolerance = 1e-6;
+  const IkResult r = SolveIk(rec, o, c0, opt);
+  EXPECT_EQ(r.summary.termination, IkTermination::kNoProgress);
+  EXPECT_NE(r.summary.message.find("below parameter_tolerance"), std::string::npos) << r.summary.message;
+  ASSERT_GE(rec.calls.size(), 3u);
+  EXPECT_LT(rec.calls.size(), 1u + opt.max_shrinks);
+  const Eigen::VectorXd range = pcc.upper() - pcc.lower();
+  for (size_t i = 1; i < rec.calls.size(); ++i)  // every trial moved by more than the tolerance
+    EXPECT_GT((rec.calls[i] - c0).cwiseAbs().cwiseQuotient(range).maxCoeff(), opt.parameter_tolerance)
+        << "trial " << i;
+  EXPECT_EQ(r.c, c0);
+}
+
 TEST(SoftLineSearch, AFailureAtTheStartIsReportedWithItsMessage) {
   PccKinematics pcc;
   test::RecordingKinematics rec(pcc);
