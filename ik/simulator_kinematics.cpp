@@ -205,6 +205,18 @@ std::string SimulatorKinematics::Solve(const Eigen::VectorXd& c, const Eigen::Ma
   return s.str();
 }
 
+Eigen::VectorXd SimulatorKinematics::ColumnStep(const Eigen::VectorXd& c, double* scaled) const {
+  Eigen::VectorXd dc(jac_columns_.size());
+  double s2 = 0.0;
+  for (size_t j = 0; j < jac_columns_.size(); ++j) {
+    const int a = jac_columns_[j];
+    dc[j] = c[a] - last_c_[a];
+    s2 += std::pow(dc[j] / std::max(upper_[a] - lower_[a], 1e-300), 2);
+  }
+  *scaled = std::sqrt(s2);
+  return dc;
+}
+
 bool SimulatorKinematics::PredictionIsSafe(const Eigen::MatrixX3d& from,
                                            const Eigen::MatrixX3d& predicted, double step) {
   // A linear extrapolation over a long step (a line search's first trial, the jump to another
@@ -269,18 +281,12 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
     if (have_last && options_.jacobian == JacobianMode::kImplicit && options_.predict_warm_start &&
         jac_c_.size() == c.size() && jac_c_ == last_c_ && jac_dXdc_.rows() == 3 * last_X_.rows()) {
       const int nv = static_cast<int>(last_X_.rows());
-      Eigen::VectorXd dc(jac_columns_.size());
-      double step2 = 0.0;  // range-scaled length of the step
-      for (size_t j = 0; j < jac_columns_.size(); ++j) {
-        const int a = jac_columns_[j];
-        dc[j] = c[a] - last_c_[a];
-        step2 += std::pow(dc[j] / std::max(upper_[a] - lower_[a], 1e-300), 2);
-      }
+      double step = 0.0;
+      const Eigen::VectorXd dc = ColumnStep(c, &step);
       const Eigen::VectorXd dx = jac_dXdc_ * dc;
       predicted = last_X_ + Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(
                                 dx.data(), nv, 3);
-      if (!predicted.allFinite() || !PredictionIsSafe(last_X_, predicted, std::sqrt(step2)))
-        predicted.resize(0, 3);
+      if (!predicted.allFinite() || !PredictionIsSafe(last_X_, predicted, step)) predicted.resize(0, 3);
     }
     std::string err;
     bool from_rest = false;
@@ -305,26 +311,24 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
     // (scaled by the ranges, as IK's broyden), so the next prediction is still close.
     if (have_last && options_.jacobian == JacobianMode::kImplicit && options_.secant_update &&
         jac_c_.size() == c.size() && jac_c_ == last_c_ && jac_dXdc_.rows() == 3 * X.rows()) {
-      const int nj = static_cast<int>(jac_columns_.size());
-      Eigen::VectorXd dc(nj), w(nj);
-      for (int j = 0; j < nj; ++j) {
-        const int a = jac_columns_[j];
-        dc[j] = c[a] - last_c_[a];
-        w[j] = dc[j] / std::max(std::pow(upper_[a] - lower_[a], 2), 1e-300);
-      }
+      double step = 0.0;
+      const Eigen::VectorXd dc = ColumnStep(c, &step);
+      Eigen::VectorXd w(dc.size());  // dc / range^2
+      for (Eigen::Index j = 0; j < dc.size(); ++j)
+        w[j] = dc[j] / std::max(std::pow(upper_[jac_columns_[j]] - lower_[jac_columns_[j]], 2), 1e-300);
       bool others_fixed = true;  // actuators outside the columns (kinks) must not have moved
       for (int a = 0; a < num_actuators(); ++a)
         if (std::find(jac_columns_.begin(), jac_columns_.end(), a) == jac_columns_.end() &&
             c[a] != last_c_[a])
           others_fixed = false;
-      const double den = dc.dot(w);
+      const double den = step * step;  // = dc . w
       // A step below the differences' own scale (fd_step of the ranges) is mostly the forward
       // solves' tolerance: dividing that noise by |dc| would wreck dX/dc (a line search that
       // shrinks its steps to 1e-7 made the next prediction fold the finger over). Over such a
       // step dX/dc is carried to the new state unchanged (first-order the same); longer steps
       // update it.
       if (others_fixed && std::isfinite(den) && den > 0.0) {
-        if (std::sqrt(den) >= options_.fd_step) {
+        if (step >= options_.fd_step) {
           const Eigen::MatrixX3d dX = X - last_X_;
           Eigen::VectorXd y(3 * X.rows());
           for (Eigen::Index v = 0; v < X.rows(); ++v)

@@ -163,6 +163,9 @@ class SimulatorKinematics : public Kinematics {
   /// came from a solve started at the rest shape. `kind` names the start for the trace.
   std::string Solve(const Eigen::VectorXd& c, const Eigen::MatrixX3d* start, FkResult* r,
                     std::string* note, const char* kind, int* solves, bool* from_rest = nullptr);
+  /// c - last_c_ over the Jacobian's columns (jac_columns_), and in *scaled its Euclidean norm
+  /// with each component divided by its actuator's range.
+  Eigen::VectorXd ColumnStep(const Eigen::VectorXd& c, double* scaled) const;
   /// Whether `predicted` (extrapolated from `from` over a range-scaled step of length `step`) is
   /// a safe start: step <= predict_max_step, and it inverts no element upright in `from`. Counts
   /// rejections.
