@@ -75,9 +75,9 @@ struct SimulatorKinematicsOptions {
   /// start (both solves are counted).
   bool predict_warm_start = true;
   /// implicit only: the longest step the prediction is trusted over, as the Euclidean norm of
-  /// the step divided by each actuator's range (the cable_finger jumps that went wrong were 0.35;
+  /// the step divided by each actuator's range (the cable_finger jumps that went wrong were 0.70;
   /// the steps of IK along a path are a few hundredths). > 0.
-  double predict_max_step = 0.1;
+  double predict_max_step = 0.25;
   /// implicit only: after each p solve that started from the state dX/dc belongs to, update
   /// dX/dc by Broyden's secant rule (dX/dc += (dX - dX/dc dc) w^T / (dc^T w), w = dc / range^2)
   /// so that it belongs to the new state. Predictions then stay first-order along a path on
