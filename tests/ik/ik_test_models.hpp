@@ -66,7 +66,8 @@ class LinearKinematics : public Kinematics {
 };
 
 /// Forwards to another Kinematics, recording every c asked for; `fail_if` makes chosen
-/// evaluations fail with a message (as a simulator that does not converge would).
+/// evaluations fail with a message (as a simulator that does not converge would), `alter`
+/// changes what the inner one returns.
 class RecordingKinematics : public Kinematics {
  public:
   explicit RecordingKinematics(Kinematics& inner) : inner_(inner) {}
@@ -83,12 +84,16 @@ class RecordingKinematics : public Kinematics {
       e.message = "injected failure: the solver did not converge";
       return e;
     }
-    return inner_.Evaluate(c, with_jacobian);
+    KinematicsEval e = inner_.Evaluate(c, with_jacobian);
+    if (alter) alter(&e);
+    return e;
   }
   long long total_fk_solves() const override { return inner_.total_fk_solves(); }
 
   std::vector<Eigen::VectorXd> calls;
   std::function<bool(const Eigen::VectorXd&)> fail_if;
+  /// Applied to every evaluation the inner kinematics returns (e.g. a wrong J on purpose).
+  std::function<void(KinematicsEval*)> alter;
 
  private:
   Kinematics& inner_;

@@ -41,6 +41,20 @@ double RelErr(const Eigen::MatrixXd& a, const Eigen::MatrixXd& ref) {
   return (a - ref).norm() / ref.norm();
 }
 
+// The scene's own solver at gradient ratio 1e-4, one thread: the FK ik_methods runs.
+FkOptions AsIkMethodsRunsIt(const Scene& s) {
+  FkOptions o = s.solver;
+  o.threads = 1;
+  o.gradient_tolerance = 1e-4;
+  return o;
+}
+
+void ExpectInvalidNaming(const SimulatorKinematicsOptions& o, const std::string& field) {
+  std::string why;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find(field), std::string::npos) << why;
+}
+
 TEST(Kinematics, JacobianModeStringsRoundTrip) {
   for (JacobianMode m : {JacobianMode::kFd, JacobianMode::kFdWarm, JacobianMode::kImplicit}) {
     JacobianMode back = JacobianMode::kFd;
@@ -263,9 +277,7 @@ TEST(Kinematics, SecantUpdatedPredictionsKeepP) {
 TEST(Kinematics, PredictionsThatFoldElementsAreNotUsed) {
   const Scene s = MakeRobot("cable_finger", 6);
   auto model = std::make_shared<const Model>(s);
-  FkOptions fk = s.solver;  // as ik_methods runs it
-  fk.threads = 1;
-  fk.gradient_tolerance = 1e-4;
+  const FkOptions fk = AsIkMethodsRunsIt(s);
   for (double max_step : {0.25, 1.0}) {
     SCOPED_TRACE(max_step);
     SimulatorKinematicsOptions o = Mode(JacobianMode::kImplicit);
@@ -284,9 +296,7 @@ TEST(Kinematics, PredictionsThatFoldElementsAreNotUsed) {
   }
   SimulatorKinematicsOptions bad = Mode(JacobianMode::kImplicit);
   bad.predict_max_step = 0.0;
-  std::string why;
-  EXPECT_FALSE(bad.IsValid(&why));
-  EXPECT_NE(why.find("predict_max_step"), std::string::npos) << why;
+  ExpectInvalidNaming(bad, "predict_max_step");
 }
 
 // From the state a few samples leave behind, lg-aa crawls at (0.97, 0.50, 0.93) on cable_finger
@@ -296,9 +306,7 @@ TEST(Kinematics, PredictionsThatFoldElementsAreNotUsed) {
 TEST(Kinematics, AStartThatCrawlsIsSolvedAgainFromRest) {
   const Scene s = MakeRobot("cable_finger", 6);
   auto model = std::make_shared<const Model>(s);
-  FkOptions fk = s.solver;
-  fk.threads = 1;
-  fk.gradient_tolerance = 1e-4;
+  const FkOptions fk = AsIkMethodsRunsIt(s);
   const std::vector<Eigen::VectorXd> path = {Vec({1, 0.5, 1}), Vec({1, 1, 0.5}), Vec({0.5, 0.5, 0.5}),
                                              Vec({0.746491, 0.5, 0.514275})};
   const Eigen::VectorXd c = Vec({0.974649, 0.501302, 0.926934});
@@ -326,9 +334,7 @@ TEST(Kinematics, AStartThatCrawlsIsSolvedAgainFromRest) {
     }
   }
   o.warm_max_iterations = -1;
-  std::string why;
-  EXPECT_FALSE(o.IsValid(&why));
-  EXPECT_NE(why.find("warm_max_iterations"), std::string::npos) << why;
+  ExpectInvalidNaming(o, "warm_max_iterations");
 }
 
 // Steps far below the differences' scale (a line search's shrinking trials) are FK noise over a
