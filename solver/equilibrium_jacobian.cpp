@@ -463,8 +463,6 @@ class FreeOperator {
 struct EquilibriumJacobianWorkspace::Impl {
   const Model* model = nullptr;
   std::vector<int> elem_pos;     ///< element i, local (q, qc): A value index of (v_q, v_qc); 36 per element
-  std::vector<int> a_transpose;  ///< A value index of (v, u) for each entry (u, v)
-  std::vector<int> a_row;        ///< row of each A entry
   Eigen::SparseMatrix<double> P; ///< free-layout pattern and values
   std::vector<int> p_src;        ///< per P value: 9 * (A entry) + 3 d + d'
   LocalPreconditioner llt;
@@ -485,18 +483,12 @@ struct EquilibriumJacobianWorkspace::Impl {
     const Eigen::SparseMatrix<double>& A = m.A();
     const int nv = m.num_vertices(), nf = m.num_free_dofs();
     const int nnz = static_cast<int>(A.nonZeros());
-    a_row.resize(nnz);
-    for (int col = 0; col < A.outerSize(); ++col)
-      for (int p = A.outerIndexPtr()[col]; p < A.outerIndexPtr()[col + 1]; ++p) a_row[p] = A.innerIndexPtr()[p];
     auto find = [&](int row, int col) {
       const int* b = A.innerIndexPtr() + A.outerIndexPtr()[col];
       const int* e = A.innerIndexPtr() + A.outerIndexPtr()[col + 1];
       const int* it = std::lower_bound(b, e, row);
       return (it != e && *it == row) ? static_cast<int>(it - A.innerIndexPtr()) : -1;
     };
-    a_transpose.resize(nnz);
-    for (int col = 0; col < A.outerSize(); ++col)
-      for (int p = A.outerIndexPtr()[col]; p < A.outerIndexPtr()[col + 1]; ++p) a_transpose[p] = find(col, a_row[p]);
     const auto& els = m.elements();
     elem_pos.assign(36 * els.size(), -1);
     for (size_t i = 0; i < els.size(); ++i)
@@ -512,15 +504,15 @@ struct EquilibriumJacobianWorkspace::Impl {
     // values of the first assembly are the source ids, read back to map P's storage.
     std::vector<Eigen::Triplet<double>> t;
     t.reserve(9 * static_cast<size_t>(nnz));
-    for (int p = 0; p < nnz; ++p) {
-      int col = static_cast<int>(std::upper_bound(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1, p) -
-                                 A.outerIndexPtr()) - 1;
-      for (int d = 0; d < 3; ++d)
-        for (int dd = 0; dd < 3; ++dd) {
-          const int a = fidx[3 * static_cast<size_t>(a_row[p]) + d], b = fidx[3 * static_cast<size_t>(col) + dd];
-          if (a >= 0 && b >= 0) t.emplace_back(a, b, 9.0 * p + 3 * d + dd);
-        }
-    }
+    for (int col = 0; col < A.outerSize(); ++col)
+      for (int p = A.outerIndexPtr()[col]; p < A.outerIndexPtr()[col + 1]; ++p) {
+        const int row = A.innerIndexPtr()[p];
+        for (int d = 0; d < 3; ++d)
+          for (int dd = 0; dd < 3; ++dd) {
+            const int a = fidx[3 * static_cast<size_t>(row) + d], b = fidx[3 * static_cast<size_t>(col) + dd];
+            if (a >= 0 && b >= 0) t.emplace_back(a, b, 9.0 * p + 3 * d + dd);
+          }
+      }
     P.resize(nf, nf);
     P.setFromTriplets(t.begin(), t.end());
     P.makeCompressed();
@@ -555,7 +547,7 @@ bool FactorLocalPreconditioner(const Model& model, const EquilibriumLinearizatio
     for (auto& b : w->blocks) b.assign(9 * nnz, 0.0);
     lin.ForEachLocalBlock([&](int i, const LocalBlock& Kb, int t) {
       const ModelElement& e = els[i];
-      const int k = e.k, n = 3 * k;
+      const int k = e.k;
       LocalBlock H = -0.5 * (Kb + Kb.transpose());
       for (int q = 0; q < k; ++q)
         for (int qc = 0; qc < k; ++qc)
@@ -571,7 +563,6 @@ bool FactorLocalPreconditioner(const Model& model, const EquilibriumLinearizatio
           for (int d = 0; d < 3; ++d)
             for (int dd = 0; dd < 3; ++dd) out[9 * p + 3 * d + dd] += H(3 * q + d, 3 * qc + dd);
         }
-      (void)n;
     });
     for (int t = 1; t < nt; ++t)
       for (size_t j = 0; j < 9 * nnz; ++j) w->blocks[0][j] += w->blocks[t][j];
