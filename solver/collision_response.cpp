@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <limits>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -131,7 +131,11 @@ bool CollisionResponse::WalkOut(const Eigen::Ref<const Eigen::MatrixX3d>& X, int
   const Eigen::Vector3d p0 = X.row(v);
   const double slack = 1e-9 * model_.size();
   int cur = tet;
-  const int max_steps = 4 * mesh.num_elements() + 16;
+  // Round-off at an edge or a vertex that the ray runs along can bounce the walk between the
+  // tets around it; it usually gets out, so revisits are allowed, but the walk is capped. A
+  // straight ray crosses far fewer tets than 4096; the cap was 4 x #tets, and bouncing walks then
+  // held one check of a 30k-tet membrane for minutes.
+  const int max_steps = std::min(4 * mesh.num_elements() + 16, 4096);
   for (int step = 0; step < max_steps; ++step) {
     const auto& e = mesh.elements[cur].v;
     const Eigen::Vector3d x0 = X.row(e[0]);
