@@ -362,6 +362,35 @@ class TetPrimitive {
 
 using TetTree = CGAL::AABB_tree<CGAL::AABB_traits<K, TetPrimitive>>;
 
+struct TriData {
+  const RowX3* X = nullptr;
+  const std::vector<std::array<int, 3>>* faces = nullptr;
+};
+
+/// A triangle of a moving surface, read from the current positions (shared data).
+class TriPrimitive {
+ public:
+  using Id = int;
+  using Point = CPoint;
+  using Datum = K::Triangle_3;
+  using Shared_data = TriData;
+  TriPrimitive() = default;
+  template <class Iterator>
+  TriPrimitive(Iterator it, const TriData&) : id_(*it) {}
+  Id id() const { return id_; }
+  Datum datum(const Shared_data& d) const {
+    const auto& f = (*d.faces)[id_];
+    return Datum(P(*d.X, f[0]), P(*d.X, f[1]), P(*d.X, f[2]));
+  }
+  Point reference_point(const Shared_data& d) const { return P(*d.X, (*d.faces)[id_][0]); }
+  static Shared_data construct_shared_data(const TriData& d) { return d; }
+
+ private:
+  int id_ = -1;
+};
+
+using TriTree = CGAL::AABB_tree<CGAL::AABB_traits<K, TriPrimitive>>;
+
 // -- the point-in-tet test ------------------------------------------------------------------------
 //
 // With D = orient(a, b, c, d) and D_i the same determinant with vertex i replaced by p, the
@@ -846,6 +875,118 @@ std::vector<ObstacleContact> DetectObstacleContacts(const std::vector<Obstacle>&
   for (const auto& c : found)
     if (c.vertex >= 0) out.push_back(c);
   return out;
+}
+
+
+// ---- MovingSurface -----------------------------------------------------------------------------
+
+struct MovingSurface::Impl {
+  RowX3 X;
+  std::vector<int> ids;
+  TriTree tree;
+  bool built = false;
+};
+
+MovingSurface::MovingSurface(std::vector<std::array<int, 3>> faces)
+    : faces_(std::move(faces)), impl_(std::make_unique<Impl>()) {
+  if (faces_.empty()) throw std::invalid_argument("MovingSurface: no triangles");
+  for (const auto& f : faces_)
+    for (int v : f)
+      if (v < 0) throw std::invalid_argument("MovingSurface: negative vertex index " + std::to_string(v));
+  impl_->ids.resize(faces_.size());
+  for (size_t i = 0; i < faces_.size(); ++i) impl_->ids[i] = static_cast<int>(i);
+}
+
+MovingSurface::~MovingSurface() = default;
+MovingSurface::MovingSurface(MovingSurface&&) noexcept = default;
+MovingSurface& MovingSurface::operator=(MovingSurface&&) noexcept = default;
+
+void MovingSurface::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) {
+  for (const auto& f : faces_)
+    for (int v : f)
+      if (v >= X.rows())
+        throw std::invalid_argument("MovingSurface: a triangle refers to vertex " + std::to_string(v) +
+                                    " but the positions have " + std::to_string(X.rows()) + " rows");
+  impl_->X = X;
+  impl_->tree.rebuild(impl_->ids.begin(), impl_->ids.end(), TriData{&impl_->X, &faces_});
+  impl_->tree.accelerate_distance_queries();
+  impl_->built = true;
+}
+
+Eigen::Vector3d MovingSurface::ClosestPoint(const Eigen::Vector3d& p, int* face) const {
+  if (!impl_->built) throw std::logic_error("MovingSurface::ClosestPoint before Update");
+  const auto cp = impl_->tree.closest_point_and_primitive(CPoint(p.x(), p.y(), p.z()));
+  if (face) *face = cp.second;
+  return Eigen::Vector3d(cp.first.x(), cp.first.y(), cp.first.z());
+}
+
+namespace {
+/// Closest point to p on the triangle (a, b, c): the Voronoi regions of its vertices, edges and
+/// interior, in turn (Ericson, Real-Time Collision Detection, Sec. 5.1.5).
+Eigen::Vector3d ClosestOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                  const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+  const double den = va + vb + vc;
+  if (!(std::abs(den) > 0)) return a;  // a degenerate triangle
+  return a + ab * (vb / den) + ac * (vc / den);
+}
+}  // namespace
+
+bool MovingSurface::ClosestFacing(const Eigen::Vector3d& p, const Eigen::Vector3d& n,
+                                  Eigen::Vector3d* closest, int* face) const {
+  if (!impl_->built) throw std::logic_error("MovingSurface::ClosestFacing before Update");
+  const auto& I = *impl_;
+  const CGAL::Bbox_3 all = I.tree.bbox();
+  const double span = std::max({all.xmax() - all.xmin(), all.ymax() - all.ymin(), all.zmax() - all.zmin()});
+  // Start from the unrestricted distance: no facing triangle is closer.
+  double r = std::max((ClosestPoint(p) - p).norm(), 1e-9 * span);
+  std::vector<int> cand;
+  for (;;) {
+    cand.clear();
+    const CGAL::Bbox_3 box(p.x() - r, p.y() - r, p.z() - r, p.x() + r, p.y() + r, p.z() + r);
+    I.tree.all_intersected_primitives(box, std::back_inserter(cand));
+    double best = std::numeric_limits<double>::infinity();
+    int best_f = -1;
+    Eigen::Vector3d best_c;
+    for (int f : cand) {
+      const auto& t = faces_[f];
+      const Eigen::Vector3d a = I.X.row(t[0]), b = I.X.row(t[1]), c = I.X.row(t[2]);
+      if (!((b - a).cross(c - a).dot(n) < 0)) continue;
+      const Eigen::Vector3d q = ClosestOnTriangle(p, a, b, c);
+      const double d = (q - p).norm();
+      if (d < best || (d == best && f < best_f)) {
+        best = d;
+        best_f = f;
+        best_c = q;
+      }
+    }
+    // Every triangle within distance r meets the box, so an answer within r is final; so is
+    // the best one once the box holds the whole surface.
+    const bool covers = box.xmin() <= all.xmin() && box.ymin() <= all.ymin() && box.zmin() <= all.zmin() &&
+                        box.xmax() >= all.xmax() && box.ymax() >= all.ymax() && box.zmax() >= all.zmax();
+    if (best <= r || covers) {
+      if (best_f < 0) return false;
+      *closest = best_c;
+      if (face) *face = best_f;
+      return true;
+    }
+    r *= 2.0;
+  }
 }
 
 }  // namespace softkin

@@ -17,6 +17,7 @@
 #include <Eigen/Dense>
 
 #include <memory>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -71,6 +72,38 @@ class Obstacle {
   struct Impl;
   TriangleSurface surface_;
   Eigen::Vector3d box_min_, box_max_;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Closest-point queries on a set of triangles whose corners move with a mesh (for example, the
+/// boundary faces of one body of a robot), through a CGAL AABB tree over the triangles at the
+/// positions of the last Update(). CGAL's tree has no refit, so Update() rebuilds it (linear in the
+/// number of triangles, plus the distance-query acceleration).
+class MovingSurface {
+ public:
+  /// `faces`: vertex indices into the positions that Update() takes (each triangle once). Throws
+  /// std::invalid_argument if it is empty or holds a negative index.
+  explicit MovingSurface(std::vector<std::array<int, 3>> faces);
+  ~MovingSurface();
+  MovingSurface(MovingSurface&&) noexcept;
+  MovingSurface& operator=(MovingSurface&&) noexcept;
+  /// Takes positions X (#V x 3, mm) and rebuilds the tree. Throws std::invalid_argument if a
+  /// face refers to a row that X does not have.
+  void Update(const Eigen::Ref<const Eigen::MatrixX3d>& X);
+  /// The closest point to p on the triangles at the last Update()'s positions, and the index
+  /// (into `faces()`) of a triangle it lies on. Update() must have been called.
+  Eigen::Vector3d ClosestPoint(const Eigen::Vector3d& p, int* face = nullptr) const;
+  /// The closest point to p among the triangles that face against `n`: those whose normal
+  /// (x1 - x0) x (x2 - x0) has a negative dot product with n. Box queries of the tree, doubled
+  /// from the unrestricted distance until they hold the answer. Returns false (and leaves the
+  /// outputs alone) if no triangle faces against n.
+  bool ClosestFacing(const Eigen::Vector3d& p, const Eigen::Vector3d& n, Eigen::Vector3d* closest,
+                     int* face = nullptr) const;
+  const std::vector<std::array<int, 3>>& faces() const { return faces_; }
+
+ private:
+  struct Impl;
+  std::vector<std::array<int, 3>> faces_;
   std::unique_ptr<Impl> impl_;
 };
 

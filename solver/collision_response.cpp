@@ -79,6 +79,7 @@ CollisionResponse::CollisionResponse(const Model& model, const CollisionOptions&
         const int t = faces[i].slot / 4, f = faces[i].slot % 4;
         const auto& v = mesh.elements[t].v;
         bfaces_.push_back({v[kFace[f][0]], v[kFace[f][1]], v[kFace[f][2]]});
+        bface_slot_.push_back(faces[i].slot);
       }  // a face shared by > 2 tets is non-manifold: left without a neighbour
       i = j;
     }
@@ -95,6 +96,33 @@ CollisionResponse::CollisionResponse(const Model& model, const CollisionOptions&
   } else {
     check_vertices_.resize(nv);
     for (int v = 0; v < nv; ++v) check_vertices_[v] = v;
+  }
+
+  // Bodies: connected components of the elements (union-find over their vertices).
+  {
+    std::vector<int> parent(nv);
+    for (int v = 0; v < nv; ++v) parent[v] = v;
+    auto find = [&](int v) {
+      while (parent[v] != v) v = parent[v] = parent[parent[v]];
+      return v;
+    };
+    for (const auto& e : mesh.elements)
+      for (int a = 1; a < e.k(); ++a) {
+        const int r0 = find(e.v[0]), r1 = find(e.v[a]);
+        if (r0 != r1) parent[std::max(r0, r1)] = std::min(r0, r1);
+      }
+    std::vector<int> label(nv, -1);
+    body_.assign(nv, -1);
+    for (int v = 0; v < nv; ++v) {
+      const int r = find(v);
+      if (label[r] < 0) label[r] = num_bodies_++;
+      body_[v] = label[r];
+    }
+  }
+  if (tets && num_bodies_ > 1) {
+    body_faces_.resize(num_bodies_);
+    for (int f = 0; f < static_cast<int>(bfaces_.size()); ++f)
+      body_faces_[body_[bfaces_[f][0]]].push_back(f);
   }
 
   // k: stiffness times the median diagonal entry of A over the tested vertices.
@@ -171,6 +199,55 @@ bool CollisionResponse::WalkOut(const Eigen::Ref<const Eigen::MatrixX3d>& X, int
     cur = next;
   }
   return false;
+}
+
+std::vector<MovingSurface> CollisionResponse::MakeBodySurfaces() const {
+  std::vector<MovingSurface> out;
+  for (const auto& list : body_faces_) {
+    std::vector<std::array<int, 3>> tri;
+    tri.reserve(list.size());
+    for (int f : list) tri.push_back(bfaces_[f]);
+    if (tri.empty()) tri.push_back({0, 0, 0});  // a body without a boundary (never queried)
+    out.emplace_back(std::move(tri));
+  }
+  return out;
+}
+
+bool CollisionResponse::BodyTarget(const MovingSurface& surface, int b,
+                                   const Eigen::Ref<const Eigen::MatrixX3d>& X, int v,
+                                   CollisionSpring* s) const {
+  if (body_faces_[b].empty()) return false;
+  const Eigen::Vector3d p = X.row(v);
+  // The closest point among the faces of b that face v's own surface (their outward normals
+  // against n(v)): a vertex of a face pressed onto b's top goes back up, not out through a side
+  // face of b that it happens to lie on. Without such a face, the closest point of all.
+  int tri = -1;
+  Eigen::Vector3d c;
+  const Eigen::Vector3d n = VertexNormal(X, v);
+  if (!(n.norm() > 0) || !surface.ClosestFacing(p, n, &c, &tri)) c = surface.ClosestPoint(p, &tri);
+  const int face = body_faces_[b][tri];
+  Eigen::Vector3d dir = c - p;
+  const double depth = dir.norm();
+  // Out of body b through its surface: towards the closest point or, with v on the surface,
+  // along the face's outward normal.
+  if (depth > 1e-9 * model_.size()) {
+    dir /= depth;
+  } else {
+    const auto& f = bfaces_[face];
+    const Eigen::Vector3d x0 = X.row(f[0]), x1 = X.row(f[1]), x2 = X.row(f[2]);
+    dir = (x1 - x0).cross(x2 - x0);
+    if (!(dir.norm() > 0)) return false;
+    dir.normalize();
+  }
+  s->vertex = v;
+  s->kind = CollisionSpring::Kind::Self;
+  s->other = -1;
+  s->normal = dir;
+  s->depth = depth;
+  s->exit_face = bface_slot_[face];
+  // Half the overlap, as for the walk (both sides of a face-to-face contact get springs).
+  s->target = p + 0.5 * (c - p) + options_.epsilon * dir;
+  return true;
 }
 
 bool CollisionResponse::SelfTarget(const Eigen::Ref<const Eigen::MatrixX3d>& X, int v, int tet,
@@ -250,10 +327,25 @@ bool CollisionResponse::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) {
     obst_vertex.push_back(c.vertex);
   }
   std::sort(obst_vertex.begin(), obst_vertex.end());
+  std::vector<char> fresh(body_faces_.size(), 0);
   for (const auto& c : self) {
     if (std::binary_search(obst_vertex.begin(), obst_vertex.end(), c.vertex)) continue;
     CollisionSpring s;
-    if (SelfTarget(X, c.vertex, c.tet, &s))
+    const int b = body_[model_.mesh().elements[c.tet].v[0]];
+    bool ok;
+    if (options_.self_target == "auto" && !body_faces_.empty() && b != body_[c.vertex]) {
+      // Between two bodies: the closest point of the other body's surface.
+      if (body_surface_.empty()) body_surface_ = MakeBodySurfaces();
+      if (!fresh[b]) {
+        body_surface_[b].Update(X);
+        fresh[b] = 1;
+      }
+      ok = BodyTarget(body_surface_[b], b, X, c.vertex, &s);
+      s.other = c.tet;
+    } else {
+      ok = SelfTarget(X, c.vertex, c.tet, &s);
+    }
+    if (ok)
       next.push_back(s);
     else
       ++stats_.unresolved;
@@ -366,9 +458,22 @@ CollisionCheck CollisionResponse::Check(const Eigen::Ref<const Eigen::MatrixX3d>
   }
   if (det) {
     det->Update(X);
+    std::vector<MovingSurface> surfaces;
+    std::vector<char> fresh(body_faces_.size(), 0);
     for (const auto& c : det->Detect()) {
       ++r.self_contacts;
       const Eigen::Vector3d p = X.row(c.vertex);
+      const int b = body_[model_.mesh().elements[c.tet].v[0]];
+      if (!body_faces_.empty() && b != body_[c.vertex] && !body_faces_[b].empty()) {
+        // Between two bodies the penetration is the distance to the other body's surface.
+        if (surfaces.empty()) surfaces = MakeBodySurfaces();
+        if (!fresh[b]) {
+          surfaces[b].Update(X);
+          fresh[b] = 1;
+        }
+        r.max_penetration = std::max(r.max_penetration, (surfaces[b].ClosestPoint(p) - p).norm());
+        continue;
+      }
       const auto& e = model_.mesh().elements[c.tet].v;
       const Eigen::Vector3d centroid =
           (X.row(e[0]) + X.row(e[1]) + X.row(e[2]) + X.row(e[3])).transpose() / 4.0;

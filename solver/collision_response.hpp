@@ -118,12 +118,21 @@ class CollisionResponse {
                const Eigen::Vector3d& dir, Eigen::Vector3d* exit, int* exit_face = nullptr) const;
   /// Outward unit normal of the boundary at vertex v (at X); zero for an interior vertex.
   Eigen::Vector3d VertexNormal(const Eigen::Ref<const Eigen::MatrixX3d>& X, int v) const;
+  /// Body of vertex v: the connected component (tets sharing a vertex) of the mesh it belongs to.
+  int body(int v) const { return body_[v]; }
+  int num_bodies() const { return num_bodies_; }
 
  private:
   /// Target of a self-collided vertex v inside `tet`; false if none was found.
   bool SelfTarget(const Eigen::Ref<const Eigen::MatrixX3d>& X, int v, int tet,
                   CollisionSpring* s) const;
   void ObstacleTarget(const Eigen::Vector3d& p, int obstacle, CollisionSpring* s) const;
+  /// Target of vertex v (at X) inside body b != body(v): the closest point on b's boundary
+  /// surface (`surface`, at the current positions). False if b has no boundary faces.
+  bool BodyTarget(const MovingSurface& surface, int b, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                  int v, CollisionSpring* s) const;
+  /// A boundary surface per body, built (once) if the mesh has more than one body.
+  std::vector<MovingSurface> MakeBodySurfaces() const;
 
   const Model& model_;
   CollisionOptions options_;
@@ -139,6 +148,14 @@ class CollisionResponse {
   // Boundary faces (outward, v0 v1 v2) and, per vertex, its boundary faces (CSR).
   std::vector<std::array<int, 3>> bfaces_;
   std::vector<int> vface_offset_, vface_;
+  std::vector<int> bface_slot_;  // tet * 4 + local face of each boundary face
+  // Bodies: connected components of the mesh (tets sharing a vertex), per vertex. Contacts
+  // between two bodies take the closest point of the other body's surface as their exit
+  // (options.self_target "auto"); body_surface_[b] holds body b's boundary faces.
+  std::vector<int> body_;
+  int num_bodies_ = 0;
+  std::vector<MovingSurface> body_surface_;
+  std::vector<std::vector<int>> body_faces_;  // per body, indices into bfaces_
   CollisionStats stats_;
 };
 

@@ -13,6 +13,8 @@ bool CollisionOptions::IsValid(std::string* why) const {
   if (check_interval < 1) return bad("collision.check_interval: expected an integer >= 1");
   if (update != "updown" && update != "refactor")
     return bad("collision.update: expected one of updown, refactor; got '" + update + "'");
+  if (self_target != "auto" && self_target != "walk")
+    return bad("collision.self_target: expected one of auto, walk; got '" + self_target + "'");
   return true;
 }
 

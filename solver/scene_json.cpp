@@ -303,6 +303,11 @@ const std::vector<KeySpec>& KeyTable() {
                     "How the factor follows the spring set: CHOLMOD update/downdate, or a numeric "
                     "refactorisation.")
                     .Def(co.update).Choices({"updown", "refactor"}));
+    t.push_back(Key("solver.collision.self_target", S, Opt,
+                    "Where a self-collided vertex is sent: 'walk' along -n(v) through the collided "
+                    "region (the thesis's rule) for every contact, or 'auto': the same within one "
+                    "body, the closest point of the other body's surface between separate bodies.")
+                    .Def(co.self_target).Choices({"auto", "walk"}));
     return t;
   }();
   return table;
@@ -1158,6 +1163,7 @@ Scene SceneParser::Build(const json& root) {
   o.collision.stiffness = Get(col, "solver.collision", "stiffness").get<double>();
   o.collision.check_interval = AsInt(Get(col, "solver.collision", "check_interval"));
   o.collision.update = Get(col, "solver.collision", "update").get<std::string>();
+  o.collision.self_target = Get(col, "solver.collision", "self_target").get<std::string>();
   std::string why;
   if (!o.IsValid(&why)) Fail("solver." + why);
 

@@ -76,6 +76,54 @@ TEST(Collision, ObstacleQueries) {
   EXPECT_GT(n.x(), 0.99);
 }
 
+// MovingSurface: closest points on the box [0, 2] x [0, 3] x [0, 4], moved rigidly, against the
+// analytic answers: the distance to the box from outside, the nearest face from inside, and the
+// top face for a point whose own surface faces down (ClosestFacing with n = -z).
+TEST(Collision, MovingSurfaceClosestPoints) {
+  const TriangleSurface box = MakeBoxSurface(Eigen::Vector3d::Zero(), Eigen::Vector3d(2, 3, 4));
+  std::vector<std::array<int, 3>> faces;
+  for (int f = 0; f < box.faces.rows(); ++f) faces.push_back({box.faces(f, 0), box.faces(f, 1), box.faces(f, 2)});
+  MovingSurface surface(faces);
+  const Eigen::Vector3d shift(10, -5, 7);
+  Eigen::MatrixX3d X = box.vertices;
+  X.rowwise() += shift.transpose();
+  surface.Update(X);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> U(-2, 6);
+  const Eigen::Array3d hi(2, 3, 4);
+  int inside = 0, outside = 0;
+  for (int k = 0; k < 400; ++k) {
+    const Eigen::Vector3d q(U(rng), U(rng), U(rng));  // box frame
+    const Eigen::Array3d below = (-q.array()).max(0.0), above = (q.array() - hi).max(0.0);
+    const Eigen::Vector3d p = q + shift;
+    int face = -1;
+    const Eigen::Vector3d c = surface.ClosestPoint(p, &face);
+    ASSERT_GE(face, 0);
+    if ((below + above).maxCoeff() > 0) {
+      ++outside;
+      EXPECT_NEAR((c - p).norm(), (below + above).matrix().norm(), 1e-9);
+    } else {
+      ++inside;
+      const double d = std::min((q.array()).minCoeff(), (hi - q.array()).minCoeff());
+      EXPECT_NEAR((c - p).norm(), d, 1e-9);
+      Eigen::Vector3d top;
+      ASSERT_TRUE(surface.ClosestFacing(p, -Eigen::Vector3d::UnitZ(), &top, &face));
+      EXPECT_NEAR((top - (p + (4.0 - q.z()) * Eigen::Vector3d::UnitZ())).norm(), 0.0, 1e-9);
+      const auto& t = faces[face];
+      EXPECT_NEAR(X(t[0], 2) + X(t[1], 2) + X(t[2], 2), 3 * (4.0 + shift.z()), 1e-9);  // a top triangle
+    }
+  }
+  EXPECT_GT(inside, 10);
+  EXPECT_GT(outside, 20);
+  // No face of a box faces against the zero vector.
+  Eigen::Vector3d none;
+  EXPECT_FALSE(surface.ClosestFacing(shift, Eigen::Vector3d::Zero(), &none));
+  EXPECT_THROW(MovingSurface({}), std::invalid_argument);
+  EXPECT_THROW(MovingSurface({{0, 1, -2}}), std::invalid_argument);
+  MovingSurface small({{0, 1, 9}});
+  EXPECT_THROW(small.Update(X), std::invalid_argument);  // X has 8 rows
+}
+
 TEST(Collision, ReadersAcceptObjAndBothStlForms) {
   const fs::path obj = Temp("cube.obj");
   Write(obj, kCubeObj);

@@ -914,6 +914,7 @@ const std::vector<std::string> kAllKeys = {
     "solver.anderson_window", "solver.anderson_safeguard", "solver.continuation_steps", "solver.threads",
     "solver.collision", "solver.collision.self", "solver.collision.obstacles", "solver.collision.epsilon",
     "solver.collision.stiffness", "solver.collision.check_interval", "solver.collision.update",
+    "solver.collision.self_target",
     "obstacles", "obstacles[].type", "obstacles[].min", "obstacles[].max", "obstacles[].base",
     "obstacles[].axis", "obstacles[].radius", "obstacles[].height", "obstacles[].segments",
     "obstacles[].file"};
