@@ -306,7 +306,8 @@ const std::vector<KeySpec>& KeyTable() {
     t.push_back(Key("solver.collision.self_target", S, Opt,
                     "Where a self-collided vertex is sent: 'walk' along -n(v) through the collided "
                     "region (the thesis's rule) for every contact, or 'auto': the same within one "
-                    "body, the closest point of the other body's surface between separate bodies.")
+                    "body, the closest facing point of the other body's surface between separate "
+                    "bodies.")
                     .Def(co.self_target).Choices({"auto", "walk"}));
     return t;
   }();
