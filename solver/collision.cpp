@@ -333,63 +333,44 @@ using RowX3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
 CPoint P(const RowX3& X, int v) { return CPoint(X(v, 0), X(v, 1), X(v, 2)); }
 
-struct TetData {
+/// Cells with N corners (tets, triangles) indexing into positions that move (shared data).
+template <int N>
+struct CellData {
   const RowX3* X = nullptr;
-  const std::vector<std::array<int, 4>>* tets = nullptr;
+  const std::vector<std::array<int, N>>* cells = nullptr;
 };
 
-/// A tetrahedron of the robot, read from the current positions (shared data), for CGAL's tree.
-class TetPrimitive {
+/// One cell (a tet of the robot, a triangle of a moving surface), read from the current positions
+/// in the shared data, for CGAL's tree. Datum: the CGAL object built from the N corners.
+template <int N, class DatumT>
+class CellPrimitive {
  public:
   using Id = int;
   using Point = CPoint;
-  using Datum = K::Tetrahedron_3;
-  using Shared_data = TetData;
-  TetPrimitive() = default;
+  using Datum = DatumT;
+  using Shared_data = CellData<N>;
+  CellPrimitive() = default;
   template <class Iterator>
-  TetPrimitive(Iterator it, const TetData&) : id_(*it) {}
+  CellPrimitive(Iterator it, const Shared_data&) : id_(*it) {}
   Id id() const { return id_; }
   Datum datum(const Shared_data& d) const {
-    const auto& t = (*d.tets)[id_];
-    return Datum(P(*d.X, t[0]), P(*d.X, t[1]), P(*d.X, t[2]), P(*d.X, t[3]));
+    const auto& c = (*d.cells)[id_];
+    if constexpr (N == 4)
+      return Datum(P(*d.X, c[0]), P(*d.X, c[1]), P(*d.X, c[2]), P(*d.X, c[3]));
+    else
+      return Datum(P(*d.X, c[0]), P(*d.X, c[1]), P(*d.X, c[2]));
   }
-  Point reference_point(const Shared_data& d) const { return P(*d.X, (*d.tets)[id_][0]); }
-  static Shared_data construct_shared_data(const TetData& d) { return d; }
+  Point reference_point(const Shared_data& d) const { return P(*d.X, (*d.cells)[id_][0]); }
+  static Shared_data construct_shared_data(const Shared_data& d) { return d; }
 
  private:
   int id_ = -1;
 };
 
-using TetTree = CGAL::AABB_tree<CGAL::AABB_traits<K, TetPrimitive>>;
-
-struct TriData {
-  const RowX3* X = nullptr;
-  const std::vector<std::array<int, 3>>* faces = nullptr;
-};
-
-/// A triangle of a moving surface, read from the current positions (shared data).
-class TriPrimitive {
- public:
-  using Id = int;
-  using Point = CPoint;
-  using Datum = K::Triangle_3;
-  using Shared_data = TriData;
-  TriPrimitive() = default;
-  template <class Iterator>
-  TriPrimitive(Iterator it, const TriData&) : id_(*it) {}
-  Id id() const { return id_; }
-  Datum datum(const Shared_data& d) const {
-    const auto& f = (*d.faces)[id_];
-    return Datum(P(*d.X, f[0]), P(*d.X, f[1]), P(*d.X, f[2]));
-  }
-  Point reference_point(const Shared_data& d) const { return P(*d.X, (*d.faces)[id_][0]); }
-  static Shared_data construct_shared_data(const TriData& d) { return d; }
-
- private:
-  int id_ = -1;
-};
-
-using TriTree = CGAL::AABB_tree<CGAL::AABB_traits<K, TriPrimitive>>;
+using TetData = CellData<4>;
+using TetTree = CGAL::AABB_tree<CGAL::AABB_traits<K, CellPrimitive<4, K::Tetrahedron_3>>>;
+using TriData = CellData<3>;
+using TriTree = CGAL::AABB_tree<CGAL::AABB_traits<K, CellPrimitive<3, K::Triangle_3>>>;
 
 // -- the point-in-tet test ------------------------------------------------------------------------
 //
