@@ -245,8 +245,7 @@ bool CollisionResponse::BodyTarget(const MovingSurface& surface, int b,
   s->normal = dir;
   s->depth = depth;
   s->exit_face = bface_slot_[face];
-  // Half the overlap, as for the walk (both sides of a face-to-face contact get springs).
-  s->target = p + 0.5 * (c - p) + options_.epsilon * dir;
+  SetSelfTarget(X, c, bfaces_[face], s);
   return true;
 }
 
@@ -278,13 +277,54 @@ bool CollisionResponse::SelfTarget(const Eigen::Ref<const Eigen::MatrixX3d>& X, 
     s->other = tet;
     s->normal = dir;
     s->depth = depth;
-    // Both sides of a face-to-face contact have vertices inside the other: each spring takes
-    // half the overlap (the targets are refreshed at every check, so a one-sided contact still
-    // closes, halving each time), plus the offset.
-    s->target = p + 0.5 * (exit - p) + options_.epsilon * dir;
+    const auto& fe = model_.mesh().elements[face / 4].v;
+    const int j = face % 4;
+    SetSelfTarget(X, exit, {fe[kFace[j][0]], fe[kFace[j][1]], fe[kFace[j][2]]}, s);
     if (q == 0) break;  // -n(v) worked
   }
   return std::isfinite(best);
+}
+
+void CollisionResponse::SetSelfTarget(const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                                      const Eigen::Vector3d& exit, const std::array<int, 3>& face,
+                                      CollisionSpring* s) const {
+  const Eigen::Vector3d p = X.row(s->vertex);
+  const Eigen::Vector3d off = options_.epsilon * s->normal;
+  s->face = {-1, -1, -1};
+  if (options_.self_spring == "pair") {
+    // Barycentric coordinates of the exit point in the face (clamped into it: the walk's exit
+    // lies on the face up to round-off, the closest point on it exactly).
+    const Eigen::Vector3d a = X.row(face[0]), b = X.row(face[1]), c = X.row(face[2]);
+    const Eigen::Vector3d e1 = b - a, e2 = c - a, r = exit - a;
+    const double d11 = e1.dot(e1), d12 = e1.dot(e2), d22 = e2.dot(e2);
+    const double det = d11 * d22 - d12 * d12;
+    if (det > 1e-12 * d11 * d22) {
+      Eigen::Vector3d w;
+      w[1] = (d22 * r.dot(e1) - d12 * r.dot(e2)) / det;
+      w[2] = (d11 * r.dot(e2) - d12 * r.dot(e1)) / det;
+      w[0] = 1.0 - w[1] - w[2];
+      w = w.cwiseMax(0.0);
+      w /= w.sum();
+      s->face = face;
+      s->weights = w;
+      // The whole overlap: the face moves towards v as v moves out.
+      s->target = exit + off;
+      s->offset = s->target - (w[0] * a + w[1] * b + w[2] * c);
+      return;
+    }
+    // A degenerate (flat) face: a fixed target, as below.
+  }
+  // Both sides of a face-to-face contact have vertices inside the other: each spring takes half
+  // the overlap (the targets are refreshed at every check, so a one-sided contact still closes,
+  // halving each time), plus the offset.
+  s->target = p + 0.5 * (exit - p) + off;
+}
+
+std::vector<SpringStencil> CollisionResponse::Stencils() const {
+  std::vector<SpringStencil> st;
+  st.reserve(springs_.size());
+  for (const auto& s : springs_) st.push_back(s.Stencil());
+  return st;
 }
 
 void CollisionResponse::ObstacleTarget(const Eigen::Vector3d& p, int obstacle,
@@ -352,6 +392,20 @@ bool CollisionResponse::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) {
   }
   std::sort(next.begin(), next.end(),
             [](const CollisionSpring& a, const CollisionSpring& b) { return a.vertex < b.vertex; });
+  // A pair spring whose contact persists on the same face, its point moved by less than a fifth
+  // of the face, keeps its weights (so its column of the matrix): the offset takes up the
+  // refreshed target.
+  for (auto& s : next) {
+    if (!s.pair()) continue;
+    const auto it = std::lower_bound(
+        springs_.begin(), springs_.end(), s.vertex,
+        [](const CollisionSpring& a, int v) { return a.vertex < v; });
+    if (it == springs_.end() || it->vertex != s.vertex || it->face != s.face) continue;
+    if ((it->weights - s.weights).cwiseAbs().maxCoeff() > 0.2) continue;
+    s.weights = it->weights;
+    s.offset = s.target - (s.weights[0] * X.row(s.face[0]) + s.weights[1] * X.row(s.face[1]) +
+                           s.weights[2] * X.row(s.face[2])).transpose();
+  }
   // Springs of vertices no longer in collision: release by Eq. 3.8, else keep (obstacle targets
   // follow the closest point as the vertex slides).
   std::vector<CollisionSpring> kept;
@@ -396,36 +450,43 @@ bool CollisionResponse::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) {
   std::sort(next.begin(), next.end(),
             [](const CollisionSpring& a, const CollisionSpring& b) { return a.vertex < b.vertex; });
   springs_ = std::move(next);
-  std::vector<int> verts(springs_.size());
-  for (size_t i = 0; i < springs_.size(); ++i) verts[i] = springs_[i].vertex;
-  const bool changed = system_.SetSprings(verts, k_);
+  const bool changed = system_.SetSprings(Stencils(), k_);
   stats_.max_springs = std::max(stats_.max_springs, static_cast<int>(springs_.size()));
   stats_.response_s += Since(t1);
   return changed;
 }
 
-void CollisionResponse::AddToRhs(Eigen::VectorXd* Bf) const {
-  for (const auto& s : springs_)
+void CollisionResponse::AddToRhs(const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                                 Eigen::VectorXd* Bf) const {
+  for (const auto& s : springs_) {
+    const SpringStencil st = s.Stencil();
+    const Eigen::Vector3d delta = s.pair() ? s.offset : s.target;
     for (int d = 0; d < 3; ++d) {
-      const int i = model_.free_index(d)[s.vertex];
-      if (i >= 0) (*Bf)[model_.free_offset(d) + i] += k_ * s.target[d];
+      const std::vector<int>& fi = model_.free_index(d);
+      // k c (delta - c . x_prescribed) on the free entries of c.
+      double a = delta[d];
+      for (int j = 0; j < 4; ++j)
+        if (st.vertex[j] >= 0 && fi[st.vertex[j]] < 0) a -= st.coef[j] * X(st.vertex[j], d);
+      for (int j = 0; j < 4; ++j)
+        if (st.vertex[j] >= 0 && fi[st.vertex[j]] >= 0)
+          (*Bf)[model_.free_offset(d) + fi[st.vertex[j]]] += k_ * st.coef[j] * a;
     }
+  }
 }
 
 void CollisionResponse::AddSpringProduct(const Eigen::Ref<const Eigen::MatrixX3d>& X,
                                          Eigen::VectorXd* y) const {
-  for (const auto& s : springs_)
-    for (int d = 0; d < 3; ++d) {
-      const int i = model_.free_index(d)[s.vertex];
-      if (i >= 0) (*y)[model_.free_offset(d) + i] += k_ * X(s.vertex, d);
-    }
+  if (springs_.empty()) return;
+  Eigen::VectorXd xf;
+  model_.GatherFree(X, &xf);
+  system_.AddSpringProduct(xf, y);
 }
 
 void CollisionResponse::Reset() {
   springs_.clear();
   k_ = k0_;
   raises_ = 0;
-  system_.SetSprings({}, k_);
+  system_.SetSprings(std::vector<SpringStencil>(), k_);
   stats_ = CollisionStats();
 }
 
@@ -435,16 +496,14 @@ bool CollisionResponse::Stiffen(int max_raises) {
   ++stats_.stiffenings;
   k_ *= 4.0;
   const auto t0 = Clock::now();
-  std::vector<int> verts(springs_.size());
-  for (size_t i = 0; i < springs_.size(); ++i) verts[i] = springs_[i].vertex;
-  system_.SetSprings(verts, k_);
+  system_.SetSprings(Stencils(), k_);
   stats_.response_s += Since(t0);
   return true;
 }
 
 double CollisionResponse::Energy(const Eigen::Ref<const Eigen::MatrixX3d>& X) const {
   double e = 0;
-  for (const auto& s : springs_) e += k_ * (X.row(s.vertex).transpose() - s.target).squaredNorm();
+  for (const auto& s : springs_) e += k_ * (X.row(s.vertex).transpose() - s.TargetAt(X)).squaredNorm();
   return e;
 }
 

@@ -19,6 +19,15 @@
 /// keeps contact without adhesion. The local-global solver minimises E_ela + E_col (Eq. 3.9):
 /// targets are fixed in the global step, whose matrix gains k on the springs' rows, kept factored
 /// by SpringSystem (CHOLMOD update/downdate).
+///
+/// With options.self_spring "pair", a self spring instead pulls v to the exit point taken as a
+/// point of the exit face f, sum_i w_i x_fi (w its barycentric coordinates when detected), plus
+/// an offset delta (eps along the exit direction): E = k ||v - sum_i w_i x_fi - delta||^2. The
+/// face's vertices are unknowns of the global step too, so the spring pushes v out and the face
+/// back with equal and opposite forces, and the target follows the face within the step. The
+/// whole overlap is the target (the face moves too). While a contact persists its face and
+/// weights are kept (delta absorbs the refreshed exit point), so the matrix changes only when a
+/// contact starts, ends, or slides to another face or by a fifth of the face.
 #include "solver/collision.hpp"
 #include "solver/model.hpp"
 #include "solver/spring_system.hpp"
@@ -43,6 +52,22 @@ struct CollisionSpring {
   /// Self: the boundary face the walk left the collided region through (tet * 4 + local face),
   /// whose current plane gives the contact surface while the vertex is out of collision.
   int exit_face = -1;
+  /// Vertex-face ("pair") springs: the face's vertex ids, the barycentric weights of the point
+  /// the spring pulls v to, and the offset delta; the target is sum_i w_i x_fi + delta. face[0]
+  /// < 0 for a fixed target.
+  std::array<int, 3> face{-1, -1, -1};
+  Eigen::Vector3d weights = Eigen::Vector3d::Zero();
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+  bool pair() const { return face[0] >= 0; }
+  /// Where the spring pulls v to at positions X.
+  Eigen::Vector3d TargetAt(const Eigen::Ref<const Eigen::MatrixX3d>& X) const {
+    if (!pair()) return target;
+    return weights[0] * X.row(face[0]).transpose() + weights[1] * X.row(face[1]).transpose() +
+           weights[2] * X.row(face[2]).transpose() + offset;
+  }
+  SpringStencil Stencil() const {
+    return pair() ? SpringStencil::VertexFace(vertex, face, weights) : SpringStencil::Unit(vertex);
+  }
 };
 
 /// Result of an exact collision check of a state.
@@ -77,13 +102,15 @@ class CollisionResponse {
   /// Detection at positions X (#V x 3) and the spring rule: adds, refreshes and releases springs.
   /// Returns true if the set of spring vertices (hence the global matrix) changed.
   bool Update(const Eigen::Ref<const Eigen::MatrixX3d>& X);
-  /// Adds the springs' k v_c to the free right-hand side (layout of Model::GatherFree).
-  void AddToRhs(Eigen::VectorXd* Bf) const;
-  /// Adds K x (the springs' k on their free coordinates, x = the free coordinates of X) to y.
+  /// Adds the springs' constant terms to the free right-hand side (layout of Model::GatherFree):
+  /// k c_s (delta_s - c_s . x_prescribed) per spring, k v_c for a fixed target. X supplies the
+  /// prescribed coordinates (of a pair spring's face).
+  void AddToRhs(const Eigen::Ref<const Eigen::MatrixX3d>& X, Eigen::VectorXd* Bf) const;
+  /// Adds K x (x = the free coordinates of X) to y.
   void AddSpringProduct(const Eigen::Ref<const Eigen::MatrixX3d>& X, Eigen::VectorXd* y) const;
   /// Releases every spring and zeroes the statistics (the start of a new solve).
   void Reset();
-  /// E_col = sum k ||v - v_c||^2 at positions X.
+  /// E_col = sum k ||v - v_c||^2 at positions X (v_c = CollisionSpring::TargetAt(X)).
   double Energy(const Eigen::Ref<const Eigen::MatrixX3d>& X) const;
   /// Solves (A_ff + K) y = rhs (free layout).
   Eigen::VectorXd Solve(const Eigen::VectorXd& rhs) const { return system_.Solve(rhs); }
@@ -127,6 +154,11 @@ class CollisionResponse {
   bool SelfTarget(const Eigen::Ref<const Eigen::MatrixX3d>& X, int v, int tet,
                   CollisionSpring* s) const;
   void ObstacleTarget(const Eigen::Vector3d& p, int obstacle, CollisionSpring* s) const;
+  /// Sets the target of self spring s (vertex, normal = exit direction set) from its exit point
+  /// on the boundary face `face` (vertex ids): half way plus eps, or the face point plus eps.
+  void SetSelfTarget(const Eigen::Ref<const Eigen::MatrixX3d>& X, const Eigen::Vector3d& exit,
+                     const std::array<int, 3>& face, CollisionSpring* s) const;
+  std::vector<SpringStencil> Stencils() const;
   /// Target of vertex v (at X) inside body b != body(v): the closest point on b's boundary
   /// surface (`surface`, at the current positions). False if b has no boundary faces.
   bool BodyTarget(const MovingSurface& surface, int b, const Eigen::Ref<const Eigen::MatrixX3d>& X,

@@ -15,6 +15,8 @@ bool CollisionOptions::IsValid(std::string* why) const {
     return bad("collision.update: expected one of updown, refactor; got '" + update + "'");
   if (self_target != "auto" && self_target != "walk")
     return bad("collision.self_target: expected one of auto, walk; got '" + self_target + "'");
+  if (self_spring != "target" && self_spring != "pair")
+    return bad("collision.self_spring: expected one of target, pair; got '" + self_spring + "'");
   return true;
 }
 

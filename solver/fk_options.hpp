@@ -30,6 +30,13 @@ struct CollisionOptions {
   /// measured cases it converges no better, and it unbalances the pressed blocks' contact forces
   /// more (docs/collision_response.md).
   std::string self_target = "walk";
+  /// What a self-collision spring pulls a vertex v to. "target" (the default, Eq. 3.5): a fixed
+  /// point v_c, half way to the exit point plus eps (both sides of a contact get springs), set at
+  /// each check. "pair": the exit point as a point of the exit face, sum_i w_i x_fi, plus eps:
+  /// the energy k ||v - sum_i w_i x_fi - delta||^2 moves with the face and loads both sides
+  /// equally and oppositely (action and reaction), so it couples v with the face's vertices in
+  /// the global matrix (SpringSystem).
+  std::string self_spring = "target";
   bool IsValid(std::string* why) const;
 };
 

@@ -55,7 +55,7 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     m.GatherFree(B, &Bf);
     if (resp) {
       *E += resp->Energy(X);
-      resp->AddToRhs(&Bf);
+      resp->AddToRhs(X, &Bf);
     }
     r->local_time_s += Seconds(t0, Clock::now());
   };

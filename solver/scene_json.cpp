@@ -309,6 +309,11 @@ const std::vector<KeySpec>& KeyTable() {
                     "body, the closest facing point of the other body's surface between separate "
                     "bodies.")
                     .Def(co.self_target).Choices({"auto", "walk"}));
+    t.push_back(Key("solver.collision.self_spring", S, Opt,
+                    "What a self-collision spring pulls its vertex to: a fixed 'target' half way "
+                    "to the exit point (Eq. 3.5), or 'pair': the exit point as a point of the "
+                    "exit face, which moves with the face and loads both sides equally.")
+                    .Def(co.self_spring).Choices({"target", "pair"}));
     return t;
   }();
   return table;
@@ -1165,6 +1170,7 @@ Scene SceneParser::Build(const json& root) {
   o.collision.check_interval = AsInt(Get(col, "solver.collision", "check_interval"));
   o.collision.update = Get(col, "solver.collision", "update").get<std::string>();
   o.collision.self_target = Get(col, "solver.collision", "self_target").get<std::string>();
+  o.collision.self_spring = Get(col, "solver.collision", "self_spring").get<std::string>();
   std::string why;
   if (!o.IsValid(&why)) Fail("solver." + why);
 

@@ -1,12 +1,15 @@
 #include "solver/spring_system.hpp"
 
+#include <Eigen/Sparse>
 #include <cholmod.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iterator>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace softkin {
 
@@ -26,6 +29,7 @@ struct SpringSystem::Impl {
     const std::vector<int>* free_index = nullptr;
     std::vector<int> inv_perm;
     int n = 0;
+    bool own_pattern = false;  // analysed for A_ff + K with coupling springs (not A's pattern)
   };
   std::vector<Factor> factors;
   std::vector<int> axes_of_factor_first;  // one axis per factor
@@ -61,33 +65,71 @@ SpringSystem::SpringSystem(const Model& model, Method method)
 
 SpringSystem::~SpringSystem() = default;
 
-bool SpringSystem::Modify(const std::vector<int>& verts, bool add) {
-  if (verts.empty()) return false;
+SpringStencil SpringStencil::Unit(int v) {
+  SpringStencil s;
+  s.vertex[0] = v;
+  s.coef[0] = 1.0;
+  return s;
+}
+
+SpringStencil SpringStencil::VertexFace(int v, const std::array<int, 3>& f, const Eigen::Vector3d& w) {
+  SpringStencil s = Unit(v);
+  for (int i = 0; i < 3; ++i) {
+    s.vertex[i + 1] = f[i];
+    s.coef[i + 1] = -w[i];
+  }
+  return s;
+}
+
+namespace {
+/// The free entries (free index, coefficient) of stencil s under `free_index`, duplicates merged.
+int FreeEntries(const SpringStencil& s, const std::vector<int>& free_index,
+                std::array<std::pair<int, double>, 4>* out) {
+  int n = 0;
+  for (int j = 0; j < 4; ++j) {
+    if (s.vertex[j] < 0 || s.coef[j] == 0.0) continue;
+    const int i = free_index[s.vertex[j]];
+    if (i < 0) continue;
+    int q = 0;
+    while (q < n && (*out)[q].first != i) ++q;
+    if (q < n)
+      (*out)[q].second += s.coef[j];
+    else
+      (*out)[n++] = {i, s.coef[j]};
+  }
+  return n;
+}
+}  // namespace
+
+bool SpringSystem::Modify(const std::vector<SpringStencil>& springs, bool add) {
+  if (springs.empty()) return false;
   auto& cm = impl_->cm;
   const double s = std::sqrt(k_);
   for (auto& F : impl_->factors) {
-    // C: n x r, one entry sqrt(k) per column, in the factor's permuted row order (L D L^T is
+    // C: n x r, one column sqrt(k) c_s per spring, in the factor's permuted row order (L D L^T is
     // the factor of P A P^T, so the update of A by c c^T is P c (P c)^T).
-    std::vector<int> rows;
-    rows.reserve(verts.size());
-    for (int v : verts) {
-      const int i = (*F.free_index)[v];
-      if (i >= 0) rows.push_back(F.inv_perm[i]);
+    std::vector<int> Cp = {0}, Ci;
+    std::vector<double> Cx;
+    for (const auto& sp : springs) {
+      std::array<std::pair<int, double>, 4> e;
+      int n = FreeEntries(sp, *F.free_index, &e);
+      for (int j = 0; j < n; ++j) e[j].first = F.inv_perm[e[j].first];
+      std::sort(e.begin(), e.begin() + n);
+      for (int j = 0; j < n; ++j) {
+        Ci.push_back(e[j].first);
+        Cx.push_back(s * e[j].second);
+      }
+      if (n > 0) Cp.push_back(static_cast<int>(Ci.size()));
     }
-    if (rows.empty()) continue;
-    const int r = static_cast<int>(rows.size());
-    cholmod_sparse* C = cholmod_allocate_sparse(F.n, r, r, /*sorted=*/1, /*packed=*/1,
+    const int r = static_cast<int>(Cp.size()) - 1;
+    if (r == 0) continue;
+    const int nnz = static_cast<int>(Ci.size());
+    cholmod_sparse* C = cholmod_allocate_sparse(F.n, r, nnz, /*sorted=*/1, /*packed=*/1,
                                                 /*stype=*/0, CHOLMOD_REAL, &cm);
     if (!C) throw std::runtime_error("spring system: CHOLMOD out of memory");
-    int* Cp = static_cast<int*>(C->p);
-    int* Ci = static_cast<int*>(C->i);
-    double* Cx = static_cast<double*>(C->x);
-    for (int j = 0; j < r; ++j) {
-      Cp[j] = j;
-      Ci[j] = rows[j];
-      Cx[j] = s;
-    }
-    Cp[r] = r;
+    std::copy(Cp.begin(), Cp.end(), static_cast<int*>(C->p));
+    std::copy(Ci.begin(), Ci.end(), static_cast<int*>(C->i));
+    std::copy(Cx.begin(), Cx.end(), static_cast<double*>(C->x));
     const auto t0 = Clock::now();
     const int ok = cholmod_updown(add ? 1 : 0, C, F.L, &cm);
     stats_.update_s += Since(t0);
@@ -109,11 +151,22 @@ void SpringSystem::Refactor() {
     auto& F = impl_->factors[f];
     const Eigen::SparseMatrix<double>& Aff = model_.A_ff(impl_->axes_of_factor_first[f]);
     // Lower triangle of A_ff + K as a CHOLMOD symmetric matrix.
-    Eigen::SparseMatrix<double> M = Aff.triangularView<Eigen::Lower>();
-    for (int v : vertices_) {
-      const int i = (*F.free_index)[v];
-      if (i >= 0) M.coeffRef(i, i) += k_;
+    std::vector<Eigen::Triplet<double>> t;
+    bool coupled = false;  // K has entries off the diagonal
+    for (const auto& sp : springs_) {
+      std::array<std::pair<int, double>, 4> e;
+      const int n = FreeEntries(sp, *F.free_index, &e);
+      for (int a = 0; a < n; ++a)
+        for (int b = 0; b < n; ++b)
+          if (e[a].first >= e[b].first) {
+            t.emplace_back(e[a].first, e[b].first, k_ * e[a].second * e[b].second);
+            coupled |= a != b;
+          }
     }
+    Eigen::SparseMatrix<double> K(Aff.rows(), Aff.cols());
+    K.setFromTriplets(t.begin(), t.end());
+    Eigen::SparseMatrix<double> M = Aff.triangularView<Eigen::Lower>();
+    M += K;
     M.makeCompressed();
     cholmod_sparse A{};
     A.nrow = A.ncol = M.rows();
@@ -128,6 +181,18 @@ void SpringSystem::Refactor() {
     A.sorted = 1;
     A.packed = 1;
     const auto t0 = Clock::now();
+    if (coupled || F.own_pattern) {
+      // cholmod_factorize needs the pattern the factor was analysed for; coupling springs add
+      // entries outside A's, so order and analyse A_ff + K itself (simplicial, as the model).
+      cm.supernodal = CHOLMOD_SIMPLICIAL;
+      cholmod_factor* L = cholmod_analyze(&A, &cm);
+      if (!L) throw std::runtime_error("spring system: CHOLMOD could not analyse A_ff + K");
+      cholmod_free_factor(&F.L, &cm);
+      F.L = L;
+      const int* perm = static_cast<const int*>(F.L->Perm);
+      for (int i = 0; i < F.n; ++i) F.inv_perm[perm[i]] = i;
+      F.own_pattern = coupled;
+    }
     const int ok = cholmod_factorize(&A, F.L, &cm);
     stats_.refactor_s += Since(t0);
     if (!ok || cm.status != CHOLMOD_OK)
@@ -139,27 +204,44 @@ void SpringSystem::Refactor() {
 }
 
 bool SpringSystem::SetSprings(const std::vector<int>& vertices, double k) {
+  std::vector<int> v = vertices;
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+  std::vector<SpringStencil> s;
+  s.reserve(v.size());
+  for (int i : v) s.push_back(SpringStencil::Unit(i));
+  return SetSprings(s, k);
+}
+
+bool SpringSystem::SetSprings(const std::vector<SpringStencil>& springs, double k) {
   if (!(k > 0) || !std::isfinite(k))
     throw std::invalid_argument("spring system: expected a finite stiffness k > 0");
-  std::vector<int> next = vertices;
+  const int nv = model_.num_vertices();
+  for (const auto& sp : springs)
+    for (int j = 0; j < 4; ++j)
+      if (sp.vertex[j] >= nv || (sp.vertex[j] < 0 && sp.vertex[j] != -1) ||
+          !std::isfinite(sp.coef[j]))
+        throw std::invalid_argument("spring system: a spring names vertex " +
+                                    std::to_string(sp.vertex[j]) + " (expected 0.." +
+                                    std::to_string(nv - 1) + ") or has a non-finite coefficient");
+  std::vector<SpringStencil> next = springs;
   std::sort(next.begin(), next.end());
-  next.erase(std::unique(next.begin(), next.end()), next.end());
-  if (vertices_.empty()) k_ = k;  // no spring yet: nothing in the factor depends on k
+  if (springs_.empty()) k_ = k;  // no spring yet: nothing in the factor depends on k
   if (k != k_) {
     // A new stiffness changes every spring's entry: recompute the factor from A_ff + K.
     k_ = k;
-    vertices_ = next;
+    springs_ = next;
     ++stats_.changes;
     Refactor();
     return true;
   }
-  if (next == vertices_) return false;
-  std::vector<int> added, removed;
-  std::set_difference(next.begin(), next.end(), vertices_.begin(), vertices_.end(),
+  if (next == springs_) return false;
+  std::vector<SpringStencil> added, removed;
+  std::set_difference(next.begin(), next.end(), springs_.begin(), springs_.end(),
                       std::back_inserter(added));
-  std::set_difference(vertices_.begin(), vertices_.end(), next.begin(), next.end(),
+  std::set_difference(springs_.begin(), springs_.end(), next.begin(), next.end(),
                       std::back_inserter(removed));
-  vertices_ = next;
+  springs_ = next;
   ++stats_.changes;
   if (method_ == Method::kRefactor ||
       (refactor_after_ > 0 && since_refactor_ + long(added.size() + removed.size()) > refactor_after_)) {
@@ -210,12 +292,22 @@ Eigen::VectorXd SpringSystem::Multiply(const Eigen::VectorXd& x) const {
     const int off = model_.free_offset(d);
     const int n = model_.free_offset(d + 1) - off;
     y.segment(off, n) = model_.A_ff(d) * x.segment(off, n);
-    for (int v : vertices_) {
-      const int i = model_.free_index(d)[v];
-      if (i >= 0) y[off + i] += k_ * x[off + i];
+  }
+  AddSpringProduct(x, &y);
+  return y;
+}
+
+void SpringSystem::AddSpringProduct(const Eigen::VectorXd& x, Eigen::VectorXd* y) const {
+  for (int d = 0; d < 3; ++d) {
+    const int off = model_.free_offset(d);
+    for (const auto& sp : springs_) {
+      std::array<std::pair<int, double>, 4> e;
+      const int n = FreeEntries(sp, model_.free_index(d), &e);
+      double dot = 0;
+      for (int j = 0; j < n; ++j) dot += e[j].second * x[off + e[j].first];
+      for (int j = 0; j < n; ++j) (*y)[off + e[j].first] += k_ * e[j].second * dot;
     }
   }
-  return y;
 }
 
 }  // namespace softkin

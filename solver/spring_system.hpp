@@ -1,26 +1,48 @@
 #pragma once
 /// \file spring_system.hpp
-/// The global system of Eq. 3.9: the model's free-free matrix A_ff plus k I on the rows of the
-/// vertices that hold a collision spring (Eq. 3.5), kept factored while springs come and go.
+/// The global system of Eq. 3.9: the model's free-free matrix A_ff plus K = k sum_s c_s c_s^T, one
+/// term per collision spring, kept factored while springs come and go.
 ///
-/// Adding a spring at free coordinate i adds k e_i e_i^T to A_ff, a rank-one change; releasing it
-/// subtracts the same. Two ways to keep the factor up to date, chosen by `Method`:
+/// A spring is a stencil c_s over at most four vertices: its energy is k (c_s^T x - delta)^2 per
+/// axis. A spring to a fixed target (Eq. 3.5) is the unit stencil c_s = e_v; a vertex-face spring
+/// that pulls v towards a point of a moving face, sum_i w_i x_fi, is c_s = e_v - sum_i w_i e_fi
+/// (SpringStencil). Coordinates a vertex has prescribed drop out of c_s (they go to the right-hand
+/// side). Adding a spring adds the rank-one k c_s c_s^T to A_ff; releasing it subtracts the same.
+/// Two ways to keep the factor up to date, chosen by `Method`:
 ///  - kUpdown (default): CHOLMOD's multiple-rank update/downdate (cholmod_updown, Davis and Hager)
-///    on a private copy of the model's factor: L D L^T +/- C C^T with one column sqrt(k) e_i per
-///    changed vertex. Its cost follows the changed columns' paths in the elimination tree, not
+///    on a private copy of the model's factor: L D L^T +/- C C^T with one column sqrt(k) c_s per
+///    changed spring. Its cost follows the changed columns' paths in the elimination tree, not
 ///    the matrix size. The copy is converted to LDL^T by CHOLMOD on the first update.
-///  - kRefactor: a numeric refactorisation of A_ff + K (reusing the symbolic analysis) whenever
-///    the spring set changes. The reference the update/downdate is measured against.
+///  - kRefactor: a numeric refactorisation of A_ff + K whenever the spring set changes (reusing
+///    the symbolic analysis while K is diagonal; vertex-face springs couple vertices that A does
+///    not, so then A_ff + K is analysed afresh). The reference the update/downdate is measured
+///    against.
 /// Long update histories accumulate round-off; after `refactor_after` updated columns (default: a
 /// quarter of the matrix size) the factor is recomputed from A_ff + K.
 #include "solver/model.hpp"
 
 #include <Eigen/Dense>
 
+#include <array>
 #include <memory>
 #include <vector>
 
 namespace softkin {
+
+/// The coefficient vector c of one spring over at most four vertices (entries with vertex -1 are
+/// unused). Ordered and compared entry by entry, so that sets of springs can be diffed.
+struct SpringStencil {
+  std::array<int, 4> vertex{-1, -1, -1, -1};
+  std::array<double, 4> coef{0, 0, 0, 0};
+  /// c = e_v: a spring of v to a fixed target.
+  static SpringStencil Unit(int v);
+  /// c = e_v - sum_i w_i e_{f_i}: v to the point sum_i w_i x_{f_i} of the face f (v not in f).
+  static SpringStencil VertexFace(int v, const std::array<int, 3>& f, const Eigen::Vector3d& w);
+  bool operator<(const SpringStencil& o) const {
+    return vertex != o.vertex ? vertex < o.vertex : coef < o.coef;
+  }
+  bool operator==(const SpringStencil& o) const { return vertex == o.vertex && coef == o.coef; }
+};
 
 class SpringSystem {
  public:
@@ -43,17 +65,23 @@ class SpringSystem {
   SpringSystem(const SpringSystem&) = delete;
   SpringSystem& operator=(const SpringSystem&) = delete;
 
-  /// Makes the springs exactly those on `vertices` (distinct vertex ids), each of stiffness k > 0
-  /// (same units as A's entries, mm^3). Coordinates a vertex has prescribed are skipped. Changing
-  /// k releases every spring and adds them again. Returns true if the set changed. Throws
-  /// std::runtime_error if CHOLMOD fails even after a refactorisation.
+  /// Makes the springs exactly `springs` (a multiset: a stencil given twice counts twice), each
+  /// of stiffness k > 0 (same units as A's entries, mm^3). Coordinates a vertex has prescribed
+  /// are skipped. Changing k releases every spring and adds them again. Returns true if the set
+  /// changed. Throws std::invalid_argument for a bad k or vertex id, std::runtime_error if CHOLMOD
+  /// fails even after a refactorisation.
+  bool SetSprings(const std::vector<SpringStencil>& springs, double k);
+  /// Unit springs on `vertices` (distinct ids; repeats are dropped).
   bool SetSprings(const std::vector<int>& vertices, double k);
   /// Solves (A_ff + K) y = rhs in the free-coordinate layout of Model::GatherFree.
   Eigen::VectorXd Solve(const Eigen::VectorXd& rhs) const;
-  /// (A_ff + K) x for free coordinates x (A_ff of the model plus the springs' diagonal).
+  /// (A_ff + K) x for free coordinates x.
   Eigen::VectorXd Multiply(const Eigen::VectorXd& x) const;
+  /// Adds K x to y (both in the free layout).
+  void AddSpringProduct(const Eigen::VectorXd& x, Eigen::VectorXd* y) const;
 
-  const std::vector<int>& springs() const { return vertices_; }
+  /// The current springs, sorted.
+  const std::vector<SpringStencil>& springs() const { return springs_; }
   double stiffness() const { return k_; }
   Method method() const { return method_; }
   const Stats& stats() const { return stats_; }
@@ -64,13 +92,13 @@ class SpringSystem {
 
  private:
   struct Impl;
-  /// Applies +/- sqrt(k) e_i columns for `verts` to every factor. Returns true if CHOLMOD failed
-  /// and the factors were recomputed from A_ff + K (which already holds the new set) instead.
-  bool Modify(const std::vector<int>& verts, bool add);
+  /// Applies +/- sqrt(k) c_s columns for `springs` to every factor. Returns true if CHOLMOD
+  /// failed and the factors were recomputed from A_ff + K (which already holds the new set).
+  bool Modify(const std::vector<SpringStencil>& springs, bool add);
   const Model& model_;
   Method method_;
   std::unique_ptr<Impl> impl_;
-  std::vector<int> vertices_;  // sorted
+  std::vector<SpringStencil> springs_;  // sorted
   double k_ = 0;
   long since_refactor_ = 0, refactor_after_ = 0;
   mutable Stats stats_;

@@ -292,7 +292,9 @@ TEST(EquilibriumJacobian, LocalPreconditionerSameAnswerFewerProducts) {
     ASSERT_TRUE(jl.ok) << jl.message;
     EXPECT_EQ(ja.preconditioner, "A_ff");
     EXPECT_EQ(jl.preconditioner.rfind("local", 0), 0u) << jl.preconditioner;
-    if (k.robot == "cable_finger") EXPECT_EQ(jl.preconditioner, "local, projected");
+    if (k.robot == "cable_finger") {
+      EXPECT_EQ(jl.preconditioner, "local, projected");
+    }
     EXPECT_LT((jl.dXdc - ja.dXdc).norm(), 1e-4 * ja.dXdc.norm());
     int pa = 0, pl = 0;
     for (size_t j = 0; j < ja.iterations.size(); ++j) {

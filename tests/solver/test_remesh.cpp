@@ -195,7 +195,9 @@ TEST(Remesh, ChamberOnlyKeepsTheBodyAndTheChamberVolume) {
   EXPECT_NEAR(rm.chamber_volume_after, rm.chamber_volume_before, 1e-9 * rm.chamber_volume_before);
   EXPECT_NEAR(rm.chamber_rest_volume_after, rm.chamber_rest_volume_before, 1e-9 * rm.chamber_rest_volume_before);
   for (const auto& e : n.mesh.elements)
-    if (e.region == 1) ASSERT_GT(SignedVolume(e, rm.positions), 0);
+    if (e.region == 1) {
+      ASSERT_GT(SignedVolume(e, rm.positions), 0);
+    }
   // Markers and the fixed set follow the renumbering.
   ASSERT_EQ(n.fixed.size(), s.fixed.size());
   for (size_t i = 0; i < s.fixed.size(); ++i) EXPECT_EQ(rm.old_index[n.fixed[i]], s.fixed[i]);
