@@ -6,7 +6,10 @@
 //                                  n others (2n rank-one modifications), then one 3-column solve:
 //                                  method 0 = CHOLMOD update/downdate, 1 = numeric refactorisation.
 //                                  Counter vs_refactor: this time over the refactorisation's at
-//                                  the same (res, n), measured in the same run.
+//                                  the same (res, n, pair), measured in the same run. pair = 1:
+//                                  vertex-face springs (each top-face vertex against its three
+//                                  nearest other vertices: 4 entries per column, and a refactor
+//                                  that must analyse A_ff + K afresh), pair = 0: unit springs.
 //   BM_CollisionResponseUpdate     one CollisionResponse::Update (detection + spring rule +
 //                                  factor update) on the finger pressed into a box obstacle
 //                                  (springs on ~ every vertex under the tip), res 6/9/12.
@@ -19,6 +22,7 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <map>
 #include <memory>
@@ -35,8 +39,8 @@ std::shared_ptr<const Model> FingerModel(int res) {
   return m;
 }
 
-std::map<std::pair<int, int>, double>& RefactorTimes() {
-  static std::map<std::pair<int, int>, double> t;
+std::map<std::array<int, 3>, double>& RefactorTimes() {
+  static std::map<std::array<int, 3>, double> t;
   return t;
 }
 
@@ -44,6 +48,7 @@ void BM_SpringUpdate(benchmark::State& state) {
   const int res = static_cast<int>(state.range(0));
   const int n = static_cast<int>(state.range(1));
   const bool refactor = state.range(2) != 0;
+  const bool pair = state.range(3) != 0;
   auto model = FingerModel(res);
   SpringSystem sys(*model, refactor ? SpringSystem::Method::kRefactor : SpringSystem::Method::kUpdown);
   sys.set_refactor_after(0);
@@ -56,7 +61,21 @@ void BM_SpringUpdate(benchmark::State& state) {
   std::mt19937 rng(3);
   std::shuffle(cand.begin(), cand.end(), rng);
   // Two disjoint sets of n springs: each iteration swaps one for the other.
-  std::vector<int> a(cand.begin(), cand.begin() + n), b(cand.begin() + n, cand.begin() + 2 * n);
+  const Eigen::MatrixX3d& P = model->rest_positions();
+  auto spring = [&](int v) {
+    if (!pair) return SpringStencil::Unit(v);
+    std::vector<std::pair<double, int>> d;
+    for (int u = 0; u < model->num_vertices(); ++u)
+      if (u != v) d.push_back({(P.row(u) - P.row(v)).squaredNorm(), u});
+    std::partial_sort(d.begin(), d.begin() + 3, d.end());
+    return SpringStencil::VertexFace(v, {d[0].second, d[1].second, d[2].second},
+                                     Eigen::Vector3d(0.5, 0.3, 0.2));
+  };
+  std::vector<SpringStencil> a, b;
+  for (int i = 0; i < n; ++i) {
+    a.push_back(spring(cand[i]));
+    b.push_back(spring(cand[n + i]));
+  }
   sys.SetSprings(a, k);
   Eigen::VectorXd rhs = Eigen::VectorXd::Ones(model->num_free_dofs());
   bool flip = false;
@@ -69,8 +88,9 @@ void BM_SpringUpdate(benchmark::State& state) {
   const double per = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() /
                      std::max<double>(1, state.iterations());
   auto& ref = RefactorTimes();
-  if (refactor) ref[{res, n}] = per;
-  if (!refactor && ref.count({res, n})) state.counters["vs_refactor"] = per / ref[{res, n}];
+  const std::array<int, 3> key = {res, n, pair ? 1 : 0};
+  if (refactor) ref[key] = per;
+  if (!refactor && ref.count(key)) state.counters["vs_refactor"] = per / ref[key];
   state.counters["tets"] = model->mesh().num_elements();
   state.counters["springs_changed"] = 2 * n;
 }
@@ -98,8 +118,8 @@ void BM_CollisionResponseUpdate(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_SpringUpdate)
-    ->ArgNames({"res", "n", "refactor"})
-    ->ArgsProduct({{6, 12}, {8, 64}, {1, 0}})
+    ->ArgNames({"res", "n", "refactor", "pair"})
+    ->ArgsProduct({{6, 12}, {8, 64}, {1, 0}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_CollisionResponseUpdate)

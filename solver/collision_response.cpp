@@ -162,8 +162,12 @@ bool CollisionResponse::WalkOut(const Eigen::Ref<const Eigen::MatrixX3d>& X, int
   // Round-off at an edge or a vertex that the ray runs along can bounce the walk between the
   // tets around it; it usually gets out, so revisits are allowed, but the walk is capped. A
   // straight ray crosses far fewer tets than 4096; the cap was 4 x #tets, and bouncing walks then
-  // held one check of a 30k-tet membrane for minutes.
+  // held one check of a 30k-tet membrane for minutes. A walk whose exit parameter has not
+  // advanced in 64 tets is bouncing in place and is given up as well: at 4096 steps each, the
+  // failed walks of ~200 contacts took seconds per check on the full-size membrane.
   const int max_steps = std::min(4 * mesh.num_elements() + 16, 4096);
+  double t_far = -std::numeric_limits<double>::infinity();
+  int last_progress = 0;
   for (int step = 0; step < max_steps; ++step) {
     const auto& e = mesh.elements[cur].v;
     const Eigen::Vector3d x0 = X.row(e[0]);
@@ -188,6 +192,12 @@ bool CollisionResponse::WalkOut(const Eigen::Ref<const Eigen::MatrixX3d>& X, int
       }
     }
     if (jout < 0 || !std::isfinite(tout) || tout < -slack) return false;
+    if (tout > t_far + slack) {
+      t_far = tout;
+      last_progress = step;
+    } else if (step - last_progress > 64) {
+      return false;
+    }
     const int next = adj_[4 * cur + jout];
     if (next < 0) {
       *exit = p0 + std::max(0.0, tout) * dir;
