@@ -189,14 +189,14 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
   if (!variants_j.is_array() || variants_j.empty())
     cfg.Fail("variants", "a non-empty array of {\"name\", [\"collision\"], [\"robot_params\"]}");
 
-  std::filesystem::create_directories(dir + "/frames");
-  CsvWriter csv(dir + "/steps.csv",
-                {"variant", "step", "actuation_scale", "tip_x", "tip_y", "tip_z", "bend_deg",
-                 "iterations", "converged", "springs", "self_contacts", "obstacle_contacts",
-                 "max_penetration_mm", "contact_vertices", "contact_area_mm2", "check_s", "response_s",
-                 "solver_s", "time_s"});
-  nlohmann::json out_variants = nlohmann::json::array();
-  std::vector<std::pair<double, std::string>> frames;
+  // Every variant is read and checked before the first one runs: a bad key in the last variant
+  // fails at once, not after the others' minutes of solving.
+  struct Prepared {
+    std::string name;
+    Scene scene;
+    FkOptions opts;
+  };
+  std::vector<Prepared> prepared;
   for (size_t vi = 0; vi < variants_j.size(); ++vi) {
     const std::string key = "variants[" + std::to_string(vi) + "]";
     const auto& v = variants_j[vi];
@@ -205,24 +205,41 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
     for (auto it = v.begin(); it != v.end(); ++it)
       if (it.key() != "name" && it.key() != "collision" && it.key() != "robot_params")
         cfg.Fail(key + "." + it.key(), "one of name, collision, robot_params");
-    const std::string name = v["name"].get<std::string>();
-    Scene scene = base;
+    Prepared pv;
+    pv.name = v["name"].get<std::string>();
+    pv.scene = base;
     if (v.contains("robot_params")) {
       RobotParams p = cfg.NumberMap("robot_params");
       MergeRobotParams(cfg, key + ".robot_params", v["robot_params"], &p);
       try {
-        scene = MakeRobot(robot, res, p);
+        pv.scene = MakeRobot(robot, res, p);
       } catch (const std::invalid_argument& e) {
         throw std::invalid_argument(cfg.path() + ": " + key + ".robot_params: " + e.what());
       }
     }
-    scene.obstacles = obstacles;
-    FkOptions opts = base_opts;  // the robot's defaults (e.g. self on), then the config's solver
+    pv.scene.obstacles = obstacles;
+    pv.opts = base_opts;  // the robot's defaults (e.g. self on), then the config's solver
     if (v.contains("collision")) {
       nlohmann::json wrap = {{"collision", v["collision"]}};
-      ApplySolverJson(wrap, cfg.path() + ": " + key, &opts);
+      ApplySolverJson(wrap, cfg.path() + ": " + key, &pv.opts);
     }
-    scene.solver = opts;
+    pv.scene.solver = pv.opts;
+    prepared.push_back(std::move(pv));
+  }
+
+  std::filesystem::create_directories(dir + "/frames");
+  CsvWriter csv(dir + "/steps.csv",
+                {"variant", "step", "actuation_scale", "tip_x", "tip_y", "tip_z", "bend_deg",
+                 "iterations", "converged", "springs", "self_contacts", "obstacle_contacts",
+                 "max_penetration_mm", "contact_vertices", "contact_area_mm2", "check_s", "response_s",
+                 "solver_s", "time_s"});
+  nlohmann::json out_variants = nlohmann::json::array();
+  std::vector<std::pair<double, std::string>> frames;
+  for (size_t vi = 0; vi < prepared.size(); ++vi) {
+    const std::string& name = prepared[vi].name;
+    const Scene& scene = prepared[vi].scene;
+    const FkOptions& opts = prepared[vi].opts;
+    const std::string key = "variants[" + std::to_string(vi) + "]";
     auto model = std::make_shared<const Model>(scene);
     auto solver = MakeFkSolver(model, opts);
     // The exact check, also for variants without response.

@@ -351,6 +351,24 @@ TEST(Cli, IkReachesAForwardSolvedTargetAndResumesATrajectory) {
   EXPECT_NE(r.out.find("path.csv:2"), std::string::npos) << r.out;
 }
 
+// A collision sweep reads every variant before it runs the first: a bad key in the last one
+// fails at once, naming the file and the key, and no variant's output is written.
+TEST(Cli, CollisionSweepRejectsABadVariantBeforeRunningAny) {
+  const std::string dir = TempDir("collision_bad_variant");
+  const std::string cfg = dir + "/bad.json";
+  std::ofstream(cfg) << R"({"name": "bad_sweep", "experiment": "collision_sweep", "seed": 1,
+    "robot": "selfcollision_finger", "res": 5, "steps": 1, "actuation": {"chamber": 1.5},
+    "variants": [{"name": "ok", "collision": {"self": true}},
+                 {"name": "bad", "collision": {"self": true, "self_spring": "glue"}}]})";
+  const CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.out.find(cfg + ": variants[1]: collision.self_spring: expected one of target, pair; got 'glue'"),
+            std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.out.find("[ok 1/1]"), std::string::npos) << r.out;  // variant 0 never ran
+  EXPECT_FALSE(std::filesystem::exists(dir + "/bad_sweep/steps.csv"));
+}
+
 TEST(Cli, IkExperimentsRunTinyConfigsAndRejectBadPaths) {
   const std::string dir = TempDir("ik_exp");
   const std::string cfg = dir + "/tiny.json";
