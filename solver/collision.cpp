@@ -901,33 +901,6 @@ Eigen::Vector3d MovingSurface::ClosestPoint(const Eigen::Vector3d& p, int* face)
   return Eigen::Vector3d(cp.first.x(), cp.first.y(), cp.first.z());
 }
 
-namespace {
-/// Closest point to p on the triangle (a, b, c): the Voronoi regions of its vertices, edges and
-/// interior, in turn (Ericson, Real-Time Collision Detection, Sec. 5.1.5).
-Eigen::Vector3d ClosestOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                                  const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return a;
-  const Eigen::Vector3d bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return b;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
-  const Eigen::Vector3d cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return c;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-    return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
-  const double den = va + vb + vc;
-  if (!(std::abs(den) > 0)) return a;  // a degenerate triangle
-  return a + ab * (vb / den) + ac * (vc / den);
-}
-}  // namespace
-
 bool MovingSurface::ClosestFacing(const Eigen::Vector3d& p, const Eigen::Vector3d& n,
                                   Eigen::Vector3d* closest, int* face) const {
   if (!impl_->built) throw std::logic_error("MovingSurface::ClosestFacing before Update");
@@ -936,6 +909,7 @@ bool MovingSurface::ClosestFacing(const Eigen::Vector3d& p, const Eigen::Vector3
   const double span = std::max({all.xmax() - all.xmin(), all.ymax() - all.ymin(), all.zmax() - all.zmin()});
   // Start from the unrestricted distance: no facing triangle is closer.
   double r = std::max((ClosestPoint(p) - p).norm(), 1e-9 * span);
+  const CPoint cp(p.x(), p.y(), p.z());
   std::vector<int> cand;
   for (;;) {
     cand.clear();
@@ -948,7 +922,9 @@ bool MovingSurface::ClosestFacing(const Eigen::Vector3d& p, const Eigen::Vector3
       const auto& t = faces_[f];
       const Eigen::Vector3d a = I.X.row(t[0]), b = I.X.row(t[1]), c = I.X.row(t[2]);
       if (!((b - a).cross(c - a).dot(n) < 0)) continue;
-      const Eigen::Vector3d q = ClosestOnTriangle(p, a, b, c);
+      const CPoint cq = K().construct_projected_point_3_object()(
+          K::Triangle_3(P(I.X, t[0]), P(I.X, t[1]), P(I.X, t[2])), cp);
+      const Eigen::Vector3d q(cq.x(), cq.y(), cq.z());
       const double d = (q - p).norm();
       if (d < best || (d == best && f < best_f)) {
         best = d;

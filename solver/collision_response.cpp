@@ -319,7 +319,7 @@ void CollisionResponse::SetSelfTarget(const Eigen::Ref<const Eigen::MatrixX3d>& 
       s->weights = w;
       // The whole overlap: the face moves towards v as v moves out.
       s->target = exit + off;
-      s->offset = s->target - (w[0] * a + w[1] * b + w[2] * c);
+      s->offset = s->target - s->FacePoint(X);
       return;
     }
     // A degenerate (flat) face: a fixed target, as below.
@@ -413,8 +413,7 @@ bool CollisionResponse::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) {
     if (it == springs_.end() || it->vertex != s.vertex || it->face != s.face) continue;
     if ((it->weights - s.weights).cwiseAbs().maxCoeff() > 0.2) continue;
     s.weights = it->weights;
-    s.offset = s.target - (s.weights[0] * X.row(s.face[0]) + s.weights[1] * X.row(s.face[1]) +
-                           s.weights[2] * X.row(s.face[2])).transpose();
+    s.offset = s.target - s.FacePoint(X);
   }
   // Springs of vertices no longer in collision: release by Eq. 3.8, else keep (obstacle targets
   // follow the closest point as the vertex slides).
@@ -482,14 +481,6 @@ void CollisionResponse::AddToRhs(const Eigen::Ref<const Eigen::MatrixX3d>& X,
           (*Bf)[model_.free_offset(d) + fi[st.vertex[j]]] += k_ * st.coef[j] * a;
     }
   }
-}
-
-void CollisionResponse::AddSpringProduct(const Eigen::Ref<const Eigen::MatrixX3d>& X,
-                                         Eigen::VectorXd* y) const {
-  if (springs_.empty()) return;
-  Eigen::VectorXd xf;
-  model_.GatherFree(X, &xf);
-  system_.AddSpringProduct(xf, y);
 }
 
 void CollisionResponse::Reset() {

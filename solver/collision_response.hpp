@@ -59,11 +59,14 @@ struct CollisionSpring {
   Eigen::Vector3d weights = Eigen::Vector3d::Zero();
   Eigen::Vector3d offset = Eigen::Vector3d::Zero();
   bool pair() const { return face[0] >= 0; }
+  /// The point sum_i w_i x_fi of a pair spring's face at positions X.
+  Eigen::Vector3d FacePoint(const Eigen::Ref<const Eigen::MatrixX3d>& X) const {
+    return weights[0] * X.row(face[0]).transpose() + weights[1] * X.row(face[1]).transpose() +
+           weights[2] * X.row(face[2]).transpose();
+  }
   /// Where the spring pulls v to at positions X.
   Eigen::Vector3d TargetAt(const Eigen::Ref<const Eigen::MatrixX3d>& X) const {
-    if (!pair()) return target;
-    return weights[0] * X.row(face[0]).transpose() + weights[1] * X.row(face[1]).transpose() +
-           weights[2] * X.row(face[2]).transpose() + offset;
+    return pair() ? Eigen::Vector3d(FacePoint(X) + offset) : target;
   }
   SpringStencil Stencil() const {
     return pair() ? SpringStencil::VertexFace(vertex, face, weights) : SpringStencil::Unit(vertex);
@@ -106,8 +109,10 @@ class CollisionResponse {
   /// k c_s (delta_s - c_s . x_prescribed) per spring, k v_c for a fixed target. X supplies the
   /// prescribed coordinates (of a pair spring's face).
   void AddToRhs(const Eigen::Ref<const Eigen::MatrixX3d>& X, Eigen::VectorXd* Bf) const;
-  /// Adds K x (x = the free coordinates of X) to y.
-  void AddSpringProduct(const Eigen::Ref<const Eigen::MatrixX3d>& X, Eigen::VectorXd* y) const;
+  /// Adds K x to y (x: free coordinates, layout of Model::GatherFree).
+  void AddSpringProduct(const Eigen::VectorXd& x, Eigen::VectorXd* y) const {
+    system_.AddSpringProduct(x, y);
+  }
   /// Releases every spring and zeroes the statistics (the start of a new solve).
   void Reset();
   /// E_col = sum k ||v - v_c||^2 at positions X (v_c = CollisionSpring::TargetAt(X)).

@@ -62,9 +62,11 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
   auto load_free = [&]() { m.GatherFree(X, &xf); };
   auto store_free = [&](const Eigen::VectorXd& y) { m.ScatterFree(y, &X); };
   // ||A_ff x_f + A_fc x_c - B_f||: the energy gradient over the free coordinates (up to 2).
-  auto residual_norm = [&]() {
+  // Loads x_f from X as well.
+  auto residual = [&]() {
+    load_free();
     m.GatherFree(m.A() * X, &AX);
-    if (resp) resp->AddSpringProduct(X, &AX);
+    if (resp) resp->AddSpringProduct(xf, &AX);
     return 2.0 * (AX - Bf).norm();
   };
 
@@ -76,7 +78,7 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     m.ApplyConstraints(c, &X);
     double E0;
     local(&E0);
-    ref_value_ = residual_norm();
+    ref_value_ = residual();
     ref_c_ = c;
     X = keep;
   }
@@ -86,10 +88,6 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     for (const auto& e : m.elements()) total_weight_ += e.wv;
   Anderson aa(nf, options_.anderson_window);
   Eigen::MatrixX3d X_good = X;
-  auto residual = [&]() {
-    load_free();
-    return residual_norm();
-  };
   const std::string& guard = options_.anderson_safeguard;
   // Merits of the iterate an accelerated step was extrapolated from.
   double base_E = 0.0, base_f = 0.0;

@@ -48,6 +48,29 @@ Scene TwoBlocks() {
   return s;
 }
 
+/// Reference for SpringSystem: (A_ff + k sum_s c_s c_s^T) y = b assembled entry by entry and
+/// solved by Eigen's own LDL^T, axis by axis. Empty if a factorisation fails.
+Eigen::VectorXd DirectSolve(const Model& model, const std::vector<SpringStencil>& springs, double k,
+                            const Eigen::VectorXd& b) {
+  Eigen::VectorXd y(model.num_free_dofs());
+  for (int d = 0; d < 3; ++d) {
+    const std::vector<int>& fi = model.free_index(d);
+    Eigen::SparseMatrix<double> M = model.A_ff(d);
+    for (const auto& sp : springs)
+      for (int a = 0; a < 4; ++a)
+        for (int c = 0; c < 4; ++c) {
+          if (sp.vertex[a] < 0 || sp.vertex[c] < 0) continue;
+          const int i = fi[sp.vertex[a]], j = fi[sp.vertex[c]];
+          if (i >= 0 && j >= 0) M.coeffRef(i, j) += k * sp.coef[a] * sp.coef[c];
+        }
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(M);
+    if (ldlt.info() != Eigen::Success) return Eigen::VectorXd();
+    const int off = model.free_offset(d), n = model.free_offset(d + 1) - off;
+    y.segment(off, n) = ldlt.solve(b.segment(off, n));
+  }
+  return y;
+}
+
 TEST(SpringSystem, UpdateDowndateMatchesADirectSolve) {
   const Scene scene = MakeRobot("pneumatic_finger", 5);
   const Model model(scene);
@@ -67,19 +90,8 @@ TEST(SpringSystem, UpdateDowndateMatchesADirectSolve) {
     set = next;
     EXPECT_TRUE(updown.SetSprings(set, k) || set.empty());
     refactor.SetSprings(set, k);
-    // Reference: Eigen's own LDL^T of A_ff + K, axis by axis.
-    Eigen::VectorXd ref(model.num_free_dofs());
-    for (int d = 0; d < 3; ++d) {
-      Eigen::SparseMatrix<double> M = model.A_ff(d);
-      for (const auto& sp : updown.springs()) {
-        const int i = model.free_index(d)[sp.vertex[0]];
-        if (i >= 0) M.coeffRef(i, i) += k;
-      }
-      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(M);
-      ASSERT_EQ(ldlt.info(), Eigen::Success);
-      const int off = model.free_offset(d), n = model.free_offset(d + 1) - off;
-      ref.segment(off, n) = ldlt.solve(b.segment(off, n));
-    }
+    const Eigen::VectorXd ref = DirectSolve(model, updown.springs(), k, b);
+    ASSERT_EQ(ref.size(), b.size());
     const Eigen::VectorXd y1 = updown.Solve(b), y2 = refactor.Solve(b);
     EXPECT_LT((y1 - ref).norm(), 1e-9 * ref.norm()) << "round " << round;
     EXPECT_LT((y2 - ref).norm(), 1e-9 * ref.norm()) << "round " << round;
@@ -128,22 +140,8 @@ TEST(SpringSystem, VertexFaceSpringsMatchADirectSolve) {
     set = next;
     EXPECT_TRUE(updown.SetSprings(set, k));
     refactor.SetSprings(set, k);
-    Eigen::VectorXd ref(model.num_free_dofs());
-    for (int d = 0; d < 3; ++d) {
-      // Reference: A_ff + k sum c c^T assembled densely per spring, solved by Eigen's LDL^T.
-      Eigen::SparseMatrix<double> M = model.A_ff(d);
-      for (const auto& sp : updown.springs())
-        for (int a = 0; a < 4; ++a)
-          for (int c = 0; c < 4; ++c) {
-            if (sp.vertex[a] < 0 || sp.vertex[c] < 0) continue;
-            const int i = model.free_index(d)[sp.vertex[a]], j = model.free_index(d)[sp.vertex[c]];
-            if (i >= 0 && j >= 0) M.coeffRef(i, j) += k * sp.coef[a] * sp.coef[c];
-          }
-      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(M);
-      ASSERT_EQ(ldlt.info(), Eigen::Success);
-      const int off = model.free_offset(d), n = model.free_offset(d + 1) - off;
-      ref.segment(off, n) = ldlt.solve(b.segment(off, n));
-    }
+    const Eigen::VectorXd ref = DirectSolve(model, updown.springs(), k, b);
+    ASSERT_EQ(ref.size(), b.size());
     const Eigen::VectorXd y1 = updown.Solve(b), y2 = refactor.Solve(b);
     EXPECT_LT((y1 - ref).norm(), 1e-9 * ref.norm()) << "round " << round;
     EXPECT_LT((y2 - ref).norm(), 1e-9 * ref.norm()) << "round " << round;
@@ -193,7 +191,9 @@ TEST(CollisionResponse, SpringEnergyGradientMatchesFiniteDifferences) {
     for (int v = 0; v < Y.rows(); ++v) Y.row(v) += 0.1 * Eigen::RowVector3d(std::sin(v), std::cos(v), 0.3);
     // Analytic: dE_col/dx_free = 2 (K x - rhs) = 2 (AddSpringProduct - AddToRhs).
     Eigen::VectorXd Kx = Eigen::VectorXd::Zero(model.num_free_dofs()), Kt = Kx;
-    resp.AddSpringProduct(Y, &Kx);
+    Eigen::VectorXd yf;
+    model.GatherFree(Y, &yf);
+    resp.AddSpringProduct(yf, &Kx);
     resp.AddToRhs(Y, &Kt);
     const Eigen::VectorXd grad = 2.0 * (Kx - Kt);
     const double h = 1e-6;
