@@ -1,6 +1,7 @@
 // Progressive chamber remeshing (thesis Sec. 3.3.2, Algorithm 2; remesh.hpp).
 #include "solver/remesh.hpp"
 
+#include "solver/collision.hpp"
 #include "solver/model.hpp"
 
 #include <Eigen/Dense>
@@ -8,6 +9,7 @@
 #include <Eigen/SparseCholesky>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -316,40 +318,17 @@ void DeformedSurfaces(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>
   build(false, outer, outer_old, "deformed outer surface S_b^k");
 }
 
-/// Distance from p to the triangle (a, b, c) (closest point by regions, Ericson 5.1.5).
-double PointTriangleDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                             const Eigen::Vector3d& c) {
-  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return (p - a).norm();
-  const Eigen::Vector3d bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return (p - b).norm();
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (p - (a + d1 / (d1 - d3) * ab)).norm();
-  const Eigen::Vector3d cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return (p - c).norm();
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (p - (a + d2 / (d2 - d6) * ac)).norm();
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-    return (p - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b))).norm();
-  const double denom = 1.0 / (va + vb + vc);
-  return (p - (a + ab * (vb * denom) + ac * (vc * denom))).norm();
-}
-
-/// Largest distance from a vertex of `from` to the surface `to` (brute force; both are small).
+/// Largest distance from a vertex of `from` to the surface `to`, by closest-point queries of a
+/// CGAL AABB tree over `to`'s triangles (MovingSurface).
 double OneSidedDeviation(const TriangleSurface& from, const TriangleSurface& to) {
+  std::vector<std::array<int, 3>> faces(static_cast<size_t>(to.faces.rows()));
+  for (int f = 0; f < to.faces.rows(); ++f) faces[f] = {to.faces(f, 0), to.faces(f, 1), to.faces(f, 2)};
+  MovingSurface tree(std::move(faces));
+  tree.Update(to.vertices);
   double worst = 0;
   for (int i = 0; i < from.vertices.rows(); ++i) {
     const Eigen::Vector3d p = from.vertices.row(i).transpose();
-    double best = std::numeric_limits<double>::infinity();
-    for (int f = 0; f < to.faces.rows() && best > 0; ++f)
-      best = std::min(best, PointTriangleDistance(p, to.vertices.row(to.faces(f, 0)).transpose(),
-                                                  to.vertices.row(to.faces(f, 1)).transpose(),
-                                                  to.vertices.row(to.faces(f, 2)).transpose()));
-    worst = std::max(worst, best);
+    worst = std::max(worst, (tree.ClosestPoint(p) - p).norm());
   }
   return worst;
 }
