@@ -13,7 +13,16 @@
 //   BM_CollisionResponseUpdate     one CollisionResponse::Update (detection + spring rule +
 //                                  factor update) on the finger pressed into a box obstacle
 //                                  (springs on ~ every vertex under the tip), res 6/9/12.
-// Wall-clock times (UseRealTime). See docs/benchmarks.md, "Collision response".
+//   BM_SelfTargetRule/res/rule     one CollisionResponse::Update on the membrane (thesis Fig. 3.13)
+//                                  with its membrane pushed 1 mm into the chamber roofs (every
+//                                  membrane-bottom vertex above a roof is a contact): rule 0 =
+//                                  self_target "walk" (ray walk along -n(v) through the tets),
+//                                  1 = "auto" (between bodies: closest facing point on the other
+//                                  body's surface, MovingSurface's CGAL AABB tree rebuilt per
+//                                  check, BodyTarget). Counter vs_walk: this time over the walk's
+//                                  at the same res, measured in the same run.
+// Wall-clock times (UseRealTime). See docs/benchmarks.md, "Collision response", and
+// docs/collision_response.md.
 #include "solver/collision_response.hpp"
 #include "solver/fk_solver.hpp"
 #include "solver/robots.hpp"
@@ -115,8 +124,43 @@ void BM_CollisionResponseUpdate(benchmark::State& state) {
   state.counters["response_ms"] = 1e3 * resp.stats().response_s / std::max(1, resp.stats().checks);
 }
 
+void BM_SelfTargetRule(benchmark::State& state) {
+  const int res = static_cast<int>(state.range(0));
+  const bool body_rule = state.range(1) != 0;
+  Scene s = MakeRobot("membrane", res);
+  s.solver.collision.self_target = body_rule ? "auto" : "walk";
+  const Model model(s);
+  CollisionResponse resp(model, s.solver.collision);
+  // The membrane (every vertex above the roofs' 2 mm air gap; its top is one cell above the roofs)
+  // lowered by 3 mm: 1 mm into the roofs.
+  const double z_roof = model.rest_positions().col(2).maxCoeff() - 250.0 / res;
+  Eigen::MatrixX3d X = model.rest_positions();
+  for (int v = 0; v < X.rows(); ++v)
+    if (X(v, 2) > z_roof + 1.0) X(v, 2) -= 3.0;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (auto _ : state) {
+    resp.Reset();
+    benchmark::DoNotOptimize(resp.Update(X));
+  }
+  const double per = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() /
+                     std::max<double>(1, state.iterations());
+  static std::map<int, double> walk;
+  if (!body_rule) walk[res] = per;
+  if (body_rule && walk.count(res)) state.counters["vs_walk"] = per / walk[res];
+  state.counters["tets"] = model.mesh().num_elements();
+  state.counters["springs"] = static_cast<double>(resp.springs().size());
+  state.counters["unresolved"] = resp.stats().unresolved;
+  state.counters["check_ms"] = 1e3 * resp.stats().check_s / std::max(1, resp.stats().checks);
+  state.counters["response_ms"] = 1e3 * resp.stats().response_s / std::max(1, resp.stats().checks);
+}
+
 }  // namespace
 
+BENCHMARK(BM_SelfTargetRule)
+    ->ArgNames({"res", "rule"})
+    ->ArgsProduct({{12, 24}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(BM_SpringUpdate)
     ->ArgNames({"res", "n", "refactor", "pair"})
     ->ArgsProduct({{6, 12}, {8, 64}, {1, 0}, {0, 1}})
