@@ -219,6 +219,11 @@ int RunCli(int argc, char** argv) {
       std::string why;
       if (!opt.IsValid(&why)) throw std::invalid_argument("option " + why);
       const Eigen::VectorXd c = ParseNumberList(actuation, "--actuation");
+      if (opt.continuation_steps > 1)
+        opt.on_step = [](int step, int steps, const std::string& status, int iterations, double sec) {
+          std::cerr << "fk: step " << step << "/" << steps << ": " << status << ", " << iterations
+                    << " iterations so far, " << sec << " s\n";
+        };
       auto model = std::make_shared<const Model>(scene);
       FkResult r = MakeFkSolver(model, opt)->Solve(c);
       if (r.status == FkStatus::InvalidInput) {

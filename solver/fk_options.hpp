@@ -1,6 +1,7 @@
 #pragma once
 /// \file fk_options.hpp
 /// Options shared by the forward-kinematics solvers (Ceres-style: IsValid(&why)).
+#include <functional>
 #include <string>
 
 namespace softkin {
@@ -68,6 +69,11 @@ struct FkOptions {
   double time_limit_s = 0.0;
   /// Collision response settings (used by lg and lg-aa).
   CollisionOptions collision;
+  /// Progress report, called after each continuation step of a Solve() (lg, lg-aa and the
+  /// general-purpose optimisers) with the step (1-based), the number of steps, the step's status
+  /// (FkStatusToString), the iterations and the seconds so far. Empty: no report.
+  std::function<void(int step, int steps, const std::string& status, int iterations, double seconds)>
+      on_step;
 
   bool IsValid(std::string* why) const;
 };

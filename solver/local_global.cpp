@@ -223,6 +223,8 @@ FkResult LocalGlobalSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
     const Eigen::VectorXd cs = (K == 1) ? Eigen::VectorXd(c)
                                         : Eigen::VectorXd(rest + (c - rest) * (double(s) / K));
     SolveStage(cs, &r.positions, &r);
+    if (options_.on_step)
+      options_.on_step(s, K, FkStatusToString(r.status), r.iterations, Seconds(t0, Clock::now()));
     if (r.status == FkStatus::Diverged || r.status == FkStatus::TimeLimit) break;
   }
   deadline_ = nullptr;

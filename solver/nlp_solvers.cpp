@@ -67,6 +67,8 @@ class RatioUpdateSolver : public FkSolver {
       const Eigen::VectorXd cs =
           K == 1 ? Eigen::VectorXd(c) : Eigen::VectorXd(rest + (c - rest) * (double(s) / K));
       updates += SolveStage(cs, &r);
+      if (options_.on_step)
+        options_.on_step(s, K, FkStatusToString(r.status), r.iterations, Seconds(t0, Clock::now()));
       if (r.status != FkStatus::Converged) break;
     }
     std::vector<double> ratios;

@@ -81,6 +81,20 @@ TEST(Cli, FkWritesTheDocumentedJson) {
   EXPECT_TRUE(std::filesystem::exists(dir + "/fk.vtu"));
 }
 
+TEST(Cli, FkReportsEachContinuationStep) {
+  const std::string dir = TempDir("fk_steps");
+  const CliRun r = Cli("fk --robot three_chamber --res 3 --actuation 1.3,1,1 --continuation 3 --json " +
+                       dir + "/fk.json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  for (const char* line : {"fk: step 1/3: converged", "fk: step 2/3: converged", "fk: step 3/3: converged"})
+    EXPECT_NE(r.out.find(line), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("step 4/3"), std::string::npos) << r.out;
+  // Without continuation there is one step and no step report.
+  const CliRun one = Cli("fk --robot three_chamber --res 3 --actuation 1.3,1,1 --json " + dir + "/fk1.json");
+  ASSERT_EQ(one.code, 0) << one.out;
+  EXPECT_EQ(one.out.find("fk: step"), std::string::npos) << one.out;
+}
+
 TEST(Cli, BadValuesNameTheOptionAndWhatWasExpected) {
   CliRun r = Cli("fk --robot three_chamber --res 3 --actuation 1.3,abc,1");
   EXPECT_EQ(r.code, 2);
