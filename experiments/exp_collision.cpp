@@ -231,8 +231,8 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
   CsvWriter csv(dir + "/steps.csv",
                 {"variant", "step", "actuation_scale", "tip_x", "tip_y", "tip_z", "bend_deg",
                  "iterations", "converged", "springs", "self_contacts", "obstacle_contacts",
-                 "max_penetration_mm", "contact_vertices", "contact_area_mm2", "check_s", "response_s",
-                 "solver_s", "time_s"});
+                 "max_penetration_mm", "self_penetration_mm", "obstacle_penetration_mm",
+                 "contact_vertices", "contact_area_mm2", "check_s", "response_s", "solver_s", "time_s"});
   nlohmann::json out_variants = nlohmann::json::array();
   std::vector<std::pair<double, std::string>> frames;
   for (size_t vi = 0; vi < prepared.size(); ++vi) {
@@ -288,14 +288,17 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
                       std::to_string(P(tip, 1)), std::to_string(P(tip, 2)), std::to_string(ang),
                       std::to_string(r.iterations), ok ? "1" : "0", std::to_string(r.springs),
                       std::to_string(ck.self_contacts), std::to_string(ck.obstacle_contacts),
-                      std::to_string(ck.max_penetration), std::to_string(touch), std::to_string(touch_area),
+                      std::to_string(ck.max_penetration), std::to_string(ck.self_penetration),
+                      std::to_string(ck.obstacle_penetration), std::to_string(touch), std::to_string(touch_area),
                       std::to_string(r.collision_stats.check_s),
                       std::to_string(r.collision_stats.response_s),
                       std::to_string(r.local_time_s + r.global_time_s), std::to_string(r.time_s)});
       if (verbose)
-        std::fprintf(stderr, "  [%s %d/%d] %s; exact check: %d self + %d obstacle contacts, max depth %.3g mm\n",
-                     name.c_str(), s, steps, r.BriefReport().c_str(), ck.self_contacts,
-                     ck.obstacle_contacts, ck.max_penetration);
+        std::fprintf(stderr,
+                     "  [%s %d/%d] %s; exact check: %d self (max depth %.3g mm) + %d obstacle contacts "
+                     "(max depth %.3g mm)\n",
+                     name.c_str(), s, steps, r.BriefReport().c_str(), ck.self_contacts, ck.self_penetration,
+                     ck.obstacle_contacts, ck.obstacle_penetration);
       last = r;
       last_check = ck;
     }
@@ -326,6 +329,8 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
     jv["self_contacts_left"] = last_check.self_contacts;
     jv["obstacle_contacts_left"] = last_check.obstacle_contacts;
     jv["max_penetration_mm"] = last_check.max_penetration;
+    jv["self_penetration_mm"] = last_check.self_penetration;
+    jv["obstacle_penetration_mm"] = last_check.obstacle_penetration;
     jv["collision_free"] = last_check.collision_free();
     jv["springs_at_end"] = last.springs;
     jv["iterations"] = iterations;

@@ -7,8 +7,10 @@ Usage: fig3_8_twisting_grasp.py RESULTS_DIR
 Reads RESULTS_DIR/steps.csv and summary.json (written by
 `softkin run experiments/fig3_8_twisting_grasp.json`). Writes RESULTS_DIR/fig3_8_twisting_grasp.png:
   left:  tip paths in the x-z plane, per variant, with the cylinder's cross-section;
-  right: vertices touching the cylinder (within the contact distance), vertices inside it, and the
-         deepest penetration of the exact check, against the chamber volume ratio asked for.
+  right: vertices touching the cylinder (within the contact distance), vertices inside it, the
+         deepest penetration into the cylinder, and the deepest self "contact" of the exact check
+         (chamber tets tangled through the body, which the obstacle response does not touch),
+         against the chamber volume ratio asked for.
 Exit status 2 with a message on stderr if a file is missing or malformed.
 """
 import os
@@ -18,7 +20,7 @@ import figlib
 
 NAME = "fig3_8_twisting_grasp"
 COLS = ["variant", "step", "actuation_scale", "tip_x", "tip_z", "contact_vertices",
-        "obstacle_contacts", "max_penetration_mm"]
+        "obstacle_contacts", "obstacle_penetration_mm", "self_penetration_mm"]
 
 
 def main(argv):
@@ -50,8 +52,10 @@ def main(argv):
                  label=f"{name}: touching vertices")
         ax1.plot(alpha, [r["obstacle_contacts"] for r in pts], "x:", color=c,
                  label=f"{name}: vertices inside the cylinder")
-        ax1b.plot(alpha, [r["max_penetration_mm"] for r in pts], "s--", color=c, alpha=0.6,
-                  label=f"{name}: max penetration")
+        ax1b.plot(alpha, [r["obstacle_penetration_mm"] for r in pts], "s--", color=c, alpha=0.6,
+                  label=f"{name}: max penetration into the cylinder")
+        ax1b.plot(alpha, [r["self_penetration_mm"] for r in pts], "^-.", color=c, alpha=0.35,
+                  label=f"{name}: max self depth (tangles)")
     figlib.plot_cylinder_sections(ax0, cfg)
     ax0.plot([-10, 10, 10, -10, -10], [0, 0, 100, 100, 0], ":", color="gray", label="robot at rest")
     ax0.set_xlabel("tip x (mm)")
@@ -62,7 +66,7 @@ def main(argv):
     ax0.set_title("Tip paths (start: tip at rest, z = 100)")
     ax1.set_xlabel("chamber volume ratio asked for, α")
     ax1.set_ylabel("vertices")
-    ax1b.set_ylabel("max penetration (mm)")
+    ax1b.set_ylabel("depth (mm)")
     ax1.grid(True, alpha=0.3)
     h0, l0 = ax1.get_legend_handles_labels()
     h1, l1 = ax1b.get_legend_handles_labels()

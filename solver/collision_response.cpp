@@ -531,7 +531,7 @@ CollisionCheck CollisionResponse::Check(const Eigen::Ref<const Eigen::MatrixX3d>
           surfaces[b].Update(X);
           fresh[b] = 1;
         }
-        r.max_penetration = std::max(r.max_penetration, (surfaces[b].ClosestPoint(p) - p).norm());
+        r.self_penetration = std::max(r.self_penetration, (surfaces[b].ClosestPoint(p) - p).norm());
         continue;
       }
       const auto& e = model_.mesh().elements[c.tet].v;
@@ -549,7 +549,7 @@ CollisionCheck CollisionResponse::Check(const Eigen::Ref<const Eigen::MatrixX3d>
         Eigen::Vector3d exit;
         if (WalkOut(X, c.vertex, c.tet, dir, &exit)) depth = std::min(depth, (exit - p).norm());
       }
-      if (std::isfinite(depth)) r.max_penetration = std::max(r.max_penetration, depth);
+      if (std::isfinite(depth)) r.self_penetration = std::max(r.self_penetration, depth);
     }
   }
   if (!model_.scene().obstacles.empty()) {
@@ -561,9 +561,10 @@ CollisionCheck CollisionResponse::Check(const Eigen::Ref<const Eigen::MatrixX3d>
     }
     for (const auto& c : DetectObstacleContacts(*obs, X, check_vertices_)) {
       ++r.obstacle_contacts;
-      r.max_penetration = std::max(r.max_penetration, c.depth);
+      r.obstacle_penetration = std::max(r.obstacle_penetration, c.depth);
     }
   }
+  r.max_penetration = std::max(r.self_penetration, r.obstacle_penetration);
   return r;
 }
 

@@ -78,6 +78,8 @@ struct CollisionCheck {
   int self_contacts = 0;      ///< boundary vertices inside a non-incident tet (exact predicates)
   int obstacle_contacts = 0;  ///< vertices strictly inside an obstacle
   double max_penetration = 0; ///< largest depth among them, mm (0 if collision-free)
+  double self_penetration = 0;      ///< largest depth among the self contacts, mm
+  double obstacle_penetration = 0;  ///< largest depth among the obstacle contacts, mm
   bool collision_free() const { return self_contacts == 0 && obstacle_contacts == 0; }
 };
 

@@ -272,6 +272,9 @@ TEST(CollisionResponse, TargetsLieOutsideTheCollidedBlock) {
   const CollisionCheck check = resp.Check(X);
   EXPECT_FALSE(check.collision_free());
   EXPECT_NEAR(check.max_penetration, 1.0, 1e-9);
+  EXPECT_NEAR(check.self_penetration, 1.0, 1e-9);  // the depth split by kind
+  EXPECT_EQ(check.obstacle_contacts, 0);
+  EXPECT_EQ(check.obstacle_penetration, 0.0);
   EXPECT_TRUE(resp.Check(model.rest_positions()).collision_free());
 }
 
@@ -465,6 +468,30 @@ TEST(CollisionResponse, BlockPressedIntoAnObstacleStaysOut) {
       EXPECT_GT(r.springs, 0);
     } else {
       EXPECT_LT(lowest, 0.0);  // passes through
+      // The exact check still reports the obstacle (response off), with the depth as its own.
+      // The box spans z in [-3, 1] and reaches at least 5 mm beyond the block's sides, so a vertex
+      // inside it is min(1 - z, z + 3) deep. The check tests the block's surface vertices (rest x
+      // or y at 0 or 8, or z at 2 or 6).
+      CollisionResponse probe(*model, t.solver.collision);
+      const CollisionCheck ck = probe.Check(r.positions);
+      double deepest = 0;
+      int inside = 0;
+      for (int v = 0; v < r.positions.rows(); ++v) {
+        const Eigen::Vector3d p0 = model->rest_positions().row(v);
+        const bool surface = std::abs(p0.x()) < 1e-9 || std::abs(p0.x() - 8) < 1e-9 ||
+                             std::abs(p0.y()) < 1e-9 || std::abs(p0.y() - 8) < 1e-9 ||
+                             std::abs(p0.z() - 2) < 1e-9 || std::abs(p0.z() - 6) < 1e-9;
+        const double z = r.positions(v, 2);
+        if (!surface || z >= 1.0) continue;
+        ++inside;
+        deepest = std::max(deepest, std::min(1.0 - z, z + 3.0));
+      }
+      EXPECT_EQ(ck.obstacle_contacts, inside);
+      EXPECT_GT(deepest, 1.5);
+      EXPECT_NEAR(ck.obstacle_penetration, deepest, 1e-9);
+      EXPECT_EQ(ck.self_contacts, 0);
+      EXPECT_EQ(ck.self_penetration, 0.0);
+      EXPECT_EQ(ck.max_penetration, ck.obstacle_penetration);
     }
   }
 }
