@@ -811,11 +811,11 @@ Scene MakeSelfCollisionFinger(int res, const RobotParams& P) {
 // Axes: membrane in x, y in [0, 250], z up. Cells of h = 250 / res mm. The membrane is one cell
 // thick (region 0), its rim (x or y at 0 or 250) fixed. Below it, a 2 x 2 array of closed boxes
 // (walls region 1, one cell thick; cavities regions 2..5 = actuators c1..c4, volume ratio in
-// [1, 4]), each about 40 mm tall, one cell apart and one cell in from the rim, standing on the
-// fixed plane z = 0, with a 2 mm air gap between their roofs and the membrane (the mesh is cut
-// there, CutSlit). Chamber k sits
-// under quadrant k: c1 (x < 125, y < 125), c2 (x > 125, y < 125), c3 (x < 125, y > 125), c4 (x >
-// 125, y > 125). Material: Mooney-Rivlin Dragon Skin 20 (Eq. 3.6-3.7) for membrane and walls.
+// [1, 4]), each about 40 mm tall, chamber_gap cells apart (default 2: with 1, neighbouring
+// chambers' swelling side walls press on each other) and one cell in from the rim, standing on
+// the fixed plane z = 0, with a 2 mm air gap between their roofs and the membrane (the mesh is
+// cut there, CutSlit). Chamber k sits under quadrant k: c1 (x < 125, y < 125), c2 (x > 125,
+// y < 125), c3 (x < 125, y > 125), c4 (x > 125, y > 125). Material: Mooney-Rivlin Dragon Skin 20 (Eq. 3.6-3.7) for membrane and walls.
 // Markers: tip (the membrane's top centre) and q1..q4 (membrane top above each chamber's
 // centre). Self-collision response is on in the scene's solver options.
 // ================================================================================================
@@ -823,13 +823,22 @@ Scene MakeSelfCollisionFinger(int res, const RobotParams& P) {
 constexpr int kMemMinRes = 10, kMemMaxRes = 60, kMemDefaultRes = 20;
 constexpr double kMemSide = 250.0, kMemChamberHeight = 40.0, kMemGap = 2.0, kMemMaxAlpha = 4.0;
 
-Scene MakeMembrane(int res, const RobotParams&) {
+Scene MakeMembrane(int res, const RobotParams& P) {
   const double h = kMemSide / res;
   const int n = res;
-  const int nc = (n - 3) / 2;  // chamber width in cells: 1 margin + nc + 1 gap + nc + (rest) margin
+  const int gap = static_cast<int>(std::lround(P.at("chamber_gap")));
+  if (std::abs(P.at("chamber_gap") - gap) > 1e-9)
+    throw std::invalid_argument("membrane: chamber_gap: expected an integer number of cells, got " +
+                                std::to_string(P.at("chamber_gap")));
+  // Chamber width in cells: 1 margin + nc + gap + nc + (the rest) margin.
+  const int nc = (n - 2 - gap) / 2;
+  if (nc < 3)
+    throw std::invalid_argument("membrane: chamber_gap = " + std::to_string(gap) + " leaves chambers " +
+                                std::to_string(nc) + " cells wide at res " + std::to_string(res) +
+                                "; expected at least 3 (raise res or lower chamber_gap)");
   const int hc = std::max(3, static_cast<int>(std::lround(kMemChamberHeight / h)));
   const int zm = hc;           // membrane cell layer, on the roofs (then lifted by the slit)
-  const int x0[2] = {1, 2 + nc};
+  const int x0[2] = {1, 1 + nc + gap};
   auto cell = [&](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
     const int i = c[0], j = c[1], k = c[2];
     if (k == zm) return 0;
@@ -1006,7 +1015,9 @@ const std::vector<RobotEntry>& Registry() {
         "Self-collision response on. Markers: tip (membrane top centre), q1..q4 (membrane top above "
         "each chamber).",
         kMemDefaultRes, "cells across the 250 mm side (cell size 250/res mm), integer in [10, 60]",
-        {}},
+        {{"chamber_gap", 2.0, 1.0, 10.0,
+          "cells between neighbouring chambers (integer). With 1 the swelling chambers' side walls "
+          "press on each other and the contact response breaks down at res 24 (docs/collision_response.md)"}}},
        kMemMinRes, kMemMaxRes, &MakeMembrane},
       {{"twisting_robot",
         "Plant-inspired twisting robot (thesis Sec. 3.4.1, Fig. 3.7-3.8): a 100 mm long cylinder of "
