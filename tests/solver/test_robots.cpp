@@ -757,5 +757,45 @@ TEST(RobotsTwisting, StrainLimitingStripRegion) {
   EXPECT_GT(strip, 50);
 }
 
+// The membrane's chambers stand chamber_gap cells apart: the gap between the wall boxes (region 1
+// and the cavities) of neighbouring chambers along x and y is exactly that many cells.
+TEST(RobotsMembrane, ChambersStandChamberGapCellsApart) {
+  for (int gap : {1, 2, 3}) {
+    const int res = 24;
+    const double h = 250.0 / res;
+    const Scene s = MakeRobot("membrane", res, {{"chamber_gap", double(gap)}});
+    // The x extent of the chamber elements (every region but the membrane's 0) left of and right
+    // of the middle, over the rows y < 125.
+    double left_max = -1, right_min = 1e9;
+    for (int e = 0; e < s.mesh.num_elements(); ++e) {
+      if (s.mesh.elements[e].region == 0) continue;
+      double cx = 0, cy = 0;
+      for (int j = 0; j < 4; ++j) {
+        cx += s.mesh.vertices(s.mesh.elements[e].v[j], 0) / 4;
+        cy += s.mesh.vertices(s.mesh.elements[e].v[j], 1) / 4;
+      }
+      if (cy > 125) continue;
+      for (int j = 0; j < 4; ++j) {
+        const double x = s.mesh.vertices(s.mesh.elements[e].v[j], 0);
+        if (cx < 125) left_max = std::max(left_max, x);
+        else right_min = std::min(right_min, x);
+      }
+    }
+    EXPECT_NEAR(right_min - left_max, gap * h, 1e-9) << "chamber_gap " << gap;
+  }
+  try {
+    MakeRobot("membrane", 24, {{"chamber_gap", 1.5}});
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("chamber_gap: expected an integer"), std::string::npos) << e.what();
+  }
+  try {
+    MakeRobot("membrane", 10, {{"chamber_gap", 3}});
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("expected at least 3"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace softkin
