@@ -232,7 +232,7 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
                 {"variant", "step", "actuation_scale", "tip_x", "tip_y", "tip_z", "bend_deg",
                  "iterations", "converged", "springs", "self_contacts", "obstacle_contacts",
                  "max_penetration_mm", "self_penetration_mm", "obstacle_penetration_mm",
-                 "contact_vertices", "contact_area_mm2", "check_s", "response_s", "solver_s", "time_s"});
+                 "inverted_elements", "contact_vertices", "contact_area_mm2", "check_s", "response_s", "solver_s", "time_s"});
   nlohmann::json out_variants = nlohmann::json::array();
   std::vector<std::pair<double, std::string>> frames;
   for (size_t vi = 0; vi < prepared.size(); ++vi) {
@@ -256,6 +256,7 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
     int iterations = 0, failed = 0;
     FkResult last;
     CollisionCheck last_check;
+    int last_inverted = 0;
     std::vector<ContactPatch> patches;  // per obstacle, at the last step
     nlohmann::json tips = nlohmann::json::array();
     for (int s = 1; s <= steps; ++s) {
@@ -265,6 +266,7 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
       if (r.status == FkStatus::InvalidInput) throw std::runtime_error(cfg.path() + ": " + key + ": " + r.message);
       X = r.positions;
       const CollisionCheck ck = probe.Check(X);
+      const int inverted = CountInvertedElements(scene.mesh, X);
       const bool ok = r.status == FkStatus::Converged;
       failed += !ok;
       iterations += r.iterations;
@@ -289,18 +291,20 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
                       std::to_string(r.iterations), ok ? "1" : "0", std::to_string(r.springs),
                       std::to_string(ck.self_contacts), std::to_string(ck.obstacle_contacts),
                       std::to_string(ck.max_penetration), std::to_string(ck.self_penetration),
-                      std::to_string(ck.obstacle_penetration), std::to_string(touch), std::to_string(touch_area),
+                      std::to_string(ck.obstacle_penetration), std::to_string(inverted), std::to_string(touch),
+                      std::to_string(touch_area),
                       std::to_string(r.collision_stats.check_s),
                       std::to_string(r.collision_stats.response_s),
                       std::to_string(r.local_time_s + r.global_time_s), std::to_string(r.time_s)});
       if (verbose)
         std::fprintf(stderr,
                      "  [%s %d/%d] %s; exact check: %d self (max depth %.3g mm) + %d obstacle contacts "
-                     "(max depth %.3g mm)\n",
+                     "(max depth %.3g mm); %d inverted elements\n",
                      name.c_str(), s, steps, r.BriefReport().c_str(), ck.self_contacts, ck.self_penetration,
-                     ck.obstacle_contacts, ck.obstacle_penetration);
+                     ck.obstacle_contacts, ck.obstacle_penetration, inverted);
       last = r;
       last_check = ck;
+      last_inverted = inverted;
     }
     if (export_region >= 0) {
       CsvWriter surf(dir + "/surface_" + name + ".csv", {"x0", "y0", "z0", "x", "y", "z"});
@@ -331,6 +335,7 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
     jv["max_penetration_mm"] = last_check.max_penetration;
     jv["self_penetration_mm"] = last_check.self_penetration;
     jv["obstacle_penetration_mm"] = last_check.obstacle_penetration;
+    jv["inverted_elements"] = last_inverted;
     jv["collision_free"] = last_check.collision_free();
     jv["springs_at_end"] = last.springs;
     jv["iterations"] = iterations;

@@ -29,12 +29,6 @@ Mesh ChamberPart(const Mesh& mesh, const std::vector<int>& regions) {
   return m;
 }
 
-int InvertedTets(const Mesh& mesh, const Eigen::MatrixX3d& X) {
-  int n = 0;
-  for (const auto& e : mesh.elements) n += SignedVolume(e, X) > 0 ? 0 : 1;
-  return n;
-}
-
 std::string Tag(const std::string& variant, double alpha) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%s_a%g", variant.c_str(), alpha);
@@ -129,7 +123,7 @@ nlohmann::json RunTwistingRemesh(const Config& cfg, const std::string& dir, bool
       if (variant == "progressive") frames.emplace_back(alpha, vtu);
     }
     const Eigen::MatrixX3d P = s.marker_positions(X);
-    const int inverted = InvertedTets(s.mesh, X);
+    const int inverted = CountInvertedElements(s.mesh, X);
     shapes_csv.RowStrings({variant, fmt(alpha), fmt(prof.back()), fmt(volume_ratio), std::to_string(remeshes),
                            std::to_string(s.mesh.num_tets()), std::to_string(inverted), fmt(mesh_s), fmt(solver_s),
                            fmt(P(tip, 0)), fmt(P(tip, 1)), fmt(P(tip, 2)), outer, chamber, vtu});

@@ -100,6 +100,16 @@ double SignedVolume(const Element& e, const Eigen::Ref<const Eigen::MatrixX3d>& 
          6.0;
 }
 
+int CountInvertedElements(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X) {
+  if (X.rows() != mesh.num_vertices())
+    throw std::invalid_argument("CountInvertedElements: " + std::to_string(X.rows()) +
+                                " positions for a mesh of " + std::to_string(mesh.num_vertices()) +
+                                " vertices");
+  int n = 0;
+  for (const auto& e : mesh.elements) n += SignedVolume(e, X) > 0 ? 0 : 1;
+  return n;
+}
+
 void FlipElement(Element& e) {
   if (e.type == ElementType::Tet) {
     std::swap(e.v[1], e.v[2]);

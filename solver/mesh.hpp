@@ -47,6 +47,10 @@ struct Mesh {
 /// three-tet split, exact for planar quad faces.
 double SignedVolume(const Element& e, const Eigen::Ref<const Eigen::MatrixX3d>& X);
 
+/// Number of elements of `mesh` whose signed volume at positions X (#V x 3) is not positive
+/// (inverted or flat): a state's tangles, as opposed to contacts between its surfaces.
+int CountInvertedElements(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X);
+
 /// Messages produced while checking a mesh: notes (e.g. flipped elements) and warnings
 /// (unused vertices, disconnected parts). Errors are thrown, never collected here.
 struct MeshReport {

@@ -219,6 +219,21 @@ TEST(MeshBasics, VolumesCountsAndFlip) {
   EXPECT_NEAR(m.size(), 1.7 * std::sqrt(1 + 1 + 4), 1e-12);
 }
 
+TEST(MeshBasics, CountsInvertedElements) {
+  Mesh m = MixedMesh();
+  EXPECT_EQ(CountInvertedElements(m, m.vertices), 0);
+  // Mirroring every position inverts every element; flattening one onto a plane makes it count.
+  Eigen::MatrixX3d X = m.vertices;
+  X.col(2) *= -1.0;
+  EXPECT_EQ(CountInvertedElements(m, X), m.num_elements());
+  X = m.vertices;
+  for (int j = 0; j < m.elements[0].k(); ++j) X(m.elements[0].v[j], 2) = 0.0;  // one element flattened
+  EXPECT_GE(CountInvertedElements(m, X), 1);
+  EXPECT_LE(CountInvertedElements(m, X), m.num_elements());
+  EXPECT_EQ(SignedVolume(m.elements[0], X), 0.0);
+  EXPECT_THROW(CountInvertedElements(m, Eigen::MatrixX3d::Zero(2, 3)), std::invalid_argument);
+}
+
 TEST(MeshValidate, FlipsOneTetAndOnePrism) {
   const Mesh good = MixedMesh();
   Mesh m = good;
