@@ -218,9 +218,11 @@ void ApplySolverJson(const nlohmann::json& j, const std::string& where, FkOption
         else if (ck == "update") { cneed(cv.is_string(), "one of updown, refactor"); co.update = cv.get<std::string>(); }
         else if (ck == "self_target") { cneed(cv.is_string(), "one of auto, walk"); co.self_target = cv.get<std::string>(); }
         else if (ck == "self_spring") { cneed(cv.is_string(), "one of target, pair"); co.self_spring = cv.get<std::string>(); }
+        else if (ck == "obstacle_spring") { cneed(cv.is_string(), "one of point, plane"); co.obstacle_spring = cv.get<std::string>(); }
         else
           throw std::invalid_argument(where + ".collision." + ck + ": unknown key (expected one of self, "
-                                      "obstacles, epsilon, stiffness, check_interval, update, self_target, self_spring)");
+                                      "obstacles, epsilon, stiffness, check_interval, update, self_target, self_spring, "
+                                      "obstacle_spring)");
       }
     }
     else

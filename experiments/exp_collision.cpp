@@ -14,6 +14,8 @@
 #include "solver/collision_response.hpp"
 #include "solver/fk_solver.hpp"
 #include "solver/mesh_io.hpp"
+#include "solver/remesh.hpp"
+#include "solver/robot_twisting.hpp"
 #include "solver/robots.hpp"
 
 #include <algorithm>
@@ -164,6 +166,53 @@ void MergeRobotParams(const Config& cfg, const std::string& key, const nlohmann:
     if (!it.value().is_number()) cfg.Fail(key + "." + it.key(), "a number");
     (*p)[it.key()] = it.value().get<double>();
   }
+}
+
+/// Progressive remeshing (Algorithm 2) of a collision_costs robot from its "remesh" object
+/// {"alpha_max", "d_max", "method", "remesh_iterations", "max_remeshes_per_step"} (every key
+/// optional; the thesis's 4 / 4, auto, 3, 2); the ladder is the robot's `steps` values.
+ProgressiveOptions CostsRemeshOptions(const Config& cfg, const std::string& key, const nlohmann::json& j,
+                                      const std::string& robot, int res, const RobotParams& params) {
+  if (!j.is_object())
+    cfg.Fail(key, "an object {\"alpha_max\", \"d_max\", \"method\", \"remesh_iterations\", \"max_remeshes_per_step\"}");
+  auto number = [&](const char* k, double def) {
+    if (!j.contains(k)) return def;
+    if (!j[k].is_number() || !std::isfinite(j[k].get<double>())) cfg.Fail(key + "." + k, "a finite number");
+    return j[k].get<double>();
+  };
+  auto integer = [&](const char* k, int def) {
+    if (!j.contains(k)) return def;
+    if (!j[k].is_number_integer() || j[k].get<int>() < 1) cfg.Fail(key + "." + k, "an integer >= 1");
+    return j[k].get<int>();
+  };
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (it.key() != "alpha_max" && it.key() != "d_max" && it.key() != "method" && it.key() != "remesh_iterations" &&
+        it.key() != "max_remeshes_per_step")
+      cfg.Fail(key + "." + it.key(), "one of alpha_max, d_max, method, remesh_iterations, max_remeshes_per_step");
+  ProgressiveOptions popt;
+  popt.criteria = {number("alpha_max", 4.0), number("d_max", 4.0)};
+  popt.max_remeshes_per_step = integer("max_remeshes_per_step", 2);
+  const std::string method = j.contains("method") && j["method"].is_string() ? j["method"].get<std::string>() : "auto";
+  if ((j.contains("method") && !j["method"].is_string()) ||
+      !RemeshMethodFromString(method, &popt.remesh_options.method))
+    cfg.Fail(key + ".method", "auto, chamber or whole");
+  popt.remesh_options.region.iterations = integer("remesh_iterations", 3);
+  popt.remesh_options.region.seed = cfg.seed();
+  if (robot == "twisting_robot") {
+    const auto tube = params.find("tube_radius");
+    popt.remesh_options.tessellation =
+        TwistingRobotTessellation(res <= 0 ? kTwistDefaultRes : res, tube == params.end() ? 2.5 : tube->second);
+  }
+  popt.remesh_options.tessellation.seed = cfg.seed();
+  std::string why;
+  if (!popt.IsValid(&why)) {
+    // why = "<key>: expected <what>, got <value>"; Fail adds the key path and the value found.
+    const size_t colon = why.find(": ");
+    std::string what = colon == std::string::npos ? why : why.substr(colon + 2);
+    if (what.rfind("expected ", 0) == 0) what = what.substr(9);
+    cfg.Fail(key + "." + why.substr(0, colon), what.substr(0, what.find(", got")));
+  }
+  return popt;
 }
 
 }  // namespace
@@ -372,22 +421,38 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
     cfg.Fail("robots", "a non-empty array of {\"robot\", \"res\", [\"robot_params\"], \"actuation\", \"steps\", [\"obstacles\"], [\"thesis\"]}");
   CsvWriter csv(dir + "/costs.csv", {"robot", "tets", "mesh_gen_s", "col_check_s", "col_resp_s",
                                      "solver_s", "step_s", "steps", "collision_free"});
-  nlohmann::json rows = nlohmann::json::array();
-  for (size_t i = 0; i < robots_j.size(); ++i) {
+  // Every robot's keys are checked before the first one runs (a bad key in the last robot fails
+  // at once, not after the others' minutes of solving).
+  auto check_robot = [&](size_t i, RobotParams* params) {
     const std::string key = "robots[" + std::to_string(i) + "]";
     const auto& rj = robots_j[i];
     if (!rj.is_object() || !rj.contains("robot") || !rj["robot"].is_string())
       cfg.Fail(key, "an object with \"robot\"");
     for (auto it = rj.begin(); it != rj.end(); ++it)
       if (it.key() != "robot" && it.key() != "res" && it.key() != "robot_params" && it.key() != "actuation" &&
-          it.key() != "steps" && it.key() != "obstacles" && it.key() != "thesis")
-        cfg.Fail(key + "." + it.key(), "one of robot, res, robot_params, actuation, steps, obstacles, thesis");
+          it.key() != "steps" && it.key() != "obstacles" && it.key() != "thesis" && it.key() != "remesh")
+        cfg.Fail(key + "." + it.key(), "one of robot, res, robot_params, actuation, steps, obstacles, remesh, thesis");
+    if (rj.contains("res") && !rj["res"].is_number_integer()) cfg.Fail(key + ".res", "an integer");
+    if (rj.contains("steps") && (!rj["steps"].is_number_integer() || rj["steps"].get<int>() < 1))
+      cfg.Fail(key + ".steps", "an integer >= 1");
+    if (rj.contains("robot_params")) MergeRobotParams(cfg, key + ".robot_params", rj["robot_params"], params);
+    if (rj.contains("remesh"))
+      (void)CostsRemeshOptions(cfg, key + ".remesh", rj["remesh"], rj["robot"].get<std::string>(),
+                               rj.value("res", 0), *params);
+  };
+  for (size_t i = 0; i < robots_j.size(); ++i) {
+    RobotParams p;
+    check_robot(i, &p);
+  }
+  nlohmann::json rows = nlohmann::json::array();
+  for (size_t i = 0; i < robots_j.size(); ++i) {
+    const std::string key = "robots[" + std::to_string(i) + "]";
+    const auto& rj = robots_j[i];
+    RobotParams params;
+    check_robot(i, &params);
     const std::string robot = rj["robot"].get<std::string>();
     const int res = rj.value("res", 0);
     const int steps = rj.value("steps", 4);
-    if (steps < 1) cfg.Fail(key + ".steps", "an integer >= 1");
-    RobotParams params;
-    if (rj.contains("robot_params")) MergeRobotParams(cfg, key + ".robot_params", rj["robot_params"], &params);
     const auto t0 = Clock::now();
     Scene scene;
     try {
@@ -402,28 +467,72 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
     FkOptions opts = scene.solver;  // the robot's defaults, then the config's solver object
     if (!solver_j.is_null()) ApplySolverJson(solver_j, cfg.path() + ": solver", &opts);
     scene.solver = opts;
-    auto model = std::make_shared<const Model>(scene);
-    auto solver = MakeFkSolver(model, opts);
     const Eigen::VectorXd rest = scene.rest_actuation();
-    Eigen::MatrixX3d X = scene.mesh.vertices;
-    double check = 0, resp = 0, solve = 0, total = 0;
+    double check = 0, resp = 0, solve = 0, total = 0, remesh_s = 0;
     bool free = true;
-    for (int s = 1; s <= steps; ++s) {
-      const Eigen::VectorXd c = rest + (double(s) / steps) * (c_end - rest);
-      FkResult r = solver->Solve(c, s > 1 ? &X : nullptr);
-      if (r.status == FkStatus::InvalidInput) throw std::runtime_error(cfg.path() + ": " + key + ": " + r.message);
-      X = r.positions;
-      check += r.collision_stats.check_s;
-      resp += r.collision_stats.response_s;
-      solve += r.local_time_s + r.global_time_s;
-      total += r.time_s;
-      free = free && (!r.collision_active || r.collision.collision_free());
-      if (verbose) std::fprintf(stderr, "  [%s %d/%d] %s\n", robot.c_str(), s, steps, r.BriefReport().c_str());
+    nlohmann::json remesh_j;
+    if (rj.contains("remesh")) {
+      // Algorithm 2 with the collision handling on: the chamber's ratio is raised over the same
+      // `steps` values, and the chamber is re-tessellated when it has grown or distorted too far.
+      ProgressiveOptions popt = CostsRemeshOptions(cfg, key + ".remesh", rj["remesh"], robot, res, params);
+      int chamber = -1;
+      try {
+        chamber = ChamberActuator(scene);
+      } catch (const std::invalid_argument& e) {
+        cfg.Fail(key + ".remesh", std::string("a robot with one pneumatic chamber actuator (") + e.what() + ")");
+      }
+      const double alpha = c_end[chamber];
+      if (!(alpha > 1)) cfg.Fail(key + ".actuation", "a chamber volume ratio > 1 (remeshing raises it)");
+      for (int s = 1; s < steps; ++s) popt.ladder.push_back(rest[chamber] + (double(s) / steps) * (alpha - rest[chamber]));
+      popt.ladder.erase(std::remove_if(popt.ladder.begin(), popt.ladder.end(), [](double a) { return !(a > 1); }),
+                        popt.ladder.end());
+      popt.on_step = [&](const ProgressiveStep& st, const Scene& s_now, const Eigen::MatrixX3d&) {
+        if (verbose)
+          std::fprintf(stderr, "  [%s alpha %.3g] %s, %d iterations, %.2f s; %d remesh(es), %.2f s, %d tets; "
+                       "exact check: %s, %d springs\n",
+                       robot.c_str(), st.alpha, FkStatusToString(st.status), st.iterations, st.solver_seconds,
+                       st.remeshes, st.mesh_seconds, s_now.mesh.num_tets(),
+                       st.collision_active ? (st.collision.collision_free() ? "collision-free" : "contacts left") : "off",
+                       st.springs);
+      };
+      const ProgressiveResult pr = SolveProgressive(scene, alpha, popt);
+      if (!pr.completed) throw std::runtime_error(cfg.path() + ": " + key + ": remeshing stopped: " + pr.message);
+      for (const ProgressiveStep& st : pr.steps) {
+        check += st.check_seconds;
+        resp += st.response_seconds;
+        solve += st.local_global_seconds;
+        total += st.solver_seconds;
+        remesh_s += st.mesh_seconds;
+        free = free && (!st.collision_active || st.collision.collision_free());
+      }
+      remesh_j = {{"remeshes", pr.remeshes}, {"remesh_failures", pr.remesh_failures},
+                  {"tets_final", pr.scene.mesh.num_tets()}, {"chamber_volume_ratio", pr.chamber_volume_ratio},
+                  {"status", FkStatusToString(pr.status)}, {"alpha_max", popt.criteria.alpha_max},
+                  {"d_max", popt.criteria.d_max}, {"initial_mesh_s", mesh_gen_s}};
+    } else {
+      auto model = std::make_shared<const Model>(scene);
+      auto solver = MakeFkSolver(model, opts);
+      Eigen::MatrixX3d X = scene.mesh.vertices;
+      for (int s = 1; s <= steps; ++s) {
+        const Eigen::VectorXd c = rest + (double(s) / steps) * (c_end - rest);
+        FkResult r = solver->Solve(c, s > 1 ? &X : nullptr);
+        if (r.status == FkStatus::InvalidInput) throw std::runtime_error(cfg.path() + ": " + key + ": " + r.message);
+        X = r.positions;
+        check += r.collision_stats.check_s;
+        resp += r.collision_stats.response_s;
+        solve += r.local_time_s + r.global_time_s;
+        total += r.time_s;
+        free = free && (!r.collision_active || r.collision.collision_free());
+        if (verbose) std::fprintf(stderr, "  [%s %d/%d] %s\n", robot.c_str(), s, steps, r.BriefReport().c_str());
+      }
     }
     nlohmann::json row;
     row["robot"] = robot;
     row["tets"] = scene.mesh.num_tets();
-    row["mesh_gen_s"] = mesh_gen_s;
+    // The thesis's mesh generation for a remeshed robot is its chamber re-tessellation per step;
+    // without remeshing it is the robot's one tessellation.
+    row["mesh_gen_s"] = remesh_j.is_null() ? mesh_gen_s : remesh_s / steps;
+    if (!remesh_j.is_null()) row["remesh"] = remesh_j;
     row["col_check_s"] = check / steps;
     row["col_resp_s"] = resp / steps;
     row["solver_s"] = solve / steps;
@@ -439,7 +548,7 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
         row["speedup_vs_thesis_step"] = thesis_step / (total / steps);
       }
     }
-    csv.RowStrings({robot, std::to_string(scene.mesh.num_tets()), std::to_string(mesh_gen_s),
+    csv.RowStrings({robot, std::to_string(scene.mesh.num_tets()), std::to_string(row["mesh_gen_s"].get<double>()),
                     std::to_string(check / steps), std::to_string(resp / steps),
                     std::to_string(solve / steps), std::to_string(total / steps),
                     std::to_string(steps), free ? "1" : "0"});

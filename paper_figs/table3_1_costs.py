@@ -45,6 +45,9 @@ def main(argv):
                        hatch="//" if who == "thesis" else None, edgecolor="k", lw=0.5)
                 bottom += v
             tets = src.get("tets", r.get("tets"))
+            remesh = r.get("remesh") if who == "ours" else None
+            if isinstance(remesh, dict) and "tets_final" in remesh:
+                tets = f"{tets}->{remesh['tets_final']}"  # remeshed during the run
             labels.append(f"{r['robot']}\n{who}, {tets} tets")
             x += 1
     ax.set_xticks(range(len(labels)))

@@ -333,8 +333,100 @@ void CollisionResponse::SetSelfTarget(const Eigen::Ref<const Eigen::MatrixX3d>& 
 std::vector<SpringStencil> CollisionResponse::Stencils() const {
   std::vector<SpringStencil> st;
   st.reserve(springs_.size());
-  for (const auto& s : springs_) st.push_back(s.Stencil());
+  for (const auto& s : springs_)
+    if (!IsPlane(s)) st.push_back(s.Stencil());
   return st;
+}
+
+void CollisionResponse::RebuildPlanes(bool system_changed) {
+  plane_.clear();
+  for (const auto& s : springs_)
+    if (IsPlane(s)) plane_.push_back({s.vertex, s.normal, s.normal.dot(s.target)});
+  if (system_changed) plane_solve_.clear();
+  const int m = static_cast<int>(plane_.size());
+  const int nf = model_.num_free_dofs();
+  // Keep the cached solves of vertices that still have a plane spring; solve for new ones.
+  std::vector<std::pair<int, Eigen::VectorXd>> cache;
+  plane_solve_of_.assign(m, -1);
+  for (int s = 0; s < m; ++s) {
+    const int v = plane_[s].vertex;
+    if (!cache.empty() && cache.back().first == v) {  // a vertex inside two obstacles
+      plane_solve_of_[s] = static_cast<int>(cache.size()) - 1;
+      continue;
+    }
+    auto it = std::lower_bound(plane_solve_.begin(), plane_solve_.end(), v,
+                               [](const std::pair<int, Eigen::VectorXd>& a, int b) { return a.first < b; });
+    if (it != plane_solve_.end() && it->first == v) {
+      cache.push_back(std::move(*it));
+    } else {
+      Eigen::VectorXd e = Eigen::VectorXd::Zero(nf);
+      for (int d = 0; d < 3; ++d) {
+        const int fi = model_.free_index(d)[v];
+        if (fi >= 0) e[model_.free_offset(d) + fi] = 1.0;
+      }
+      cache.emplace_back(v, system_.Solve(e));
+    }
+    plane_solve_of_[s] = static_cast<int>(cache.size()) - 1;
+  }
+  plane_solve_ = std::move(cache);
+  if (m == 0) return;
+  // Capacitance I / k + U^T W: (U^T W)_st = sum_d n_s,d n_t,d (S^-1 e_(v_t,d))_(v_s,d).
+  Eigen::MatrixXd C = Eigen::MatrixXd::Identity(m, m) / k_;
+  for (int t = 0; t < m; ++t) {
+    const Eigen::VectorXd& g = plane_solve_[plane_solve_of_[t]].second;
+    for (int s = 0; s < m; ++s)
+      for (int d = 0; d < 3; ++d) {
+        const int fi = model_.free_index(d)[plane_[s].vertex];
+        if (fi >= 0) C(s, t) += plane_[s].normal[d] * plane_[t].normal[d] * g[model_.free_offset(d) + fi];
+      }
+  }
+  plane_capacitance_.compute(0.5 * (C + C.transpose()));
+}
+
+Eigen::VectorXd CollisionResponse::PlaneDot(const Eigen::VectorXd& x) const {
+  Eigen::VectorXd r = Eigen::VectorXd::Zero(plane_.size());
+  for (size_t s = 0; s < plane_.size(); ++s)
+    for (int d = 0; d < 3; ++d) {
+      const int fi = model_.free_index(d)[plane_[s].vertex];
+      if (fi >= 0) r[s] += plane_[s].normal[d] * x[model_.free_offset(d) + fi];
+    }
+  return r;
+}
+
+void CollisionResponse::AddPlaneProduct(const Eigen::VectorXd& x, Eigen::VectorXd* y) const {
+  if (plane_.empty()) return;
+  const Eigen::VectorXd r = PlaneDot(x);
+  for (size_t s = 0; s < plane_.size(); ++s)
+    for (int d = 0; d < 3; ++d) {
+      const int fi = model_.free_index(d)[plane_[s].vertex];
+      if (fi >= 0) (*y)[model_.free_offset(d) + fi] += k_ * plane_[s].normal[d] * r[s];
+    }
+}
+
+void CollisionResponse::AddSpringProduct(const Eigen::VectorXd& x, Eigen::VectorXd* y) const {
+  system_.AddSpringProduct(x, y);
+  AddPlaneProduct(x, y);
+}
+
+Eigen::VectorXd CollisionResponse::Multiply(const Eigen::VectorXd& x) const {
+  Eigen::VectorXd y = system_.Multiply(x);
+  AddPlaneProduct(x, &y);
+  return y;
+}
+
+Eigen::VectorXd CollisionResponse::Solve(const Eigen::VectorXd& rhs) const {
+  Eigen::VectorXd y = system_.Solve(rhs);
+  if (plane_.empty()) return y;
+  const Eigen::VectorXd z = plane_capacitance_.solve(PlaneDot(y));
+  // y - W z, W's column s = n_s spread over the axis blocks of S^-1 sum_d e_(v_s, d).
+  for (size_t s = 0; s < plane_.size(); ++s) {
+    const Eigen::VectorXd& g = plane_solve_[plane_solve_of_[s]].second;
+    for (int d = 0; d < 3; ++d) {
+      const int a = model_.free_offset(d), len = model_.free_offset(d + 1) - a;
+      y.segment(a, len).noalias() -= (z[s] * plane_[s].normal[d]) * g.segment(a, len);
+    }
+  }
+  return y;
 }
 
 void CollisionResponse::ObstacleTarget(const Eigen::Vector3d& p, int obstacle,
@@ -458,8 +550,17 @@ bool CollisionResponse::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) {
   next.insert(next.end(), kept.begin(), kept.end());
   std::sort(next.begin(), next.end(),
             [](const CollisionSpring& a, const CollisionSpring& b) { return a.vertex < b.vertex; });
+  std::vector<int> planes_before;
+  for (const auto& s : springs_)
+    if (IsPlane(s)) planes_before.push_back(s.vertex);
   springs_ = std::move(next);
-  const bool changed = system_.SetSprings(Stencils(), k_);
+  bool changed = system_.SetSprings(Stencils(), k_);
+  std::vector<int> planes_after;
+  for (const auto& s : springs_)
+    if (IsPlane(s)) planes_after.push_back(s.vertex);
+  // The plane springs' normals and offsets follow the refreshed closest points at every check.
+  RebuildPlanes(changed);
+  changed = changed || planes_after != planes_before;
   stats_.max_springs = std::max(stats_.max_springs, static_cast<int>(springs_.size()));
   stats_.response_s += Since(t1);
   return changed;
@@ -468,6 +569,17 @@ bool CollisionResponse::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) {
 void CollisionResponse::AddToRhs(const Eigen::Ref<const Eigen::MatrixX3d>& X,
                                  Eigen::VectorXd* Bf) const {
   for (const auto& s : springs_) {
+    if (IsPlane(s)) {
+      // k n (n . v_c - n . x_prescribed) on the vertex's free coordinates.
+      double b = s.normal.dot(s.target);
+      for (int d = 0; d < 3; ++d)
+        if (model_.free_index(d)[s.vertex] < 0) b -= s.normal[d] * X(s.vertex, d);
+      for (int d = 0; d < 3; ++d) {
+        const int fi = model_.free_index(d)[s.vertex];
+        if (fi >= 0) (*Bf)[model_.free_offset(d) + fi] += k_ * s.normal[d] * b;
+      }
+      continue;
+    }
     const SpringStencil st = s.Stencil();
     const Eigen::Vector3d delta = s.pair() ? s.offset : s.target;
     for (int d = 0; d < 3; ++d) {
@@ -488,6 +600,7 @@ void CollisionResponse::Reset() {
   k_ = k0_;
   raises_ = 0;
   system_.SetSprings(std::vector<SpringStencil>(), k_);
+  RebuildPlanes(true);
   stats_ = CollisionStats();
 }
 
@@ -498,13 +611,17 @@ bool CollisionResponse::Stiffen(int max_raises) {
   k_ *= 4.0;
   const auto t0 = Clock::now();
   system_.SetSprings(Stencils(), k_);
+  RebuildPlanes(true);
   stats_.response_s += Since(t0);
   return true;
 }
 
 double CollisionResponse::Energy(const Eigen::Ref<const Eigen::MatrixX3d>& X) const {
   double e = 0;
-  for (const auto& s : springs_) e += k_ * (X.row(s.vertex).transpose() - s.TargetAt(X)).squaredNorm();
+  for (const auto& s : springs_) {
+    const Eigen::Vector3d r = X.row(s.vertex).transpose() - s.TargetAt(X);
+    e += IsPlane(s) ? k_ * std::pow(s.normal.dot(r), 2) : k_ * r.squaredNorm();
+  }
   return e;
 }
 

@@ -112,17 +112,19 @@ class CollisionResponse {
   /// prescribed coordinates (of a pair spring's face).
   void AddToRhs(const Eigen::Ref<const Eigen::MatrixX3d>& X, Eigen::VectorXd* Bf) const;
   /// Adds K x to y (x: free coordinates, layout of Model::GatherFree).
-  void AddSpringProduct(const Eigen::VectorXd& x, Eigen::VectorXd* y) const {
-    system_.AddSpringProduct(x, y);
-  }
+  void AddSpringProduct(const Eigen::VectorXd& x, Eigen::VectorXd* y) const;
   /// Releases every spring and zeroes the statistics (the start of a new solve).
   void Reset();
   /// E_col = sum k ||v - v_c||^2 at positions X (v_c = CollisionSpring::TargetAt(X)).
   double Energy(const Eigen::Ref<const Eigen::MatrixX3d>& X) const;
-  /// Solves (A_ff + K) y = rhs (free layout).
-  Eigen::VectorXd Solve(const Eigen::VectorXd& rhs) const { return system_.Solve(rhs); }
+  /// Solves (A_ff + K) y = rhs (free layout). With plane obstacle springs, K also holds their
+  /// k u_s u_s^T terms (u_s = n_s on the vertex's free coordinates), applied to the factored
+  /// per-axis system by the Woodbury identity (the file comment).
+  Eigen::VectorXd Solve(const Eigen::VectorXd& rhs) const;
   /// (A_ff + K) x (free layout).
-  Eigen::VectorXd Multiply(const Eigen::VectorXd& x) const { return system_.Multiply(x); }
+  Eigen::VectorXd Multiply(const Eigen::VectorXd& x) const;
+  /// Number of plane (normal-only) obstacle springs in the current set.
+  int num_plane_springs() const { return static_cast<int>(plane_.size()); }
   /// Exact check of positions X: contacts left and the deepest penetration (for a self contact,
   /// the shortest exit found along -n(v), away from the collided tet's centroid and the six axis
   /// directions: an upper bound on the distance to the collided region's surface).
@@ -172,6 +174,16 @@ class CollisionResponse {
                   int v, CollisionSpring* s) const;
   /// A boundary surface per body, built (once) if the mesh has more than one body.
   std::vector<MovingSurface> MakeBodySurfaces() const;
+  /// Whether spring s is a plane (normal-only) obstacle spring.
+  bool IsPlane(const CollisionSpring& s) const {
+    return s.kind == CollisionSpring::Kind::Obstacle && options_.obstacle_spring == "plane";
+  }
+  /// Rebuilds the Woodbury terms of the plane springs from springs_ (after any change of the
+  /// springs, their normals, k or the factored system; `system_changed`: the factored system
+  /// changed, so the cached solves S^-1 e_v are stale).
+  void RebuildPlanes(bool system_changed);
+  /// Adds k U U^T x to y (the plane springs' part of K).
+  void AddPlaneProduct(const Eigen::VectorXd& x, Eigen::VectorXd* y) const;
 
   const Model& model_;
   CollisionOptions options_;
@@ -195,6 +207,23 @@ class CollisionResponse {
   int num_bodies_ = 0;
   std::vector<MovingSurface> body_surface_;
   std::vector<std::vector<int>> body_faces_;  // per body, indices into bfaces_
+  // Plane obstacle springs (options.obstacle_spring "plane"): energy k (n_s . v_s - b_s)^2 with
+  // b_s = n_s . v_c. Their k U U^T is not in system_ (it couples x, y and z, which system_ solves
+  // apart); Solve adds it by the Woodbury identity:
+  //   (S + k U U^T)^-1 r = y - W (I / k + U^T W)^-1 U^T y,  y = S^-1 r,  W = S^-1 U.
+  // Column s of W is n_s spread over the axis blocks of S^-1 (sum_d e_(v_s, d)) (S is block
+  // diagonal by axis), cached per vertex in plane_solve_ until the factored system changes.
+  struct PlaneSpring {
+    int vertex;
+    Eigen::Vector3d normal;
+    double offset;
+  };
+  std::vector<PlaneSpring> plane_;
+  std::vector<std::pair<int, Eigen::VectorXd>> plane_solve_;  // (vertex, S^-1 sum_d e_(v,d)), sorted
+  std::vector<int> plane_solve_of_;                          // per plane spring, its entry there
+  Eigen::LDLT<Eigen::MatrixXd> plane_capacitance_;           // I / k + U^T W
+  /// U^T x: per plane spring, n_s . (x's free coordinates of v_s).
+  Eigen::VectorXd PlaneDot(const Eigen::VectorXd& x) const;
   CollisionStats stats_;
 };
 

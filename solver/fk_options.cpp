@@ -17,6 +17,8 @@ bool CollisionOptions::IsValid(std::string* why) const {
     return bad("collision.self_target: expected one of auto, walk; got '" + self_target + "'");
   if (self_spring != "target" && self_spring != "pair")
     return bad("collision.self_spring: expected one of target, pair; got '" + self_spring + "'");
+  if (obstacle_spring != "point" && obstacle_spring != "plane")
+    return bad("collision.obstacle_spring: expected one of point, plane; got '" + obstacle_spring + "'");
   return true;
 }
 

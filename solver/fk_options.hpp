@@ -38,6 +38,14 @@ struct CollisionOptions {
   /// equally and oppositely (action and reaction), so it couples v with the face's vertices in
   /// the global matrix (SpringSystem).
   std::string self_spring = "target";
+  /// What an obstacle spring resists. "plane" (the default): only the normal part of the offset
+  /// to v_c (the closest point plus eps), k (n . (v - v_c))^2, against the obstacle's tangent
+  /// plane at v_c: a frictionless contact. Its n n^T term couples a vertex's x, y and z, so the
+  /// global step adds it to the factored per-axis system by a low-rank (Woodbury) correction.
+  /// "point" (Eq. 3.5 as written): k ||v - v_c||^2, refreshed at each check; it has the same
+  /// fixed point, but between checks it also holds the vertex tangentially, so a sliding contact
+  /// creeps by the tangential force / k per check (docs/collision_response.md).
+  std::string obstacle_spring = "plane";
   bool IsValid(std::string* why) const;
 };
 

@@ -728,6 +728,10 @@ bool ProgressiveOptions::IsValid(std::string* why) const {
   if (!remesh_options.IsValid(why)) return false;
   for (double s : snapshots)
     if (!(s > 1) || !std::isfinite(s)) return fail("snapshots: expected volume ratios > 1, got " + Num(s));
+  for (size_t i = 0; i < ladder.size(); ++i)
+    if (!(ladder[i] > 1) || !std::isfinite(ladder[i]) || (i > 0 && !(ladder[i] > ladder[i - 1])))
+      return fail("ladder: expected increasing volume ratios > 1, got " + Num(ladder[i]) + " at position " +
+                  std::to_string(i));
   return true;
 }
 
@@ -755,13 +759,19 @@ ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target, cons
     if (s > alpha_target)
       throw std::invalid_argument("SolveProgressive: snapshot " + Num(s) + " is beyond alpha_target " +
                                   Num(alpha_target) + "; expected snapshots in (1, alpha_target]");
+  if (!opt.ladder.empty() && opt.ladder.back() > alpha_target)
+    throw std::invalid_argument("SolveProgressive: ladder value " + Num(opt.ladder.back()) +
+                                " is beyond alpha_target " + Num(alpha_target) +
+                                "; expected ladder values in (1, alpha_target]");
   const std::vector<int> regions = act.regions;
   const double step = opt.step > 0 ? opt.step : opt.criteria.alpha_max;
 
-  // The ladder: k * step below the target, the snapshot values, and the target.
-  std::vector<double> ladder;
-  for (int k = 1; k * step < alpha_target - 1e-12; ++k)
-    if (k * step > 1) ladder.push_back(k * step);
+  // The ladder: k * step below the target (or the explicit values), the snapshot values, and the
+  // target.
+  std::vector<double> ladder = opt.ladder;
+  if (ladder.empty())
+    for (int k = 1; k * step < alpha_target - 1e-12; ++k)
+      if (k * step > 1) ladder.push_back(k * step);
   for (double s : opt.snapshots)
     if (s < alpha_target) ladder.push_back(s);
   ladder.push_back(alpha_target);
@@ -806,6 +816,12 @@ ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target, cons
       st.solver_seconds += r.time_s;
       st.iterations += r.iterations;
       st.status = r.status;
+      st.check_seconds += r.collision_stats.check_s;
+      st.response_seconds += r.collision_stats.response_s;
+      st.local_global_seconds += r.local_time_s + r.global_time_s;
+      st.collision_active = r.collision_active;
+      st.collision = r.collision;
+      st.springs = r.springs;
       // A state that has grown far beyond any inflation is a runaway of the iteration, not a
       // shape: treat it as diverged (and keep the previous state). The soft actuation of the
       // local-global solver reaches less than the ratio asked for, so a chamber beyond twice it

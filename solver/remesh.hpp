@@ -179,6 +179,13 @@ struct ProgressiveStep {
   FkStatus status = FkStatus::Converged;  ///< of the step's last solve
   double chamber_volume_ratio = 1.0;      ///< chamber volume / original chamber volume, reached
   double max_volume_ratio = 1.0, max_distortion = 1.0;  ///< CheckRemesh after the first solve
+  /// Of the step's solves (summed): collision detection and response time (0 without collision
+  /// handling) and the local and global steps' time, s.
+  double check_seconds = 0, response_seconds = 0, local_global_seconds = 0;
+  /// With collision handling: the exact check of the step's last solve, and its springs.
+  bool collision_active = false;
+  CollisionCheck collision;
+  int springs = 0;
 };
 
 /// Options of SolveProgressive.
@@ -186,6 +193,9 @@ struct ProgressiveOptions {
   RemeshCriteria criteria;
   /// Step of the actuation ladder alpha_k = k * step; 0: criteria.alpha_max (Algorithm 2).
   double step = 0.0;
+  /// Explicit ladder values (increasing, in (1, alpha_target]); when given they replace the
+  /// k * step values (the target and the snapshots are still added).
+  std::vector<double> ladder;
   /// false: the same ladder of solves without remeshing (for comparisons).
   bool remesh = true;
   /// Remesh-and-re-solve rounds allowed at one ladder value.

@@ -314,6 +314,12 @@ const std::vector<KeySpec>& KeyTable() {
                     "to the exit point (Eq. 3.5), or 'pair': the exit point as a point of the "
                     "exit face, which moves with the face and loads both sides equally.")
                     .Def(co.self_spring).Choices({"target", "pair"}));
+    t.push_back(Key("solver.collision.obstacle_spring", S, Opt,
+                    "What an obstacle spring resists: 'plane', only the normal part of the offset "
+                    "to the closest point plus eps, against the obstacle's tangent plane "
+                    "(frictionless), or 'point', the whole offset (Eq. 3.5 as written; it holds "
+                    "the vertex tangentially between checks, so sliding contacts creep).")
+                    .Def(co.obstacle_spring).Choices({"plane", "point"}));
     return t;
   }();
   return table;
@@ -1171,6 +1177,7 @@ Scene SceneParser::Build(const json& root) {
   o.collision.update = Get(col, "solver.collision", "update").get<std::string>();
   o.collision.self_target = Get(col, "solver.collision", "self_target").get<std::string>();
   o.collision.self_spring = Get(col, "solver.collision", "self_spring").get<std::string>();
+  o.collision.obstacle_spring = Get(col, "solver.collision", "obstacle_spring").get<std::string>();
   std::string why;
   if (!o.IsValid(&why)) Fail("solver." + why);
 

@@ -365,6 +365,29 @@ TEST(Cli, IkReachesAForwardSolvedTargetAndResumesATrajectory) {
   EXPECT_NE(r.out.find("path.csv:2"), std::string::npos) << r.out;
 }
 
+// Table 3.1's cost experiment checks every robot's keys before it runs the first, including the
+// progressive remeshing object of a robot driven as Algorithm 2 does.
+TEST(Cli, CollisionCostsRejectsABadRemeshKeyBeforeRunningAny) {
+  const std::string dir = TempDir("collision_costs_bad_remesh");
+  const std::string cfg = dir + "/bad.json";
+  for (const auto& [remesh, message] : std::vector<std::pair<std::string, std::string>>{
+           {R"({"alpha_max": "four"})", "robots[1].remesh.alpha_max: expected a finite number"},
+           {R"({"alpha": 4})", "robots[1].remesh.alpha: expected one of alpha_max, d_max, method"},
+           {R"({"method": "all"})", "robots[1].remesh.method: expected auto, chamber or whole"},
+           {R"({"d_max": 0.5})", "robots[1].remesh.d_max: expected"},
+           {R"([4])", "robots[1].remesh: expected an object"}}) {
+    SCOPED_TRACE(remesh);
+    std::ofstream(cfg) << R"({"name": "bad_costs", "experiment": "collision_costs", "seed": 1,
+      "robots": [{"robot": "selfcollision_finger", "res": 5, "steps": 1, "actuation": {"chamber": 1.5}},
+                 {"robot": "twisting_robot", "res": 1, "steps": 2, "actuation": {"chamber": 3.0},
+                  "remesh": )" << remesh << "}]}";
+    const CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
+    EXPECT_NE(r.code, 0);
+    EXPECT_NE(r.out.find(cfg + ": " + message), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("[selfcollision_finger 1/1]"), std::string::npos) << r.out;  // robot 0 never ran
+  }
+}
+
 // A collision sweep reads every variant before it runs the first: a bad key in the last one
 // fails at once, naming the file and the key, and no variant's output is written.
 TEST(Cli, CollisionSweepRejectsABadVariantBeforeRunningAny) {

@@ -286,6 +286,20 @@ TEST(Remesh, SolveProgressiveRemeshesAndReachesTheTarget) {
   const ProgressiveResult q = SolveProgressive(s, 8.0, o);
   EXPECT_EQ(q.remeshes, 0);
   EXPECT_EQ(q.scene.mesh.num_tets(), s.mesh.num_tets());
+  // An explicit ladder replaces the k * alpha_max values (the target is still added). Each
+  // step's time splits into the local and global steps (no collision handling here).
+  o.ladder = {2.5, 5.0};
+  const ProgressiveResult l = SolveProgressive(s, 8.0, o);
+  ASSERT_EQ(l.steps.size(), 3u);
+  EXPECT_DOUBLE_EQ(l.steps[0].alpha, 2.5);
+  EXPECT_DOUBLE_EQ(l.steps[1].alpha, 5.0);
+  EXPECT_DOUBLE_EQ(l.steps[2].alpha, 8.0);
+  for (const auto& st : l.steps) {
+    EXPECT_FALSE(st.collision_active);
+    EXPECT_EQ(st.check_seconds, 0.0);
+    EXPECT_GT(st.local_global_seconds, 0.0);
+    EXPECT_LE(st.local_global_seconds, st.solver_seconds);
+  }
 }
 
 TEST(Remesh, ProgressiveRejectsScenesWithoutOneChamberAndBadTargets) {
@@ -309,6 +323,18 @@ TEST(Remesh, ProgressiveRejectsScenesWithoutOneChamberAndBadTargets) {
   o.snapshots = {20.0};
   EXPECT_THROW(SolveProgressive(s, 12.0, o), std::invalid_argument);
   o.snapshots = {};
+  o.ladder = {3.0, 14.0};  // beyond the target
+  EXPECT_THROW(SolveProgressive(s, 12.0, o), std::invalid_argument);
+  o.ladder = {5.0, 3.0};  // not increasing
+  try {
+    SolveProgressive(s, 12.0, o);
+    FAIL() << "expected an error for a decreasing ladder";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("ladder: expected increasing volume ratios > 1, got 3 at position 1"),
+              std::string::npos)
+        << e.what();
+  }
+  o.ladder = {};
   o.criteria.d_max = 0.5;
   EXPECT_THROW(SolveProgressive(s, 12.0, o), std::invalid_argument);
 }

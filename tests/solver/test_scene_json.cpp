@@ -916,6 +916,7 @@ const std::vector<std::string> kAllKeys = {
     "solver.collision.stiffness", "solver.collision.check_interval", "solver.collision.update",
     "solver.collision.self_target",
     "solver.collision.self_spring",
+    "solver.collision.obstacle_spring",
     "obstacles", "obstacles[].type", "obstacles[].min", "obstacles[].max", "obstacles[].base",
     "obstacles[].axis", "obstacles[].radius", "obstacles[].height", "obstacles[].segments",
     "obstacles[].file"};
