@@ -488,10 +488,10 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
                         popt.ladder.end());
       popt.on_step = [&](const ProgressiveStep& st, const Scene& s_now, const Eigen::MatrixX3d&) {
         if (verbose)
-          std::fprintf(stderr, "  [%s alpha %.3g] %s, %d iterations, %.2f s; %d remesh(es), %.2f s, %d tets; "
+          std::fprintf(stderr, "  [%s alpha %.3g] %s, %d iterations, %.2f s; %d remesh(es), %d failed, %.2f s, %d tets; "
                        "exact check: %s, %d springs\n",
                        robot.c_str(), st.alpha, FkStatusToString(st.status), st.iterations, st.solver_seconds,
-                       st.remeshes, st.mesh_seconds, s_now.mesh.num_tets(),
+                       st.remeshes, st.remesh_failures, st.mesh_seconds, s_now.mesh.num_tets(),
                        st.collision_active ? (st.collision.collision_free() ? "collision-free" : "contacts left") : "off",
                        st.springs);
       };
@@ -506,6 +506,7 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
         free = free && (!st.collision_active || st.collision.collision_free());
       }
       remesh_j = {{"remeshes", pr.remeshes}, {"remesh_failures", pr.remesh_failures},
+                  {"first_remesh_failure", pr.first_remesh_failure},
                   {"tets_final", pr.scene.mesh.num_tets()}, {"chamber_volume_ratio", pr.chamber_volume_ratio},
                   {"status", FkStatusToString(pr.status)}, {"alpha_max", popt.criteria.alpha_max},
                   {"d_max", popt.criteria.d_max}, {"initial_mesh_s", mesh_gen_s}};

@@ -11,7 +11,10 @@
 ///    (a fold, where -n(v) points back into v's own part), the walk is retried from v along the
 ///    direction from the collided tet's centroid to v.
 ///  - obstacle (v strictly inside it): v_s = the closest point on the obstacle surface (CGAL
-///    AABB tree), v_c = v_s + eps n, n the obstacle's outward normal there.
+///    AABB tree), v_c = v_s + eps n, n the obstacle's outward normal there. With
+///    options.obstacle_spring "plane" (the default) the spring keeps only the normal part,
+///    k (n . (v - v_c))^2: a frictionless contact against the tangent plane at v_c, whose
+///    k n n^T Hessian Solve adds to the factored per-axis system by the Woodbury identity.
 /// Springs are added for every newly collided vertex and their targets refreshed at every check.
 /// A spring whose vertex is no longer in collision is released once the vertex is more than eps
 /// beyond its target along the spring normal (Eq. 3.8: n . (v - v_c) > eps), i.e. when the body

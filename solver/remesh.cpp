@@ -852,10 +852,13 @@ ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target, cons
       }
       if (!opt.remesh || !check.needed || round >= opt.max_remeshes_per_step) break;
       ChamberRemesh rm;
+      const auto tr = Clock::now();
       try {
         rm = RemeshChamber(res.scene, X, opt.remesh_options);
       } catch (const std::runtime_error& e) {
         // Keep the state on the current mesh and go on up the ladder; the next check will try again.
+        // The failed attempt's time is mesh generation time too.
+        st.mesh_seconds += Seconds(tr);
         ++st.remesh_failures;
         ++res.remesh_failures;
         if (res.first_remesh_failure.empty()) res.first_remesh_failure = "alpha " + Num(st.alpha) + ": " + e.what();

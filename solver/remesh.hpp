@@ -173,7 +173,7 @@ struct ProgressiveStep {
   std::string methods;          ///< the methods used by them, joined by '+' ("" if none)
   int remesh_failures = 0;      ///< remeshes that threw std::runtime_error (the step went on without)
   int tets = 0, chamber_tets = 0;       ///< after the step
-  double mesh_seconds = 0;      ///< time in RemeshChamber at this step, s
+  double mesh_seconds = 0;      ///< time in RemeshChamber at this step (failed attempts too), s
   double solver_seconds = 0;    ///< time in FkSolver::Solve (and Model builds) at this step, s
   int iterations = 0;           ///< solver iterations summed over the step's solves
   FkStatus status = FkStatus::Converged;  ///< of the step's last solve
