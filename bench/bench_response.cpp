@@ -10,9 +10,16 @@
 //                                  vertex-face springs (each top-face vertex against its three
 //                                  nearest other vertices: 4 entries per column, and a refactor
 //                                  that must analyse A_ff + K afresh), pair = 0: unit springs.
-//   BM_CollisionResponseUpdate     one CollisionResponse::Update (detection + spring rule +
-//                                  factor update) on the finger pressed into a box obstacle
-//                                  (springs on ~ every vertex under the tip), res 6/9/12.
+//   BM_CollisionResponseUpdate/res/plane
+//                                  one CollisionResponse::Update (detection + spring rule +
+//                                  factor update) from an empty spring set on the finger pressed
+//                                  into a box obstacle (springs on ~ every vertex under the tip),
+//                                  res 6/9/12; plane 0 = "point" obstacle springs (unit columns
+//                                  in the factor), 1 = "plane" (one cached solve per contact
+//                                  vertex and the m x m capacitance matrix; vs_point: this time
+//                                  over point's at the same res). solve_ms: one global solve with
+//                                  the springs; solve_vs_axis: over the per-axis solve without
+//                                  the plane springs' Woodbury correction.
 //   BM_SelfTargetRule/res/rule     one CollisionResponse::Update on the membrane (thesis Fig. 3.13)
 //                                  with its membrane pushed 1 mm into the chamber roofs (every
 //                                  membrane-bottom vertex above a roof is a contact): rule 0 =
@@ -106,22 +113,43 @@ void BM_SpringUpdate(benchmark::State& state) {
 
 void BM_CollisionResponseUpdate(benchmark::State& state) {
   const int res = static_cast<int>(state.range(0));
+  const bool plane = state.range(1) != 0;
   Scene s = MakeRobot("pneumatic_finger", res);
   s.obstacles.push_back(MakeBoxSurface(Eigen::Vector3d(100, -10, -10), Eigen::Vector3d(140, 30, 2)));
+  s.solver.collision.obstacle_spring = plane ? "plane" : "point";
   const Model model(s);
   CollisionResponse resp(model, s.solver.collision);
   // The tip end of the finger moved 2 mm down into the box's top (z <= 2).
   Eigen::MatrixX3d X = model.rest_positions();
   for (int v = 0; v < X.rows(); ++v)
     if (X(v, 0) > 100) X(v, 2) -= 2.0;
+  const auto t0 = std::chrono::steady_clock::now();
   for (auto _ : state) {
     resp.Reset();
     benchmark::DoNotOptimize(resp.Update(X));
   }
+  const double per = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() /
+                     std::max<double>(1, state.iterations());
+  static std::map<int, double> point;
+  if (!plane) point[res] = per;
+  if (plane && point.count(res)) state.counters["vs_point"] = per / point[res];
+  // One global solve with the springs in place (what every iteration pays), against the
+  // per-axis solve without the plane springs' Woodbury correction.
+  Eigen::VectorXd rhs = Eigen::VectorXd::Ones(model.num_free_dofs());
+  auto time_solves = [&](auto&& solve) {
+    const int reps = 5;
+    const auto t1 = std::chrono::steady_clock::now();
+    for (int i = 0; i < reps; ++i) benchmark::DoNotOptimize(solve(rhs));
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count() / reps;
+  };
+  const double solve_s = time_solves([&](const Eigen::VectorXd& b) { return resp.Solve(b); });
+  const double base_s = time_solves([&](const Eigen::VectorXd& b) { return resp.system().Solve(b); });
   state.counters["tets"] = model.mesh().num_elements();
   state.counters["springs"] = static_cast<double>(resp.springs().size());
   state.counters["check_ms"] = 1e3 * resp.stats().check_s / std::max(1, resp.stats().checks);
   state.counters["response_ms"] = 1e3 * resp.stats().response_s / std::max(1, resp.stats().checks);
+  state.counters["solve_ms"] = 1e3 * solve_s;
+  state.counters["solve_vs_axis"] = solve_s / base_s;
 }
 
 void BM_SelfTargetRule(benchmark::State& state) {
@@ -167,8 +195,8 @@ BENCHMARK(BM_SpringUpdate)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_CollisionResponseUpdate)
-    ->ArgNames({"res"})
-    ->Arg(6)->Arg(9)->Arg(12)
+    ->ArgNames({"res", "plane"})
+    ->ArgsProduct({{6, 9, 12}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

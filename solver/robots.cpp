@@ -756,7 +756,7 @@ void CutSlit(Mesh* mesh, const std::function<bool(const Eigen::Vector3d&)>& on_c
 Scene MakeSelfCollisionFinger(int res, const RobotParams& P) {
   const double h = kFingerWidth / res;
   const int ny = res, nz = static_cast<int>(std::lround(kFingerHeight / h));
-  const int base = Cells(kFingerBase, h), floor = Cells(kFingerFloor, h), wall = Cells(kFingerWall, h);
+  const int base = Cells(kFingerBase, h), floor = Cells(kFingerFloor, h), wall = Cells(P.at("wall"), h);
   const int cavity = Cells(kScfCavity, h);
   const int pitch = 2 * wall + cavity;
   const int nx = static_cast<int>(std::lround(kFingerLength / h));
@@ -1006,7 +1006,10 @@ const std::vector<RobotEntry>& Registry() {
         "actuator 'chamber' (volume ratio in [1, 6]). Self-collision response on. Markers: tip, "
         "tip_top, tip_bottom.",
         kScfDefaultRes, "cells across the 20 mm width (cell size 20/res mm), integer in [5, 32]",
-        {{"material", 0.0, 0.0, 1.0, "0: Ecoflex 00-30, 1: Dragon Skin 20 (rounded)"}}},
+        {{"material", 0.0, 0.0, 1.0, "0: Ecoflex 00-30, 1: Dragon Skin 20 (rounded)"},
+         {"wall", kFingerWall, 1.0, 5.0,
+          "chamber wall thickness, mm, snapped to whole cells (at least one): one tet layer at the "
+          "default 1.5 mm, whose walls invert under contact on fine meshes (docs/collision_response.md)"}}},
        kScfMinRes, kScfMaxRes, &MakeSelfCollisionFinger},
       {{"membrane",
         "250 x 250 mm Dragon Skin 20 membrane (rim fixed) shaped by four pneumatic chambers below "

@@ -759,6 +759,36 @@ TEST(RobotsTwisting, StrainLimitingStripRegion) {
 
 // The membrane's chambers stand chamber_gap cells apart: the gap between the wall boxes (region 1
 // and the cavities) of neighbouring chambers along x and y is exactly that many cells.
+TEST(RobotsSelfCollisionFinger, WallParameterSetsTheTetLayersOfTheChamberWalls) {
+  // At res 12 (cells of 20/12 mm) the default 1.5 mm wall snaps to one cell; 3.34 mm to two. The
+  // side walls are the cells between the cavities (region 1) and the finger's sides y = 0, 20.
+  const int res = 12;
+  const double h = 20.0 / res;
+  for (const auto& [wall, cells] : std::vector<std::pair<double, int>>{{1.5, 1}, {3.34, 2}}) {
+    SCOPED_TRACE(wall);
+    const Scene s = MakeRobot("selfcollision_finger", res, {{"wall", wall}});
+    double ymin = 1e9, ymax = -1e9;
+    int cavity = 0;
+    for (const auto& e : s.mesh.elements) {
+      if (e.region != 1) continue;
+      ++cavity;
+      for (int j = 0; j < 4; ++j) {
+        ymin = std::min(ymin, s.mesh.vertices(e.v[j], 1));
+        ymax = std::max(ymax, s.mesh.vertices(e.v[j], 1));
+      }
+    }
+    ASSERT_GT(cavity, 0);
+    EXPECT_NEAR(ymin, cells * h, 1e-9);
+    EXPECT_NEAR(20.0 - ymax, cells * h, 1e-9);
+  }
+  try {
+    MakeRobot("selfcollision_finger", res, {{"wall", 0.5}});
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("wall"), std::string::npos) << e.what();
+  }
+}
+
 TEST(RobotsMembrane, ChambersStandChamberGapCellsApart) {
   for (int gap : {1, 2, 3}) {
     const int res = 24;
