@@ -438,10 +438,13 @@ TEST(CollisionResponse, PressedBlocksAreCollisionFreeOnlyWithResponse) {
   }
 }
 
-TEST(CollisionResponse, BlockPressedIntoAnObstacleStaysOut) {
-  // One block, its top face pressed 3 mm down onto a box obstacle under it.
+/// A 4 x 4 x 2-cell block (x, y in [0, 8], z in [2, 6]) whose top face a displacement actuator
+/// moves along `axis`, above a box obstacle (top face at z = 1) or, with `cylinder`, above a
+/// cylinder lying along y (axis at x = 4, z = -9, radius 10: top at z = 1), so contact normals
+/// are tilted.
+Scene BlockOverObstacle(const Eigen::Vector3d& axis, bool cylinder) {
   Scene s;
-  s.name = "block_on_obstacle";
+  s.name = "block_over_obstacle";
   s.mesh = VoxelTetMesh(Eigen::Vector3d(0, 0, 2), kH, Eigen::Vector3i(4, 4, 2),
                         [](const Eigen::Vector3d&, const Eigen::Vector3i&) { return 0; });
   s.body[0] = Material{"body", 0.5, 1.0};
@@ -449,12 +452,22 @@ TEST(CollisionResponse, BlockPressedIntoAnObstacleStaysOut) {
   press.name = "press";
   press.type = ActuatorType::Displacement;
   press.vertices = VerticesOnPlane(s.mesh, Eigen::Vector3d(0, 0, 6), Eigen::Vector3d::UnitZ(), 1e-9);
-  press.axis = -Eigen::Vector3d::UnitZ();
+  press.axis = axis.normalized();
   press.rest = press.min = 0.0;
-  press.max = 4.0;
+  press.max = 6.0;
   s.actuators.push_back(press);
-  // The moved top face is held in every coordinate; nothing else is fixed.
-  s.obstacles.push_back(MakeBoxSurface(Eigen::Vector3d(-5, -5, -3), Eigen::Vector3d(15, 15, 1)));
+  if (cylinder)
+    s.obstacles.push_back(MakeCylinderSurface(Eigen::Vector3d(4, -10, -9), Eigen::Vector3d::UnitY(), 10.0, 28.0, 96));
+  else
+    s.obstacles.push_back(MakeBoxSurface(Eigen::Vector3d(-20, -20, -3), Eigen::Vector3d(30, 30, 1)));
+  s.validate();
+  return s;
+}
+
+TEST(CollisionResponse, BlockPressedIntoAnObstacleStaysOut) {
+  // One block, its top face pressed 3 mm down onto a box obstacle under it. The moved top face is
+  // held in every coordinate; nothing else is fixed.
+  const Scene s = BlockOverObstacle(-Eigen::Vector3d::UnitZ(), false);
   Eigen::VectorXd c(1);
   c << 3.0;  // the bottom (z = 2) would reach z = -1 if it moved rigidly
   for (bool respond : {false, true}) {
@@ -499,32 +512,6 @@ TEST(CollisionResponse, BlockPressedIntoAnObstacleStaysOut) {
       EXPECT_EQ(ck.max_penetration, ck.obstacle_penetration);
     }
   }
-}
-
-/// A 4 x 4 x 2-cell block (x, y in [0, 8], z in [2, 6]) whose top face a displacement actuator
-/// moves along `axis`, above a box obstacle (top face at z = 1) or, with `cylinder`, above a
-/// cylinder lying along y (axis at x = 4, z = -9, radius 10: top at z = 1), so contact normals
-/// are tilted.
-Scene BlockOverObstacle(const Eigen::Vector3d& axis, bool cylinder) {
-  Scene s;
-  s.name = "block_over_obstacle";
-  s.mesh = VoxelTetMesh(Eigen::Vector3d(0, 0, 2), kH, Eigen::Vector3i(4, 4, 2),
-                        [](const Eigen::Vector3d&, const Eigen::Vector3i&) { return 0; });
-  s.body[0] = Material{"body", 0.5, 1.0};
-  Actuator press;
-  press.name = "press";
-  press.type = ActuatorType::Displacement;
-  press.vertices = VerticesOnPlane(s.mesh, Eigen::Vector3d(0, 0, 6), Eigen::Vector3d::UnitZ(), 1e-9);
-  press.axis = axis.normalized();
-  press.rest = press.min = 0.0;
-  press.max = 6.0;
-  s.actuators.push_back(press);
-  if (cylinder)
-    s.obstacles.push_back(MakeCylinderSurface(Eigen::Vector3d(4, -10, -9), Eigen::Vector3d::UnitY(), 10.0, 28.0, 96));
-  else
-    s.obstacles.push_back(MakeBoxSurface(Eigen::Vector3d(-20, -20, -3), Eigen::Vector3d(30, 30, 1)));
-  s.validate();
-  return s;
 }
 
 TEST(CollisionResponse, PlaneObstacleSpringsSolveTheCoupledSystem) {
