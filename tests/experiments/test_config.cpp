@@ -1,10 +1,12 @@
 // Experiment configs (experiments/config.hpp): errors name the file and the key, with the value
 // found there, also for nested keys.
 #include "experiments/config.hpp"
+#include "experiments/runner.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <string>
 
@@ -40,6 +42,26 @@ TEST(Config, FailNamesNestedKeysWithTheValueFoundThere) {
   EXPECT_EQ(message("seed.x"), path + ": seed.x: expected a number (missing)");
   EXPECT_EQ(message("robots[x]"), path + ": robots[x]: expected a number (missing)");
   std::remove(path.c_str());
+}
+
+// Every config shipped in experiments/ loads (full and quick), is named after its file, names an
+// experiment type the runner knows, and has the plot script that regenerates its figure.
+TEST(Config, EveryShippedConfigLoadsAndHasAPlotScript) {
+  namespace fs = std::filesystem;
+  const fs::path root(SOFTKIN_SOURCE_DIR);
+  int checked = 0;
+  for (const auto& entry : fs::directory_iterator(root / "experiments")) {
+    if (entry.path().extension() != ".json") continue;
+    SCOPED_TRACE(entry.path().string());
+    for (bool quick : {false, true}) {
+      const Config cfg = Config::Load(entry.path().string(), quick);
+      EXPECT_EQ(cfg.name(), entry.path().stem().string());
+      EXPECT_NE(FindExperiment(cfg.type()), nullptr) << cfg.type();
+    }
+    EXPECT_TRUE(fs::exists(root / "paper_figs" / (entry.path().stem().string() + ".py")));
+    ++checked;
+  }
+  EXPECT_GE(checked, 30);
 }
 
 }  // namespace
