@@ -430,8 +430,10 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
       cfg.Fail(key, "an object with \"robot\"");
     for (auto it = rj.begin(); it != rj.end(); ++it)
       if (it.key() != "robot" && it.key() != "res" && it.key() != "robot_params" && it.key() != "actuation" &&
-          it.key() != "steps" && it.key() != "obstacles" && it.key() != "thesis" && it.key() != "remesh")
-        cfg.Fail(key + "." + it.key(), "one of robot, res, robot_params, actuation, steps, obstacles, remesh, thesis");
+          it.key() != "steps" && it.key() != "obstacles" && it.key() != "thesis" && it.key() != "remesh" &&
+          it.key() != "collision")
+        cfg.Fail(key + "." + it.key(),
+                 "one of robot, res, robot_params, actuation, steps, obstacles, remesh, collision, thesis");
     if (rj.contains("res") && !rj["res"].is_number_integer()) cfg.Fail(key + ".res", "an integer");
     if (rj.contains("steps") && (!rj["steps"].is_number_integer() || rj["steps"].get<int>() < 1))
       cfg.Fail(key + ".steps", "an integer >= 1");
@@ -439,6 +441,10 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
     if (rj.contains("remesh"))
       (void)CostsRemeshOptions(cfg, key + ".remesh", rj["remesh"], rj["robot"].get<std::string>(),
                                rj.value("res", 0), *params);
+    if (rj.contains("collision")) {
+      FkOptions probe;
+      ApplySolverJson({{"collision", rj["collision"]}}, cfg.path() + ": " + key, &probe);
+    }
   };
   for (size_t i = 0; i < robots_j.size(); ++i) {
     RobotParams p;
@@ -466,6 +472,8 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
     const Eigen::VectorXd c_end = ConfigActuation(cfg, key + ".actuation", rj["actuation"], scene);
     FkOptions opts = scene.solver;  // the robot's defaults, then the config's solver object
     if (!solver_j.is_null()) ApplySolverJson(solver_j, cfg.path() + ": solver", &opts);
+    // ... then the robot's own collision options (e.g. a spring stiffness for its contact set).
+    if (rj.contains("collision")) ApplySolverJson({{"collision", rj["collision"]}}, cfg.path() + ": " + key, &opts);
     scene.solver = opts;
     const Eigen::VectorXd rest = scene.rest_actuation();
     double check = 0, resp = 0, solve = 0, total = 0, remesh_s = 0;
@@ -534,6 +542,7 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
     // without remeshing it is the robot's one tessellation.
     row["mesh_gen_s"] = remesh_j.is_null() ? mesh_gen_s : remesh_s / steps;
     if (!remesh_j.is_null()) row["remesh"] = remesh_j;
+    row["spring_stiffness"] = opts.collision.stiffness;
     row["col_check_s"] = check / steps;
     row["col_resp_s"] = resp / steps;
     row["solver_s"] = solve / steps;

@@ -386,6 +386,16 @@ TEST(Cli, CollisionCostsRejectsABadRemeshKeyBeforeRunningAny) {
     EXPECT_NE(r.out.find(cfg + ": " + message), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("[selfcollision_finger 1/1]"), std::string::npos) << r.out;  // robot 0 never ran
   }
+  // A robot's own collision options are checked up front too.
+  std::ofstream(cfg) << R"({"name": "bad_costs", "experiment": "collision_costs", "seed": 1,
+    "robots": [{"robot": "selfcollision_finger", "res": 5, "steps": 1, "actuation": {"chamber": 1.5}},
+               {"robot": "membrane", "res": 10, "steps": 1, "actuation": {"c1": 1.5},
+                "collision": {"stiffness": "soft"}}]})";
+  const CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.out.find(cfg + ": robots[1].collision.stiffness: expected a number, got \"soft\""), std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.out.find("[selfcollision_finger 1/1]"), std::string::npos) << r.out;
 }
 
 // A collision sweep reads every variant before it runs the first: a bad key in the last one
