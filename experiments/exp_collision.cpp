@@ -26,6 +26,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 namespace softkin {
 
@@ -198,11 +199,7 @@ ProgressiveOptions CostsRemeshOptions(const Config& cfg, const std::string& key,
     cfg.Fail(key + ".method", "auto, chamber or whole");
   popt.remesh_options.region.iterations = integer("remesh_iterations", 3);
   popt.remesh_options.region.seed = cfg.seed();
-  if (robot == "twisting_robot") {
-    const auto tube = params.find("tube_radius");
-    popt.remesh_options.tessellation =
-        TwistingRobotTessellation(res <= 0 ? kTwistDefaultRes : res, tube == params.end() ? 2.5 : tube->second);
-  }
+  if (robot == "twisting_robot") popt.remesh_options.tessellation = TwistingRobotTessellation(res, params);
   popt.remesh_options.tessellation.seed = cfg.seed();
   std::string why;
   if (!popt.IsValid(&why)) {
@@ -421,9 +418,14 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
     cfg.Fail("robots", "a non-empty array of {\"robot\", \"res\", [\"robot_params\"], \"actuation\", \"steps\", [\"obstacles\"], [\"thesis\"]}");
   CsvWriter csv(dir + "/costs.csv", {"robot", "tets", "mesh_gen_s", "col_check_s", "col_resp_s",
                                      "solver_s", "step_s", "steps", "collision_free"});
-  // Every robot's keys are checked before the first one runs (a bad key in the last robot fails
-  // at once, not after the others' minutes of solving).
-  auto check_robot = [&](size_t i, RobotParams* params) {
+  // Every robot's keys are read and checked before the first one runs (a bad key in the last
+  // robot fails at once, not after the others' minutes of solving).
+  struct Plan {
+    RobotParams params;
+    std::optional<ProgressiveOptions> remesh;
+  };
+  std::vector<Plan> plans(robots_j.size());
+  for (size_t i = 0; i < robots_j.size(); ++i) {
     const std::string key = "robots[" + std::to_string(i) + "]";
     const auto& rj = robots_j[i];
     if (!rj.is_object() || !rj.contains("robot") || !rj["robot"].is_string())
@@ -437,25 +439,20 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
     if (rj.contains("res") && !rj["res"].is_number_integer()) cfg.Fail(key + ".res", "an integer");
     if (rj.contains("steps") && (!rj["steps"].is_number_integer() || rj["steps"].get<int>() < 1))
       cfg.Fail(key + ".steps", "an integer >= 1");
-    if (rj.contains("robot_params")) MergeRobotParams(cfg, key + ".robot_params", rj["robot_params"], params);
+    if (rj.contains("robot_params")) MergeRobotParams(cfg, key + ".robot_params", rj["robot_params"], &plans[i].params);
     if (rj.contains("remesh"))
-      (void)CostsRemeshOptions(cfg, key + ".remesh", rj["remesh"], rj["robot"].get<std::string>(),
-                               rj.value("res", 0), *params);
+      plans[i].remesh = CostsRemeshOptions(cfg, key + ".remesh", rj["remesh"], rj["robot"].get<std::string>(),
+                                           rj.value("res", 0), plans[i].params);
     if (rj.contains("collision")) {
       FkOptions probe;
       ApplySolverJson({{"collision", rj["collision"]}}, cfg.path() + ": " + key, &probe);
     }
-  };
-  for (size_t i = 0; i < robots_j.size(); ++i) {
-    RobotParams p;
-    check_robot(i, &p);
   }
   nlohmann::json rows = nlohmann::json::array();
   for (size_t i = 0; i < robots_j.size(); ++i) {
     const std::string key = "robots[" + std::to_string(i) + "]";
     const auto& rj = robots_j[i];
-    RobotParams params;
-    check_robot(i, &params);
+    const RobotParams& params = plans[i].params;
     const std::string robot = rj["robot"].get<std::string>();
     const int res = rj.value("res", 0);
     const int steps = rj.value("steps", 4);
@@ -479,10 +476,10 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
     double check = 0, resp = 0, solve = 0, total = 0, remesh_s = 0;
     bool free = true;
     nlohmann::json remesh_j;
-    if (rj.contains("remesh")) {
+    if (plans[i].remesh) {
       // Algorithm 2 with the collision handling on: the chamber's ratio is raised over the same
       // `steps` values, and the chamber is re-tessellated when it has grown or distorted too far.
-      ProgressiveOptions popt = CostsRemeshOptions(cfg, key + ".remesh", rj["remesh"], robot, res, params);
+      ProgressiveOptions popt = *plans[i].remesh;
       int chamber = -1;
       try {
         chamber = ChamberActuator(scene);

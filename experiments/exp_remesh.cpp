@@ -75,10 +75,7 @@ nlohmann::json RunTwistingRemesh(const Config& cfg, const std::string& dir, bool
     cfg.Fail("remesh_method", "auto, chamber or whole");
   popt.remesh_options.region.iterations = remesh_iterations;
   popt.remesh_options.region.seed = cfg.seed();
-  const auto params = cfg.NumberMap("robot_params");
-  const auto tube = params.find("tube_radius");
-  popt.remesh_options.tessellation = TwistingRobotTessellation(res <= 0 ? kTwistDefaultRes : res,
-                                                               tube == params.end() ? 2.5 : tube->second);
+  popt.remesh_options.tessellation = TwistingRobotTessellation(res, cfg.NumberMap("robot_params"));
   popt.remesh_options.tessellation.seed = cfg.seed();
   popt.snapshots.assign(alphas.begin(), alphas.end() - 1);
   std::string why;

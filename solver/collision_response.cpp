@@ -550,17 +550,14 @@ bool CollisionResponse::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) {
   next.insert(next.end(), kept.begin(), kept.end());
   std::sort(next.begin(), next.end(),
             [](const CollisionSpring& a, const CollisionSpring& b) { return a.vertex < b.vertex; });
-  std::vector<int> planes_before;
-  for (const auto& s : springs_)
-    if (IsPlane(s)) planes_before.push_back(s.vertex);
   springs_ = std::move(next);
   bool changed = system_.SetSprings(Stencils(), k_);
-  std::vector<int> planes_after;
-  for (const auto& s : springs_)
-    if (IsPlane(s)) planes_after.push_back(s.vertex);
-  // The plane springs' normals and offsets follow the refreshed closest points at every check.
+  // The plane springs' normals and offsets follow the refreshed closest points at every check;
+  // a changed set of plane-spring vertices changes the matrix too.
+  const std::vector<PlaneSpring> planes_before = std::move(plane_);
   RebuildPlanes(changed);
-  changed = changed || planes_after != planes_before;
+  changed = changed || !std::equal(plane_.begin(), plane_.end(), planes_before.begin(), planes_before.end(),
+                                   [](const PlaneSpring& a, const PlaneSpring& b) { return a.vertex == b.vertex; });
   stats_.max_springs = std::max(stats_.max_springs, static_cast<int>(springs_.size()));
   stats_.response_s += Since(t1);
   return changed;

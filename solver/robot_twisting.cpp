@@ -131,6 +131,10 @@ TessellationOptions TwistingRobotTessellation(int res, double tube_radius) {
   return o;
 }
 
+TessellationOptions TwistingRobotTessellation(int res, const RobotParams& params) {
+  return TwistingRobotTessellation(res <= 0 ? kTwistDefaultRes : res, Param(params, "tube_radius", 2.5));
+}
+
 Scene MakeTwistingRobot(int res, const RobotParams& P) {
   if (res <= 0) res = kTwistDefaultRes;
   if (res < kTwistMinRes || res > kTwistMaxRes)
@@ -138,7 +142,7 @@ Scene MakeTwistingRobot(int res, const RobotParams& P) {
                                 ", " + std::to_string(kTwistMaxRes) + "], got " + std::to_string(res));
   TriangleSurface chamber, body;
   TwistingRobotSurfaces(P, &chamber, &body);
-  const TessellationOptions topt = TwistingRobotTessellation(res, Param(P, "tube_radius", 2.5));
+  const TessellationOptions topt = TwistingRobotTessellation(res, P);
   Scene s;
   s.name = "twisting_robot";
   s.mesh = Tessellate(chamber, body, topt);

@@ -53,6 +53,9 @@ void TwistingRobotSurfaces(const RobotParams& params, TriangleSurface* chamber, 
 /// 8 / res mm, chamber_cell_size = min(cell_size, 0.8 tube_radius) (so the tube has interior
 /// vertices), facet_distance = 0.05 * cell_size, seed 1.
 TessellationOptions TwistingRobotTessellation(int res, double tube_radius = 2.5);
+/// The same for the robot built with `params` (its tube_radius, default 2.5) at res (<= 0: the
+/// default resolution): the sizing MakeTwistingRobot uses, e.g. for re-tessellating its chamber.
+TessellationOptions TwistingRobotTessellation(int res, const RobotParams& params);
 
 /// Builds the twisting robot (res <= 0: default). Parameters: helix_radius, tube_radius, turns,
 /// hyperelastic (full defaults in ListRobots()). Deterministic.
