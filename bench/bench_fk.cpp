@@ -142,6 +142,23 @@ double SvdPass(const std::vector<Eigen::Matrix3d>& M, int threads) {
 double PolarPass(const std::vector<Eigen::Matrix3d>& M, int threads) {
   return RotationPass(M, threads, [](const Eigen::Matrix3d& A) { return BestRotation(A); });
 }
+double PolarBatchPass(const std::vector<Eigen::Matrix3d>& M, int threads) {
+  const int n = static_cast<int>(M.size());
+  const int nt = threads > 0 ? threads : omp_get_max_threads();
+  const int nb = (n + kRotationBatch - 1) / kRotationBatch;
+  double sink = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : sink) num_threads(nt)
+  for (int b = 0; b < nb; ++b) {
+    Eigen::Matrix3d R[kRotationBatch];
+    const int i0 = b * kRotationBatch, m = std::min(kRotationBatch, n - i0);
+    BestRotations(M.data() + i0, m, R);
+    for (int l = 0; l < m; ++l) sink += R[l](0, 0) + R[l](1, 1) + R[l](2, 2);
+  }
+  return sink;
+}
+double PolarEigenPass(const std::vector<Eigen::Matrix3d>& M, int threads) {
+  return RotationPass(M, threads, [](const Eigen::Matrix3d& A) { return BestRotationEigen(A); });
+}
 
 double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -332,6 +349,33 @@ void BM_PolarPass(benchmark::State& state) {
   SizeCounters(state, f, true);
 }
 BENCHMARK(BM_PolarPass)->Apply(ResolutionThreadSweep)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// The same pass with BestRotations, the batched polar iteration the local step uses. Counters
+/// (medians of 7 alternating repetitions in one process): single_vs_batch = BestRotation one
+/// matrix at a time / this pass, eigen_vs_batch = BestRotationEigen (the closed-form
+/// eigen-decomposition of M^T M, BestRotation's fallback for inverted elements) / this pass.
+void BM_PolarPassBatch(benchmark::State& state) {
+  const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
+  const int threads = static_cast<int>(state.range(1));
+  for (auto _ : state) benchmark::DoNotOptimize(PolarBatchPass(f.M, threads));
+  std::vector<double> tb, ts, te;
+  for (int r = 0; r < 7; ++r) {
+    const auto t0 = Clock::now();
+    benchmark::DoNotOptimize(PolarBatchPass(f.M, threads));
+    const auto t1 = Clock::now();
+    benchmark::DoNotOptimize(PolarPass(f.M, threads));
+    const auto t2 = Clock::now();
+    benchmark::DoNotOptimize(PolarEigenPass(f.M, threads));
+    const auto t3 = Clock::now();
+    tb.push_back(std::chrono::duration<double>(t1 - t0).count());
+    ts.push_back(std::chrono::duration<double>(t2 - t1).count());
+    te.push_back(std::chrono::duration<double>(t3 - t2).count());
+  }
+  state.counters["single_vs_batch"] = Median(ts) / Median(tb);
+  state.counters["eigen_vs_batch"] = Median(te) / Median(tb);
+  SizeCounters(state, f, true);
+}
+BENCHMARK(BM_PolarPassBatch)->Apply(ResolutionThreadSweep)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 /// One full local-global iteration through the public solver API: LocalGlobalSolver::Solve with
 /// max_iterations = 1 from a warm start (nothing subtracted, so the per-call overhead of Solve is

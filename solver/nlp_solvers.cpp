@@ -21,6 +21,14 @@
 namespace softkin {
 namespace {
 
+/// A number in %.3g form, for messages.
+std::string FormatG(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.3g", v);
+  return buf;
+}
+
+
 using Clock = std::chrono::steady_clock;
 double Seconds(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double>(b - a).count();
@@ -138,6 +146,25 @@ class RatioUpdateSolver : public FkSolver {
       if (updates > 0 && move < options_.tolerance &&
           (r->gradient_ratio < options_.gradient_tolerance || grad <= floor)) {
         r->status = FkStatus::Converged;
+        return updates;
+      }
+      if (updates > 0 && move == 0.0) {
+        // The last inner solve left every coordinate as it was, so the ratios are those it was
+        // given and every further update would repeat it: the loop is at a fixed point in floating
+        // point. That happens at the precision floor, where the optimiser can no longer lower the
+        // energy (Ceres: |cost change| / cost = 0), and before the gradient target when that target
+        // is below what double precision resolves. Within 100x of the target this is convergence;
+        // further out the optimiser is stuck.
+        if (r->gradient_ratio < 100.0 * options_.gradient_tolerance) {
+          r->status = FkStatus::Converged;
+          r->message = "stopped at the precision floor: the optimiser no longer changes the positions "
+                       "(gradient ratio " + FormatG(r->gradient_ratio) + ", target " +
+                       FormatG(options_.gradient_tolerance) + ")";
+        } else {
+          r->status = FkStatus::Diverged;
+          r->message = "stalled: the optimiser no longer changes the positions at gradient ratio " +
+                       FormatG(r->gradient_ratio) + " (target " + FormatG(options_.gradient_tolerance) + ")";
+        }
         return updates;
       }
       if (SecondsLeft() <= 0) {

@@ -84,17 +84,29 @@ Eigen::Matrix3d DeformationGradient(const ModelElement& e, const ElemRows& D) {
   return (D.topRows(e.k).transpose() * P) * G.inverse();
 }
 
-void ElementTarget(const ModelElement& e, const ElemRows& D, double ratio, ElemRows* T) {
-  const int k = e.k;
-  if (ratio == kVented && e.role != ElementRole::Body) {
-    *T = D;  // vented chamber: empty space
-    return;
+namespace {
+
+/// The shape an element's best rotation is fitted to (max tr(R^T D^T P)): the rest shape for body
+/// and pneumatic elements (isotropic scaling does not change the rotation), the reshaped rest shape
+/// for cable and DEA elements (actuation.hpp). False for a vented chamber, which has no rotation.
+inline bool FittedShape(const ModelElement& e, double ratio, ElemRows* P) {
+  if (ratio == kVented && e.role != ElementRole::Body) return false;
+  if (e.role == ElementRole::Body || e.role == ElementRole::Pneumatic) {
+    *P = e.rest;
+  } else {
+    P->setZero();
+    P->topRows(e.k) = e.rest.topRows(e.k) * ActuationShape(e, ratio).transpose();
   }
+  return true;
+}
+
+/// The target of an element with a fitted shape, given the best rotation R of D onto P.
+void TargetFromRotation(const ModelElement& e, const ElemRows& D, double ratio, const ElemRows& P,
+                        const Eigen::Matrix3d& R, ElemRows* T) {
+  const int k = e.k;
   T->setZero();
   if (e.role == ElementRole::Body) {
-    // Best rotation from the rest shape to the current shape: max tr(R^T D^T P).
-    const Eigen::Matrix3d R = BestRotation(D.topRows(k).transpose() * e.rest.topRows(k));
-    T->topRows(k) = e.rest.topRows(k) * R.transpose();  // V^r = R V (rows), Eq. 2.3
+    T->topRows(k) = P.topRows(k) * R.transpose();  // V^r = R V (rows), Eq. 2.3
     if (e.curve) {
       // Hyperelastic (Eq. 3.6-3.7): blend the current shape with the rotated rest shape by
       // R_omega(strain), then rescale the blend to the rest volume.
@@ -110,17 +122,24 @@ void ElementTarget(const ModelElement& e, const ElemRows& D, double ratio, ElemR
       T->topRows(k) = e.r_omega * T->topRows(k) + (1.0 - e.r_omega) * s * D.topRows(k);  // Eq. 2.5
     }
   } else if (e.role == ElementRole::Pneumatic) {
-    // Rest shape scaled by cbrt(alpha_i) about its centre, rotated (Eq. 2.8). Isotropic scaling
-    // does not change the best rotation.
-    const Eigen::Matrix3d R = BestRotation(D.topRows(k).transpose() * e.rest.topRows(k));
-    T->topRows(k) = std::cbrt(ratio) * (e.rest.topRows(k) * R.transpose());
+    // Rest shape scaled by cbrt(alpha_i) about its centre, rotated (Eq. 2.8).
+    T->topRows(k) = std::cbrt(ratio) * (P.topRows(k) * R.transpose());
   } else {
-    // Cable / DEA: reshape the rest shape (actuation.hpp), then rotate it onto the current shape.
-    ElemRows Ps = ElemRows::Zero();
-    Ps.topRows(k) = e.rest.topRows(k) * ActuationShape(e, ratio).transpose();
-    const Eigen::Matrix3d R = BestRotation(D.topRows(k).transpose() * Ps.topRows(k));
-    T->topRows(k) = Ps.topRows(k) * R.transpose();
+    // Cable / DEA: the reshaped rest shape rotated onto the current shape.
+    T->topRows(k) = P.topRows(k) * R.transpose();
   }
+}
+
+}  // namespace
+
+void ElementTarget(const ModelElement& e, const ElemRows& D, double ratio, ElemRows* T) {
+  ElemRows P;
+  if (!FittedShape(e, ratio, &P)) {
+    *T = D;  // vented chamber: empty space
+    return;
+  }
+  const Eigen::Matrix3d R = BestRotation(D.topRows(e.k).transpose() * P.topRows(e.k));
+  TargetFromRotation(e, D, ratio, P, R, T);
 }
 
 double LocalStep(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
@@ -128,16 +147,39 @@ double LocalStep(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X
   const auto& els = model.elements();
   const int ne = static_cast<int>(els.size());
   if (static_cast<int>(weighted->size()) != ne) weighted->resize(ne);
+  // Elements go in blocks of kRotationBatch so that their best rotations are computed together
+  // (BestRotations: the same bits as ElementTarget's BestRotation, about twice as fast).
+  constexpr int W = kRotationBatch;
+  const int nb = (ne + W - 1) / W;
   double energy = 0.0;
   const int nt = threads > 0 ? threads : 0;
 #pragma omp parallel for schedule(static) reduction(+ : energy) num_threads(nt > 0 ? nt : omp_get_max_threads())
-  for (int i = 0; i < ne; ++i) {
-    const ModelElement& e = els[i];
-    ElemRows D, T;
-    GatherRows(e, X, &D);
-    ElementTarget(e, D, ratios[i], &T);
-    energy += e.wv * (D - T).squaredNorm();
-    (*weighted)[i] = e.wv * T;
+  for (int b = 0; b < nb; ++b) {
+    const int i0 = b * W, m = std::min(W, ne - i0);
+    ElemRows D[W], P[W];
+    Eigen::Matrix3d M[W], R[W];
+    bool fitted[W];
+    for (int l = 0; l < m; ++l) {
+      const ModelElement& e = els[i0 + l];
+      GatherRows(e, X, &D[l]);
+      fitted[l] = FittedShape(e, ratios[i0 + l], &P[l]);
+      if (fitted[l])
+        M[l].noalias() = D[l].topRows(e.k).transpose() * P[l].topRows(e.k);
+      else
+        M[l].setIdentity();
+    }
+    BestRotations(M, m, R);
+    for (int l = 0; l < m; ++l) {
+      const int i = i0 + l;
+      const ModelElement& e = els[i];
+      ElemRows T;
+      if (fitted[l])
+        TargetFromRotation(e, D[l], ratios[i], P[l], R[l], &T);
+      else
+        T = D[l];  // vented chamber: empty space
+      energy += e.wv * (D[l] - T).squaredNorm();
+      (*weighted)[i] = e.wv * T;
+    }
   }
   return energy;
 }

