@@ -342,28 +342,57 @@ constexpr double kUntangleHeight = 0.05;
 /// in every incident tet, at a height of at least kUntangleHeight of that face's size; its violated
 /// half-spaces are projected onto simultaneously (averaged). The moved set is the free vertices of
 /// inverted tets, grown by one ring of neighbours every 50 passes while some remain (at most 400
-/// passes). Returns the number of vertex moves; the caller checks the result.
+/// passes, and none after 100 passes without a new low in the number of inverted tets). Returns
+/// the number of vertex moves; the caller checks the result.
 int UntangleTets(Mesh& m, const std::vector<char>& held) {
-  const int nv = m.num_vertices();
+  const int nv = m.num_vertices(), ne = m.num_elements();
   std::vector<std::vector<std::pair<int, int>>> star(nv);  // (element, local slot)
-  for (int i = 0; i < m.num_elements(); ++i)
+  for (int i = 0; i < ne; ++i)
     for (int j = 0; j < 4; ++j) star[m.elements[i].v[j]].emplace_back(i, j);
+  // The inverted tets, kept up to date incrementally: a tet's volume changes only when one of its
+  // vertices moves, so after the first full scan only the stars of the moved vertices are
+  // re-examined (the passes and moves are those of a full scan per pass).
+  std::vector<char> inverted(ne, 0);
+  std::vector<int> bad;
+  for (int i = 0; i < ne; ++i)
+    if (!(SignedVolume(m.elements[i], m.vertices) > 0)) {
+      inverted[i] = 1;
+      bad.push_back(i);
+    }
   int moves = 0;
+  std::vector<int> active, grown, moved, touched;
+  std::vector<char> listed(ne, 0);
+  size_t best = bad.size();
+  int best_pass = 0;
   for (int pass = 0; pass < 400; ++pass) {
-    std::set<int> active;
-    for (const auto& e : m.elements)
-      if (!(SignedVolume(e, m.vertices) > 0))
-        for (int j = 0; j < 4; ++j)
-          if (!held[e.v[j]]) active.insert(e.v[j]);
+    if (bad.empty()) break;
+    if (bad.size() < best) {
+      best = bad.size();
+      best_pass = pass;
+    }
+    // Give up once the count of inverted tets has not reached a new low for 100 passes (two ring
+    // growths): on the twisting robot's failing remeshes it creeps from 186 to 167 in the first 200
+    // passes and then stays there until pass 400 (about 0.2 s of futile passes per attempt).
+    if (pass - best_pass >= 100) break;
+    // The free vertices of the inverted tets, ascending and unique (the order they move in).
+    active.clear();
+    for (int t : bad)
+      for (int j = 0; j < 4; ++j)
+        if (!held[m.elements[t].v[j]]) active.push_back(m.elements[t].v[j]);
+    std::sort(active.begin(), active.end());
+    active.erase(std::unique(active.begin(), active.end()), active.end());
     if (active.empty()) break;
     for (int ring = 0; ring < pass / 50; ++ring) {
-      std::set<int> grown = active;
+      grown = active;
       for (int v : active)
         for (const auto& [t, j] : star[v])
           for (int k = 0; k < 4; ++k)
-            if (!held[m.elements[t].v[k]]) grown.insert(m.elements[t].v[k]);
+            if (!held[m.elements[t].v[k]]) grown.push_back(m.elements[t].v[k]);
+      std::sort(grown.begin(), grown.end());
+      grown.erase(std::unique(grown.begin(), grown.end()), grown.end());
       active.swap(grown);
     }
+    moved.clear();
     for (int v : active) {
       Eigen::Vector3d p = m.vertices.row(v).transpose(), shift = Eigen::Vector3d::Zero();
       int violated = 0;
@@ -384,8 +413,25 @@ int UntangleTets(Mesh& m, const std::vector<char>& held) {
       }
       if (violated == 0) continue;
       m.vertices.row(v) = (p + shift / violated).transpose();
+      moved.push_back(v);
       ++moves;
     }
+    // Re-examine the tets around the moved vertices.
+    touched.clear();
+    for (int v : moved)
+      for (const auto& [t, j] : star[v]) touched.push_back(t);
+    std::sort(touched.begin(), touched.end());
+    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+    for (int t : touched) inverted[t] = SignedVolume(m.elements[t], m.vertices) > 0 ? 0 : 1;
+    // bad <- every inverted tet: the listed ones still inverted, and the newly inverted touched ones.
+    for (int t : bad) listed[t] = 1;
+    std::vector<int> next;
+    for (int t : bad)
+      if (inverted[t]) next.push_back(t);
+    for (int t : touched)
+      if (inverted[t] && !listed[t]) next.push_back(t);
+    for (int t : bad) listed[t] = 0;
+    bad.swap(next);
   }
   return moves;
 }

@@ -88,16 +88,14 @@ namespace {
 
 /// The shape an element's best rotation is fitted to (max tr(R^T D^T P)): the rest shape for body
 /// and pneumatic elements (isotropic scaling does not change the rotation), the reshaped rest shape
-/// for cable and DEA elements (actuation.hpp). False for a vented chamber, which has no rotation.
-inline bool FittedShape(const ModelElement& e, double ratio, ElemRows* P) {
-  if (ratio == kVented && e.role != ElementRole::Body) return false;
-  if (e.role == ElementRole::Body || e.role == ElementRole::Pneumatic) {
-    *P = e.rest;
-  } else {
-    P->setZero();
-    P->topRows(e.k) = e.rest.topRows(e.k) * ActuationShape(e, ratio).transpose();
-  }
-  return true;
+/// for cable and DEA elements (actuation.hpp), written to `buf`. Null for a vented chamber, which
+/// has no rotation.
+inline const ElemRows* FittedShape(const ModelElement& e, double ratio, ElemRows* buf) {
+  if (ratio == kVented && e.role != ElementRole::Body) return nullptr;
+  if (e.role == ElementRole::Body || e.role == ElementRole::Pneumatic) return &e.rest;
+  buf->setZero();
+  buf->topRows(e.k) = e.rest.topRows(e.k) * ActuationShape(e, ratio).transpose();
+  return buf;
 }
 
 /// The target of an element with a fitted shape, given the best rotation R of D onto P.
@@ -133,13 +131,14 @@ void TargetFromRotation(const ModelElement& e, const ElemRows& D, double ratio, 
 }  // namespace
 
 void ElementTarget(const ModelElement& e, const ElemRows& D, double ratio, ElemRows* T) {
-  ElemRows P;
-  if (!FittedShape(e, ratio, &P)) {
+  ElemRows buf;
+  const ElemRows* P = FittedShape(e, ratio, &buf);
+  if (!P) {
     *T = D;  // vented chamber: empty space
     return;
   }
-  const Eigen::Matrix3d R = BestRotation(D.topRows(e.k).transpose() * P.topRows(e.k));
-  TargetFromRotation(e, D, ratio, P, R, T);
+  const Eigen::Matrix3d R = BestRotation(D.topRows(e.k).transpose() * P->topRows(e.k));
+  TargetFromRotation(e, D, ratio, *P, R, T);
 }
 
 double LocalStep(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
@@ -156,15 +155,15 @@ double LocalStep(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X
 #pragma omp parallel for schedule(static) reduction(+ : energy) num_threads(nt > 0 ? nt : omp_get_max_threads())
   for (int b = 0; b < nb; ++b) {
     const int i0 = b * W, m = std::min(W, ne - i0);
-    ElemRows D[W], P[W];
+    ElemRows D[W], buf[W];
+    const ElemRows* P[W];
     Eigen::Matrix3d M[W], R[W];
-    bool fitted[W];
     for (int l = 0; l < m; ++l) {
       const ModelElement& e = els[i0 + l];
       GatherRows(e, X, &D[l]);
-      fitted[l] = FittedShape(e, ratios[i0 + l], &P[l]);
-      if (fitted[l])
-        M[l].noalias() = D[l].topRows(e.k).transpose() * P[l].topRows(e.k);
+      P[l] = FittedShape(e, ratios[i0 + l], &buf[l]);
+      if (P[l])
+        M[l].noalias() = D[l].topRows(e.k).transpose() * P[l]->topRows(e.k);
       else
         M[l].setIdentity();
     }
@@ -173,8 +172,8 @@ double LocalStep(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X
       const int i = i0 + l;
       const ModelElement& e = els[i];
       ElemRows T;
-      if (fitted[l])
-        TargetFromRotation(e, D[l], ratios[i], P[l], R[l], &T);
+      if (P[l])
+        TargetFromRotation(e, D[l], ratios[i], *P[l], R[l], &T);
       else
         T = D[l];  // vented chamber: empty space
       energy += e.wv * (D[l] - T).squaredNorm();
