@@ -167,7 +167,8 @@ double Median(std::vector<double> v) {
 }
 
 /// Baseline of one iteration: the bare global solve (3 RHS) + the bare SVD pass (default threads),
-/// and, for the stricter ratio against the solver's own rotation fit, the polar pass. `iteration`
+/// and, for the stricter ratio against the solver's own rotation fit, the batched polar pass
+/// (BestRotations, as in the local step). `iteration`
 /// (optional) times one sample of the iteration being compared; it is interleaved with the
 /// baseline passes so that load changes on a shared machine hit both sides alike. Medians of
 /// `reps` repetitions after one warm-up.
@@ -180,7 +181,7 @@ Baseline MeasureBaseline(const Fixture& f, const std::function<double()>& iterat
   std::vector<double> ts, tv, tp, ti;
   benchmark::DoNotOptimize(f.model->SolveFree(f.rhs_free));
   benchmark::DoNotOptimize(SvdPass(f.M, 0));
-  benchmark::DoNotOptimize(PolarPass(f.M, 0));
+  benchmark::DoNotOptimize(PolarBatchPass(f.M, 0));
   if (iteration) iteration();
   for (int k = 0; k < reps; ++k) {
     auto t0 = Clock::now();
@@ -192,7 +193,7 @@ Baseline MeasureBaseline(const Fixture& f, const std::function<double()>& iterat
     benchmark::DoNotOptimize(s);
     tv.push_back(Since(t0));
     t0 = Clock::now();
-    s = PolarPass(f.M, 0);
+    s = PolarBatchPass(f.M, 0);
     benchmark::DoNotOptimize(s);
     tp.push_back(Since(t0));
     if (iteration) ti.push_back(iteration());
