@@ -32,14 +32,19 @@ void ComputeLocalRatios(const Model& model, const Eigen::Ref<const Eigen::Matrix
     const double rho = model.GroupRatio(g, c);
     const int side = model.group_side(g);
     const bool vented = side != 0 && !(side * c[model.group_actuator(g)] > 0.0);
-    double Md = 0.0;
-    for (int i : ids) {
+    // The measures in parallel (each element on its own), their sum in element order, so the
+    // result does not depend on the number of threads.
+    const int ng = static_cast<int>(ids.size());
+#pragma omp parallel for schedule(static) if (ng > 2048)
+    for (int q = 0; q < ng; ++q) {
+      const int i = ids[q];
       ElemRows D;
       for (int j = 0; j < els[i].k; ++j) D.row(j) = X.row(els[i].v[j]);
       // Inverted or collapsed elements count as (almost) empty.
       (*ratios)[i] = std::max(ActuationMeasure(els[i], D), kMinMeasure * els[i].measure0);
-      Md += (*ratios)[i];
     }
+    double Md = 0.0;
+    for (int i : ids) Md += (*ratios)[i];
     group_achieved[g] = (Md + LR) / (M + LR);
     if (vented) {
       for (int i : ids) (*ratios)[i] = kVented;
