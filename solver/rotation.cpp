@@ -113,7 +113,7 @@ void NewtonPolar(double x[9][W], double ok[W]) {
       }
     cofactor();
     double any = 0.0;
-    #pragma omp simd
+    #pragma omp simd reduction(+ : any)
     for (int l = 0; l < W; ++l) {
       const double done = (active[l] > 0.0) & (step2[l] < 1e-18) ? 1.0 : 0.0;
       ok[l] = done > 0.0 ? 1.0 : ok[l];
