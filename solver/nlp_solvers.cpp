@@ -28,7 +28,6 @@ std::string FormatG(double v) {
   return buf;
 }
 
-
 using Clock = std::chrono::steady_clock;
 double Seconds(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double>(b - a).count();
