@@ -1,4 +1,5 @@
 #include "solver/mesh.hpp"
+#include "solver/text_format.hpp"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -62,12 +63,6 @@ std::string Where(const std::string& source, const std::vector<int>& lines, int 
 [[noreturn]] void Throw(const std::string& where, const std::string& what,
                         const std::string& expected) {
   throw std::runtime_error(where + ": " + what + "; expected " + expected);
-}
-
-std::string Num(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
 }
 
 struct UnionFind {
@@ -198,8 +193,8 @@ MeshReport ValidateAndOrient(Mesh& mesh, const std::string& source,
     if (!(std::abs(vol) > tol)) {
       Throw(Where(source, element_lines, i, "element"),
             "element " + std::to_string(i) + " (" + ElementTypeToString(e.type) +
-                ") is degenerate: signed volume " + Num(vol) + " mm^3",
-            "|volume| > 1e-12 * size^3 = " + Num(tol) + " mm^3");
+                ") is degenerate: signed volume " + FormatNumber(vol) + " mm^3",
+            "|volume| > 1e-12 * size^3 = " + FormatNumber(tol) + " mm^3");
     }
     if (vol < 0) {
       FlipElement(e);

@@ -4,6 +4,7 @@
 #include "solver/energy.hpp"
 #include "solver/rotation.hpp"
 #include "solver/targets.hpp"
+#include "solver/text_format.hpp"
 
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
@@ -20,13 +21,6 @@
 
 namespace softkin {
 namespace {
-
-/// A number in %.3g form, for messages.
-std::string FormatG(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.3g", v);
-  return buf;
-}
 
 using Clock = std::chrono::steady_clock;
 double Seconds(Clock::time_point a, Clock::time_point b) {
@@ -157,12 +151,12 @@ class RatioUpdateSolver : public FkSolver {
         if (r->gradient_ratio < 100.0 * options_.gradient_tolerance) {
           r->status = FkStatus::Converged;
           r->message = "stopped at the precision floor: the optimiser no longer changes the positions "
-                       "(gradient ratio " + FormatG(r->gradient_ratio) + ", target " +
-                       FormatG(options_.gradient_tolerance) + ")";
+                       "(gradient ratio " + FormatNumber(r->gradient_ratio, 3) + ", target " +
+                       FormatNumber(options_.gradient_tolerance, 3) + ")";
         } else {
           r->status = FkStatus::Diverged;
           r->message = "stalled: the optimiser no longer changes the positions at gradient ratio " +
-                       FormatG(r->gradient_ratio) + " (target " + FormatG(options_.gradient_tolerance) + ")";
+                       FormatNumber(r->gradient_ratio, 3) + " (target " + FormatNumber(options_.gradient_tolerance, 3) + ")";
         }
         return updates;
       }

@@ -1,5 +1,6 @@
 // Progressive chamber remeshing (thesis Sec. 3.3.2, Algorithm 2; remesh.hpp).
 #include "solver/remesh.hpp"
+#include "solver/text_format.hpp"
 
 #include "solver/collision.hpp"
 #include "solver/model.hpp"
@@ -34,12 +35,6 @@ constexpr double kRunawayExtent = 5.0;
 constexpr double kRunawayRatio = 2.0;
 
 double Seconds(Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); }
-
-std::string Num(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
 
 Rows4 TetRows(const Element& e, const Eigen::Ref<const Eigen::MatrixX3d>& X) {
   Rows4 r;
@@ -141,11 +136,11 @@ std::vector<int> Remap(const std::vector<int>& ids, const std::vector<int>& new_
 
 bool RemeshCriteria::IsValid(std::string* why) const {
   if (!(alpha_max > 1) || !std::isfinite(alpha_max)) {
-    if (why) *why = "alpha_max: expected a finite volume ratio > 1, got " + Num(alpha_max);
+    if (why) *why = "alpha_max: expected a finite volume ratio > 1, got " + FormatNumber(alpha_max);
     return false;
   }
   if (!(d_max > 1) || !std::isfinite(d_max)) {
-    if (why) *why = "d_max: expected a finite distortion > 1, got " + Num(d_max);
+    if (why) *why = "d_max: expected a finite distortion > 1, got " + FormatNumber(d_max);
     return false;
   }
   return true;
@@ -360,8 +355,12 @@ int UntangleTets(Mesh& m, const std::vector<char>& held) {
       bad.push_back(i);
     }
   int moves = 0;
-  std::vector<int> active, grown, moved, touched;
+  std::vector<int> active, grown, moved, touched, next;
   std::vector<char> listed(ne, 0);
+  auto sort_unique = [](std::vector<int>& v) {
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+  };
   size_t best = bad.size();
   int best_pass = 0;
   for (int pass = 0; pass < 400; ++pass) {
@@ -379,8 +378,7 @@ int UntangleTets(Mesh& m, const std::vector<char>& held) {
     for (int t : bad)
       for (int j = 0; j < 4; ++j)
         if (!held[m.elements[t].v[j]]) active.push_back(m.elements[t].v[j]);
-    std::sort(active.begin(), active.end());
-    active.erase(std::unique(active.begin(), active.end()), active.end());
+    sort_unique(active);
     if (active.empty()) break;
     for (int ring = 0; ring < pass / 50; ++ring) {
       grown = active;
@@ -388,8 +386,7 @@ int UntangleTets(Mesh& m, const std::vector<char>& held) {
         for (const auto& [t, j] : star[v])
           for (int k = 0; k < 4; ++k)
             if (!held[m.elements[t].v[k]]) grown.push_back(m.elements[t].v[k]);
-      std::sort(grown.begin(), grown.end());
-      grown.erase(std::unique(grown.begin(), grown.end()), grown.end());
+      sort_unique(grown);
       active.swap(grown);
     }
     moved.clear();
@@ -420,12 +417,11 @@ int UntangleTets(Mesh& m, const std::vector<char>& held) {
     touched.clear();
     for (int v : moved)
       for (const auto& [t, j] : star[v]) touched.push_back(t);
-    std::sort(touched.begin(), touched.end());
-    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+    sort_unique(touched);
     for (int t : touched) inverted[t] = SignedVolume(m.elements[t], m.vertices) > 0 ? 0 : 1;
     // bad <- every inverted tet: the listed ones still inverted, and the newly inverted touched ones.
     for (int t : bad) listed[t] = 1;
-    std::vector<int> next;
+    next.clear();
     for (int t : bad)
       if (inverted[t]) next.push_back(t);
     for (int t : touched)
@@ -584,7 +580,7 @@ void RemeshWhole(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX3d>& X
     if (!(v > 0))
       throw std::runtime_error("RemeshChamber (whole): new tet " + std::to_string(i) + " (region " +
                                std::to_string(fresh.elements[i].region) + ") has interpolated rest volume " +
-                               Num(v) + " mm^3; expected positive");
+                               FormatNumber(v) + " mm^3; expected positive");
   }
   out->scene = scene;
   out->scene.mesh = std::move(fresh);
@@ -713,7 +709,7 @@ ChamberRemesh RemeshChamber(const Scene& scene, const Eigen::Ref<const Eigen::Ma
     }
     if (worst_outside < -1e-6)
       throw std::runtime_error("RemeshChamber: a created vertex lies outside the old chamber (barycentric " +
-                               Num(worst_outside) + "); expected every created vertex inside it");
+                               FormatNumber(worst_outside) + "); expected every created vertex inside it");
     {
       // Where the old deformation bends sharply, a thin new tet's pulled-back rest shape can come
       // out inverted: untangle by moving created vertices only (UntangleTets).
@@ -731,7 +727,7 @@ ChamberRemesh RemeshChamber(const Scene& scene, const Eigen::Ref<const Eigen::Ma
       const double v = SignedVolume(e, fresh.vertices);
       if (!(v > 0))
         throw std::runtime_error("RemeshChamber: the pulled-back rest shape of new chamber tet " + std::to_string(i) +
-                                 " has volume " + Num(v) + " mm^3; expected positive (the previous deformation "
+                                 " has volume " + FormatNumber(v) + " mm^3; expected positive (the previous deformation "
                                  "varies too much across it; remesh earlier, i.e. lower alpha_max / d_max)");
     }
     std::vector<int> new_of_old(mesh.num_vertices(), -1);
@@ -769,14 +765,14 @@ bool ProgressiveOptions::IsValid(std::string* why) const {
     if (why) *why = m;
     return false;
   };
-  if (!(step >= 0) || !std::isfinite(step)) return fail("step: expected >= 0 (0: alpha_max), got " + Num(step));
+  if (!(step >= 0) || !std::isfinite(step)) return fail("step: expected >= 0 (0: alpha_max), got " + FormatNumber(step));
   if (max_remeshes_per_step < 1) return fail("max_remeshes_per_step: expected an integer >= 1");
   if (!remesh_options.IsValid(why)) return false;
   for (double s : snapshots)
-    if (!(s > 1) || !std::isfinite(s)) return fail("snapshots: expected volume ratios > 1, got " + Num(s));
+    if (!(s > 1) || !std::isfinite(s)) return fail("snapshots: expected volume ratios > 1, got " + FormatNumber(s));
   for (size_t i = 0; i < ladder.size(); ++i)
     if (!(ladder[i] > 1) || !std::isfinite(ladder[i]) || (i > 0 && !(ladder[i] > ladder[i - 1])))
-      return fail("ladder: expected increasing volume ratios > 1, got " + Num(ladder[i]) + " at position " +
+      return fail("ladder: expected increasing volume ratios > 1, got " + FormatNumber(ladder[i]) + " at position " +
                   std::to_string(i));
   return true;
 }
@@ -799,15 +795,15 @@ ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target, cons
   const int a = ChamberActuator(scene);
   const Actuator& act = scene.actuators[a];
   if (!(alpha_target > 1) || alpha_target > act.max || alpha_target < act.min)
-    throw std::invalid_argument("SolveProgressive: alpha_target " + Num(alpha_target) + " is outside (1, " +
-                                Num(act.max) + "], the range of actuator '" + act.name + "'");
+    throw std::invalid_argument("SolveProgressive: alpha_target " + FormatNumber(alpha_target) + " is outside (1, " +
+                                FormatNumber(act.max) + "], the range of actuator '" + act.name + "'");
   for (double s : opt.snapshots)
     if (s > alpha_target)
-      throw std::invalid_argument("SolveProgressive: snapshot " + Num(s) + " is beyond alpha_target " +
-                                  Num(alpha_target) + "; expected snapshots in (1, alpha_target]");
+      throw std::invalid_argument("SolveProgressive: snapshot " + FormatNumber(s) + " is beyond alpha_target " +
+                                  FormatNumber(alpha_target) + "; expected snapshots in (1, alpha_target]");
   if (!opt.ladder.empty() && opt.ladder.back() > alpha_target)
-    throw std::invalid_argument("SolveProgressive: ladder value " + Num(opt.ladder.back()) +
-                                " is beyond alpha_target " + Num(alpha_target) +
+    throw std::invalid_argument("SolveProgressive: ladder value " + FormatNumber(opt.ladder.back()) +
+                                " is beyond alpha_target " + FormatNumber(alpha_target) +
                                 "; expected ladder values in (1, alpha_target]");
   const std::vector<int> regions = act.regions;
   const double step = opt.step > 0 ? opt.step : opt.criteria.alpha_max;
@@ -876,8 +872,8 @@ ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target, cons
         const double extent = (r.positions.colwise().maxCoeff() - r.positions.colwise().minCoeff()).norm();
         const double ratio = RegionVolume(res.scene.mesh, r.positions, regions) / V0;
         if (!(extent <= kRunawayExtent * rest_extent) || !(ratio <= kRunawayRatio * st.alpha)) {
-          r.message = "runaway: the chamber reached " + Num(ratio) + " times its volume for alpha " +
-                      Num(st.alpha) + ", the bounding box " + Num(extent / rest_extent) + " times the rest one (" +
+          r.message = "runaway: the chamber reached " + FormatNumber(ratio) + " times its volume for alpha " +
+                      FormatNumber(st.alpha) + ", the bounding box " + FormatNumber(extent / rest_extent) + " times the rest one (" +
                       FkStatusToString(r.status) + "); treated as diverged";
           r.status = FkStatus::Diverged;
           st.status = r.status;
@@ -886,7 +882,7 @@ ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target, cons
       if (r.status == FkStatus::Diverged || r.status == FkStatus::InvalidInput) {
         res.status = r.status;
         res.completed = false;
-        res.message = "alpha " + Num(st.alpha) + ": " + r.message;
+        res.message = "alpha " + FormatNumber(st.alpha) + ": " + r.message;
         stop = true;
         break;
       }
@@ -907,7 +903,7 @@ ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target, cons
         st.mesh_seconds += Seconds(tr);
         ++st.remesh_failures;
         ++res.remesh_failures;
-        if (res.first_remesh_failure.empty()) res.first_remesh_failure = "alpha " + Num(st.alpha) + ": " + e.what();
+        if (res.first_remesh_failure.empty()) res.first_remesh_failure = "alpha " + FormatNumber(st.alpha) + ": " + e.what();
         break;
       }
       st.mesh_seconds += rm.seconds;
@@ -924,7 +920,7 @@ ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target, cons
     }
     if (st.status != FkStatus::Converged && res.status == FkStatus::Converged) {
       res.status = st.status;
-      if (res.message.empty()) res.message = "alpha " + Num(st.alpha) + ": " + FkStatusToString(st.status);
+      if (res.message.empty()) res.message = "alpha " + FormatNumber(st.alpha) + ": " + FkStatusToString(st.status);
     }
     st.tets = res.scene.mesh.num_tets();
     st.chamber_tets = 0;

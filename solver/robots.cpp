@@ -1,4 +1,5 @@
 #include "solver/robots.hpp"
+#include "solver/text_format.hpp"
 
 #include "solver/hyperelastic.hpp"
 
@@ -19,12 +20,6 @@ namespace softkin {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-std::string FormatNumber(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
 
 // ================================================================================================
 // pneumatic_finger (thesis Fig. 2.11): PneuNet-style bending actuator on a voxel grid.

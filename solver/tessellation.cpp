@@ -2,6 +2,7 @@
 // tetrahedral remeshing (tessellation.hpp). All of SoftKin's CGAL meshing lives in this file so
 // that only one translation unit pays for Mesh_3's compile time.
 #include "solver/tessellation.hpp"
+#include "solver/text_format.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Mesh_complex_3_in_triangulation_3.h>
@@ -55,12 +56,6 @@ using RemeshTr = CGAL::Tetrahedral_remeshing::Remeshing_triangulation_3<K>;
 using Clock = std::chrono::steady_clock;
 
 double Seconds(Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); }
-
-std::string Num(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
 
 std::string SourceOf(const TriangleSurface& s, const char* role) {
   return s.source.empty() ? std::string(role) : s.source;
@@ -117,18 +112,18 @@ bool TessellationOptions::IsValid(std::string* why) const {
     if (why) *why = m;
     return false;
   };
-  if (!(cell_size > 0) || !std::isfinite(cell_size)) return fail("cell_size: expected a finite size > 0 mm, got " + Num(cell_size));
+  if (!(cell_size > 0) || !std::isfinite(cell_size)) return fail("cell_size: expected a finite size > 0 mm, got " + FormatNumber(cell_size));
   if (!(chamber_cell_size >= 0) || !std::isfinite(chamber_cell_size))
-    return fail("chamber_cell_size: expected >= 0 mm (0: cell_size), got " + Num(chamber_cell_size));
-  if (!(facet_size >= 0) || !std::isfinite(facet_size)) return fail("facet_size: expected >= 0 mm (0: cell_size), got " + Num(facet_size));
+    return fail("chamber_cell_size: expected >= 0 mm (0: cell_size), got " + FormatNumber(chamber_cell_size));
+  if (!(facet_size >= 0) || !std::isfinite(facet_size)) return fail("facet_size: expected >= 0 mm (0: cell_size), got " + FormatNumber(facet_size));
   if (!(facet_distance >= 0) || !std::isfinite(facet_distance))
-    return fail("facet_distance: expected >= 0 mm (0: cell_size / 10), got " + Num(facet_distance));
+    return fail("facet_distance: expected >= 0 mm (0: cell_size / 10), got " + FormatNumber(facet_distance));
   if (!(facet_angle > 0 && facet_angle <= 30))
-    return fail("facet_angle: expected an angle in (0, 30] degrees (Mesh_3 terminates only up to 30), got " + Num(facet_angle));
+    return fail("facet_angle: expected an angle in (0, 30] degrees (Mesh_3 terminates only up to 30), got " + FormatNumber(facet_angle));
   if (!(radius_edge_ratio >= 2) || !std::isfinite(radius_edge_ratio))
-    return fail("radius_edge_ratio: expected a finite ratio >= 2, got " + Num(radius_edge_ratio));
+    return fail("radius_edge_ratio: expected a finite ratio >= 2, got " + FormatNumber(radius_edge_ratio));
   if (!(feature_angle >= 0 && feature_angle < 180))
-    return fail("feature_angle: expected an angle in [0, 180) degrees (0: no protection), got " + Num(feature_angle));
+    return fail("feature_angle: expected an angle in [0, 180) degrees (0: no protection), got " + FormatNumber(feature_angle));
   if (body_region == chamber_region)
     return fail("body_region and chamber_region: expected two different tags, both are " + std::to_string(body_region));
   return true;
@@ -140,7 +135,7 @@ bool RegionRemeshOptions::IsValid(std::string* why) const {
     return false;
   };
   if (!(target_edge >= 0) || !std::isfinite(target_edge))
-    return fail("target_edge: expected >= 0 mm (0: the region boundary's mean edge), got " + Num(target_edge));
+    return fail("target_edge: expected >= 0 mm (0: the region boundary's mean edge), got " + FormatNumber(target_edge));
   if (iterations < 1) return fail("iterations: expected an integer >= 1, got " + std::to_string(iterations));
   return true;
 }
@@ -250,7 +245,7 @@ Mesh Tessellate(const TriangleSurface& chamber_in, const TriangleSurface& body_i
   if (body_tets == 0 || chamber_tets == 0)
     throw std::runtime_error("T(S_c, S_b): Mesh_3 produced " + std::to_string(body_tets) + " body and " +
                              std::to_string(chamber_tets) + " chamber tets for " + body.source + " and " +
-                             chamber.source + " at cell_size " + Num(opt.cell_size) +
+                             chamber.source + " at cell_size " + FormatNumber(opt.cell_size) +
                              " mm; expected both regions meshed (use smaller sizes)");
   // CGAL's cells are positively oriented; orient explicitly anyway (a no-op then) and reject
   // degenerate tets with the mesh module's checks.
@@ -365,7 +360,7 @@ RegionRemeshResult RemeshRegionInterior(const Mesh& mesh, const Eigen::Ref<const
                                  X.row(e.v[2]).transpose(), X.row(e.v[3]).transpose());
     if (e.region == region && !(vol > 0))
       throw std::invalid_argument("RemeshRegionInterior: tet " + std::to_string(i) + " (region " +
-                                  std::to_string(e.region) + ") has volume " + Num(vol) +
+                                  std::to_string(e.region) + ") has volume " + FormatNumber(vol) +
                                   " mm^3 at the given positions; expected the region's tets positively oriented");
     cells.push_back({e.v[0], e.v[1], e.v[2], e.v[3], subdomain_of(e.region)});
     if (e.region == region) ++region_before;
@@ -479,7 +474,7 @@ RegionRemeshResult RemeshRegionInterior(const Mesh& mesh, const Eigen::Ref<const
     const double vol = TetVolume(V.row(m.v[0]).transpose(), V.row(m.v[1]).transpose(),
                                  V.row(m.v[2]).transpose(), V.row(m.v[3]).transpose());
     if (!(vol > 0))
-      throw std::runtime_error("RemeshRegionInterior: CGAL's remesher produced a tet of volume " + Num(vol) +
+      throw std::runtime_error("RemeshRegionInterior: CGAL's remesher produced a tet of volume " + FormatNumber(vol) +
                                " mm^3 in region " + std::to_string(region) + "; expected positive volumes");
     out.mesh.elements.push_back(m);
   }

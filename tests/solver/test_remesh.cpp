@@ -110,9 +110,19 @@ FkResult Solve(const Scene& s, double alpha, const Eigen::MatrixX3d* warm = null
   return MakeFkSolver(model, s.solver)->Solve(c, warm);
 }
 
-/// The Mooney-Rivlin robot solved at alpha = 3, once.
+/// The Mooney-Rivlin robot solved at alpha = 3, once, a hundred times more tightly than the
+/// scene's default (tolerance 1e-7, gradient 1e-9), so that the state the remesh tests start from
+/// is the equilibrium to well below the solver's default stopping error.
 const FkResult& SolvedAt3() {
-  static const FkResult r = Solve(Twisting(), 3.0);
+  static const FkResult r = [] {
+    const Scene& s = Twisting();
+    FkOptions o = s.solver;
+    o.tolerance = 1e-7;
+    o.gradient_tolerance = 1e-9;
+    Eigen::VectorXd c = s.rest_actuation();
+    c[0] = 3.0;
+    return MakeFkSolver(std::make_shared<const Model>(s), o)->Solve(c, nullptr);
+  }();
   return r;
 }
 
@@ -211,14 +221,15 @@ TEST(Remesh, ChamberOnlyKeepsTheBodyAndTheChamberVolume) {
   // polar rotations, each at the scene's tolerance and at 1e-7) gave drifts of 1.91, 2.06, 2.18
   // and 1.82 mm against a motion of 9.93 mm: 0.18-0.22 of it (re-solve energies 9016.0, 8983.9,
   // 8995.9, 8971.2; the same with lg, lg-aa and the energy safeguard; the CGAL seed changes
-  // nothing). The earlier bound of 0.2 sat in the middle of that spread, a coin flip on rounding;
-  // 0.25 covers it. (The thesis resets the chamber's rest shapes at a remesh, docs/remeshing.md.)
+  // nothing). So this bound sits near the edge of that spread: the shipped solver and the tight
+  // solve above give 1.82 mm, 0.183. The fix is the thesis's reset of the chamber's rest shapes
+  // at a remesh (docs/remeshing.md), after which the drift should fall well below it.
   const FkResult again = Solve(n, 3.0, &rm.positions);
   ASSERT_EQ(again.status, FkStatus::Converged) << again.BriefReport();
   const double moved = (s.marker_positions(r.positions).row(tip) - s.marker_positions(s.mesh.vertices).row(tip)).norm();
   const double drift = (n.marker_positions(again.positions).row(tip) - n.marker_positions(rm.positions).row(tip)).norm();
   std::printf("  moved %.4f mm, drift after remesh %.4f mm; %s\n", moved, drift, again.BriefReport().c_str());
-  EXPECT_LT(drift, 0.25 * moved) << "moved " << moved << " mm, drift after remesh " << drift << " mm";
+  EXPECT_LT(drift, 0.2 * moved) << "moved " << moved << " mm, drift after remesh " << drift << " mm";
 }
 
 TEST(Remesh, WholeRetessellationKeepsTheSurfacesWithinTolerance) {
