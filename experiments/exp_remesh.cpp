@@ -46,6 +46,7 @@ nlohmann::json RunTwistingRemesh(const Config& cfg, const std::string& dir, bool
   const double d_max = cfg.Number("d_max", 4.0);
   const double step = cfg.Number("step", 0.0);
   const std::string method_name = cfg.String("remesh_method", "auto");
+  const std::string rest_name = cfg.String("chamber_rest", "remeshed");
   const int remesh_iterations = cfg.Int("remesh_iterations", 3);
   const int max_remeshes = cfg.Int("max_remeshes_per_step", 2);
   const int sections = cfg.Int("sections", 20);
@@ -73,6 +74,7 @@ nlohmann::json RunTwistingRemesh(const Config& cfg, const std::string& dir, bool
   popt.max_remeshes_per_step = max_remeshes;
   if (!RemeshMethodFromString(method_name, &popt.remesh_options.method))
     cfg.Fail("remesh_method", "auto, chamber or whole");
+  if (!ChamberRestFromString(rest_name, &popt.remesh_options.rest)) cfg.Fail("chamber_rest", "remeshed or original");
   popt.remesh_options.region.iterations = remesh_iterations;
   popt.remesh_options.region.seed = cfg.seed();
   popt.remesh_options.tessellation = TwistingRobotTessellation(res, cfg.NumberMap("robot_params"));
@@ -222,6 +224,7 @@ nlohmann::json RunTwistingRemesh(const Config& cfg, const std::string& dir, bool
   j["robot_build_seconds"] = build_s;
   j["alpha_max"] = alpha_max;
   j["d_max"] = d_max;
+  j["chamber_rest"] = ChamberRestToString(popt.remesh_options.rest);
   j["progressive"] = {{"status", FkStatusToString(prog.status)},
                       {"completed", prog.completed},
                       {"message", prog.message},

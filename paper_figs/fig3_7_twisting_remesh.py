@@ -136,7 +136,8 @@ def main(argv):
     quick = " (quick run)" if summary.get("quick") else ""
     prog_sum = summary.get("progressive", {})
     fig.suptitle(f"Twisting robot, progressive chamber remeshing (Alg. 2): {prog_sum.get('remeshes', '?')} remeshes, "
-                 f"alpha_max = d_max = {summary.get('alpha_max', '?')}{quick}")
+                 f"alpha_max = d_max = {summary.get('alpha_max', '?')}, chamber rest shape: "
+                 f"{summary.get('chamber_rest', 'remeshed')}{quick}")
     figlib.save_figure(fig, results, NAME)
     return 0
 

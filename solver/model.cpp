@@ -52,7 +52,8 @@ Model::Model(const Scene& scene) : scene_(scene) {
     me.role = r;
     me.group = grp;
     ElemRows P = ElemRows::Zero();
-    for (int j = 0; j < me.k; ++j) P.row(j) = m.vertices.row(e.v[j]);
+    const Eigen::MatrixX3d& rest = scene_.rest_positions_of(e.region);
+    for (int j = 0; j < me.k; ++j) P.row(j) = rest.row(e.v[j]);
     me.rest_volume = RowsVolume(P, me.k);
     if (!(me.rest_volume > 0))
       throw std::invalid_argument("scene '" + scene_.name + "': element " + std::to_string(i) +

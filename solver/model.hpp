@@ -59,6 +59,8 @@ class Model {
 
   const Scene& scene() const { return scene_; }
   const Mesh& mesh() const { return scene_.mesh; }
+  /// The mesh's rest vertex positions (the solvers' starting point). Elements of the regions in
+  /// Scene::region_rest take their rest shapes from there instead (ModelElement::rest).
   const Eigen::MatrixX3d& rest_positions() const { return scene_.mesh.vertices; }
   int num_vertices() const { return scene_.mesh.num_vertices(); }
   int num_actuators() const { return scene_.num_actuators(); }

@@ -240,6 +240,19 @@ bool RemeshMethodFromString(const std::string& s, RemeshMethod* m) {
   return false;
 }
 
+const char* ChamberRestToString(ChamberRest r) {
+  return r == ChamberRest::Remeshed ? "remeshed" : "original";
+}
+
+bool ChamberRestFromString(const std::string& s, ChamberRest* r) {
+  for (ChamberRest x : {ChamberRest::Remeshed, ChamberRest::Original})
+    if (s == ChamberRestToString(x)) {
+      *r = x;
+      return true;
+    }
+  return false;
+}
+
 bool ChamberRemeshOptions::IsValid(std::string* why) const {
   if (!region.IsValid(why)) return false;
   if (tessellation.cell_size > 0) {
@@ -568,14 +581,29 @@ void RemeshWhole(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX3d>& X
   }
   fresh.vertices = rest;
   // Interpolated rest shapes of thin new tets can come out inverted where the old deformation
-  // bends sharply (near old inverted tets). Untangle locally (UntangleTets).
+  // bends sharply (near old inverted tets). Untangle locally (UntangleTets). With
+  // ChamberRest::Remeshed the chamber's tets take their new (deformed) shapes as rest shapes, so
+  // only the body's interpolated rest shapes need to be valid; the chamber-interior vertices'
+  // pulled-back positions in mesh.vertices are then only a picture of the chamber in the original
+  // frame.
+  const bool chamber_too = opt.rest == ChamberRest::Original;
   {
     std::vector<char> held(nv, 0);
     for (int v : fixed) held[v] = 1;
-    out->untangled_vertices = UntangleTets(fresh, held);
+    if (chamber_too) {
+      out->untangled_vertices = UntangleTets(fresh, held);
+    } else {
+      Mesh body;
+      body.vertices = std::move(fresh.vertices);
+      for (const auto& e : fresh.elements)
+        if (e.region != region) body.elements.push_back(e);
+      out->untangled_vertices = UntangleTets(body, held);
+      fresh.vertices = std::move(body.vertices);
+    }
   }
   rest = fresh.vertices;
   for (int i = 0; i < fresh.num_elements(); ++i) {
+    if (!chamber_too && fresh.elements[i].region == region) continue;
     const double v = SignedVolume(fresh.elements[i], rest);
     if (!(v > 0))
       throw std::runtime_error("RemeshChamber (whole): new tet " + std::to_string(i) + " (region " +
@@ -629,7 +657,7 @@ ChamberRemesh RemeshChamber(const Scene& scene, const Eigen::Ref<const Eigen::Ma
       ++out.chamber_tets_before;
       if (!(SignedVolume(e, X) > 0)) ++out.inverted_chamber_tets;
     }
-  out.chamber_rest_volume_before = RegionVolume(mesh, mesh.vertices, regions);
+  out.chamber_rest_volume_before = RegionVolume(mesh, scene.rest_positions_of(region), regions);
   out.chamber_volume_before = RegionVolume(mesh, X, regions);
 
   // Positions the chamber-only re-tessellation starts from: X with the chamber's interior
@@ -710,7 +738,10 @@ ChamberRemesh RemeshChamber(const Scene& scene, const Eigen::Ref<const Eigen::Ma
     if (worst_outside < -1e-6)
       throw std::runtime_error("RemeshChamber: a created vertex lies outside the old chamber (barycentric " +
                                FormatNumber(worst_outside) + "); expected every created vertex inside it");
-    {
+    // With ChamberRest::Remeshed the new chamber tets' rest shapes are their shapes at X (set
+    // below), and the pulled-back positions are only a picture of the chamber in the original
+    // frame; they need not be valid tets.
+    if (options.rest == ChamberRest::Original) {
       // Where the old deformation bends sharply, a thin new tet's pulled-back rest shape can come
       // out inverted: untangle by moving created vertices only (UntangleTets).
       // Held: the vertices of body tets (their rest positions are the body's memory). The
@@ -720,15 +751,15 @@ ChamberRemesh RemeshChamber(const Scene& scene, const Eigen::Ref<const Eigen::Ma
         if (e.region != region)
           for (int j = 0; j < 4; ++j) held[e.v[j]] = 1;
       out.untangled_vertices = UntangleTets(fresh, held);
-    }
-    for (int i = 0; i < fresh.num_elements(); ++i) {
-      const Element& e = fresh.elements[i];
-      if (e.region != region) continue;
-      const double v = SignedVolume(e, fresh.vertices);
-      if (!(v > 0))
-        throw std::runtime_error("RemeshChamber: the pulled-back rest shape of new chamber tet " + std::to_string(i) +
-                                 " has volume " + FormatNumber(v) + " mm^3; expected positive (the previous deformation "
-                                 "varies too much across it; remesh earlier, i.e. lower alpha_max / d_max)");
+      for (int i = 0; i < fresh.num_elements(); ++i) {
+        const Element& e = fresh.elements[i];
+        if (e.region != region) continue;
+        const double v = SignedVolume(e, fresh.vertices);
+        if (!(v > 0))
+          throw std::runtime_error("RemeshChamber: the pulled-back rest shape of new chamber tet " + std::to_string(i) +
+                                   " has volume " + FormatNumber(v) + " mm^3; expected positive (the previous deformation "
+                                   "varies too much across it; remesh earlier, i.e. lower alpha_max / d_max)");
+      }
     }
     std::vector<int> new_of_old(mesh.num_vertices(), -1);
     for (int v = 0; v < fresh.num_vertices(); ++v)
@@ -747,11 +778,15 @@ ChamberRemesh RemeshChamber(const Scene& scene, const Eigen::Ref<const Eigen::Ma
     DeformedSurfaces(mesh, X, region, &sc, &u, &sb, &w);
     out.outer_volume_before = out.outer_volume_after = EnclosedVolume(sb);
   }
+  // The chamber's rest shape (ChamberRest): its shape at the remesh, or the pulled-back one now in
+  // mesh.vertices.
+  out.scene.region_rest = {};
+  if (options.rest == ChamberRest::Remeshed) out.scene.region_rest = {{region}, out.positions};
   out.scene.validate();
   out.chamber_tets_after = 0;
   for (const auto& e : out.scene.mesh.elements)
     if (e.region == region) ++out.chamber_tets_after;
-  out.chamber_rest_volume_after = RegionVolume(out.scene.mesh, out.scene.mesh.vertices, regions);
+  out.chamber_rest_volume_after = RegionVolume(out.scene.mesh, out.scene.rest_positions_of(region), regions);
   out.chamber_volume_after = RegionVolume(out.scene.mesh, out.positions, regions);
   out.seconds = Seconds(t0);
   return out;
@@ -825,7 +860,7 @@ ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target, cons
   res.scene = scene;
   Eigen::MatrixX3d X = scene.mesh.vertices, Xref = X;
   const double rest_extent = scene.mesh.size();
-  const double V0 = RegionVolume(scene.mesh, scene.mesh.vertices, regions);
+  const double V0 = RegionVolume(scene.mesh, scene.rest_positions_of(regions[0]), regions);
   auto build = [&](const Scene& s) {
     auto model = std::make_shared<const Model>(s);
     return MakeFkSolver(model, s.solver);
@@ -838,10 +873,11 @@ ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target, cons
   // rest volume a whole re-tessellation may change slightly.
   // After a remesh the actuator's range is widened by the same factor (before the model is built).
   auto value_for = [&](double alpha) {
-    return alpha * V0 / RegionVolume(res.scene.mesh, res.scene.mesh.vertices, regions);
+    return alpha * V0 / RegionVolume(res.scene.mesh, res.scene.rest_positions_of(regions[0]), regions);
   };
   auto widen = [&]() {
     res.scene.actuators[a].max = std::max(act.max, value_for(act.max));
+    res.scene.actuators[a].min = std::min(act.min, value_for(act.min));
   };
 
   for (size_t k = 0; k < ladder.size(); ++k) {

@@ -33,16 +33,22 @@
 ///  - auto: chamber-only when the chamber has no inverted tet at the positions after untangling
 ///    its interior vertices (and the chamber-only re-tessellation succeeds), else whole.
 /// In both, the deformed positions are where the vertices are (kept, or created by CGAL in the
-/// deformed shape), and vertices created inside the old chamber (chamber-only) get their rest
-/// positions pulled back through the old chamber tets (then untangled where a thin new tet's
-/// pulled-back shape comes out inverted), so the chamber's rest volume stays the
-/// original chamber's (exactly for chamber-only; up to Mesh_3's re-sampling for whole): the
-/// actuation stays a ratio of the original chamber volume (SolveProgressive rescales it by the
-/// rest-volume change of a whole re-tessellation).
-/// Why not "the chamber's new rest shape is its deformed shape": SoftKin's Model takes every
-/// element's rest shape from one array of rest vertex positions, and the interface vertices are
-/// shared by body tets (which need their original rest positions) and chamber tets; a chamber
-/// rest shape equal to the deformed one would need per-element rest shapes in the Model.
+/// deformed shape). The chamber's rest shape after a remesh (ChamberRest):
+///  - remeshed (default, Algorithm 2, line 11): the new chamber tets' shapes at the remesh, kept in
+///    Scene::region_rest (the body tets sharing the interface vertices keep their rest positions in
+///    mesh.vertices). The chamber's rest volume becomes its volume at the remesh, M_k, and
+///    SolveProgressive asks for alpha V_c^0 / M_k of it, so alpha stays a ratio of the original
+///    chamber volume V_c^0. The chamber's elements start well shaped, their targets are their
+///    current shapes scaled, and their weights (w Vol) follow their volumes at the remesh.
+///  - original: vertices created inside the old chamber get their rest positions pulled back
+///    through the old chamber tets (then untangled where a thin new tet's pulled-back shape comes
+///    out inverted), so the chamber's rest volume stays the original chamber's (exactly for
+///    chamber-only; up to Mesh_3's re-sampling for whole). The new elements' targets then carry the
+///    old mesh's deformation, which is what the thesis's remeshing is there to drop; kept for
+///    comparison (exp fig3_7 `chamber_rest`).
+/// mesh.vertices always holds the original frame: with "remeshed" the chamber-interior vertices'
+/// pulled-back positions there are only a picture of the chamber in that frame (not used by the
+/// Model, and not required to form valid tets).
 /// The remeshing checks compare each chamber element with its shape when the chamber was last
 /// meshed (the "reference" positions, = the deformed positions at the last remesh), which is the
 /// reference Algorithm 2's tests use.
@@ -116,9 +122,25 @@ const char* RemeshMethodToString(RemeshMethod m);
 /// Parses the names of RemeshMethodToString; false if unknown.
 bool RemeshMethodFromString(const std::string& s, RemeshMethod* m);
 
+/// The rest shape a re-tessellated chamber takes (file comment).
+enum class ChamberRest {
+  /// Its shape when it was re-tessellated (Algorithm 2, line 11: M^k = M_b^k + T(S_c^k)), kept in
+  /// Scene::region_rest: the new elements start well shaped and the actuation scales their
+  /// current shapes, and the chamber's rest volume becomes its volume at the remesh.
+  Remeshed,
+  /// The original chamber's rest shape: created vertices' rest positions are pulled back through
+  /// the previous deformation, so the rest volume stays the original chamber's.
+  Original
+};
+/// "remeshed" / "original".
+const char* ChamberRestToString(ChamberRest r);
+/// Parses the names of ChamberRestToString; false if unknown.
+bool ChamberRestFromString(const std::string& s, ChamberRest* r);
+
 /// Options of RemeshChamber.
 struct ChamberRemeshOptions {
   RemeshMethod method = RemeshMethod::Auto;
+  ChamberRest rest = ChamberRest::Remeshed;
   /// The chamber-only re-tessellation.
   RegionRemeshOptions region;
   /// Sizing of the whole re-tessellation T(S_c^k, S_b^k). cell_size <= 0: derived from the
@@ -247,8 +269,9 @@ struct ProgressiveResult {
 /// (so whatever the solver does, e.g. collision response, applies); after each solve, if
 /// CheckRemesh (against the state at the last remesh) fires and remeshing is on, RemeshChamber
 /// and solve again at the same alpha. alpha is a ratio of the original chamber volume V_c^0:
-/// the actuator gets alpha V_c^0 / M_k, M_k the current chamber rest volume (= V_c^0 until a
-/// whole re-tessellation changes it slightly; the actuator's range is widened to match). A remesh
+/// the actuator gets alpha V_c^0 / M_k, M_k the current chamber rest volume (ChamberRest: the
+/// chamber's volume at the last remesh, or V_c^0 up to a whole re-tessellation's re-sampling; the
+/// actuator's range is widened to match). A remesh
 /// that throws std::runtime_error is counted (remesh_failures) and the step keeps its state on the
 /// current mesh; a diverged or invalid solve ends the ladder (completed = false), and so does a
 /// runaway (a solution whose bounding box exceeds 5 times the rest one or whose chamber volume

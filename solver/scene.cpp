@@ -77,6 +77,12 @@ Eigen::MatrixX3d Scene::marker_positions(const Eigen::Ref<const Eigen::MatrixX3d
   return P;
 }
 
+const Eigen::MatrixX3d& Scene::rest_positions_of(int region) const {
+  for (int r : region_rest.regions)
+    if (r == region) return region_rest.positions;
+  return mesh.vertices;
+}
+
 void Scene::validate() const {
   auto fail = [&](const std::string& m) {
     throw std::invalid_argument("scene '" + name + "': " + m);
@@ -159,6 +165,14 @@ void Scene::validate() const {
   }
   std::set<int> used;
   for (const auto& e : mesh.elements) used.insert(e.region);
+  if (!region_rest.regions.empty()) {
+    if (region_rest.positions.rows() != mesh.num_vertices())
+      fail("region_rest: expected one row of rest positions per vertex (" + std::to_string(mesh.num_vertices()) +
+           "), got " + std::to_string(region_rest.positions.rows()));
+    if (!region_rest.positions.allFinite()) fail("region_rest: expected finite rest positions");
+    for (int r : region_rest.regions)
+      if (!used.count(r)) fail("region_rest: region " + std::to_string(r) + " has no elements");
+  }
   for (int r : used)
     if (!role.count(r))
       fail("region " + std::to_string(r) + " has elements but no role (body or actuator)");

@@ -109,6 +109,14 @@ struct Scene {
   /// the local-global solvers respond to them with springs (FkOptions::collision).
   std::vector<TriangleSurface> obstacles;
   FkOptions solver;                  ///< default solver options for this scene
+  /// Rest positions for the elements of some regions when they differ from mesh.vertices. Progressive
+  /// remeshing (remesh.hpp, thesis Algorithm 2) gives a re-tessellated chamber the shape it was
+  /// meshed in as its rest shape, while the body tets sharing its interface vertices keep theirs
+  /// (mesh.vertices). Empty `regions`: none.
+  struct RegionRest {
+    std::vector<int> regions;     ///< region tags whose elements use `positions`
+    Eigen::MatrixX3d positions;   ///< #V x 3, mm (only the rows of those elements' vertices matter)
+  } region_rest;
 
   int num_actuators() const { return static_cast<int>(actuators.size()); }
   /// Index of the actuator or marker with that name, or -1.
@@ -118,12 +126,16 @@ struct Scene {
   Eigen::VectorXd rest_actuation() const;
   /// Marker positions (#markers x 3) for vertex positions X.
   Eigen::MatrixX3d marker_positions(const Eigen::Ref<const Eigen::MatrixX3d>& X) const;
+  /// The rest positions of the elements with region tag `region`: region_rest.positions if its
+  /// regions list it, else mesh.vertices.
+  const Eigen::MatrixX3d& rest_positions_of(int region) const;
   /// Whether vertex v's coordinate d is prescribed (fixed, held on axis d, or moved by a motion
   /// actuator). Linear in the constraint lists; for setup code, not inner loops.
   bool is_constrained(int v, int d) const;
   /// Throws std::invalid_argument with a clear message if the scene is inconsistent: a region with
   /// no role or two roles, an actuator without elements, empty fixed set, marker vertex out of
-  /// range, bad ranges or materials.
+  /// range, bad ranges or materials, a region_rest of the wrong size, non-finite or naming a region
+  /// with no elements.
   void validate() const;
 };
 
