@@ -424,7 +424,7 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
   cfg.CheckNoUnknownKeys();
   if (!robots_j.is_array() || robots_j.empty())
     cfg.Fail("robots", "a non-empty array of {\"robot\", \"res\", [\"robot_params\"], \"actuation\", \"steps\", [\"obstacles\"], [\"thesis\"]}");
-  CsvWriter csv(dir + "/costs.csv", {"robot", "tets", "mesh_gen_s", "col_check_s", "col_resp_s",
+  CsvWriter csv(dir + "/costs.csv", {"robot", "label", "tets", "mesh_gen_s", "col_check_s", "col_resp_s",
                                      "solver_s", "step_s", "steps", "collision_free"});
   // Every robot's keys are read and checked before the first one runs (a bad key in the last
   // robot fails at once, not after the others' minutes of solving).
@@ -441,9 +441,11 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
     for (auto it = rj.begin(); it != rj.end(); ++it)
       if (it.key() != "robot" && it.key() != "res" && it.key() != "robot_params" && it.key() != "actuation" &&
           it.key() != "steps" && it.key() != "obstacles" && it.key() != "thesis" && it.key() != "remesh" &&
-          it.key() != "collision")
+          it.key() != "collision" && it.key() != "label")
         cfg.Fail(key + "." + it.key(),
-                 "one of robot, res, robot_params, actuation, steps, obstacles, remesh, collision, thesis");
+                 "one of robot, label, res, robot_params, actuation, steps, obstacles, remesh, collision, thesis");
+    if (rj.contains("label") && (!rj["label"].is_string() || rj["label"].get<std::string>().empty()))
+      cfg.Fail(key + ".label", "a non-empty string naming the row (default: the robot)");
     if (rj.contains("res") && !rj["res"].is_number_integer()) cfg.Fail(key + ".res", "an integer");
     if (rj.contains("steps") && (!rj["steps"].is_number_integer() || rj["steps"].get<int>() < 1))
       cfg.Fail(key + ".steps", "an integer >= 1");
@@ -546,6 +548,7 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
     }
     nlohmann::json row;
     row["robot"] = robot;
+    row["label"] = rj.value("label", robot);
     row["tets"] = scene.mesh.num_tets();
     // The thesis's mesh generation for a remeshed robot is its chamber re-tessellation per step;
     // without remeshing it is the robot's one tessellation.
@@ -571,7 +574,7 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
         row["speedup_vs_thesis_step"] = thesis_step / (total / steps);
       }
     }
-    csv.RowStrings({robot, std::to_string(scene.mesh.num_tets()), std::to_string(row["mesh_gen_s"].get<double>()),
+    csv.RowStrings({robot, row["label"].get<std::string>(), std::to_string(scene.mesh.num_tets()), std::to_string(row["mesh_gen_s"].get<double>()),
                     std::to_string(check / steps), std::to_string(resp / steps),
                     std::to_string(solve / steps), std::to_string(total / steps),
                     std::to_string(steps), free ? "1" : "0"});

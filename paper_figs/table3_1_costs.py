@@ -48,7 +48,7 @@ def main(argv):
             remesh = r.get("remesh") if who == "ours" else None
             if isinstance(remesh, dict) and "tets_final" in remesh:
                 tets = f"{tets}->{remesh['tets_final']}"  # remeshed during the run
-            labels.append(f"{r['robot']}\n{who}, {tets} tets")
+            labels.append(f"{r.get('label', r['robot'])}\n{who}, {tets} tets")
             x += 1
     ax.set_xticks(range(len(labels)))
     ax.set_xticklabels(labels, fontsize=7)

@@ -374,6 +374,7 @@ TEST(Cli, CollisionCostsRejectsABadRemeshKeyBeforeRunningAny) {
            {R"({"alpha_max": "four"})", "robots[1].remesh.alpha_max: expected a finite number"},
            {R"({"alpha": 4})", "robots[1].remesh.alpha: expected one of alpha_max, d_max, method"},
            {R"({"method": "all"})", "robots[1].remesh.method: expected auto, chamber or whole"},
+           {R"({"chamber_rest": "deformed"})", "robots[1].remesh.chamber_rest: expected remeshed or original"},
            {R"({"d_max": 0.5})", "robots[1].remesh.d_max: expected"},
            {R"([4])", "robots[1].remesh: expected an object"}}) {
     SCOPED_TRACE(remesh);
