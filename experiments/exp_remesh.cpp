@@ -118,7 +118,7 @@ nlohmann::json RunTwistingRemesh(const Config& cfg, const std::string& dir, bool
     std::string vtu;
     if (write_vtu) {
       vtu = "shapes/" + tag + ".vtu";
-      WriteVtu(dir + "/" + vtu, s.mesh, X);
+      WriteVtu(dir + "/" + vtu, s.mesh, X, s.region_rest.regions, &s.region_rest.positions);
       if (variant == "progressive") frames.emplace_back(alpha, vtu);
     }
     const Eigen::MatrixX3d P = s.marker_positions(X);

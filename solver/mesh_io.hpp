@@ -38,14 +38,20 @@ Mesh ReadMesh(const std::string& path, MeshReport* report = nullptr);
 /// ParaView `.vtu` (ASCII XML) of the mesh at positions X (#V x 3): point data "displacement"
 /// (X - rest), cell data "region", "element_type" (VTK type id) and "strain" (a per-element
 /// strain measure: ||F^T F - I||_F / 2 of the best-fit deformation gradient).
-void WriteVtu(const std::string& path, const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X);
+/// `rest_regions` / `rest_positions` (#V x 3): elements of those regions measure their strain from
+/// rest_positions instead of mesh.vertices (a Scene's region_rest, e.g. a remeshed chamber).
+void WriteVtu(const std::string& path, const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+              const std::vector<int>& rest_regions = {}, const Eigen::MatrixX3d* rest_positions = nullptr);
 /// `.pvd` collection listing (time, file) pairs, files relative to the pvd's folder.
 void WritePvd(const std::string& path, const std::vector<std::pair<double, std::string>>& steps);
 /// Boundary surface (faces used by one element) as Wavefront `.obj` at positions X.
 void WriteSurfaceObj(const std::string& path, const Mesh& mesh,
                      const Eigen::Ref<const Eigen::MatrixX3d>& X);
 
-/// Per-element strain measure used by WriteVtu (#E values).
-std::vector<double> ElementStrain(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X);
+/// Per-element strain measure used by WriteVtu (#E values; NaN for an element whose rest shape is
+/// degenerate). Elements of `rest_regions` take their rest shapes from `rest_positions` (#V x 3).
+std::vector<double> ElementStrain(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                                  const std::vector<int>& rest_regions = {},
+                                  const Eigen::MatrixX3d* rest_positions = nullptr);
 
 }  // namespace softkin

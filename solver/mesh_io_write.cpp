@@ -1,6 +1,7 @@
 /// \file mesh_io_write.cpp
 /// ReadMesh (dispatch by extension), ParaView output (.vtu, .pvd), the boundary surface as .obj and
 /// the per-element strain measure.
+#include <algorithm>
 #include <Eigen/Dense>
 #include <cmath>
 #include <limits>
@@ -57,26 +58,32 @@ Mesh ReadMesh(const std::string& path, MeshReport* report) {
                ".tet, .node/.ele (TetGen), .msh (Gmsh 2.2/4.1) or .vtk (legacy ASCII)");
 }
 
-std::vector<double> ElementStrain(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X) {
+std::vector<double> ElementStrain(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                                  const std::vector<int>& rest_regions, const Eigen::MatrixX3d* rest_positions) {
   if (X.rows() != mesh.num_vertices())
     throw std::invalid_argument("ElementStrain: positions have " + std::to_string(X.rows()) +
                                 " rows; expected " + std::to_string(mesh.num_vertices()));
+  if (!rest_regions.empty() && (!rest_positions || rest_positions->rows() != mesh.num_vertices()))
+    throw std::invalid_argument("ElementStrain: expected rest positions with one row per vertex (" +
+                                std::to_string(mesh.num_vertices()) + ") for regions with their own rest shape");
   std::vector<double> strain(mesh.elements.size());
   for (std::size_t i = 0; i < mesh.elements.size(); ++i) {
     const Element& e = mesh.elements[i];
     const int k = e.k();
+    const bool own = std::find(rest_regions.begin(), rest_regions.end(), e.region) != rest_regions.end();
+    const Eigen::MatrixX3d& rest = own ? *rest_positions : mesh.vertices;
     // Centred rest (P) and deformed (Q) positions; F minimises sum ||F p - q||^2:
     // F = (Q^T P) (P^T P)^{-1}. For a tet the affine map is exact, so this is the exact F.
     Eigen::Vector3d pc = Eigen::Vector3d::Zero(), qc = Eigen::Vector3d::Zero();
     for (int a = 0; a < k; ++a) {
-      pc += mesh.vertices.row(e.v[a]).transpose();
+      pc += rest.row(e.v[a]).transpose();
       qc += X.row(e.v[a]).transpose();
     }
     pc /= k;
     qc /= k;
     Eigen::Matrix3d PtP = Eigen::Matrix3d::Zero(), QtP = Eigen::Matrix3d::Zero();
     for (int a = 0; a < k; ++a) {
-      const Eigen::Vector3d p = mesh.vertices.row(e.v[a]).transpose() - pc;
+      const Eigen::Vector3d p = rest.row(e.v[a]).transpose() - pc;
       const Eigen::Vector3d q = X.row(e.v[a]).transpose() - qc;
       PtP.noalias() += p * p.transpose();
       QtP.noalias() += q * p.transpose();
@@ -96,10 +103,10 @@ std::vector<double> ElementStrain(const Mesh& mesh, const Eigen::Ref<const Eigen
   return strain;
 }
 
-void WriteVtu(const std::string& path, const Mesh& mesh,
-              const Eigen::Ref<const Eigen::MatrixX3d>& X) {
+void WriteVtu(const std::string& path, const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+              const std::vector<int>& rest_regions, const Eigen::MatrixX3d* rest_positions) {
   CheckPositions(path, mesh, X);
-  const std::vector<double> strain = ElementStrain(mesh, X);
+  const std::vector<double> strain = ElementStrain(mesh, X, rest_regions, rest_positions);
   std::ofstream out = detail::OpenForWrite(path);
   const int nv = mesh.num_vertices(), ne = mesh.num_elements();
   out << "<?xml version=\"1.0\"?>\n"

@@ -821,6 +821,20 @@ TEST_F(MeshIoVtu, WritesArraysAndStrain) {
       Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   const Eigen::MatrixX3d Y = (m.vertices * R.transpose()).rowwise() + Eigen::RowVector3d(5, -2, 1);
   for (double s : ElementStrain(m, Y)) EXPECT_NEAR(s, 0.0, 1e-12);
+  // Region 7 resting in the stretched shape (a Scene's region_rest, e.g. a remeshed chamber):
+  // its element has no strain at X, the others keep theirs, and it is written so.
+  const std::vector<double> own = ElementStrain(m, X, {7}, &X);
+  ASSERT_EQ(own.size(), 3u);
+  EXPECT_NEAR(own[0], 0.105, 1e-12);
+  EXPECT_NEAR(own[1], 0.105, 1e-12);
+  EXPECT_NEAR(own[2], 0.0, 1e-12);
+  WriteVtu(Path("own_rest.vtu"), m, X, {7}, &X);
+  const std::vector<double> own_written = ArrayValues(ReadText(Path("own_rest.vtu")), "strain");
+  ASSERT_EQ(own_written.size(), 3u);
+  EXPECT_NEAR(own_written[2], 0.0, 1e-12);
+  EXPECT_THROW(ElementStrain(m, X, {7}, nullptr), std::invalid_argument);
+  const Eigen::MatrixX3d short_rest = X.topRows(3);
+  EXPECT_THROW(ElementStrain(m, X, {7}, &short_rest), std::invalid_argument);
   // Wrong number of rows is rejected.
   EXPECT_NE(ErrorOf([&] { WriteVtu(Path("bad.vtu"), m, X.topRows(3)); }).find("bad.vtu"),
             std::string::npos);
