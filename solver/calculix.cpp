@@ -55,6 +55,9 @@ void WriteCalculixInput(const Model& model, const Eigen::Ref<const Eigen::Vector
     throw std::invalid_argument("calculix: law: expected linear or neo-hooke, got '" + opt.law + "'");
   if (!(opt.young > 0) || !(opt.poisson >= 0 && opt.poisson < 0.5) || opt.increments < 1)
     throw std::invalid_argument("calculix: expected young > 0, 0 <= poisson < 0.5, increments >= 1");
+  if (!s.region_rest.regions.empty())
+    throw std::invalid_argument("calculix: scene '" + s.name + "' has regions with their own rest shape (a remeshed "
+                                "chamber); the CalculiX export needs one rest mesh");
   for (int i = 0; i < mesh.num_elements(); ++i)
     if (mesh.elements[i].k() != 4)
       throw std::invalid_argument("calculix: element " + std::to_string(i) +

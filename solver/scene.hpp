@@ -112,7 +112,9 @@ struct Scene {
   /// Rest positions for the elements of some regions when they differ from mesh.vertices. Progressive
   /// remeshing (remesh.hpp, thesis Algorithm 2) gives a re-tessellated chamber the shape it was
   /// meshed in as its rest shape, while the body tets sharing its interface vertices keep theirs
-  /// (mesh.vertices). Empty `regions`: none.
+  /// (mesh.vertices). Empty `regions`: none. Such a scene has no zero-energy state (the interface
+  /// vertices rest differently for the two sides), so warm-start its solves from the state it was
+  /// remeshed in; exporters that need one rest mesh (CalculiX) refuse it.
   struct RegionRest {
     std::vector<int> regions;     ///< region tags whose elements use `positions`
     Eigen::MatrixX3d positions;   ///< #V x 3, mm (only the rows of those elements' vertices matter)

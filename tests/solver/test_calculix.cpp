@@ -122,6 +122,18 @@ TEST(Calculix, InpExportParsesBack) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("tets only"), std::string::npos) << e.what();
   }
+  // So is a scene whose regions have their own rest shapes (a remeshed chamber): here the bar's
+  // pneumatic region rests in a uniformly grown copy of the mesh.
+  Scene own = s;
+  own.region_rest.regions = {own.actuators[0].regions[0]};
+  own.region_rest.positions = 1.1 * own.mesh.vertices;
+  const Model om(own);
+  try {
+    WriteCalculixInput(om, c, opt, p.string());
+    ADD_FAILURE() << "a scene with region_rest was exported";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("own rest shape"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Calculix, DatReaderAcceptsIncrementsAndRejectsBadFiles) {
