@@ -221,9 +221,9 @@ TEST(Remesh, ChamberOnlyKeepsTheBodyAndTheChamberVolume) {
   EXPECT_LT((n.marker_positions(rm.positions).row(tip) - s.marker_positions(r.positions).row(tip)).norm(), 1e-12);
   // The carried state is (close to) an equilibrium of the new model: re-solving moves the tip
   // little compared with how far the actuation moved it (with the original rest shape only; with
-  // the default ChamberRest::Remeshed the re-solve inflates the chamber further, next test). The new chamber tets keep rest shapes
-  // pulled back through the old deformation, so the equilibrium does shift, by about a fifth of the
-  // motion, and by how much depends on the CGAL tessellation, which follows the last bits of the
+  // the default ChamberRest::Remeshed the re-solve inflates the chamber further, next test). The
+  // new chamber tets keep rest shapes pulled back through the old deformation, so the equilibrium
+  // does shift, by about a fifth of the motion, and by how much depends on the CGAL tessellation, which follows the last bits of the
   // solved state. Four solves of the same equilibrium (the eigen-decomposition and the Newton
   // polar rotations, each at the scene's tolerance and at 1e-7) gave drifts of 1.91, 2.06, 2.18
   // and 1.82 mm against a motion of 9.93 mm: 0.18-0.22 of it (re-solve energies 9016.0, 8983.9,
