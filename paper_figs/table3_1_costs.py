@@ -6,10 +6,11 @@ Usage: table3_1_costs.py RESULTS_DIR
 Reads RESULTS_DIR/summary.json (written by `softkin run experiments/table3_1_costs.json`). Writes
 RESULTS_DIR/table3_1_costs.png: per robot, stacked bars of mesh generation, collision check,
 collision response and iterative solver per step, ours beside the thesis's, labelled with tet
-counts. Exit status 2 with a message on stderr if the summary is missing or malformed.
+counts; a row whose exact check left contacts is marked above its bar. Exit status 2 with a message on stderr if the summary is missing or malformed.
 """
 import os
 import sys
+import textwrap
 
 import figlib
 
@@ -31,7 +32,8 @@ def main(argv):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(8.5, 4.8))
+    bars = sum(1 + isinstance(r.get("thesis"), dict) for r in rows)
+    fig, ax = plt.subplots(figsize=(max(8.5, 1.25 * bars + 1.5), 5.2))
     colors = ["tab:gray", "tab:blue", "tab:orange", "tab:green"]
     labels, x = [], 0
     for r in rows:
@@ -44,17 +46,25 @@ def main(argv):
                 ax.bar(x, v, bottom=bottom, color=c, label=name if x == 0 else None,
                        hatch="//" if who == "thesis" else None, edgecolor="k", lw=0.5)
                 bottom += v
+            if who == "ours" and r.get("collision_free") is False:
+                fc = r.get("final_check") if isinstance(r.get("final_check"), dict) else {}
+                ax.annotate(f"contacts left\n({fc.get('self_contacts', '?')} self, "
+                            f"{fc.get('obstacle_contacts', '?')} obstacle)",
+                            (x, bottom), xytext=(0, 3), textcoords="offset points", ha="center", fontsize=7,
+                            color="tab:red")
             tets = src.get("tets", r.get("tets"))
             remesh = r.get("remesh") if who == "ours" else None
             if isinstance(remesh, dict) and "tets_final" in remesh:
                 tets = f"{tets}->{remesh['tets_final']}"  # remeshed during the run
-            labels.append(f"{r.get('label', r['robot'])}\n{who}, {tets} tets")
+            name = "\n".join(textwrap.wrap(str(r.get("label", r["robot"])), 20, break_long_words=False))
+            labels.append(f"{name}\n{who}\n{tets} tets")
             x += 1
     ax.set_xticks(range(len(labels)))
     ax.set_xticklabels(labels, fontsize=7)
     ax.set_ylabel("seconds per step")
     ax.set_yscale("symlog", linthresh=0.01)
-    ax.legend(fontsize=8)
+    ax.set_ylim(top=4.0 * max(ax.get_ylim()[1], 0.01))  # room for the contact notes
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     quick = " (quick run)" if summary.get("quick") else ""
     ax.set_title(f"Computing cost per step (Table 3.1){quick}")
     figlib.save_figure(fig, results, NAME)
