@@ -106,10 +106,10 @@ inline const ElemRows* FittedShape(const ModelElement& e, double ratio, ElemRows
 /// The target of an element with a fitted shape, given the best rotation R of D onto P.
 void TargetFromRotation(const ModelElement& e, const ElemRows& D, double ratio, const ElemRows& P,
                         const Eigen::Matrix3d& R, ElemRows* T) {
+  // P's and D's rows past k are zero (CenterRows, FittedShape), and so are T's.
   const int k = e.k;
-  T->setZero();
   if (e.role == ElementRole::Body) {
-    T->topRows(k) = P.topRows(k) * R.transpose();  // V^r = R V (rows), Eq. 2.3
+    T->noalias() = P * R.transpose();  // V^r = R V (rows), Eq. 2.3
     if (e.curve) {
       // Hyperelastic (Eq. 3.6-3.7): blend the current shape with the rotated rest shape by
       // R_omega(strain), then rescale the blend to the rest volume.
@@ -122,28 +122,31 @@ void TargetFromRotation(const ModelElement& e, const ElemRows& D, double ratio, 
       double s = 1.0;
       if (vd > 1e-9 * e.rest_volume) s = std::cbrt(e.rest_volume / vd);  // Eq. 2.4, volume restored
       s = std::min(s, 10.0);
-      T->topRows(k) = e.r_omega * T->topRows(k) + (1.0 - e.r_omega) * s * D.topRows(k);  // Eq. 2.5
+      *T = e.r_omega * *T + (1.0 - e.r_omega) * s * D;  // Eq. 2.5
     }
   } else if (e.role == ElementRole::Pneumatic) {
     // Rest shape scaled by cbrt(alpha_i) about its centre, rotated (Eq. 2.8).
-    T->topRows(k) = std::cbrt(ratio) * (P.topRows(k) * R.transpose());
+    T->noalias() = std::cbrt(ratio) * (P * R.transpose());
   } else {
     // Cable / DEA: the reshaped rest shape rotated onto the current shape.
-    T->topRows(k) = P.topRows(k) * R.transpose();
+    T->noalias() = P * R.transpose();
   }
 }
 
 }  // namespace
 
 void ElementTarget(const ModelElement& e, const ElemRows& D, double ratio, ElemRows* T) {
+  // TargetFromRotation works on full 6-row blocks: the caller's rows past k may hold anything.
+  ElemRows Dk = D;
+  Dk.bottomRows(6 - e.k).setZero();
   ElemRows buf;
   const ElemRows* P = FittedShape(e, ratio, &buf);
   if (!P) {
-    *T = D;  // vented chamber: empty space
+    *T = Dk;  // vented chamber: empty space
     return;
   }
-  const Eigen::Matrix3d R = BestRotation(D.topRows(e.k).transpose() * P->topRows(e.k));
-  TargetFromRotation(e, D, ratio, *P, R, T);
+  const Eigen::Matrix3d R = BestRotation(Dk.transpose() * *P);  // rows past k are zero
+  TargetFromRotation(e, Dk, ratio, *P, R, T);
 }
 
 double LocalStep(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
@@ -167,8 +170,10 @@ double LocalStep(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X
       const ModelElement& e = els[i0 + l];
       GatherRows(e, X, &D[l]);
       P[l] = FittedShape(e, ratios[i0 + l], &buf[l]);
+      // The rows past k are zero in both (CenterRows, FittedShape), so the fixed 6-row product
+      // is the k-row one, without a runtime-sized loop.
       if (P[l])
-        M[l].noalias() = D[l].topRows(e.k).transpose() * P[l]->topRows(e.k);
+        M[l].noalias() = D[l].transpose() * *P[l];
       else
         M[l].setIdentity();
     }

@@ -60,7 +60,9 @@ constexpr double kMinBlendVolume = 0.125;
 double HyperelasticBlendWeight(const ElemRows& Rr, const ElemRows& D, int k, double rho,
                                double rest_volume);
 
-/// Target of one element: D = N V^d (centred current rows), ratio = r_i (ignored for body). Writes the centred target T, already rotated to the current frame.
+/// Target of one element: D = N V^d (centred current rows; rows past k are ignored), ratio = r_i
+/// (ignored for body). Writes the centred target T (rows past k zero), already rotated to the
+/// current frame.
 void ElementTarget(const ModelElement& e, const ElemRows& D, double ratio, ElemRows* T);
 
 /// The local step: for every element computes its target (stored as w_i Vol_i * T in `weighted`,
