@@ -286,7 +286,7 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
                 {"variant", "step", "actuation_scale", "tip_x", "tip_y", "tip_z", "bend_deg",
                  "iterations", "converged", "springs", "self_contacts", "obstacle_contacts",
                  "max_penetration_mm", "self_penetration_mm", "obstacle_penetration_mm",
-                 "inverted_elements", "contact_vertices", "contact_area_mm2", "check_s", "response_s", "solver_s", "time_s"});
+                 "inverted_elements", "tangled_contacts", "contact_vertices", "contact_area_mm2", "check_s", "response_s", "solver_s", "time_s"});
   nlohmann::json out_variants = nlohmann::json::array();
   std::vector<std::pair<double, std::string>> frames;
   for (size_t vi = 0; vi < prepared.size(); ++vi) {
@@ -310,7 +310,6 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
     int iterations = 0, failed = 0;
     FkResult last;
     CollisionCheck last_check;
-    int last_inverted = 0;
     std::vector<ContactPatch> patches;  // per obstacle, at the last step
     nlohmann::json tips = nlohmann::json::array();
     for (int s = 1; s <= steps; ++s) {
@@ -320,7 +319,6 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
       if (r.status == FkStatus::InvalidInput) throw std::runtime_error(cfg.path() + ": " + key + ": " + r.message);
       X = r.positions;
       const CollisionCheck ck = probe.Check(X);
-      const int inverted = CountInvertedElements(scene.mesh, X);
       const bool ok = r.status == FkStatus::Converged;
       failed += !ok;
       iterations += r.iterations;
@@ -345,20 +343,20 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
                       std::to_string(r.iterations), ok ? "1" : "0", std::to_string(r.springs),
                       std::to_string(ck.self_contacts), std::to_string(ck.obstacle_contacts),
                       std::to_string(ck.max_penetration), std::to_string(ck.self_penetration),
-                      std::to_string(ck.obstacle_penetration), std::to_string(inverted), std::to_string(touch),
+                      std::to_string(ck.obstacle_penetration), std::to_string(ck.inverted_elements),
+                      std::to_string(ck.tangled_contacts), std::to_string(touch),
                       std::to_string(touch_area),
                       std::to_string(r.collision_stats.check_s),
                       std::to_string(r.collision_stats.response_s),
                       std::to_string(r.local_time_s + r.global_time_s), std::to_string(r.time_s)});
       if (verbose)
         std::fprintf(stderr,
-                     "  [%s %d/%d] %s; exact check: %d self (max depth %.3g mm) + %d obstacle contacts "
-                     "(max depth %.3g mm); %d inverted elements\n",
+                     "  [%s %d/%d] %s; exact check: %d self (max depth %.3g mm; %d in tangles) + %d obstacle "
+                     "contacts (max depth %.3g mm); %d inverted elements\n",
                      name.c_str(), s, steps, r.BriefReport().c_str(), ck.self_contacts, ck.self_penetration,
-                     ck.obstacle_contacts, ck.obstacle_penetration, inverted);
+                     ck.tangled_contacts, ck.obstacle_contacts, ck.obstacle_penetration, ck.inverted_elements);
       last = r;
       last_check = ck;
-      last_inverted = inverted;
     }
     if (export_region >= 0) {
       CsvWriter surf(dir + "/surface_" + name + ".csv", {"x0", "y0", "z0", "x", "y", "z"});
@@ -389,7 +387,8 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
     jv["max_penetration_mm"] = last_check.max_penetration;
     jv["self_penetration_mm"] = last_check.self_penetration;
     jv["obstacle_penetration_mm"] = last_check.obstacle_penetration;
-    jv["inverted_elements"] = last_inverted;
+    jv["inverted_elements"] = last_check.inverted_elements;
+    jv["tangled_contacts"] = last_check.tangled_contacts;
     jv["collision_free"] = last_check.collision_free();
     jv["springs_at_end"] = last.springs;
     jv["iterations"] = iterations;
@@ -505,11 +504,11 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
       popt.on_step = [&](const ProgressiveStep& st, const Scene& s_now, const Eigen::MatrixX3d&) {
         if (verbose)
           std::fprintf(stderr, "  [%s alpha %.3g] %s, %d iterations, %.2f s; %d remesh(es), %d failed, %.2f s, %d tets; "
-                       "exact check: %s, %d springs\n",
+                       "exact check: %s, %d springs, %d inverted elements\n",
                        robot.c_str(), st.alpha, FkStatusToString(st.status), st.iterations, st.solver_seconds,
                        st.remeshes, st.remesh_failures, st.mesh_seconds, s_now.mesh.num_tets(),
                        st.collision_active ? (st.collision.collision_free() ? "collision-free" : "contacts left") : "off",
-                       st.springs);
+                       st.springs, st.collision.inverted_elements);
       };
       const ProgressiveResult pr = SolveProgressive(scene, alpha, popt);
       if (!pr.completed) throw std::runtime_error(cfg.path() + ": " + key + ": remeshing stopped: " + pr.message);
@@ -564,7 +563,9 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
     // What the exact check found after the last step (Sec. 3.2.3: the penetration left).
     row["final_check"] = {{"self_contacts", left.self_contacts},
                           {"obstacle_contacts", left.obstacle_contacts},
-                          {"max_penetration_mm", left.max_penetration}};
+                          {"max_penetration_mm", left.max_penetration},
+                          {"inverted_elements", left.inverted_elements},
+                          {"tangled_contacts", left.tangled_contacts}};
     if (rj.contains("thesis")) {
       const auto& t = rj["thesis"];
       row["thesis"] = t;

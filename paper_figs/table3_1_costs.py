@@ -6,7 +6,9 @@ Usage: table3_1_costs.py RESULTS_DIR
 Reads RESULTS_DIR/summary.json (written by `softkin run experiments/table3_1_costs.json`). Writes
 RESULTS_DIR/table3_1_costs.png: per robot, stacked bars of mesh generation, collision check,
 collision response and iterative solver per step, ours beside the thesis's, labelled with tet
-counts; a row whose exact check left contacts is marked above its bar. Exit status 2 with a message on stderr if the summary is missing or malformed.
+counts; a row whose exact check left contacts is marked above its bar, with the inverted tets and
+the contacts inside that tangle. Exit status 2 with a message on stderr if the summary is missing
+or malformed.
 """
 import os
 import sys
@@ -48,8 +50,12 @@ def main(argv):
                 bottom += v
             if who == "ours" and r.get("collision_free") is False:
                 fc = r.get("final_check") if isinstance(r.get("final_check"), dict) else {}
+                tangle = ""
+                if fc.get("inverted_elements"):
+                    tangle = (f"\n{fc.get('tangled_contacts', '?')} in a tangle of\n"
+                              f"{fc['inverted_elements']} inverted tets")
                 ax.annotate(f"contacts left\n({fc.get('self_contacts', '?')} self, "
-                            f"{fc.get('obstacle_contacts', '?')} obstacle)",
+                            f"{fc.get('obstacle_contacts', '?')} obstacle){tangle}",
                             (x, bottom), xytext=(0, 3), textcoords="offset points", ha="center", fontsize=7,
                             color="tab:red")
             tets = src.get("tets", r.get("tets"))

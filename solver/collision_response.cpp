@@ -624,6 +624,16 @@ double CollisionResponse::Energy(const Eigen::Ref<const Eigen::MatrixX3d>& X) co
 
 CollisionCheck CollisionResponse::Check(const Eigen::Ref<const Eigen::MatrixX3d>& X) const {
   CollisionCheck r;
+  // Inverted elements (as CountInvertedElements counts them), and the vertices that belong to one.
+  const Mesh& mesh = model_.mesh();
+  std::vector<char> inverted(mesh.num_elements(), 0), at_inverted(mesh.num_vertices(), 0);
+  for (int t = 0; t < mesh.num_elements(); ++t) {
+    const Element& e = mesh.elements[t];
+    if (SignedVolume(e, X) > 0) continue;
+    inverted[t] = 1;
+    ++r.inverted_elements;
+    for (int j = 0; j < e.k(); ++j) at_inverted[e.v[j]] = 1;
+  }
   std::unique_ptr<SelfCollisionDetector> own;
   SelfCollisionDetector* det = detector_.get();
   if (!det && !adj_.empty()) {
@@ -636,6 +646,7 @@ CollisionCheck CollisionResponse::Check(const Eigen::Ref<const Eigen::MatrixX3d>
     std::vector<char> fresh(body_faces_.size(), 0);
     for (const auto& c : det->Detect()) {
       ++r.self_contacts;
+      if (at_inverted[c.vertex] || inverted[c.tet]) ++r.tangled_contacts;
       const Eigen::Vector3d p = X.row(c.vertex);
       const int b = body_[model_.mesh().elements[c.tet].v[0]];
       if (!body_faces_.empty() && b != body_[c.vertex] && !body_faces_[b].empty()) {

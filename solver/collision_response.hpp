@@ -83,6 +83,12 @@ struct CollisionCheck {
   double max_penetration = 0; ///< largest depth among them, mm (0 if collision-free)
   double self_penetration = 0;      ///< largest depth among the self contacts, mm
   double obstacle_penetration = 0;  ///< largest depth among the obstacle contacts, mm
+  /// Elements with non-positive signed volume at the checked positions (CountInvertedElements):
+  /// where the mesh has folded through itself, which no spring on a boundary vertex can undo.
+  int inverted_elements = 0;
+  /// Self contacts inside a tangle: the vertex belongs to an inverted element, or the tet it lies
+  /// in is inverted. Contacts between separate parts of the surface are self_contacts minus these.
+  int tangled_contacts = 0;
   bool collision_free() const { return self_contacts == 0 && obstacle_contacts == 0; }
 };
 
@@ -130,7 +136,8 @@ class CollisionResponse {
   int num_plane_springs() const { return static_cast<int>(plane_.size()); }
   /// Exact check of positions X: contacts left and the deepest penetration (for a self contact,
   /// the shortest exit found along -n(v), away from the collided tet's centroid and the six axis
-  /// directions: an upper bound on the distance to the collided region's surface).
+  /// directions: an upper bound on the distance to the collided region's surface), and the
+  /// inverted elements and the self contacts among them (CollisionCheck::tangled_contacts).
   CollisionCheck Check(const Eigen::Ref<const Eigen::MatrixX3d>& X) const;
 
   /// Whether `check` has contacts of a kind this response handles (self contacts only count when

@@ -45,6 +45,11 @@ std::string FkResult::BriefReport() const {
                   springs, collision.collision_free() ? "collision-free" : "contacts left",
                   collision.max_penetration, collision_stats.check_s, collision_stats.response_s);
     s += buf;
+    if (collision.inverted_elements > 0) {
+      std::snprintf(buf, sizeof(buf), "; %d inverted elements (%d of the self contacts in them)",
+                    collision.inverted_elements, collision.tangled_contacts);
+      s += buf;
+    }
   }
   return s;
 }

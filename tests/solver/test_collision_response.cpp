@@ -280,7 +280,38 @@ TEST(CollisionResponse, TargetsLieOutsideTheCollidedBlock) {
   EXPECT_NEAR(check.self_penetration, 1.0, 1e-9);  // the depth split by kind
   EXPECT_EQ(check.obstacle_contacts, 0);
   EXPECT_EQ(check.obstacle_penetration, 0.0);
+  // Two intact blocks overlapping: contacts between separate parts, no tangle.
+  EXPECT_EQ(check.inverted_elements, 0);
+  EXPECT_EQ(check.tangled_contacts, 0);
   EXPECT_TRUE(resp.Check(model.rest_positions()).collision_free());
+}
+
+// A fold of one block through itself (the top-face vertex over the block's centre pushed 3 mm
+// down, through its 2 mm top layer): the check counts the inverted elements as
+// CountInvertedElements does, finds the fold's self contacts, and attributes every one of them to
+// the tangle. The rest shape has neither.
+TEST(CollisionResponse, CheckSeparatesTanglesFromContacts) {
+  Scene scene = TwoBlocks();
+  scene.solver.collision.self = true;
+  const Model model(scene);
+  CollisionResponse resp(model, scene.solver.collision);
+  const CollisionCheck rest = resp.Check(model.rest_positions());
+  EXPECT_EQ(rest.inverted_elements, 0);
+  EXPECT_EQ(rest.tangled_contacts, 0);
+  EXPECT_EQ(rest.self_contacts, 0);
+
+  Eigen::MatrixX3d X = model.rest_positions();
+  int top = -1;
+  for (int v = 0; v < X.rows(); ++v)
+    if ((X.row(v) - Eigen::RowVector3d(4, 4, 10)).norm() < 1e-9) top = v;
+  ASSERT_GE(top, 0);
+  X(top, 2) = 7.0;
+  const CollisionCheck fold = resp.Check(X);
+  EXPECT_EQ(fold.inverted_elements, CountInvertedElements(model.mesh(), X));
+  EXPECT_GT(fold.inverted_elements, 0);
+  EXPECT_GE(fold.self_contacts, 1);
+  EXPECT_EQ(fold.tangled_contacts, fold.self_contacts);
+  EXPECT_FALSE(fold.collision_free());
 }
 
 // Between two bodies of one mesh ("auto"), a vertex goes to the closest point of the other body's
