@@ -388,6 +388,7 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
     jv["self_penetration_mm"] = last_check.self_penetration;
     jv["obstacle_penetration_mm"] = last_check.obstacle_penetration;
     jv["inverted_elements"] = last_check.inverted_elements;
+    jv["inverted_body_elements"] = last_check.inverted_body_elements;
     jv["tangled_contacts"] = last_check.tangled_contacts;
     jv["collision_free"] = last_check.collision_free();
     jv["springs_at_end"] = last.springs;
@@ -504,11 +505,11 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
       popt.on_step = [&](const ProgressiveStep& st, const Scene& s_now, const Eigen::MatrixX3d&) {
         if (verbose)
           std::fprintf(stderr, "  [%s alpha %.3g] %s, %d iterations, %.2f s; %d remesh(es), %d failed, %.2f s, %d tets; "
-                       "exact check: %s, %d springs, %d inverted elements\n",
+                       "exact check: %s, %d springs, %d inverted elements (%d body)\n",
                        robot.c_str(), st.alpha, FkStatusToString(st.status), st.iterations, st.solver_seconds,
                        st.remeshes, st.remesh_failures, st.mesh_seconds, s_now.mesh.num_tets(),
                        st.collision_active ? (st.collision.collision_free() ? "collision-free" : "contacts left") : "off",
-                       st.springs, st.collision.inverted_elements);
+                       st.springs, st.collision.inverted_elements, st.collision.inverted_body_elements);
       };
       const ProgressiveResult pr = SolveProgressive(scene, alpha, popt);
       if (!pr.completed) throw std::runtime_error(cfg.path() + ": " + key + ": remeshing stopped: " + pr.message);
@@ -565,6 +566,7 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
                           {"obstacle_contacts", left.obstacle_contacts},
                           {"max_penetration_mm", left.max_penetration},
                           {"inverted_elements", left.inverted_elements},
+                          {"inverted_body_elements", left.inverted_body_elements},
                           {"tangled_contacts", left.tangled_contacts}};
     if (rj.contains("thesis")) {
       const auto& t = rj["thesis"];

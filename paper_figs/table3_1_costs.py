@@ -6,8 +6,8 @@ Usage: table3_1_costs.py RESULTS_DIR
 Reads RESULTS_DIR/summary.json (written by `softkin run experiments/table3_1_costs.json`). Writes
 RESULTS_DIR/table3_1_costs.png: per robot, stacked bars of mesh generation, collision check,
 collision response and iterative solver per step, ours beside the thesis's, labelled with tet
-counts; a row whose exact check left contacts is marked above its bar, with the inverted tets and
-the contacts inside that tangle. Exit status 2 with a message on stderr if the summary is missing
+counts; above our bars, the contacts the exact check left (and how many of them lie in tangles) and
+the body tets left inverted. Exit status 2 with a message on stderr if the summary is missing
 or malformed.
 """
 import os
@@ -48,16 +48,17 @@ def main(argv):
                 ax.bar(x, v, bottom=bottom, color=c, label=name if x == 0 else None,
                        hatch="//" if who == "thesis" else None, edgecolor="k", lw=0.5)
                 bottom += v
+            fc = r.get("final_check") if isinstance(r.get("final_check"), dict) else {}
+            notes = []
             if who == "ours" and r.get("collision_free") is False:
-                fc = r.get("final_check") if isinstance(r.get("final_check"), dict) else {}
-                tangle = ""
-                if fc.get("inverted_elements"):
-                    tangle = (f"\n{fc.get('tangled_contacts', '?')} in a tangle of\n"
-                              f"{fc['inverted_elements']} inverted tets")
-                ax.annotate(f"contacts left\n({fc.get('self_contacts', '?')} self, "
-                            f"{fc.get('obstacle_contacts', '?')} obstacle){tangle}",
-                            (x, bottom), xytext=(0, 3), textcoords="offset points", ha="center", fontsize=7,
-                            color="tab:red")
+                notes.append(f"contacts left\n({fc.get('self_contacts', '?')} self, "
+                             f"{fc.get('obstacle_contacts', '?')} obstacle;\n"
+                             f"{fc.get('tangled_contacts', '?')} in tangles)")
+            if who == "ours" and fc.get("inverted_body_elements"):
+                notes.append(f"{fc['inverted_body_elements']} inverted\nbody tets")
+            if notes:
+                ax.annotate("\n".join(notes), (x, bottom), xytext=(0, 3), textcoords="offset points",
+                            ha="center", fontsize=7, color="tab:red")
             tets = src.get("tets", r.get("tets"))
             remesh = r.get("remesh") if who == "ours" else None
             if isinstance(remesh, dict) and "tets_final" in remesh:

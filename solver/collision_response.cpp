@@ -632,6 +632,7 @@ CollisionCheck CollisionResponse::Check(const Eigen::Ref<const Eigen::MatrixX3d>
     if (SignedVolume(e, X) > 0) continue;
     inverted[t] = 1;
     ++r.inverted_elements;
+    if (model_.elements()[t].role == ElementRole::Body) ++r.inverted_body_elements;
     for (int j = 0; j < e.k(); ++j) at_inverted[e.v[j]] = 1;
   }
   std::unique_ptr<SelfCollisionDetector> own;

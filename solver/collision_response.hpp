@@ -86,6 +86,8 @@ struct CollisionCheck {
   /// Elements with non-positive signed volume at the checked positions (CountInvertedElements):
   /// where the mesh has folded through itself, which no spring on a boundary vertex can undo.
   int inverted_elements = 0;
+  /// Those of them that are body elements (the rest belong to actuators, e.g. a chamber's gas).
+  int inverted_body_elements = 0;
   /// Self contacts inside a tangle: the vertex belongs to an inverted element, or the tet it lies
   /// in is inverted. Contacts between separate parts of the surface are self_contacts minus these.
   int tangled_contacts = 0;

@@ -309,9 +309,26 @@ TEST(CollisionResponse, CheckSeparatesTanglesFromContacts) {
   const CollisionCheck fold = resp.Check(X);
   EXPECT_EQ(fold.inverted_elements, CountInvertedElements(model.mesh(), X));
   EXPECT_GT(fold.inverted_elements, 0);
+  EXPECT_EQ(fold.inverted_body_elements, fold.inverted_elements);  // TwoBlocks is all body
   EXPECT_GE(fold.self_contacts, 1);
   EXPECT_EQ(fold.tangled_contacts, fold.self_contacts);
   EXPECT_FALSE(fold.collision_free());
+
+  // The same fold when the upper block is a pneumatic chamber: its inverted elements are not
+  // body elements.
+  Scene chamber = scene;
+  for (auto& e : chamber.mesh.elements)
+    if (chamber.mesh.vertices.row(e.v[0]).z() > 5.0) e.region = 1;
+  Actuator gas;
+  gas.name = "gas";
+  gas.regions = {1};
+  chamber.actuators.push_back(gas);
+  chamber.validate();
+  const Model chamber_model(chamber);
+  CollisionResponse chamber_resp(chamber_model, chamber.solver.collision);
+  const CollisionCheck gas_fold = chamber_resp.Check(X);
+  EXPECT_EQ(gas_fold.inverted_elements, fold.inverted_elements);
+  EXPECT_EQ(gas_fold.inverted_body_elements, 0);
 }
 
 // Between two bodies of one mesh ("auto"), a vertex goes to the closest point of the other body's
