@@ -303,6 +303,74 @@ BENCHMARK(BM_LocalStepLaw)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
+/// The hyperelastic target's volume guard (HyperelasticBlendWeight, Eq. 3.6-3.7) on inverted
+/// tets, where it searches for the blend weight that lifts the blend's volume to the floor.
+/// method 0: the library's (the volume sampled four times, then bisection on that cubic);
+/// method 1: the bisection that re-blends the element and takes its volume at every halving (the
+/// library's method until session 20). Counter over_cubic: method 1's time over method 0's in
+/// this run; max_dt: the largest difference of the two weights.
+void BM_HyperelasticGuard(benchmark::State& state) {
+  constexpr int kTets = 4096;
+  static std::vector<ElemRows> Rr, D;
+  static std::vector<double> rest;
+  if (Rr.empty()) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-1.0, 1.0), depth(0.9, 2.5);
+    for (int i = 0; i < kTets; ++i) {
+      ElemRows P = ElemRows::Zero();
+      P.row(1) = Eigen::RowVector3d(10, 0, 0);
+      P.row(2) = Eigen::RowVector3d(0, 10, 0);
+      P.row(3) = Eigen::RowVector3d(0, 0, 10);
+      for (int j = 0; j < 4; ++j) P.row(j) += 0.5 * Eigen::RowVector3d(u(rng), u(rng), u(rng));
+      CenterRows(P, 4);
+      // The current shape: vertex 0 pushed through the opposite face (flat to fully inverted).
+      ElemRows X = P;
+      const Eigen::RowVector3d f = (X.row(1) + X.row(2) + X.row(3)) / 3.0;
+      X.row(0) = f + (1.0 - depth(rng)) * (X.row(0) - f);
+      CenterRows(X, 4);
+      Rr.push_back(P);  // its rotated rest shape (any rotation: the guard only blends)
+      D.push_back(X);
+      rest.push_back(RowsVolume(P, 4));
+    }
+  }
+  const double rho = 0.1;
+  auto reference = [&](int i) {
+    auto volume = [&](double t) {
+      ElemRows B = ElemRows::Zero();
+      B.topRows(4) = t * Rr[i].topRows(4) + (1.0 - t) * D[i].topRows(4);
+      return RowsVolume(B, 4);
+    };
+    const double floor = kMinBlendVolume * rest[i];
+    if (volume(rho) >= floor) return rho;
+    double lo = rho, hi = 1.0;
+    for (int it = 0; it < 50; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (volume(mid) < floor ? lo : hi) = mid;
+    }
+    return hi;
+  };
+  const bool ref = state.range(0) == 1;
+  static double cubic_time = 0;
+  const auto t0 = Clock::now();
+  int64_t n = 0;
+  for (auto _ : state) {
+    double sum = 0;
+    for (int i = 0; i < kTets; ++i)
+      sum += ref ? reference(i) : HyperelasticBlendWeight(Rr[i], D[i], 4, rho, rest[i]);
+    benchmark::DoNotOptimize(sum);
+    ++n;
+  }
+  const double per = Since(t0) / std::max<int64_t>(n, 1);
+  if (!ref) cubic_time = per;
+  if (ref && cubic_time > 0) state.counters["over_cubic"] = per / cubic_time;
+  double max_dt = 0;
+  for (int i = 0; i < kTets; ++i)
+    max_dt = std::max(max_dt, std::abs(reference(i) - HyperelasticBlendWeight(Rr[i], D[i], 4, rho, rest[i])));
+  state.counters["max_dt"] = max_dt;
+  state.counters["ns_per_tet"] = 1e9 * per / kTets;
+}
+BENCHMARK(BM_HyperelasticGuard)->ArgNames({"method"})->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond)->UseRealTime();
+
 /// Right-hand side gather sum_i w_i Vol_i S_i^T T_i (#V x 3).
 void BM_AssembleRhs(benchmark::State& state) {
   const Fixture& f = GetFixture(static_cast<int>(state.range(0)));

@@ -70,15 +70,28 @@ double HyperelasticBlendWeight(const ElemRows& Rr, const ElemRows& D, int k, dou
     return RowsVolume(B, k);
   };
   const double floor = kMinBlendVolume * rest_volume;
-  if (volume(rho) >= floor) return rho;
-  // volume(1) = rest_volume > floor: bisection on [rho, 1] for the crossing (the volume is a cubic
-  // in t; 50 halvings leave an interval of 1e-15).
+  const double vr = volume(rho);
+  if (vr >= floor) return rho;
+  // The blend's volume is a cubic in t (each of a tet's edge vectors is linear in t): sample it at
+  // t = 0, 1/3, 2/3, 1 and write it in Newton's forward differences, in s = 3 t. volume(1) =
+  // rest_volume > floor, so [rho, 1] brackets a crossing: Newton's method on the cubic, kept inside
+  // the bracket (a step that would leave it bisects instead), to a step below 1e-15.
+  const double v0 = volume(0.0), v1 = volume(1.0 / 3.0), v2 = volume(2.0 / 3.0), v3 = volume(1.0);
+  const double d1 = v1 - v0, d2 = v2 - 2.0 * v1 + v0, d3 = v3 - 3.0 * v2 + 3.0 * v1 - v0;
   double lo = rho, hi = 1.0;
-  for (int it = 0; it < 50; ++it) {
-    const double mid = 0.5 * (lo + hi);
-    (volume(mid) < floor ? lo : hi) = mid;
+  double t = rho + (1.0 - rho) * (floor - vr) / (v3 - vr);  // the chord's crossing
+  for (int it = 0; it < 100; ++it) {
+    const double s = 3.0 * t;
+    const double f = v0 + s * (d1 + (s - 1.0) / 2.0 * (d2 + (s - 2.0) / 3.0 * d3)) - floor;
+    const double df = 3.0 * (d1 + (2.0 * s - 1.0) / 2.0 * d2 + (3.0 * s * s - 6.0 * s + 2.0) / 6.0 * d3);
+    (f < 0.0 ? lo : hi) = t;
+    double next = t - f / df;
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    const double step = std::abs(next - t);
+    t = next;
+    if (step < 1e-15 || hi - lo < 1e-15) break;
   }
-  return hi;
+  return std::isfinite(t) ? t : 1.0;  // non-finite rows: the rotated rest shape
 }
 
 Eigen::Matrix3d DeformationGradient(const ModelElement& e, const ElemRows& D) {

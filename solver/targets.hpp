@@ -56,7 +56,8 @@ constexpr double kMinBlendVolume = 0.125;
 /// Blend weight t >= rho of the rotated rest rows Rr (P R^T) against the current rows D (both
 /// centred) for a hyperelastic body element: rho itself when Vol(t Rr + (1 - t) D) >=
 /// kMinBlendVolume * rest_volume, otherwise the t in (rho, 1] where the blend's volume reaches that
-/// floor (bisection; Vol(Rr) = rest_volume). The target's volume factor is then at most 2.
+/// floor (the blend's volume is a cubic in t, solved by Newton's method kept inside [rho, 1];
+/// Vol(Rr) = rest_volume). The target's volume factor is then at most 2.
 double HyperelasticBlendWeight(const ElemRows& Rr, const ElemRows& D, int k, double rho,
                                double rest_volume);
 
