@@ -253,6 +253,24 @@ int RunCli(int argc, char** argv) {
       for (size_t i = 0; i < scene.markers.size(); ++i)
         markers[scene.markers[i].name] = {P(i, 0), P(i, 1), P(i, 2)};
       j["markers"] = markers;
+      if (r.collision_active) {
+        // The exact check of the final state (docs/collision_response.md, "Stopping and the
+        // final check") and the response's work.
+        const CollisionCheck& ck = r.collision;
+        j["collision"] = {{"collision_free", ck.collision_free()},
+                          {"self_contacts", ck.self_contacts},
+                          {"obstacle_contacts", ck.obstacle_contacts},
+                          {"max_penetration_mm", ck.max_penetration},
+                          {"self_penetration_mm", ck.self_penetration},
+                          {"obstacle_penetration_mm", ck.obstacle_penetration},
+                          {"inverted_elements", ck.inverted_elements},
+                          {"inverted_body_elements", ck.inverted_body_elements},
+                          {"tangled_contacts", ck.tangled_contacts},
+                          {"springs", r.springs},
+                          {"unresolved_contacts", r.collision_stats.unresolved},
+                          {"check_s", r.collision_stats.check_s},
+                          {"response_s", r.collision_stats.response_s}};
+      }
       if (!json_out.empty()) WriteJson(json_out, j);
       else std::cout << j.dump(2) << "\n";
       if (!vtu_out.empty()) WriteVtu(vtu_out, scene.mesh, r.positions);

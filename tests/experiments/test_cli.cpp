@@ -81,6 +81,33 @@ TEST(Cli, FkWritesTheDocumentedJson) {
   EXPECT_TRUE(std::filesystem::exists(dir + "/fk.vtu"));
 }
 
+// With collision handling on, the JSON carries the exact check of the final state; without it,
+// no collision object.
+TEST(Cli, FkJsonCarriesTheCollisionCheck) {
+  const std::string dir = TempDir("fk_collision");
+  const CliRun r = Cli("fk --robot selfcollision_finger --res 5 --actuation 1.5 --json " + dir + "/fk.json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::ifstream f(dir + "/fk.json");
+  const auto j = nlohmann::json::parse(f);
+  ASSERT_TRUE(j.contains("collision")) << j.dump();
+  const auto& c = j["collision"];
+  for (const char* k : {"collision_free", "self_contacts", "obstacle_contacts", "max_penetration_mm",
+                        "inverted_elements", "inverted_body_elements", "tangled_contacts", "springs",
+                        "unresolved_contacts", "check_s", "response_s"})
+    EXPECT_TRUE(c.contains(k)) << k;
+  // The finger's walls press on each other at this inflation: springs hold them apart, and the
+  // final state passes the exact check.
+  EXPECT_TRUE(c["collision_free"].get<bool>());
+  EXPECT_EQ(c["self_contacts"].get<int>(), 0);
+  EXPECT_GT(c["springs"].get<int>(), 0);
+  EXPECT_GT(c["check_s"].get<double>(), 0.0);
+
+  const CliRun plain = Cli("fk --robot three_chamber --res 3 --actuation 1.3,1,1 --json " + dir + "/plain.json");
+  ASSERT_EQ(plain.code, 0) << plain.out;
+  std::ifstream g(dir + "/plain.json");
+  EXPECT_FALSE(nlohmann::json::parse(g).contains("collision"));
+}
+
 TEST(Cli, FkReportsEachContinuationStep) {
   const std::string dir = TempDir("fk_steps");
   const CliRun r = Cli("fk --robot three_chamber --res 3 --actuation 1.3,1,1 --continuation 3 --json " +
