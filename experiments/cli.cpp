@@ -256,20 +256,12 @@ int RunCli(int argc, char** argv) {
       if (r.collision_active) {
         // The exact check of the final state (docs/collision_response.md, "Stopping and the
         // final check") and the response's work.
-        const CollisionCheck& ck = r.collision;
-        j["collision"] = {{"collision_free", ck.collision_free()},
-                          {"self_contacts", ck.self_contacts},
-                          {"obstacle_contacts", ck.obstacle_contacts},
-                          {"max_penetration_mm", ck.max_penetration},
-                          {"self_penetration_mm", ck.self_penetration},
-                          {"obstacle_penetration_mm", ck.obstacle_penetration},
-                          {"inverted_elements", ck.inverted_elements},
-                          {"inverted_body_elements", ck.inverted_body_elements},
-                          {"tangled_contacts", ck.tangled_contacts},
-                          {"springs", r.springs},
-                          {"unresolved_contacts", r.collision_stats.unresolved},
-                          {"check_s", r.collision_stats.check_s},
-                          {"response_s", r.collision_stats.response_s}};
+        nlohmann::json c = CollisionCheckJson(r.collision);
+        c["springs"] = r.springs;
+        c["unresolved_contacts"] = r.collision_stats.unresolved;
+        c["check_s"] = r.collision_stats.check_s;
+        c["response_s"] = r.collision_stats.response_s;
+        j["collision"] = c;
       }
       if (!json_out.empty()) WriteJson(json_out, j);
       else std::cout << j.dump(2) << "\n";

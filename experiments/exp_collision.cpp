@@ -562,12 +562,7 @@ nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool
     row["collision_share"] = total > 0 ? (check + resp) / total : 0.0;
     row["collision_free"] = free;
     // What the exact check found after the last step (Sec. 3.2.3: the penetration left).
-    row["final_check"] = {{"self_contacts", left.self_contacts},
-                          {"obstacle_contacts", left.obstacle_contacts},
-                          {"max_penetration_mm", left.max_penetration},
-                          {"inverted_elements", left.inverted_elements},
-                          {"inverted_body_elements", left.inverted_body_elements},
-                          {"tangled_contacts", left.tangled_contacts}};
+    row["final_check"] = CollisionCheckJson(left);
     if (rj.contains("thesis")) {
       const auto& t = rj["thesis"];
       row["thesis"] = t;

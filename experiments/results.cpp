@@ -1,5 +1,7 @@
 #include "experiments/results.hpp"
 
+#include "solver/collision_response.hpp"
+
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -156,6 +158,18 @@ void ResumeJournal::Append(const nlohmann::json& key, const nlohmann::json& row)
   out_.flush();
   if (!out_) throw std::runtime_error("cannot write " + path_);
   records_.push_back({{"key", key}, {"row", row}});
+}
+
+nlohmann::json CollisionCheckJson(const CollisionCheck& check) {
+  return {{"collision_free", check.collision_free()},
+          {"self_contacts", check.self_contacts},
+          {"obstacle_contacts", check.obstacle_contacts},
+          {"max_penetration_mm", check.max_penetration},
+          {"self_penetration_mm", check.self_penetration},
+          {"obstacle_penetration_mm", check.obstacle_penetration},
+          {"inverted_elements", check.inverted_elements},
+          {"inverted_body_elements", check.inverted_body_elements},
+          {"tangled_contacts", check.tangled_contacts}};
 }
 
 }  // namespace softkin

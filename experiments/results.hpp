@@ -10,11 +10,16 @@
 
 namespace softkin {
 
+struct CollisionCheck;
+
 /// Creates (if needed) and returns the result folder `root`/`name`.
 std::string ResultDir(const std::string& root, const std::string& name);
 /// The git commit of the source tree (or "unknown"), and a description of the machine.
 std::string GitCommit();
 nlohmann::json MachineInfo();
+/// The exact collision check of a state as JSON: collision_free, self_contacts, obstacle_contacts,
+/// max/self/obstacle_penetration_mm, inverted_elements, inverted_body_elements, tangled_contacts.
+nlohmann::json CollisionCheckJson(const CollisionCheck& check);
 /// Writes JSON with 2-space indentation; throws std::runtime_error naming the path on failure.
 void WriteJson(const std::string& path, const nlohmann::json& j);
 
