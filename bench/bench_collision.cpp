@@ -1,4 +1,4 @@
-// Google Benchmark suite for collision detection (solver/collision.hpp, thesis Sec. 3.2.2).
+// Google Benchmark suite for collision detection (solver/collision/collision.hpp, thesis Sec. 3.2.2).
 //
 // The meshes are pneumatic_finger at resolution `res` (cells across the 20 mm width, 27 res^3
 // tets). The deformed configuration is the one bench_fk uses: alpha = 3 on the chamber, 40 lg-aa
@@ -14,10 +14,10 @@
 // (registered first). All timings are wall-clock (UseRealTime): the passes use OpenMP.
 //
 // See docs/benchmarks.md (section "Self-collision detection") for how to run them and results.
-#include "solver/collision.hpp"
-#include "solver/fk_solver.hpp"
-#include "solver/model.hpp"
-#include "solver/robots.hpp"
+#include "softkin/solver/collision/collision.hpp"
+#include "softkin/solver/fk/fk_solver.hpp"
+#include "softkin/solver/fk/model.hpp"
+#include "softkin/solver/robots/robots.hpp"
 
 #include <benchmark/benchmark.h>
 #include <omp.h>

@@ -8,13 +8,13 @@
 // All timings are wall-clock (UseRealTime): the local step and the passes run with OpenMP.
 //
 // See docs/benchmarks.md for what each benchmark measures and how to run them.
-#include "solver/anderson.hpp"
-#include "solver/fk_solver.hpp"
-#include "solver/local_global.hpp"
-#include "solver/model.hpp"
-#include "solver/robots.hpp"
-#include "solver/rotation.hpp"
-#include "solver/targets.hpp"
+#include "softkin/solver/fk/anderson.hpp"
+#include "softkin/solver/fk/fk_solver.hpp"
+#include "softkin/solver/fk/local_global.hpp"
+#include "softkin/solver/fk/model.hpp"
+#include "softkin/solver/robots/robots.hpp"
+#include "softkin/solver/fk/rotation.hpp"
+#include "softkin/solver/fk/targets.hpp"
 
 #include <benchmark/benchmark.h>
 #include <omp.h>

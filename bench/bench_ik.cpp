@@ -15,10 +15,10 @@
 // range(0): method (enum order), range(1): resolution (7 is the robot's default). Counters:
 // fk_solves, rejected_predictions (first-order starts kept out by the guard), evaluations,
 // jac_evals, err_mm.
-#include "ik/ik_solver.hpp"
-#include "ik/pcc_kinematics.hpp"
-#include "ik/simulator_kinematics.hpp"
-#include "solver/robots.hpp"
+#include "softkin/ik/ik_solver.hpp"
+#include "softkin/ik/pcc_kinematics.hpp"
+#include "softkin/ik/simulator_kinematics.hpp"
+#include "softkin/solver/robots/robots.hpp"
 
 #include <benchmark/benchmark.h>
 

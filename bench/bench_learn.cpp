@@ -4,15 +4,15 @@
 // (3 -> 35 -> 35 -> n_out, h = 2, b = 35, §5.3.4); data come from the analytical PCC finger
 // (3 actuators): n_out = 3 is N_fk (tip position), 9 the tip Jacobian (N_J), 27 the Jacobian of
 // three tracked points. Training sets have 4096 x 0.7 = 2867 samples (16^3 grid, 70 % split).
-#include "ik/ik_solver.hpp"
-#include "ik/objectives.hpp"
-#include "ik/pcc_chamber_kinematics.hpp"
-#include "ik/pcc_kinematics.hpp"
-#include "ik/trajectory.hpp"
-#include "learn/net_kinematics.hpp"
-#include "learn/train_nets.hpp"
-#include "learn/ceres_trainer.hpp"
-#include "learn/lm_trainer.hpp"
+#include "softkin/ik/ik_solver.hpp"
+#include "softkin/ik/objectives.hpp"
+#include "softkin/ik/pcc_chamber_kinematics.hpp"
+#include "softkin/ik/pcc_kinematics.hpp"
+#include "softkin/ik/trajectory.hpp"
+#include "softkin/learn/net_kinematics.hpp"
+#include "softkin/learn/train_nets.hpp"
+#include "softkin/learn/ceres_trainer.hpp"
+#include "softkin/learn/lm_trainer.hpp"
 
 #include <benchmark/benchmark.h>
 

@@ -1,6 +1,6 @@
 // Google Benchmark suite for mesh generation (thesis Table 3.1, first column): the volume
-// tessellation T(S_c, S_b) of the twisting robot (solver/tessellation.hpp) and a progressive
-// remesh of its chamber (solver/remesh.hpp, Algorithm 2).
+// tessellation T(S_c, S_b) of the twisting robot (solver/remesh/tessellation.hpp) and a progressive
+// remesh of its chamber (solver/remesh/remesh.hpp, Algorithm 2).
 //
 // Robot: twisting_robot with the Ch. 2 shape-blending body (hyperelastic = 0), at resolution `res`
 // (cell size 8/res mm; res 4 has 29,156 tets, like the thesis's 28,198). Benchmarks:
@@ -16,12 +16,12 @@
 // per step at 28,198 tets over the time of one call (res 4 only).
 //
 // See docs/benchmarks.md (section "Mesh generation") for how to run them and results.
-#include "solver/fk_solver.hpp"
-#include "solver/model.hpp"
-#include "solver/remesh.hpp"
-#include "solver/robot_twisting.hpp"
-#include "solver/robots.hpp"
-#include "solver/tessellation.hpp"
+#include "softkin/solver/fk/fk_solver.hpp"
+#include "softkin/solver/fk/model.hpp"
+#include "softkin/solver/remesh/remesh.hpp"
+#include "softkin/solver/robots/robot_twisting.hpp"
+#include "softkin/solver/robots/robots.hpp"
+#include "softkin/solver/remesh/tessellation.hpp"
 
 #include <benchmark/benchmark.h>
 

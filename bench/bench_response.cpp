@@ -1,5 +1,5 @@
-// Google Benchmark suite for collision response (solver/spring_system.hpp,
-// solver/collision_response.hpp; thesis Sec. 3.2.3 and Table 3.1's "Col. Resp." column).
+// Google Benchmark suite for collision response (solver/collision/spring_system.hpp,
+// solver/collision/collision_response.hpp; thesis Sec. 3.2.3 and Table 3.1's "Col. Resp." column).
 //
 // Mesh: pneumatic_finger at resolution `res` (27 res^3 tets; res 12 = 46,656 tets).
 //   BM_SpringUpdate/res/n/method   one change of the spring set that adds n springs and releases
@@ -30,10 +30,10 @@
 //                                  at the same res, measured in the same run.
 // Wall-clock times (UseRealTime). See docs/benchmarks.md, "Collision response", and
 // docs/collision_response.md.
-#include "solver/collision_response.hpp"
-#include "solver/fk_solver.hpp"
-#include "solver/robots.hpp"
-#include "solver/spring_system.hpp"
+#include "softkin/solver/collision/collision_response.hpp"
+#include "softkin/solver/fk/fk_solver.hpp"
+#include "softkin/solver/robots/robots.hpp"
+#include "softkin/solver/collision/spring_system.hpp"
 
 #include <benchmark/benchmark.h>
 

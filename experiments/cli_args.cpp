@@ -1,4 +1,4 @@
-#include "experiments/cli_args.hpp"
+#include "softkin/experiments/cli_args.hpp"
 
 #include <cctype>
 #include <cmath>

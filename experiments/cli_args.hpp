@@ -2,7 +2,7 @@
 /// \file cli_args.hpp
 /// Parsing of `softkin` option values shared by several commands. Every error is a
 /// std::invalid_argument that names the option and says what was expected.
-#include "solver/robots.hpp"
+#include "softkin/solver/robots/robots.hpp"
 
 #include <Eigen/Core>
 

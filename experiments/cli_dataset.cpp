@@ -1,11 +1,11 @@
-#include "experiments/cli_dataset.hpp"
+#include "softkin/experiments/cli_dataset.hpp"
 
-#include "experiments/cli_args.hpp"
-#include "experiments/results.hpp"
-#include "ik/simulator_kinematics.hpp"
-#include "learn/dataset.hpp"
-#include "learn/twin.hpp"
-#include "solver/robots.hpp"
+#include "softkin/experiments/cli_args.hpp"
+#include "softkin/experiments/results.hpp"
+#include "softkin/ik/simulator_kinematics.hpp"
+#include "softkin/learn/dataset.hpp"
+#include "softkin/learn/twin.hpp"
+#include "softkin/solver/robots/robots.hpp"
 
 #include <cmath>
 #include <cstdio>

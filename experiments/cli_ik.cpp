@@ -1,13 +1,13 @@
-#include "experiments/cli_ik.hpp"
+#include "softkin/experiments/cli_ik.hpp"
 
-#include "experiments/cli_args.hpp"
-#include "ik/ik_solver.hpp"
-#include "ik/simulator_kinematics.hpp"
-#include "ik/trajectory.hpp"
-#include "ik/trajectory_io.hpp"
-#include "learn/net_kinematics.hpp"
-#include "solver/robots.hpp"
-#include "solver/scene_json.hpp"
+#include "softkin/experiments/cli_args.hpp"
+#include "softkin/ik/ik_solver.hpp"
+#include "softkin/ik/simulator_kinematics.hpp"
+#include "softkin/ik/trajectory.hpp"
+#include "softkin/ik/trajectory_io.hpp"
+#include "softkin/learn/net_kinematics.hpp"
+#include "softkin/solver/robots/robots.hpp"
+#include "softkin/solver/scene/scene_json.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -1,11 +1,11 @@
-#include "experiments/cli_train.hpp"
+#include "softkin/experiments/cli_train.hpp"
 
-#include "experiments/cli_args.hpp"
-#include "experiments/results.hpp"
-#include "learn/dataset.hpp"
-#include "learn/net_kinematics.hpp"
-#include "learn/train_nets.hpp"
-#include "solver/robots.hpp"
+#include "softkin/experiments/cli_args.hpp"
+#include "softkin/experiments/results.hpp"
+#include "softkin/learn/dataset.hpp"
+#include "softkin/learn/net_kinematics.hpp"
+#include "softkin/learn/train_nets.hpp"
+#include "softkin/solver/robots/robots.hpp"
 
 #include <cmath>
 #include <filesystem>

@@ -1,4 +1,4 @@
-#include "experiments/config.hpp"
+#include "softkin/experiments/config.hpp"
 
 #include <fstream>
 #include <sstream>

@@ -4,7 +4,7 @@
 /// experiment's parameters and an optional "quick" object whose keys override the top-level ones
 /// in --quick mode (for CI). Every key is checked: unknown keys and wrong types are errors that name
 /// the config file and the key.
-#include "solver/fk_options.hpp"
+#include "softkin/solver/fk/fk_options.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -1,8 +1,8 @@
 // Ablation: plain local-global against Anderson-accelerated, at mid and full actuation.
-#include "experiments/results.hpp"
-#include "experiments/runner.hpp"
-#include "solver/fk_solver.hpp"
-#include "solver/robots.hpp"
+#include "softkin/experiments/results.hpp"
+#include "softkin/experiments/runner.hpp"
+#include "softkin/solver/fk/fk_solver.hpp"
+#include "softkin/solver/robots/robots.hpp"
 
 #include <cstdio>
 #include <iostream>

@@ -1,10 +1,10 @@
 // Fig. 2.11 / Table 2.2: bend the pneumatic finger through its range, warm-started along the sweep.
-#include "experiments/measure.hpp"
-#include "experiments/results.hpp"
-#include "experiments/runner.hpp"
-#include "solver/fk_solver.hpp"
-#include "solver/mesh_io.hpp"
-#include "solver/robots.hpp"
+#include "softkin/experiments/measure.hpp"
+#include "softkin/experiments/results.hpp"
+#include "softkin/experiments/runner.hpp"
+#include "softkin/solver/fk/fk_solver.hpp"
+#include "softkin/solver/mesh/io/mesh_io.hpp"
+#include "softkin/solver/robots/robots.hpp"
 
 #include <chrono>
 #include <cmath>

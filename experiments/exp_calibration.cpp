@@ -2,10 +2,10 @@
 // elongation test (Eq. 2.9) on bimaterial_bar, for the thesis's two material pairs; its
 // sensitivity to the mesh resolution; the twisting test at the calibrated parameters; and the
 // calibration curve R_m(R_omega^A / R_omega^B) for the plot.
-#include "experiments/results.hpp"
-#include "experiments/runner.hpp"
-#include "solver/calibration.hpp"
-#include "solver/robots.hpp"
+#include "softkin/experiments/results.hpp"
+#include "softkin/experiments/runner.hpp"
+#include "softkin/solver/materials/calibration.hpp"
+#include "softkin/solver/robots/robots.hpp"
 
 #include <cmath>
 #include <cstdio>

@@ -8,15 +8,15 @@
 //
 // "collision_costs" (Table 3.1): per robot, the time of one simulation step split as the thesis
 // does: mesh generation, collision check, collision response and iterative solver.
-#include "experiments/measure.hpp"
-#include "experiments/results.hpp"
-#include "experiments/runner.hpp"
-#include "solver/collision_response.hpp"
-#include "solver/fk_solver.hpp"
-#include "solver/mesh_io.hpp"
-#include "solver/remesh.hpp"
-#include "solver/robot_twisting.hpp"
-#include "solver/robots.hpp"
+#include "softkin/experiments/measure.hpp"
+#include "softkin/experiments/results.hpp"
+#include "softkin/experiments/runner.hpp"
+#include "softkin/solver/collision/collision_response.hpp"
+#include "softkin/solver/fk/fk_solver.hpp"
+#include "softkin/solver/mesh/io/mesh_io.hpp"
+#include "softkin/solver/remesh/remesh.hpp"
+#include "softkin/solver/robots/robot_twisting.hpp"
+#include "softkin/solver/robots/robots.hpp"
 
 #include <algorithm>
 #include <array>

@@ -1,12 +1,12 @@
 // Hyperelastic body elements (thesis Sec. 3.3.1, Eq. 3.6-3.7; our derivation in
-// solver/hyperelastic.hpp): the fitted R_omega(strain) of each Mooney-Rivlin material, and its
+// solver/materials/hyperelastic.hpp): the fitted R_omega(strain) of each Mooney-Rivlin material, and its
 // uniaxial response three ways against the analytic Mooney-Rivlin curve: the homogeneous state
 // of the law, a simulated tension test of a bar with the law, and the same bar with the constant
 // R_omega of Ch. 2. Stresses are normalised by each response's small-strain modulus.
-#include "experiments/results.hpp"
-#include "experiments/runner.hpp"
-#include "solver/calibration.hpp"
-#include "solver/hyperelastic.hpp"
+#include "softkin/experiments/results.hpp"
+#include "softkin/experiments/runner.hpp"
+#include "softkin/solver/materials/calibration.hpp"
+#include "softkin/solver/materials/hyperelastic.hpp"
 
 #include <cmath>
 #include <cstdio>

@@ -1,9 +1,9 @@
 // Thesis Chapter 4 with the simulator in the loop: the initial guess (Fig. 4.1), trajectory
 // following (Algorithm 4; Fig. 4.2, 4.3, 4.5) and every IK method x Jacobian mode on one path.
-#include "experiments/ik_config.hpp"
-#include "experiments/results.hpp"
-#include "experiments/runner.hpp"
-#include "ik/trajectory_io.hpp"
+#include "softkin/experiments/ik_config.hpp"
+#include "softkin/experiments/results.hpp"
+#include "softkin/experiments/runner.hpp"
+#include "softkin/ik/trajectory_io.hpp"
 
 #include <cstdio>
 #include <fstream>

@@ -1,18 +1,18 @@
 // Thesis Chapter 5 on three_chamber and finger_manipulator: the network architecture sweep
 // (Fig. 5.5), the IK methods compared (Table 5.1) and, with ik/pcc_chamber_kinematics, the
 // simulator against the analytical PCC model as the data source of sim-to-real (Fig. 5.14).
-#include "experiments/ik_config.hpp"
-#include "experiments/learn_common.hpp"
-#include "experiments/results.hpp"
-#include "experiments/runner.hpp"
-#include "ik/ik_solver.hpp"
-#include "ik/objectives.hpp"
-#include "ik/pcc_chamber_kinematics.hpp"
-#include "ik/trajectory.hpp"
-#include "learn/net_kinematics.hpp"
-#include "learn/train_nets.hpp"
-#include "learn/twin.hpp"
-#include "ik/trajectory_io.hpp"
+#include "softkin/experiments/ik_config.hpp"
+#include "softkin/experiments/learn_common.hpp"
+#include "softkin/experiments/results.hpp"
+#include "softkin/experiments/runner.hpp"
+#include "softkin/ik/ik_solver.hpp"
+#include "softkin/ik/objectives.hpp"
+#include "softkin/ik/pcc_chamber_kinematics.hpp"
+#include "softkin/ik/trajectory.hpp"
+#include "softkin/learn/net_kinematics.hpp"
+#include "softkin/learn/train_nets.hpp"
+#include "softkin/learn/twin.hpp"
+#include "softkin/ik/trajectory_io.hpp"
 
 #include <algorithm>
 #include <chrono>

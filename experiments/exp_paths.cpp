@@ -1,8 +1,8 @@
 // Fig. 2.12: actuators of one robot driven alone and together, with the tip trajectory of each.
-#include "experiments/results.hpp"
-#include "experiments/runner.hpp"
-#include "solver/fk_solver.hpp"
-#include "solver/robots.hpp"
+#include "softkin/experiments/results.hpp"
+#include "softkin/experiments/runner.hpp"
+#include "softkin/solver/fk/fk_solver.hpp"
+#include "softkin/solver/robots/robots.hpp"
 
 #include <cstdio>
 #include <sstream>

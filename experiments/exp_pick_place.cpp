@@ -13,10 +13,10 @@
 // Where the object is: `pick_design_actuation` (c1, c2) is a pose; the object's centre is put at
 // R + d from its P0 on the inner side of its end face. The pick stage then starts from rest and
 // must find a pose that holds it. The place target is p1 + `place_offset`.
-#include "experiments/ik_config.hpp"
-#include "experiments/results.hpp"
-#include "experiments/runner.hpp"
-#include "ik/subset_kinematics.hpp"
+#include "softkin/experiments/ik_config.hpp"
+#include "softkin/experiments/results.hpp"
+#include "softkin/experiments/runner.hpp"
+#include "softkin/ik/subset_kinematics.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,13 +1,13 @@
 // Fig. 3.7 (thesis Sec. 3.3.2, Algorithm 2): the twisting robot inflated progressively with chamber
 // remeshing up to alpha = 115, with the shapes at alpha = 5, 28 and 115, against alpha = 28
 // applied at once on the initial mesh without remeshing.
-#include "experiments/results.hpp"
-#include "experiments/runner.hpp"
-#include "solver/fk_solver.hpp"
-#include "solver/mesh_io.hpp"
-#include "solver/model.hpp"
-#include "solver/remesh.hpp"
-#include "solver/robot_twisting.hpp"
+#include "softkin/experiments/results.hpp"
+#include "softkin/experiments/runner.hpp"
+#include "softkin/solver/fk/fk_solver.hpp"
+#include "softkin/solver/mesh/io/mesh_io.hpp"
+#include "softkin/solver/fk/model.hpp"
+#include "softkin/solver/remesh/remesh.hpp"
+#include "softkin/solver/robots/robot_twisting.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -2,13 +2,13 @@
 // warm-started along the sweep exactly like fig2_11 (secant predictor), with the same stopping
 // rule. Times to 90 / 180 / 240 degrees, iterations, final energy and its gap to the lowest,
 // status, distance to the lg-aa shape and the tip trajectory of every method.
-#include "experiments/measure.hpp"
-#include "experiments/results.hpp"
-#include "experiments/runner.hpp"
-#include "solver/calculix.hpp"
-#include "solver/energy.hpp"
-#include "solver/fk_solver.hpp"
-#include "solver/robots.hpp"
+#include "softkin/experiments/measure.hpp"
+#include "softkin/experiments/results.hpp"
+#include "softkin/experiments/runner.hpp"
+#include "softkin/solver/baselines/calculix.hpp"
+#include "softkin/solver/fk/energy.hpp"
+#include "softkin/solver/fk/fk_solver.hpp"
+#include "softkin/solver/robots/robots.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -1,11 +1,11 @@
 // Marker trajectories under an actuation sweep, for one or more design variants of a robot
 // (Fig. 2.9: two material distributions of a cable gripper; Fig. 2.10: the DEA crawler's shape and
 // leg spacing against lambda).
-#include "experiments/results.hpp"
-#include "experiments/runner.hpp"
-#include "solver/fk_solver.hpp"
-#include "solver/mesh_io.hpp"
-#include "solver/robots.hpp"
+#include "softkin/experiments/results.hpp"
+#include "softkin/experiments/runner.hpp"
+#include "softkin/solver/fk/fk_solver.hpp"
+#include "softkin/solver/mesh/io/mesh_io.hpp"
+#include "softkin/solver/robots/robots.hpp"
 
 #include <cstdio>
 #include <filesystem>

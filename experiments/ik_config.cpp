@@ -1,7 +1,7 @@
-#include "experiments/ik_config.hpp"
+#include "softkin/experiments/ik_config.hpp"
 
-#include "experiments/runner.hpp"
-#include "ik/trajectory_io.hpp"
+#include "softkin/experiments/runner.hpp"
+#include "softkin/ik/trajectory_io.hpp"
 
 #include <algorithm>
 #include <cmath>

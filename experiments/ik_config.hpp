@@ -23,11 +23,11 @@
 ///               ik_config.cpp and docs/ik.md).
 /// Every path may carry "thesis": {...}, the thesis's numbers for it (e.g. {"total_time_s": 38}),
 /// copied into the summary beside ours.
-#include "experiments/config.hpp"
-#include "ik/ik_solver.hpp"
-#include "ik/simulator_kinematics.hpp"
-#include "ik/trajectory.hpp"
-#include "solver/scene.hpp"
+#include "softkin/experiments/config.hpp"
+#include "softkin/ik/ik_solver.hpp"
+#include "softkin/ik/simulator_kinematics.hpp"
+#include "softkin/ik/trajectory.hpp"
+#include "softkin/solver/scene/scene.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -1,9 +1,9 @@
-#include "experiments/learn_common.hpp"
+#include "softkin/experiments/learn_common.hpp"
 
-#include "experiments/results.hpp"
-#include "ik/simulator_kinematics.hpp"
-#include "learn/twin.hpp"
-#include "solver/robots.hpp"
+#include "softkin/experiments/results.hpp"
+#include "softkin/ik/simulator_kinematics.hpp"
+#include "softkin/learn/twin.hpp"
+#include "softkin/solver/robots/robots.hpp"
 
 #include <filesystem>
 #include <fstream>
@@ -153,7 +153,7 @@ Dataset CachedDataset(const DatasetSpec& spec, const std::string& cache_dir, boo
 
 }  // namespace softkin
 
-#include "learn/train_nets.hpp"
+#include "softkin/learn/train_nets.hpp"
 
 namespace softkin {
 

@@ -5,9 +5,9 @@
 /// finished dataset is reused by every experiment that asks for the same one), and the kinematics
 /// they come from (a robot's simulator, or a labelled "hardware" twin).
 
-#include "experiments/config.hpp"
-#include "ik/kinematics.hpp"
-#include "learn/dataset.hpp"
+#include "softkin/experiments/config.hpp"
+#include "softkin/ik/kinematics.hpp"
+#include "softkin/learn/dataset.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -1,3 +1,3 @@
-#include "experiments/cli.hpp"
+#include "softkin/experiments/cli.hpp"
 
 int main(int argc, char** argv) { return softkin::RunCli(argc, argv); }

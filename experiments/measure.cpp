@@ -1,4 +1,4 @@
-#include "experiments/measure.hpp"
+#include "softkin/experiments/measure.hpp"
 
 #include <cmath>
 #include <stdexcept>

@@ -1,7 +1,7 @@
 #pragma once
 /// \file measure.hpp
 /// Measurements taken on FK results for experiments: the bending angle of a robot's distal end.
-#include "solver/scene.hpp"
+#include "softkin/solver/scene/scene.hpp"
 
 #include <Eigen/Dense>
 

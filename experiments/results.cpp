@@ -1,6 +1,6 @@
-#include "experiments/results.hpp"
+#include "softkin/experiments/results.hpp"
 
-#include "solver/collision_response.hpp"
+#include "softkin/solver/collision/collision_response.hpp"
 
 #include <cstdio>
 #include <ctime>

@@ -1,8 +1,8 @@
-#include "experiments/runner.hpp"
+#include "softkin/experiments/runner.hpp"
 
-#include "solver/robots.hpp"
+#include "softkin/solver/robots/robots.hpp"
 
-#include "experiments/results.hpp"
+#include "softkin/experiments/results.hpp"
 
 #include <chrono>
 #include <cstdlib>

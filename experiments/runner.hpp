@@ -3,8 +3,8 @@
 /// `softkin run CONFIG`: dispatches an experiment config to its experiment, writes
 /// results/<name>/{summary.json, config.json, run.json, *.csv} and, unless disabled, runs the
 /// matching paper_figs/<name>.py to make the PNG.
-#include "experiments/config.hpp"
-#include "solver/scene.hpp"
+#include "softkin/experiments/config.hpp"
+#include "softkin/solver/scene/scene.hpp"
 
 #include <nlohmann/json.hpp>
 

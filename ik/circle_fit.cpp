@@ -1,4 +1,4 @@
-#include "ik/circle_fit.hpp"
+#include "softkin/ik/circle_fit.hpp"
 
 #include <Eigen/Dense>
 

@@ -1,6 +1,6 @@
-#include "ik/gauss_newton.hpp"
+#include "softkin/ik/gauss_newton.hpp"
 
-#include "ik/ik_problem.hpp"
+#include "softkin/ik/ik_problem.hpp"
 
 #include <Eigen/Dense>
 

@@ -23,7 +23,7 @@
 /// J diag(range). On the simulator a Jacobian costs one to two forward solves, and along a smooth
 /// path J barely changes between waypoints: a warm waypoint then costs its trial solves only.
 
-#include "ik/ik_solver.hpp"
+#include "softkin/ik/ik_solver.hpp"
 
 namespace softkin {
 

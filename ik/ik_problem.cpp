@@ -1,4 +1,4 @@
-#include "ik/ik_problem.hpp"
+#include "softkin/ik/ik_problem.hpp"
 
 #include <cmath>
 #include <sstream>

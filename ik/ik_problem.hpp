@@ -4,7 +4,7 @@
 /// differences, Eq. 4.2), with evaluation / FK counting, the best point seen, the time budget, and
 /// failures turned into an IkTermination plus message instead of exceptions.
 
-#include "ik/ik_solver.hpp"
+#include "softkin/ik/ik_solver.hpp"
 
 #include <chrono>
 

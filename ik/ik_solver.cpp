@@ -1,8 +1,8 @@
-#include "ik/ik_solver.hpp"
+#include "softkin/ik/ik_solver.hpp"
 
-#include "ik/gauss_newton.hpp"
-#include "ik/nlopt_ik.hpp"
-#include "ik/soft_line_search.hpp"
+#include "softkin/ik/gauss_newton.hpp"
+#include "softkin/ik/nlopt_ik.hpp"
+#include "softkin/ik/soft_line_search.hpp"
 
 #include <cmath>
 #include <iomanip>

@@ -12,8 +12,8 @@
 /// Options follow the Ceres pattern (IsValid), results come with an IkSummary (termination type,
 /// message, iterations, objective history, evaluation and FK counts, time, BriefReport()).
 
-#include "ik/kinematics.hpp"
-#include "ik/objectives.hpp"
+#include "softkin/ik/kinematics.hpp"
+#include "softkin/ik/objectives.hpp"
 
 #include <Eigen/Core>
 

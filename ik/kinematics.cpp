@@ -1,4 +1,4 @@
-#include "ik/kinematics.hpp"
+#include "softkin/ik/kinematics.hpp"
 
 #include <cmath>
 #include <sstream>

@@ -1,6 +1,6 @@
-#include "ik/nlopt_ik.hpp"
+#include "softkin/ik/nlopt_ik.hpp"
 
-#include "ik/ik_problem.hpp"
+#include "softkin/ik/ik_problem.hpp"
 
 #include <nlopt.hpp>
 

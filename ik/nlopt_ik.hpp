@@ -15,7 +15,7 @@
 /// FAILURE / INVALID_ARGS / OUT_OF_MEMORY -> solver-failure with NLopt's message.
 /// The result is the best point evaluated. summary.iterations counts objective evaluations.
 
-#include "ik/ik_solver.hpp"
+#include "softkin/ik/ik_solver.hpp"
 
 namespace softkin {
 

@@ -1,6 +1,6 @@
-#include "ik/objectives.hpp"
+#include "softkin/ik/objectives.hpp"
 
-#include "ik/circle_fit.hpp"
+#include "softkin/ik/circle_fit.hpp"
 
 #include <Eigen/Geometry>
 

@@ -1,4 +1,4 @@
-#include "ik/pcc_chamber_kinematics.hpp"
+#include "softkin/ik/pcc_chamber_kinematics.hpp"
 
 #include <ceres/jet.h>
 #include <Eigen/Dense>

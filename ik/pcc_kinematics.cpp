@@ -1,4 +1,4 @@
-#include "ik/pcc_kinematics.hpp"
+#include "softkin/ik/pcc_kinematics.hpp"
 
 #include <chrono>
 #include <cmath>

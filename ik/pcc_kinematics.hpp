@@ -23,7 +23,7 @@
 /// (backbone[K-1] is the tip again). Points of one arc lie on a circle of diameter 2/kappa, which
 /// makes the grasp objective's fit checkable.
 
-#include "ik/kinematics.hpp"
+#include "softkin/ik/kinematics.hpp"
 
 namespace softkin {
 

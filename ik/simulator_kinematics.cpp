@@ -1,6 +1,6 @@
-#include "ik/simulator_kinematics.hpp"
+#include "softkin/ik/simulator_kinematics.hpp"
 
-#include "solver/mesh.hpp"
+#include "softkin/solver/mesh/mesh.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -7,7 +7,7 @@
 ///             from);
 ///   fd-warm   central differences whose probes start from the converged state at c;
 ///   implicit  implicit differentiation of the local-global equilibrium
-///             (solver/equilibrium_jacobian.hpp): no extra forward solves.
+///             (solver/sensitivity/equilibrium_jacobian.hpp): no extra forward solves.
 /// Step of the differences: delta_a = fd_step * (c_max,a - c_min,a) (default 1/160 = 1/(10 N) with
 /// N = 16 samples per actuator, thesis Sec. 5.2.1 and 5.3.2). At a bound, where c +- delta would
 /// leave [c_min, c_max], the second-order one-sided difference (3 p(c) - 4 p(c -+ delta) +
@@ -29,10 +29,10 @@
 /// (status iteration_cap, diverged, time_limit) from there makes the evaluation fail (ok = false, message with the FK status and the actuation), unless
 /// accept_iteration_cap is set, in which case an iteration_cap result is used and `message` says
 /// so. p and J are never NaN when ok.
-#include "ik/kinematics.hpp"
-#include "solver/equilibrium_jacobian.hpp"
-#include "solver/fk_solver.hpp"
-#include "solver/scene.hpp"
+#include "softkin/ik/kinematics.hpp"
+#include "softkin/solver/sensitivity/equilibrium_jacobian.hpp"
+#include "softkin/solver/fk/fk_solver.hpp"
+#include "softkin/solver/scene/scene.hpp"
 
 #include <memory>
 #include <string>

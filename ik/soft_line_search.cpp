@@ -1,6 +1,6 @@
-#include "ik/soft_line_search.hpp"
+#include "softkin/ik/soft_line_search.hpp"
 
-#include "ik/ik_problem.hpp"
+#include "softkin/ik/ik_problem.hpp"
 
 #include <limits>
 #include <sstream>

@@ -16,7 +16,7 @@
 /// from it); a failure at an accepted point (where the gradient is needed) ends the solve.
 /// The thesis writes c + h grad O; the step here goes downhill, as the text intends.
 
-#include "ik/ik_solver.hpp"
+#include "softkin/ik/ik_solver.hpp"
 
 namespace softkin {
 

@@ -1,4 +1,4 @@
-#include "ik/subset_kinematics.hpp"
+#include "softkin/ik/subset_kinematics.hpp"
 
 #include <algorithm>
 #include <stdexcept>

@@ -4,7 +4,7 @@
 /// values: the pick-and-place stages of thesis Sec. 4.4 solve for c = {c1, c2} (Eq. 4.5-4.6) with
 /// the gripper segment at rest, then for the gripper alone (Eq. 4.7) with the first two held.
 /// Points, bounds and Jacobian columns are those of the driven actuators, in the given order.
-#include "ik/kinematics.hpp"
+#include "softkin/ik/kinematics.hpp"
 
 #include <vector>
 

@@ -1,6 +1,6 @@
-#include "ik/trajectory.hpp"
+#include "softkin/ik/trajectory.hpp"
 
-#include "ik/objectives.hpp"
+#include "softkin/ik/objectives.hpp"
 
 #include <algorithm>
 #include <chrono>

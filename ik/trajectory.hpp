@@ -15,7 +15,7 @@
 /// Results go to a callback as they are computed (the CLI streams CSV rows), and a run can resume
 /// from a waypoint with the previous actuation as the warm start.
 
-#include "ik/ik_solver.hpp"
+#include "softkin/ik/ik_solver.hpp"
 
 #include <functional>
 #include <string>

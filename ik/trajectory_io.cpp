@@ -1,4 +1,4 @@
-#include "ik/trajectory_io.hpp"
+#include "softkin/ik/trajectory_io.hpp"
 
 #include <algorithm>
 #include <cctype>

@@ -6,14 +6,14 @@
 /// Waypoint file: one waypoint per line, "x y z" in mm separated by whitespace (spaces, tabs)
 /// and/or commas; '#' starts a comment (to the end of the line); blank lines are skipped; an
 /// optional header line "x y z" (any case, same separators) before the first waypoint. This reads
-/// ../shared/data/real/flower_trajectory.txt (120 tab-separated lines, no header) as it is.
+/// data/thesis/flower_trajectory.txt (120 tab-separated lines, no header) as it is.
 ///
 /// Waypoint CSV: the header from WaypointCsvHeader, then one WaypointCsvRow per waypoint:
 ///   index,target_x,target_y,target_z,c0..c{n-1},reached_x,reached_y,reached_z,error_mm,
 ///   objective,converged,termination,iterations,evaluations,fk_solves,time_s,jump
 /// (numbers with 17 significant digits for the actuation, so a resumed run continues exactly).
 
-#include "ik/trajectory.hpp"
+#include "softkin/ik/trajectory.hpp"
 
 #include <Eigen/Core>
 

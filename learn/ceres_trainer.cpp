@@ -1,4 +1,4 @@
-#include "learn/ceres_trainer.hpp"
+#include "softkin/learn/ceres_trainer.hpp"
 
 #include <ceres/ceres.h>
 #include <omp.h>

@@ -14,8 +14,8 @@
 /// the in-house trainer). The fit stops when the training mse reaches `target_mse` (an
 /// IterationCallback), so the time to a given loss can be compared with LmSummary::TimeToTrainMse.
 
-#include "learn/fnn.hpp"
-#include "learn/sample_set.hpp"
+#include "softkin/learn/fnn.hpp"
+#include "softkin/learn/sample_set.hpp"
 
 #include <cstdint>
 #include <string>

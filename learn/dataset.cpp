@@ -1,4 +1,4 @@
-#include "learn/dataset.hpp"
+#include "softkin/learn/dataset.hpp"
 
 #include <algorithm>
 #include <cassert>

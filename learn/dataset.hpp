@@ -32,8 +32,8 @@
 /// "shard": {...}, "provenance": {...}}: `config` identifies the dataset (source, points,
 /// actuator bounds, sampling, jacobian, block) and must match on resume and merge; `provenance`
 /// (git commit, command, ...) is recorded only.
-#include "ik/kinematics.hpp"
-#include "learn/sample_set.hpp"
+#include "softkin/ik/kinematics.hpp"
+#include "softkin/learn/sample_set.hpp"
 
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>

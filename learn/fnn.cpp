@@ -1,4 +1,4 @@
-#include "learn/fnn.hpp"
+#include "softkin/learn/fnn.hpp"
 
 #include <cassert>
 #include <cmath>

@@ -1,5 +1,5 @@
 // The "softkin-fnn v1" file format of Fnn (documented in learn/fnn.hpp): writer and checking reader.
-#include "learn/fnn.hpp"
+#include "softkin/learn/fnn.hpp"
 
 #include <cerrno>
 #include <cmath>

@@ -1,6 +1,6 @@
-#include "learn/lm_trainer.hpp"
+#include "softkin/learn/lm_trainer.hpp"
 
-#include "learn/tiled_cholesky.hpp"
+#include "softkin/learn/tiled_cholesky.hpp"
 
 #include <omp.h>
 

@@ -28,8 +28,8 @@
 /// val_fail). With a validation set, the network returned is the one of the best validation mse
 /// (whatever stopped the run).
 
-#include "learn/fnn.hpp"
-#include "learn/sample_set.hpp"
+#include "softkin/learn/fnn.hpp"
+#include "softkin/learn/sample_set.hpp"
 
 #include <cstdint>
 #include <string>

@@ -1,4 +1,4 @@
-#include "learn/net_kinematics.hpp"
+#include "softkin/learn/net_kinematics.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -18,8 +18,8 @@
 /// which networks exist, and free-form "info": dataset, errors, training provenance) beside one
 /// `softkin-fnn v1` file per network: fk.fnn, jac.fnn, s2r.fnn, ik.fnn.
 
-#include "ik/kinematics.hpp"
-#include "learn/fnn.hpp"
+#include "softkin/ik/kinematics.hpp"
+#include "softkin/learn/fnn.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -1,4 +1,4 @@
-#include "learn/sample_set.hpp"
+#include "softkin/learn/sample_set.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "learn/tiled_cholesky.hpp"
+#include "softkin/learn/tiled_cholesky.hpp"
 
 #include <Eigen/Cholesky>
 

@@ -1,4 +1,4 @@
-#include "learn/train_nets.hpp"
+#include "softkin/learn/train_nets.hpp"
 
 #include <algorithm>
 #include <cmath>

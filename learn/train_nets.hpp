@@ -4,11 +4,11 @@
 /// thesis reports (RMSE, and the mean and largest point distance in mm, also as % of the
 /// workspace width), and the sim-to-real samples of Sec. 5.3.4.
 
-#include "learn/dataset.hpp"
-#include "learn/fnn.hpp"
-#include "learn/lm_trainer.hpp"
-#include "learn/net_kinematics.hpp"
-#include "learn/sample_set.hpp"
+#include "softkin/learn/dataset.hpp"
+#include "softkin/learn/fnn.hpp"
+#include "softkin/learn/lm_trainer.hpp"
+#include "softkin/learn/net_kinematics.hpp"
+#include "softkin/learn/sample_set.hpp"
 
 #include <nlohmann/json.hpp>
 

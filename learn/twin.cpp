@@ -1,4 +1,4 @@
-#include "learn/twin.hpp"
+#include "softkin/learn/twin.hpp"
 
 #include <cmath>
 #include <cstring>

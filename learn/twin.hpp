@@ -13,9 +13,9 @@
 /// generator keyed by (seed, the bits of c, point, coordinate): a frozen noise field. The same c
 /// always gives the same measurement, so datasets made from a twin are reproducible, resumable
 /// and shardable like any other.
-#include "ik/kinematics.hpp"
-#include "ik/simulator_kinematics.hpp"
-#include "solver/robots.hpp"
+#include "softkin/ik/kinematics.hpp"
+#include "softkin/ik/simulator_kinematics.hpp"
+#include "softkin/solver/robots/robots.hpp"
 
 #include <Eigen/Core>
 
@@ -29,7 +29,7 @@ namespace softkin {
 /// How a twin differs from its nominal robot.
 struct TwinSpec {
   std::string name;                 ///< e.g. "three_chamber/robot1"
-  std::string robot;                ///< the nominal robot (solver/robots.hpp)
+  std::string robot;                ///< the nominal robot (solver/robots/robots.hpp)
   RobotParams params;               ///< geometry / design parameters given to MakeRobot
   double body_r_omega = 1.0;        ///< R_omega of every body region (nominal: the robot's own)
   bool set_body_r_omega = false;    ///< whether body_r_omega replaces the robot's values

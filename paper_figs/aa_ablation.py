@@ -3,7 +3,7 @@
 
 Usage: aa_ablation.py RESULTS_DIR
 
-Reads RESULTS_DIR/aa_ablation.csv (written by `softkin run experiments/aa_ablation.json`) and, if
+Reads RESULTS_DIR/aa_ablation.csv (written by `softkin run experiments/configs/aa_ablation.json`) and, if
 present, RESULTS_DIR/summary.json. Writes RESULTS_DIR/aa_ablation.png: grouped bars of the
 iteration count of plain local-global (lg) and of each Anderson-accelerated variant
 ("lg-aa m=<window> <safeguard>") for every robot and actuation level, on a log scale, with the

@@ -3,7 +3,7 @@
 
 Usage: fig2_10_dea_crawler.py RESULTS_DIR
 
-Reads RESULTS_DIR/markers.csv (written by `softkin run experiments/fig2_10_dea_crawler.json`,
+Reads RESULTS_DIR/markers.csv (written by `softkin run experiments/configs/fig2_10_dea_crawler.json`,
 one row per variant x step x marker; only the first variant is plotted) and, if present,
 RESULTS_DIR/summary.json. Writes RESULTS_DIR/fig2_10_dea_crawler.png:
   left:  side view (x-z, mm, equal aspect) of the body at every step, the polyline

@@ -3,7 +3,7 @@
 
 Usage: fig2_11_pneumatic_bending.py RESULTS_DIR
 
-Reads RESULTS_DIR/trajectory.csv (written by `softkin run experiments/fig2_11_pneumatic_bending.json`)
+Reads RESULTS_DIR/trajectory.csv (written by `softkin run experiments/configs/fig2_11_pneumatic_bending.json`)
 and, if present, RESULTS_DIR/summary.json. Writes RESULTS_DIR/fig2_11_pneumatic_bending.png:
   left:  tip path in the x-z plane (mm, equal aspect), coloured by actuation, with markers where
          the bend angle first crosses 90, 180 and 240 degrees;

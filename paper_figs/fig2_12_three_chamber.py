@@ -3,7 +3,7 @@
 
 Usage: fig2_12_three_chamber.py RESULTS_DIR
 
-Reads RESULTS_DIR/paths.csv (written by `softkin run experiments/fig2_12_three_chamber.json`) and,
+Reads RESULTS_DIR/paths.csv (written by `softkin run experiments/configs/fig2_12_three_chamber.json`) and,
 if present, RESULTS_DIR/summary.json. Writes RESULTS_DIR/fig2_12_three_chamber.png:
   left:  tip trajectories seen along the robot's long axis (x-z cross-section plane, mm), one per
          actuation path (e.g. c1, c1+c2, c1+c2+c3), starting at the rest tip;

@@ -3,7 +3,7 @@
 
 Usage: fig2_13_resolution.py RESULTS_DIR
 
-Reads RESULTS_DIR/resolution.csv (written by `softkin run experiments/fig2_13_resolution.json`)
+Reads RESULTS_DIR/resolution.csv (written by `softkin run experiments/configs/fig2_13_resolution.json`)
 and, if present, RESULTS_DIR/summary.json. Writes RESULTS_DIR/fig2_13_resolution.png:
   left:   milliseconds per iteration and iteration count against the number of tets (log x);
   middle: tip coordinates against the number of tets;

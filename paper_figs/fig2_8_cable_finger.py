@@ -3,7 +3,7 @@
 
 Usage: fig2_8_cable_finger.py RESULTS_DIR
 
-Reads RESULTS_DIR/trajectory.csv (written by `softkin run experiments/fig2_8_cable_finger.json`)
+Reads RESULTS_DIR/trajectory.csv (written by `softkin run experiments/configs/fig2_8_cable_finger.json`)
 and, if present, RESULTS_DIR/summary.json. Writes RESULTS_DIR/fig2_8_cable_finger.png:
   left:  tip path in the x-z plane (mm, equal aspect), coloured by the shortening ratio s;
   right: bend angle of the tip face and the solve time of each step against the shortening

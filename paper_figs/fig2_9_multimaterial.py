@@ -4,7 +4,7 @@ three boundary markers m1, m2, m3 as the cable is shortened.
 
 Usage: fig2_9_multimaterial.py RESULTS_DIR
 
-Reads RESULTS_DIR/markers.csv (written by `softkin run experiments/fig2_9_multimaterial.json`,
+Reads RESULTS_DIR/markers.csv (written by `softkin run experiments/configs/fig2_9_multimaterial.json`,
 one row per variant x step x marker) and, if present, RESULTS_DIR/summary.json (robot, the
 robot_params of each variant, solve times). Writes RESULTS_DIR/fig2_9_multimaterial.png:
   one panel per variant (same x-z limits, mm, equal aspect; x the long axis, z up): the paths of

@@ -6,7 +6,7 @@ it.
 Usage: fig3_10_selfcollision_tip.py RESULTS_DIR
 
 Reads RESULTS_DIR/steps.csv and summary.json (written by
-`softkin run experiments/fig3_10_selfcollision_tip.json`). Writes
+`softkin run experiments/configs/fig3_10_selfcollision_tip.json`). Writes
 RESULTS_DIR/fig3_10_selfcollision_tip.png:
   left:  tip trajectory in the x-z plane, one curve per variant, from the rest tip;
   right: exact check per step: the deepest penetration left (mm) per variant.

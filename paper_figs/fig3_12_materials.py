@@ -6,7 +6,7 @@ regions.
 Usage: fig3_12_materials.py RESULTS_DIR
 
 Reads RESULTS_DIR/steps.csv and summary.json (written by
-`softkin run experiments/fig3_12_materials.json`). Writes RESULTS_DIR/fig3_12_materials.png:
+`softkin run experiments/configs/fig3_12_materials.json`). Writes RESULTS_DIR/fig3_12_materials.png:
   left:  tip trajectories in the x-z plane with the obstacle's cross-section;
   right: contact region per material: vertices touching and the touching area.
 Exit status 2 with a message on stderr if a file is missing or malformed.

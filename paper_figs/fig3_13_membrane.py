@@ -4,7 +4,7 @@
 Usage: fig3_13_membrane.py RESULTS_DIR
 
 Reads RESULTS_DIR/surface_membrane.csv (the membrane's vertices, rest and final positions) and
-summary.json (written by `softkin run experiments/fig3_13_membrane.json`). Writes
+summary.json (written by `softkin run experiments/configs/fig3_13_membrane.json`). Writes
 RESULTS_DIR/fig3_13_membrane.png: the membrane's upward displacement over its rest position
 (top-face vertices), as a colour map, with the chamber actuations in the title.
 Exit status 2 with a message on stderr if a file is missing or malformed.

@@ -4,7 +4,7 @@ pulled back to the original chamber (chamber_rest = original) instead of its rem
 
 Usage: fig3_7_original_rest.py RESULTS_DIR
 
-Reads the files `softkin run experiments/fig3_7_original_rest.json` writes (the same as
+Reads the files `softkin run experiments/configs/fig3_7_original_rest.json` writes (the same as
 fig3_7_twisting_remesh's) and draws the same panels into RESULTS_DIR/fig3_7_original_rest.png.
 Exit status 2 with a message on stderr if a file is missing or malformed.
 """

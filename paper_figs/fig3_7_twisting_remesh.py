@@ -6,7 +6,7 @@ Usage: fig3_7_twisting_remesh.py RESULTS_DIR
 
 Reads RESULTS_DIR/shapes.csv (one row per shape, naming its outer and chamber surface OBJ files),
 steps.csv (one row per ladder step) and summary.json, written by
-`softkin run experiments/fig3_7_twisting_remesh.json`. Writes RESULTS_DIR/fig3_7_twisting_remesh.png:
+`softkin run experiments/configs/fig3_7_twisting_remesh.json`. Writes RESULTS_DIR/fig3_7_twisting_remesh.png:
   top row:    the deformed shapes, progressive (one panel per alpha) and at once (last panel);
               the body surface in grey, the chamber in red; the tip twist in the title;
   bottom row: tip twist and reached chamber volume ratio against the asked alpha, and the tet

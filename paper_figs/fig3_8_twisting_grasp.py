@@ -5,7 +5,7 @@ plane with and without the obstacle response, and how the grasp tightens with th
 Usage: fig3_8_twisting_grasp.py RESULTS_DIR
 
 Reads RESULTS_DIR/steps.csv and summary.json (written by
-`softkin run experiments/fig3_8_twisting_grasp.json`). Writes RESULTS_DIR/fig3_8_twisting_grasp.png:
+`softkin run experiments/configs/fig3_8_twisting_grasp.json`). Writes RESULTS_DIR/fig3_8_twisting_grasp.png:
   left:  tip paths in the x-z plane, per variant, with the cylinder's cross-section;
   right: vertices touching the cylinder (within the contact distance), vertices inside it, the
          deepest penetration into the cylinder, and the deepest self "contact" of the exact check

@@ -5,7 +5,7 @@ uniaxial response against the Mooney-Rivlin curve.
 Usage: fig3_materials_hyperelastic.py RESULTS_DIR
 
 Reads RESULTS_DIR/curve.csv and response.csv (written by
-`softkin run experiments/fig3_materials_hyperelastic.json`) and summary.json. Writes
+`softkin run experiments/configs/fig3_materials_hyperelastic.json`) and summary.json. Writes
 RESULTS_DIR/fig3_materials_hyperelastic.png:
   left:  R_omega against the equivalent Hencky strain, one curve per material;
   right: normalised nominal stress against stretch: analytic Mooney-Rivlin (lines), the law's

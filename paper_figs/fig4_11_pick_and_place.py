@@ -4,7 +4,7 @@
 Usage: fig4_11_pick_and_place.py RESULTS_DIR
 
 Reads RESULTS_DIR/summary.json, RESULTS_DIR/stages.csv and RESULTS_DIR/shapes.csv (written by
-`softkin run experiments/fig4_11_pick_and_place.json`). Writes RESULTS_DIR/fig4_11_pick_and_place.png:
+`softkin run experiments/configs/fig4_11_pick_and_place.json`). Writes RESULTS_DIR/fig4_11_pick_and_place.png:
   left:  side view (x-z, mm) of the robot's side-face vertices at rest and after each stage, with
          the object (circle of radius R) at its pick and place positions;
   right: the objective of each stage (Eq. 4.5 pick, Eq. 4.7 grasp, place) at its start and end

@@ -5,7 +5,7 @@ configuration against the closest sample.
 Usage: fig4_1_initial_guess.py RESULTS_DIR
 
 Reads RESULTS_DIR/summary.json, RESULTS_DIR/samples.csv and RESULTS_DIR/history.csv (written by
-`softkin run experiments/fig4_1_initial_guess.json`). Writes RESULTS_DIR/fig4_1_initial_guess.png:
+`softkin run experiments/configs/fig4_1_initial_guess.json`). Writes RESULTS_DIR/fig4_1_initial_guess.png:
   left:  the tip positions of the configuration-space samples (x-z, mm), the target (star) and the
          closest sample (triangle), the initial guess of the sampled start;
   right: the objective O = |p - p_t|^2 (mm^2, log scale) against the iteration, from rest and from

@@ -3,7 +3,7 @@
 
 Usage: fig4_2_trajectories.py RESULTS_DIR
 
-Reads RESULTS_DIR/summary.json (written by `softkin run experiments/fig4_2_trajectories.json`),
+Reads RESULTS_DIR/summary.json (written by `softkin run experiments/configs/fig4_2_trajectories.json`),
 RESULTS_DIR/path_<name>.csv for every path it lists and RESULTS_DIR/samples.csv. Writes
 RESULTS_DIR/fig4_2_trajectories.png, one row per path:
   left:  the target waypoints and the reached tip positions in the finger's motion plane (x-z, mm),

@@ -3,7 +3,7 @@
 
 Usage: fig4_3_unreachable.py RESULTS_DIR
 
-Reads RESULTS_DIR/summary.json (written by `softkin run experiments/fig4_3_unreachable.json`),
+Reads RESULTS_DIR/summary.json (written by `softkin run experiments/configs/fig4_3_unreachable.json`),
 RESULTS_DIR/path_<name>.csv and RESULTS_DIR/samples.csv. Writes RESULTS_DIR/fig4_3_unreachable.png:
   left:  the target waypoints (red) and the reached points (black), each pair joined by a grey
          dashed line, over the sampled configuration space (x-z, mm);

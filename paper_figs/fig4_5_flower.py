@@ -3,7 +3,7 @@
 
 Usage: fig4_5_flower.py RESULTS_DIR
 
-Reads RESULTS_DIR/summary.json (written by `softkin run experiments/fig4_5_flower.json`),
+Reads RESULTS_DIR/summary.json (written by `softkin run experiments/configs/fig4_5_flower.json`),
 RESULTS_DIR/path_<name>.csv and RESULTS_DIR/samples.csv. Writes RESULTS_DIR/fig4_5_flower.png:
   (a) the sampled tip workspace and the mapped target path, side view (x against y = long axis);
   (b) top view (x-z): target and tracked tip;

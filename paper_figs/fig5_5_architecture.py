@@ -4,7 +4,7 @@
 Usage: fig5_5_architecture.py RESULTS_DIR
 
 Reads RESULTS_DIR/architecture.csv (robot, net, h, b, test_mean_pct, test_max_pct, ...), written
-by `softkin run experiments/fig5_5_architecture.json`. Writes RESULTS_DIR/fig5_5_architecture.png:
+by `softkin run experiments/configs/fig5_5_architecture.json`. Writes RESULTS_DIR/fig5_5_architecture.png:
 one panel per robot and network, the mean test error (% of the workspace width) against b, one
 line per h, with the thesis's chosen architecture marked where it is in the sweep.
 Exit status 2 with a message on stderr if a file is missing or malformed.

@@ -3,7 +3,7 @@
 
 Usage: ik_methods.py RESULTS_DIR
 
-Reads RESULTS_DIR/methods.csv (written by `softkin run experiments/ik_methods.json`) and
+Reads RESULTS_DIR/methods.csv (written by `softkin run experiments/configs/ik_methods.json`) and
 RESULTS_DIR/summary.json. Writes RESULTS_DIR/ik_methods.png:
   left:  mean time per waypoint (ms, log scale) of each method, one bar per Jacobian mode;
   right: mean and maximum error (mm) of each, with lambda.

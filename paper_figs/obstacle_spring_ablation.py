@@ -5,7 +5,7 @@ against Eq. 3.5's 'point' spring on the same contact, in iterations and seconds 
 Usage: obstacle_spring_ablation.py RESULTS_DIR
 
 Reads RESULTS_DIR/steps.csv and summary.json (written by
-`softkin run experiments/obstacle_spring_ablation.json`). Writes
+`softkin run experiments/configs/obstacle_spring_ablation.json`). Writes
 RESULTS_DIR/obstacle_spring_ablation.png:
   left:  local-global iterations per step, one bar per variant;
   right: seconds per step, with each variant's total and the distance between the final tips.

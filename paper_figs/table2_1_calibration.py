@@ -4,7 +4,7 @@
 Usage: table2_1_calibration.py RESULTS_DIR
 
 Reads RESULTS_DIR/curve.csv, calibration.csv and twist.csv (written by
-`softkin run experiments/table2_1_calibration.json`) and summary.json. Writes
+`softkin run experiments/configs/table2_1_calibration.json`) and summary.json. Writes
 RESULTS_DIR/table2_1_calibration.png:
   left:   the calibration curve, simulated R_m against R_omega^A / R_omega^B, with the calibrated
           points and the thesis's Table 2.1 pairs;

@@ -4,7 +4,7 @@
 Usage: table2_2_solver_comparison.py RESULTS_DIR
 
 Reads RESULTS_DIR/trajectories.csv and RESULTS_DIR/summary.json (written by
-`softkin run experiments/table2_2_solver_comparison.json`). Writes
+`softkin run experiments/configs/table2_2_solver_comparison.json`). Writes
 RESULTS_DIR/table2_2_solver_comparison.png with two panels:
   left:  cumulative solve time against the bend angle for each method (log time), with the
          thesis's Table 2.2 times at 90/180/240 degrees as markers;

@@ -3,7 +3,7 @@
 
 Usage: table3_1_costs.py RESULTS_DIR
 
-Reads RESULTS_DIR/summary.json (written by `softkin run experiments/table3_1_costs.json`). Writes
+Reads RESULTS_DIR/summary.json (written by `softkin run experiments/configs/table3_1_costs.json`). Writes
 RESULTS_DIR/table3_1_costs.png: per robot, stacked bars of mesh generation, collision check,
 collision response and iterative solver per step, ours beside the thesis's, labelled with tet
 counts; above our bars, the contacts the exact check left (and how many of them lie in tangles) and

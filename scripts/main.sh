@@ -3,7 +3,7 @@
 # range (thesis Fig. 2.11 / Table 2.2) and plot the tip trajectory.
 set -euo pipefail
 
-CONFIG=experiments/fig2_11_pneumatic_bending.json
+CONFIG=experiments/configs/fig2_11_pneumatic_bending.json
 NAME=fig2_11_pneumatic_bending
 
 usage() {

@@ -1,7 +1,7 @@
 // Experiment configs (experiments/config.hpp): errors name the file and the key, with the value
 // found there, also for nested keys.
-#include "experiments/config.hpp"
-#include "experiments/runner.hpp"
+#include "softkin/experiments/config.hpp"
+#include "softkin/experiments/runner.hpp"
 
 #include <gtest/gtest.h>
 
@@ -50,7 +50,7 @@ TEST(Config, EveryShippedConfigLoadsAndHasAPlotScript) {
   namespace fs = std::filesystem;
   const fs::path root(SOFTKIN_SOURCE_DIR);
   int checked = 0;
-  for (const auto& entry : fs::directory_iterator(root / "experiments")) {
+  for (const auto& entry : fs::directory_iterator(root / "experiments" / "configs")) {
     if (entry.path().extension() != ".json") continue;
     SCOPED_TRACE(entry.path().string());
     for (bool quick : {false, true}) {

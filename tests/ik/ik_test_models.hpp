@@ -2,7 +2,7 @@
 /// \file
 /// Analytic Kinematics for the IK tests: a linear map, and a decorator that records every
 /// actuation evaluated (and can fail on request), plus a finite-difference helper.
-#include "ik/kinematics.hpp"
+#include "softkin/ik/kinematics.hpp"
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>

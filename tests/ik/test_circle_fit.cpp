@@ -1,6 +1,6 @@
 // The least-squares circle of the grasp objective (Eq. 4.7): exact on circles, invariant under
 // rigid motions, and its derivative against finite differences.
-#include "ik/circle_fit.hpp"
+#include "softkin/ik/circle_fit.hpp"
 
 #include "ik_test_models.hpp"
 

@@ -1,8 +1,8 @@
 // SolveIk across methods: string converters, options validation, recovery of a known actuation to
 // lambda from its own forward result (every method, both gradient sources, linear and PCC models),
 // budgets, and failures reported rather than thrown.
-#include "ik/ik_solver.hpp"
-#include "ik/pcc_kinematics.hpp"
+#include "softkin/ik/ik_solver.hpp"
+#include "softkin/ik/pcc_kinematics.hpp"
 
 #include "ik_test_models.hpp"
 

@@ -1,5 +1,5 @@
 // The Kinematics interface's shared pieces: input checks and point lookup.
-#include "ik/kinematics.hpp"
+#include "softkin/ik/kinematics.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // Every objective's gradient against finite differences, its least-squares form against its value
 // and gradient, the chain rule through J, and the errors for missing points.
-#include "ik/objectives.hpp"
-#include "ik/pcc_kinematics.hpp"
+#include "softkin/ik/objectives.hpp"
+#include "softkin/ik/pcc_kinematics.hpp"
 
 #include "ik_test_models.hpp"
 

@@ -1,6 +1,6 @@
 // The PCC model of three_chamber: straight when the chambers agree, bending away from the longest
 // chamber, 3-fold symmetric, points on the arc, J against finite differences, and the fit.
-#include "ik/pcc_chamber_kinematics.hpp"
+#include "softkin/ik/pcc_chamber_kinematics.hpp"
 
 #include "ik_test_models.hpp"
 

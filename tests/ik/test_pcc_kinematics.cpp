@@ -1,5 +1,5 @@
 // The analytical PCC model: identities of the arc and its Jacobian against finite differences.
-#include "ik/pcc_kinematics.hpp"
+#include "softkin/ik/pcc_kinematics.hpp"
 
 #include "ik_test_models.hpp"
 

@@ -2,8 +2,8 @@
 // (implicit against tightly converged central differences), J dc predicts the change of p, the
 // three-chamber robot's 120-degree symmetry carries over to J, the point spec, the FK-solve
 // counts and warm-start reuse, one-sided differences at a bound, and the failure paths.
-#include "ik/simulator_kinematics.hpp"
-#include "solver/robots.hpp"
+#include "softkin/ik/simulator_kinematics.hpp"
+#include "softkin/solver/robots/robots.hpp"
 
 #include <gtest/gtest.h>
 

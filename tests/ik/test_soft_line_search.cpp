@@ -1,8 +1,8 @@
 // Algorithm 3: the soft line search never accepts an increase and never leaves the box, on the
 // nonlinear bounded PCC model, with reachable and unreachable targets, the raw and the
 // range-normalised gradient, and evaluations that fail.
-#include "ik/pcc_kinematics.hpp"
-#include "ik/soft_line_search.hpp"
+#include "softkin/ik/pcc_kinematics.hpp"
+#include "softkin/ik/soft_line_search.hpp"
 
 #include "ik_test_models.hpp"
 

@@ -1,7 +1,7 @@
 // SubsetKinematics: the driven actuators' slice of another Kinematics, the rest held fixed.
-#include "ik/subset_kinematics.hpp"
+#include "softkin/ik/subset_kinematics.hpp"
 
-#include "ik/ik_solver.hpp"
+#include "softkin/ik/ik_solver.hpp"
 #include "ik_test_models.hpp"
 
 #include <gtest/gtest.h>

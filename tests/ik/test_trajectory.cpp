@@ -1,7 +1,7 @@
 // Algorithm 4 on the PCC finger: continuity on a smooth path, unreachable waypoints reported with
 // their distance, the closest-sample initial guess, the sample cache, streaming and resuming.
-#include "ik/trajectory.hpp"
-#include "ik/pcc_kinematics.hpp"
+#include "softkin/ik/trajectory.hpp"
+#include "softkin/ik/pcc_kinematics.hpp"
 
 #include "ik_test_models.hpp"
 

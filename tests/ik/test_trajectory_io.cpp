@@ -1,6 +1,6 @@
 // Waypoint files (the thesis group's flower path included) and the streamed CSV: errors name the
 // file and the line.
-#include "ik/trajectory_io.hpp"
+#include "softkin/ik/trajectory_io.hpp"
 
 #include <gtest/gtest.h>
 
@@ -31,7 +31,7 @@ void ExpectError(const std::string& text, const std::string& line_tag, const std
 }
 
 TEST(WaypointFile, ReadsTheFlowerTrajectory) {
-  const Eigen::MatrixX3d w = ReadWaypoints(std::string(SOFTKIN_SHARED_DATA) + "/flower_trajectory.txt");
+  const Eigen::MatrixX3d w = ReadWaypoints(std::string(SOFTKIN_THESIS_DATA) + "/flower_trajectory.txt");
   // 121 lines (the README says 120): the last one, without a newline, closes the loop.
   ASSERT_EQ(w.rows(), 121);
   EXPECT_EQ(w.row(120), w.row(0));

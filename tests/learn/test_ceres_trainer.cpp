@@ -1,7 +1,7 @@
 // The Ceres peer of the LM trainer: it reaches the loss the in-house trainer reaches, on the same
 // network, data and start.
-#include "learn/ceres_trainer.hpp"
-#include "learn/lm_trainer.hpp"
+#include "softkin/learn/ceres_trainer.hpp"
+#include "softkin/learn/lm_trainer.hpp"
 
 #include "learn_test_util.hpp"
 

@@ -1,9 +1,9 @@
 // Datasets: serpentine order, resume and shard identities (bit for bit), the loader's checks and
 // the seeded split. The kinematics is the analytical PCC model wrapped so that its output depends
 // on its warm-start history, which makes the block replay of resume and shards observable.
-#include "learn/dataset.hpp"
+#include "softkin/learn/dataset.hpp"
 
-#include "ik/pcc_kinematics.hpp"
+#include "softkin/ik/pcc_kinematics.hpp"
 
 #include <gtest/gtest.h>
 

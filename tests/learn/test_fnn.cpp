@@ -1,6 +1,6 @@
 // The FNN: Eq. 5.7, normalisation identities, Jacobians against finite differences, the parameter
 // layout, Nguyen-Widrow init, and the softkin-fnn v1 file round trip and its rejection of corrupt files.
-#include "learn/fnn.hpp"
+#include "softkin/learn/fnn.hpp"
 
 #include "learn_test_util.hpp"
 

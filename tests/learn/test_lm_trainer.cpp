@@ -1,7 +1,7 @@
 // The Levenberg-Marquardt trainer: exact fits of teacher data, monotone training loss, bitwise
 // determinism across thread counts, early stopping on validation, the stopping tests, and the
 // seeded split helper.
-#include "learn/lm_trainer.hpp"
+#include "softkin/learn/lm_trainer.hpp"
 
 #include "learn_test_util.hpp"
 

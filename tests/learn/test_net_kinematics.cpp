@@ -1,12 +1,12 @@
 // Learned kinematics (Eq. 5.4): the Jacobian of the composed networks against finite differences,
 // the network-directory format, and the whole chain dataset -> training -> learned IK on an
 // analytical robot whose truth is known (the PCC cable finger).
-#include "learn/net_kinematics.hpp"
-#include "learn/train_nets.hpp"
+#include "softkin/learn/net_kinematics.hpp"
+#include "softkin/learn/train_nets.hpp"
 
-#include "ik/ik_solver.hpp"
-#include "ik/objectives.hpp"
-#include "ik/pcc_kinematics.hpp"
+#include "softkin/ik/ik_solver.hpp"
+#include "softkin/ik/objectives.hpp"
+#include "softkin/ik/pcc_kinematics.hpp"
 #include "learn_test_util.hpp"
 
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
 // The tiled Cholesky factorisation: it solves SPD systems like Eigen's LLT, gives the same bits for
 // any thread count, and reports a matrix that is not positive definite.
-#include "learn/tiled_cholesky.hpp"
+#include "softkin/learn/tiled_cholesky.hpp"
 
 #include "learn_test_util.hpp"
 

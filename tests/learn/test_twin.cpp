@@ -1,10 +1,10 @@
 // The "hardware" twins: labelled as twins, positions only, and differing from the nominal robot
 // exactly by the documented offset and noise where the physics agrees (at rest), by more where
 // the perturbed material and geometry act (when actuated).
-#include "learn/twin.hpp"
+#include "softkin/learn/twin.hpp"
 
-#include "ik/simulator_kinematics.hpp"
-#include "solver/robots.hpp"
+#include "softkin/ik/simulator_kinematics.hpp"
+#include "softkin/solver/robots/robots.hpp"
 
 #include <gtest/gtest.h>
 

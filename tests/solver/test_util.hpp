@@ -3,8 +3,8 @@
 /// Small helpers shared by the energy and local-global tests: scene builders (voxel bars with
 /// chosen regions and materials, a hand-built prism slab), random rotations and matrix comparisons
 /// that report the first failing (row, col) entry.
-#include "solver/mesh_gen.hpp"
-#include "solver/scene.hpp"
+#include "softkin/solver/mesh/mesh_gen.hpp"
+#include "softkin/solver/scene/scene.hpp"
 
 #include <Eigen/Dense>
 #include <Eigen/Geometry>

@@ -1,5 +1,5 @@
 // Downstream use of an installed SoftKin: build an embedded robot scene and report its size.
-#include "solver/robots.hpp"
+#include <softkin/solver/robots/robots.hpp>
 
 #include <cstdio>
 #include <exception>

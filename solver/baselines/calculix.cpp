@@ -1,0 +1,373 @@
+#include "softkin/solver/baselines/calculix.hpp"
+
+#include "softkin/solver/fk/energy.hpp"
+#include "softkin/solver/fk/targets.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace softkin {
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Seconds(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+
+std::string Num(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof(buf), "%.12g", v);
+  return buf;
+}
+
+/// Writes a list of integers, at most 8 per line (the .inp line-length convention).
+void WriteIds(std::ostream& o, const std::vector<int>& ids) {
+  for (size_t q = 0; q < ids.size(); ++q) {
+    o << ids[q] + 1;
+    o << ((q + 1) % 8 == 0 || q + 1 == ids.size() ? "\n" : ", ");
+  }
+}
+
+}  // namespace
+
+void WriteCalculixInput(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& c,
+                        const CalculixOptions& opt, const std::string& path) {
+  const Scene& s = model.scene();
+  const Mesh& mesh = s.mesh;
+  CheckActuation(model, c);
+  if (opt.law != "linear" && opt.law != "neo-hooke")
+    throw std::invalid_argument("calculix: law: expected linear or neo-hooke, got '" + opt.law + "'");
+  if (!(opt.young > 0) || !(opt.poisson >= 0 && opt.poisson < 0.5) || opt.increments < 1)
+    throw std::invalid_argument("calculix: expected young > 0, 0 <= poisson < 0.5, increments >= 1");
+  if (!s.region_rest.regions.empty())
+    throw std::invalid_argument("calculix: scene '" + s.name + "' has regions with their own rest shape (a remeshed "
+                                "chamber); the CalculiX export needs one rest mesh");
+  for (int i = 0; i < mesh.num_elements(); ++i)
+    if (mesh.elements[i].k() != 4)
+      throw std::invalid_argument("calculix: element " + std::to_string(i) +
+                                  " is a prism; the CalculiX export supports tets only (C3D4)");
+  for (const auto& a : s.actuators)
+    if (a.type != ActuatorType::Pneumatic)
+      throw std::invalid_argument("calculix: actuator '" + a.name + "' is " +
+                                  ActuatorTypeToString(a.type) +
+                                  "; the CalculiX export supports pneumatic actuators only");
+
+  std::ofstream o(path);
+  if (!o) throw std::runtime_error("calculix: cannot write '" + path + "'");
+  o << "** SoftKin scene '" << s.name << "' exported for CalculiX (solver/baselines/calculix.hpp)\n";
+  o << "*NODE, NSET=NALL\n";
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    o << v + 1 << ", " << Num(mesh.vertices(v, 0)) << ", " << Num(mesh.vertices(v, 1)) << ", "
+      << Num(mesh.vertices(v, 2)) << "\n";
+
+  // Element sets: one per body region, one per actuation group.
+  std::map<std::string, std::vector<int>> sets;
+  std::vector<int> elem_group(mesh.num_elements(), -1);
+  for (int g = 0; g < model.num_groups(); ++g)
+    for (int i : model.group_elements(g)) elem_group[i] = g;
+  for (int i = 0; i < mesh.num_elements(); ++i) {
+    const std::string name = elem_group[i] >= 0 ? "G" + std::to_string(elem_group[i])
+                                                : "R" + std::to_string(mesh.elements[i].region);
+    sets[name].push_back(i);
+  }
+  for (const auto& [name, ids] : sets) {
+    o << "*ELEMENT, TYPE=C3D4, ELSET=" << name << "\n";
+    for (int i : ids) {
+      const auto& e = mesh.elements[i];
+      o << i + 1 << ", " << e.v[0] + 1 << ", " << e.v[1] + 1 << ", " << e.v[2] + 1 << ", "
+        << e.v[3] + 1 << "\n";
+    }
+  }
+  // Boundary conditions.
+  if (!s.fixed.empty()) {
+    o << "*NSET, NSET=FIXED\n";
+    WriteIds(o, s.fixed);
+    o << "*BOUNDARY\nFIXED, 1, 3, 0.\n";
+  }
+  for (int d = 0; d < 3; ++d) {
+    if (s.fixed_axis[d].empty()) continue;
+    o << "*NSET, NSET=HELD" << "XYZ"[d] << "\n";
+    WriteIds(o, s.fixed_axis[d]);
+    o << "*BOUNDARY\nHELD" << "XYZ"[d] << ", " << d + 1 << ", " << d + 1 << ", 0.\n";
+  }
+  for (const auto& a : s.actuators)
+    if (a.is_motion())
+      throw std::invalid_argument("calculix: motion actuator '" + a.name + "' is not exported");
+
+  // Materials and sections.
+  auto material = [&](const std::string& name, double E, double expansion, const Material* mr) {
+    o << "*MATERIAL, NAME=" << name << "\n";
+    if (opt.law == "linear") {
+      o << "*ELASTIC\n" << Num(E) << ", " << Num(opt.poisson) << "\n";
+    } else if (mr) {
+      // A Mooney-Rivlin body region keeps its c1 : c2 ratio, scaled to the small-strain modulus E.
+      const double sc = E / (6.0 * (mr->c1 + mr->c2));
+      const double d1 = 6.0 * (1.0 - 2.0 * opt.poisson) / E;
+      o << "*HYPERELASTIC, MOONEY-RIVLIN\n" << Num(sc * mr->c1) << ", " << Num(sc * mr->c2) << ", "
+        << Num(d1) << "\n";
+    } else {
+      const double c10 = E / (4.0 * (1.0 + opt.poisson));
+      const double d1 = 6.0 * (1.0 - 2.0 * opt.poisson) / E;
+      o << "*HYPERELASTIC, NEO HOOKE\n" << Num(c10) << ", " << Num(d1) << "\n";
+    }
+    o << "*EXPANSION\n" << Num(expansion) << "\n";
+  };
+  for (const auto& [name, ids] : sets) {
+    double E = opt.young, a = 0.0;
+    const Material* mr = nullptr;
+    if (name[0] == 'R') {
+      const Material& mat = s.body.at(std::stoi(name.substr(1)));
+      E = mat.weight * opt.young;
+      if (mat.hyperelastic()) mr = &mat;
+    } else {
+      const int g = std::stoi(name.substr(1));
+      const Actuator& act = s.actuators[model.group_actuator(g)];
+      const int side = model.group_side(g);
+      const bool vented = side != 0 && side * c[model.group_actuator(g)] <= 0.0;
+      if (vented) {
+        E = 1e-3 * opt.young;
+      } else {
+        E = act.weight * opt.young;
+        a = std::cbrt(model.GroupRatio(g, c)) - 1.0;
+      }
+    }
+    material("M" + name, E, a, mr);
+    o << "*SOLID SECTION, ELSET=" << name << ", MATERIAL=M" << name << "\n";
+  }
+  const double dt = 1.0 / opt.increments;
+  o << "*INITIAL CONDITIONS, TYPE=TEMPERATURE\nNALL, 0.\n";
+  o << "*STEP, NLGEOM, INC=" << 100 * opt.increments << "\n";
+  o << "*STATIC\n" << Num(dt) << ", 1., " << Num(1e-4 * dt) << ", " << Num(dt) << "\n";
+  o << "*TEMPERATURE\nNALL, 1.\n";
+  o << "*NODE PRINT, NSET=NALL\nU\n";
+  o << "*END STEP\n";
+  if (!o) throw std::runtime_error("calculix: error while writing '" + path + "'");
+}
+
+std::vector<std::pair<double, Eigen::MatrixX3d>> ReadCalculixDisplacements(const std::string& dat,
+                                                                           int nv) {
+  std::ifstream in(dat);
+  if (!in) throw std::runtime_error("calculix: cannot open '" + dat + "'");
+  std::vector<std::pair<double, Eigen::MatrixX3d>> out;
+  std::string line;
+  int line_no = 0;
+  Eigen::MatrixX3d* cur = nullptr;
+  std::vector<bool> seen;
+  auto finish = [&]() {
+    if (!cur) return;
+    for (int v = 0; v < nv; ++v)
+      if (!seen[v])
+        throw std::runtime_error(dat + ": the block ending before line " + std::to_string(line_no) +
+                                 " lacks node " + std::to_string(v + 1));
+    cur = nullptr;
+  };
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.find("displacements (vx,vy,vz)") != std::string::npos) {
+      finish();
+      const auto p = line.find("time");
+      double t = 0;
+      if (p == std::string::npos || std::sscanf(line.c_str() + p + 4, "%lf", &t) != 1)
+        throw std::runtime_error(dat + ":" + std::to_string(line_no) + ": expected 'time T'");
+      out.emplace_back(t, Eigen::MatrixX3d::Zero(nv, 3));
+      cur = &out.back().second;
+      seen.assign(nv, false);
+      continue;
+    }
+    if (!cur) continue;
+    std::istringstream ss(line);
+    long node;
+    double x, y, z;
+    if (!(ss >> node)) {
+      if (line.find_first_not_of(" \t\r") == std::string::npos) continue;  // blank line
+      finish();  // another kind of block
+      continue;
+    }
+    if (!(ss >> x >> y >> z))
+      throw std::runtime_error(dat + ":" + std::to_string(line_no) + ": expected node ux uy uz");
+    if (node < 1 || node > nv)
+      throw std::runtime_error(dat + ":" + std::to_string(line_no) + ": node " +
+                               std::to_string(node) + " out of range 1.." + std::to_string(nv));
+    cur->row(node - 1) << x, y, z;
+    seen[node - 1] = true;
+  }
+  finish();
+  return out;
+}
+
+double CalculixRatioAtLoad(double alpha, double load) {
+  const double r = 1.0 + (std::cbrt(alpha) - 1.0) * load;
+  return r * r * r;
+}
+
+int CountConvergedIncrements(const std::string& sta) {
+  std::ifstream in(sta);
+  int n = 0;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream ss(line);
+    long step, inc;
+    std::string att;
+    if (ss >> step >> inc >> att && !att.empty() && att.back() != 'U' &&
+        att.find_first_not_of("0123456789") == std::string::npos)
+      ++n;
+  }
+  return n;
+}
+
+std::string FindCcx() {
+  const char* path = std::getenv("PATH");
+  if (!path) return "";
+  std::stringstream ss(path);
+  std::string dir;
+  while (std::getline(ss, dir, ':')) {
+    if (dir.empty()) continue;
+    const fs::path p = fs::path(dir) / "ccx";
+    if (::access(p.c_str(), X_OK) == 0) return p.string();
+  }
+  return "";
+}
+
+CalculixSolver::CalculixSolver(std::shared_ptr<const Model> model, const FkOptions& fk,
+                               CalculixOptions options)
+    : FkSolver(std::move(model)), name_(fk.solver), options_(std::move(options)) {
+  if (fk.time_limit_s > 0 && options_.time_limit_s <= 0) options_.time_limit_s = fk.time_limit_s;
+  if (fk.continuation_steps > 1) options_.increments = fk.continuation_steps;
+}
+
+FkResult CalculixSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c, const Eigen::MatrixX3d*) {
+  const Model& m = *model_;
+  const auto t0 = Clock::now();
+  FkResult r;
+  history_.clear();
+  const bool input_ok = StartResult(c, nullptr, &r);  // FEM loads from rest: no warm start
+  auto finish = [&](FkStatus st, const std::string& msg) {
+    r.status = st;
+    r.message = msg;
+    if (st != FkStatus::InvalidInput) {
+      std::vector<double> ratios;
+      ComputeLocalRatios(m, r.positions, c, &ratios, &r.volume_ratios);
+      Eigen::MatrixX3d G;
+      r.energy = FixedRatioEnergyAndGradient(m, r.positions, ratios, &G);
+    }
+    r.time_s = Seconds(t0, Clock::now());
+    return r;
+  };
+  if (!input_ok) return finish(FkStatus::InvalidInput, r.message);
+  const std::string ccx = FindCcx();
+  if (ccx.empty())
+    return finish(FkStatus::InvalidInput,
+                  "ccx (CalculiX) is not installed or not on PATH; install the Debian package "
+                  "calculix-ccx (scripts/setup.sh does)");
+  std::string tmpl = (fs::temp_directory_path() / "softkin_ccx_XXXXXX").string();
+  if (!::mkdtemp(tmpl.data())) return finish(FkStatus::InvalidInput, "cannot create a temporary folder");
+  const fs::path work(tmpl);
+  struct Cleanup {
+    fs::path p;
+    bool keep;
+    ~Cleanup() {
+      std::error_code ec;
+      if (!keep) fs::remove_all(p, ec);
+    }
+  } cleanup{work, options_.keep_files};
+  try {
+    WriteCalculixInput(m, c, options_, (work / "job.inp").string());
+  } catch (const std::invalid_argument& e) {
+    return finish(FkStatus::InvalidInput, e.what());
+  } catch (const std::runtime_error& e) {
+    return finish(FkStatus::InvalidInput, e.what());
+  }
+  // Run ccx -i job in the work folder, output to ccx.log; no shell is involved.
+  const std::string log = (work / "ccx.log").string();
+  const pid_t pid = ::fork();
+  if (pid < 0) return finish(FkStatus::Diverged, "fork failed");
+  if (pid == 0) {
+    if (::chdir(work.c_str()) != 0) ::_exit(126);
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) {
+      ::dup2(fd, 1);
+      ::dup2(fd, 2);
+      ::close(fd);
+    }
+    ::setenv("OMP_NUM_THREADS", "2", 0);
+    char* const argv[] = {const_cast<char*>("ccx"), const_cast<char*>("-i"),
+                          const_cast<char*>("job"), nullptr};
+    ::execv(ccx.c_str(), argv);
+    ::_exit(127);
+  }
+  int wstatus = 0;
+  bool timed_out = false;
+  // Time-stamp each converged increment as it appears in job.sta (re-read only when it grows).
+  const std::string sta = (work / "job.sta").string();
+  std::vector<double> stamps;
+  std::uintmax_t sta_size = 0;
+  auto poll_sta = [&]() {
+    std::error_code ec;
+    const std::uintmax_t size = fs::file_size(sta, ec);
+    if (ec || size == sta_size) return;
+    sta_size = size;
+    const int n = CountConvergedIncrements(sta);
+    const double now = Seconds(t0, Clock::now());
+    while (static_cast<int>(stamps.size()) < n) stamps.push_back(now);
+  };
+  for (;;) {
+    const pid_t w = ::waitpid(pid, &wstatus, WNOHANG);
+    poll_sta();
+    if (w == pid) break;
+    if (w < 0) return finish(FkStatus::Diverged, "waitpid failed");
+    if (options_.time_limit_s > 0 && Seconds(t0, Clock::now()) > options_.time_limit_s) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &wstatus, 0);
+      timed_out = true;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  std::vector<std::pair<double, Eigen::MatrixX3d>> blocks;
+  try {
+    blocks = ReadCalculixDisplacements((work / "job.dat").string(), m.num_vertices());
+  } catch (const std::runtime_error& e) {
+    if (!timed_out) return finish(FkStatus::Diverged, std::string("ccx output: ") + e.what());
+  }
+  // Block k of job.dat is converged increment k of job.sta; a block ccx wrote after the last
+  // poll (possible only at the very end) gets the end time.
+  const double end_s = Seconds(t0, Clock::now());
+  for (size_t k = 0; k < blocks.size(); ++k)
+    history_.push_back({blocks[k].first, k < stamps.size() ? stamps[k] : end_s,
+                        blocks[k].second + m.rest_positions()});
+  r.iterations = static_cast<int>(history_.size());
+  if (!history_.empty()) r.positions = history_.back().positions;
+  if (timed_out)
+    return finish(FkStatus::TimeLimit,
+                  "time limit of " + std::to_string(options_.time_limit_s) + " s reached");
+  const bool reached = !history_.empty() && std::abs(history_.back().load - 1.0) < 1e-6;
+  if (reached && r.positions.allFinite()) return finish(FkStatus::Converged, "");
+  // The last error line of the log says why.
+  std::ifstream lg(log);
+  std::string line, last;
+  while (std::getline(lg, line))
+    if (line.find("ERROR") != std::string::npos || line.find("error") != std::string::npos) last = line;
+  if (!r.positions.allFinite()) r.positions = m.rest_positions();
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "ccx stopped at time %.4g of 1",
+                history_.empty() ? 0.0 : history_.back().load);
+  return finish(FkStatus::Diverged, std::string(buf) + (last.empty() ? "" : ": " + last));
+}
+
+}  // namespace softkin

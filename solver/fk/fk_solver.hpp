@@ -1,0 +1,81 @@
+#pragma once
+/// \file fk_solver.hpp
+/// The forward-kinematics solver interface: Solve(c, warm_start) -> FkResult. Implementations are
+/// chosen by name (FkOptions::solver). Two tiers: the one-shot SolveFk(scene, c) and a stateful
+/// solver (MakeFkSolver) that reuses the model's factorisation across calls.
+#include "softkin/solver/collision/collision_response.hpp"
+#include "softkin/solver/fk/fk_options.hpp"
+#include "softkin/solver/fk/model.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace softkin {
+
+/// TimeLimit: FkOptions::time_limit_s ran out (the positions are the last checked iterate).
+enum class FkStatus { Converged, IterationCap, Diverged, InvalidInput, TimeLimit };
+const char* FkStatusToString(FkStatus s);
+bool FkStatusFromString(const std::string& s, FkStatus* out);
+
+struct FkResult {
+  FkStatus status = FkStatus::InvalidInput;
+  std::string message;
+  std::string solver;
+  Eigen::VectorXd actuation;    ///< the actuation solved for
+  Eigen::MatrixX3d positions;   ///< #V x 3, mm; never NaN (the last finite iterate on divergence)
+  int iterations = 0;           ///< local-global iterations (summed over continuation steps)
+  double energy = 0;            ///< E at `positions` (Eq. 2.10)
+  double gradient_ratio = 0;    ///< ||local-global residual|| / its reference value at the start
+  double max_move = 0;          ///< last per-iteration vertex move / model size
+  double time_s = 0, local_time_s = 0, global_time_s = 0;
+  int aa_accepted = 0, aa_rejected = 0;
+  std::vector<double> volume_ratios;  ///< achieved volume ratio per actuator
+  /// Collision handling (lg / lg-aa when FkOptions::collision is active for the scene): whether
+  /// it ran, the exact check of the final positions, the springs still active at the end, and
+  /// the detection / response counts and times of this solve.
+  bool collision_active = false;
+  CollisionCheck collision;
+  int springs = 0;
+  CollisionStats collision_stats;
+  /// One line: status, iterations, energy, time.
+  std::string BriefReport() const;
+};
+
+class FkSolver {
+ public:
+  virtual ~FkSolver() = default;
+  virtual std::string name() const = 0;
+  /// Solves for actuation c (one value per actuator, within its range). warm_start: #V x 3
+  /// positions to start from (nullptr: rest shape). Bad input yields status InvalidInput with a
+  /// message (never an exception from here), non-convergence IterationCap or Diverged.
+  virtual FkResult Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
+                         const Eigen::MatrixX3d* warm_start = nullptr) = 0;
+  const Model& model() const { return *model_; }
+
+ protected:
+  explicit FkSolver(std::shared_ptr<const Model> m) : model_(std::move(m)) {}
+  /// Fills in what every Solve() starts from: the solver's name, the actuation, the positions
+  /// (the warm start, or the rest shape). Returns false, with status invalid_input and the reason
+  /// (SolveInputError) in *r, if c or the warm start is bad.
+  bool StartResult(const Eigen::Ref<const Eigen::VectorXd>& c, const Eigen::MatrixX3d* warm_start,
+                   FkResult* r) const;
+  std::shared_ptr<const Model> model_;
+};
+
+/// Checks an actuation vector (CheckActuation) and an optional warm start (#V x 3, finite) for
+/// `model`; returns "" or the reason. Every solver's Solve() reports it as invalid_input.
+std::string SolveInputError(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& c,
+                            const Eigen::MatrixX3d* warm_start);
+
+/// Names accepted by MakeFkSolver.
+std::vector<std::string> FkSolverNames();
+/// Builds the solver named options.solver; throws std::invalid_argument for an unknown name or
+/// invalid options (message from FkOptions::IsValid).
+std::unique_ptr<FkSolver> MakeFkSolver(std::shared_ptr<const Model> model, const FkOptions& options);
+
+/// One shot: builds the model and solves. Options default to the scene's.
+FkResult SolveFk(const Scene& scene, const Eigen::Ref<const Eigen::VectorXd>& c,
+                 const FkOptions* options = nullptr);
+
+}  // namespace softkin

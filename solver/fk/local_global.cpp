@@ -1,0 +1,245 @@
+#include "softkin/solver/fk/local_global.hpp"
+
+#include "softkin/solver/fk/anderson.hpp"
+#include "softkin/solver/fk/energy.hpp"
+#include "softkin/solver/fk/targets.hpp"
+
+#include <chrono>
+#include <optional>
+#include <cmath>
+#include <stdexcept>
+
+namespace softkin {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double Seconds(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+}  // namespace
+
+LocalGlobalSolver::LocalGlobalSolver(std::shared_ptr<const Model> model, const FkOptions& options)
+    : FkSolver(std::move(model)), options_(options) {
+  std::string why;
+  if (!options_.IsValid(&why)) throw std::invalid_argument("solver options: " + why);
+}
+
+void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* Xp, FkResult* r) {
+  const Model& m = *model_;
+  Eigen::MatrixX3d& X = *Xp;
+  const int nf = m.num_free_dofs();
+  const int nt = options_.threads;
+  const bool aa_on = options_.solver == "lg-aa";
+  const double tol = options_.tolerance;
+  const double gtol = options_.gradient_tolerance;
+
+  // Prescribed coordinates for this actuation (motion actuators move theirs with c), and their
+  // contribution A_fc x_c to the global system: A X restricted to the free rows, with every free
+  // coordinate zero.
+  m.ApplyConstraints(c, &X);
+  Eigen::VectorXd Cfix;
+  {
+    Eigen::MatrixX3d Xc = Eigen::MatrixX3d::Zero(m.num_vertices(), 3);
+    m.ApplyConstraints(c, &Xc);
+    m.GatherFree(m.A() * Xc, &Cfix);
+  }
+
+  Eigen::MatrixX3d B(m.num_vertices(), 3), Mv(m.num_vertices(), 3);
+  Eigen::VectorXd Bf(nf), xf(nf), Gf(nf), Gprev(nf), step(nf), AX(nf);
+  CollisionResponse* resp = response_.get();
+  auto local = [&](double* E) {
+    const auto t0 = Clock::now();
+    ComputeLocalRatios(m, X, c, &ratios_);
+    *E = LocalStep(m, X, ratios_, &weighted_, nt);
+    AssembleRhs(m, weighted_, &B, nt);
+    m.GatherFree(B, &Bf);
+    if (resp) {
+      *E += resp->Energy(X);
+      resp->AddToRhs(X, &Bf);
+    }
+    r->local_time_s += Seconds(t0, Clock::now());
+  };
+  auto load_free = [&]() { m.GatherFree(X, &xf); };
+  auto store_free = [&](const Eigen::VectorXd& y) { m.ScatterFree(y, &X); };
+  // ||A_ff x_f + A_fc x_c - B_f||: the energy gradient over the free coordinates (up to 2).
+  // Loads x_f from X as well.
+  auto residual = [&]() {
+    load_free();
+    m.GatherFree(m.A() * X, &AX);
+    if (resp) resp->AddSpringProduct(xf, &AX);
+    return 2.0 * (AX - Bf).norm();
+  };
+
+  // Reference residual: the residual at the rest shape for this actuation. It depends on c only,
+  // so it is cached across calls (sweeps and finite differences re-solve the same c often).
+  if (ref_c_.size() != c.size() || ref_c_ != c) {
+    const Eigen::MatrixX3d keep = X;
+    X = m.rest_positions();
+    m.ApplyConstraints(c, &X);
+    double E0;
+    local(&E0);
+    ref_value_ = residual();
+    ref_c_ = c;
+    X = keep;
+  }
+  double ref = ref_value_;
+
+  if (total_weight_ == 0.0)
+    for (const auto& e : m.elements()) total_weight_ += e.wv;
+  Anderson aa(nf, options_.anderson_window);
+  Eigen::MatrixX3d X_good = X;
+  const std::string& guard = options_.anderson_safeguard;
+  // Merits of the iterate an accelerated step was extrapolated from.
+  double base_E = 0.0, base_f = 0.0;
+  bool accelerated = false;  // X is an Anderson (extrapolated) iterate, not yet checked
+  auto reject = [&]() {      // fall back to the plain step G(x_k); the history is kept
+    store_free(Gprev);
+    ++r->aa_rejected;
+    accelerated = false;
+  };
+  const int interval = options_.collision.check_interval;
+  for (int it = 0; it < options_.max_iterations; ++it) {
+    if (deadline_ && Clock::now() > *deadline_) {
+      X = X_good;
+      r->status = FkStatus::TimeLimit;
+      r->message = "time limit of " + std::to_string(options_.time_limit_s) + " s reached";
+      return;
+    }
+    if (resp && it % interval == 0 && resp->Update(X)) {
+      // The spring set (so the energy and the map G) changed: this iterate starts a new history.
+      aa.Reset();
+      accelerated = false;
+    }
+    double E;
+    local(&E);
+    const double grad = residual();
+    const bool finite = std::isfinite(E) && X.allFinite() && std::isfinite(grad);
+    if (accelerated && (!finite || (guard == "energy" && !(E <= base_E)))) {
+      reject();
+      ++r->iterations;
+      continue;
+    }
+    if (!finite) {
+      X = X_good;
+      r->status = FkStatus::Diverged;
+      r->message = "non-finite energy or positions at iteration " + std::to_string(r->iterations);
+      return;
+    }
+
+    const auto t1 = Clock::now();
+    Gf = resp ? resp->Solve(Bf - Cfix) : m.SolveFree(Bf - Cfix);
+    r->global_time_s += Seconds(t1, Clock::now());
+    ++r->iterations;
+    if (!Gf.allFinite()) {
+      if (accelerated) {
+        reject();
+        continue;
+      }
+      X = X_good;
+      r->status = FkStatus::Diverged;
+      r->message = "the global step produced non-finite positions";
+      return;
+    }
+    step = Gf - xf;
+    const double fnorm = step.norm();  // fixed-point residual ||G(x) - x||
+    if (accelerated) {
+      if (guard == "hybrid" && !(E <= base_E || fnorm <= base_f)) {
+        reject();
+        continue;
+      }
+      ++r->aa_accepted;
+      accelerated = false;
+    }
+    X_good = X;  // the last iterate whose merit was checked
+    if (it == 0) {
+      // Floor: a residual this small is round-off (e.g. at the rest actuation, where both the
+      // residual at rest and at the start are ~0 and their ratio would be noise).
+      ref = std::max({ref, grad, 1e-8 * total_weight_ * m.size()});
+    }
+    r->gradient_ratio = ref > 0 ? grad / ref : 0.0;
+    Mv.setZero();
+    m.ScatterFree(step, &Mv);
+    const double move = Mv.rowwise().norm().maxCoeff() / m.size();
+    r->max_move = move;
+    // A residual at round-off level (e.g. at the rest actuation, where the reference is itself
+    // round-off) counts as converged whatever the ratio.
+    const bool roundoff = grad <= 1e-12 * total_weight_ * m.size();
+    if (move < tol && (r->gradient_ratio < gtol || roundoff)) {
+      store_free(Gf);
+      // With collisions, stop only if a check at this state leaves the spring set as it is.
+      if (resp && (resp->Update(X) || (resp->HasHandledContacts(resp->Check(X)) && resp->Stiffen()))) {
+        // Springs changed, or contacts are left (springs yield by force / k): raise k.
+        aa.Reset();
+        continue;
+      }
+      r->status = FkStatus::Converged;
+      return;
+    }
+    if (aa_on) {
+      const Eigen::VectorXd& xn = aa.Compute(Gf, step);
+      Gprev = Gf;
+      base_E = E;
+      base_f = fnorm;
+      accelerated = aa.history() > 0;
+      store_free(xn);
+    } else {
+      store_free(Gf);
+    }
+  }
+  X = X_good;  // never return an unchecked (extrapolated) iterate
+  r->status = FkStatus::IterationCap;
+  r->message = "iteration cap of " + std::to_string(options_.max_iterations) + " reached";
+}
+
+FkResult LocalGlobalSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
+                                  const Eigen::MatrixX3d* warm_start) {
+  const Model& m = *model_;
+  const auto t0 = Clock::now();
+  FkResult r;
+  if (!StartResult(c, warm_start, &r)) {
+    r.time_s = Seconds(t0, Clock::now());
+    return r;
+  }
+  if (warm_start) m.ApplyConstraints(c, &r.positions);
+  const Eigen::VectorXd rest = m.scene().rest_actuation();
+  const int K = warm_start ? 1 : options_.continuation_steps;  // a warm start is already close
+  std::optional<Clock::time_point> deadline;
+  if (options_.time_limit_s > 0)
+    deadline = t0 + std::chrono::duration_cast<Clock::duration>(
+                        std::chrono::duration<double>(options_.time_limit_s));
+  deadline_ = deadline ? &*deadline : nullptr;
+  if (CollisionResponse::Active(m.scene(), options_.collision)) {
+    try {
+      if (!response_) response_ = std::make_unique<CollisionResponse>(m, options_.collision);
+    } catch (const std::exception& e) {
+      r.status = FkStatus::InvalidInput;
+      r.message = e.what();
+      r.time_s = Seconds(t0, Clock::now());
+      return r;
+    }
+    response_->Reset();
+  }
+  for (int s = 1; s <= K; ++s) {
+    const Eigen::VectorXd cs = (K == 1) ? Eigen::VectorXd(c)
+                                        : Eigen::VectorXd(rest + (c - rest) * (double(s) / K));
+    SolveStage(cs, &r.positions, &r);
+    if (options_.on_step)
+      options_.on_step(s, K, FkStatusToString(r.status), r.iterations, Seconds(t0, Clock::now()));
+    if (r.status == FkStatus::Diverged || r.status == FkStatus::TimeLimit) break;
+  }
+  deadline_ = nullptr;
+  ComputeLocalRatios(m, r.positions, c, &ratios_, &r.volume_ratios);
+  r.energy = LocalStep(m, r.positions, ratios_, &weighted_, options_.threads);
+  if (response_ && CollisionResponse::Active(m.scene(), options_.collision)) {
+    r.collision_active = true;
+    r.springs = static_cast<int>(response_->springs().size());
+    r.collision_stats = response_->stats();
+    const auto tc = Clock::now();
+    r.collision = response_->Check(r.positions);  // the exact check of the final state
+    r.collision_stats.check_s += Seconds(tc, Clock::now());
+  }
+  r.time_s = Seconds(t0, Clock::now());
+  return r;
+}
+
+}  // namespace softkin

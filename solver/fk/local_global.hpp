@@ -1,0 +1,55 @@
+#pragma once
+/// \file local_global.hpp
+/// The local-global solver of Algorithm 1 with optional Anderson acceleration.
+///  - local step: per-element targets and best rotations (parallel, no per-element allocation);
+///  - global step: A_ff X_f = B_f - A_fc X_c with the CHOLMOD factor of the model (3 right-hand
+///    sides), fixed vertices eliminated as Dirichlet conditions;
+///  - Anderson acceleration of the positions (x <- G(x) = global(local(x))) with a safeguard. An
+///    accelerated iterate x_a, extrapolated from x_k, is checked after its own local and global
+///    steps; when it fails, the plain step G(x_k) is taken instead and the history is kept (it holds
+///    only checked iterates). FkOptions::anderson_safeguard picks the test:
+///      "energy": E(x_a) <= E(x_k), the classic rule for local-global solvers of a fixed energy;
+///      "hybrid" (default): E(x_a) <= E(x_k) OR ||G(x_a) - x_a|| <= ||G(x_k) - x_k||;
+///      "none": every finite step is kept.
+///    Why "hybrid": the plain iteration descends on E only when every target is a minimiser over
+///    its free variables (rigid bodies, fixed ratios). With the volume-proportional chamber ratios
+///    and blended bodies of Ch. 2 the fixed point of Algorithm 1 is not a minimum of E; plain steps
+///    raise E near it and the energy rule rejects most accelerated steps (measured in
+///    docs/benchmarks.md and the aa_ablation experiment). The residual alternative still rejects
+///    extrapolations that make both measures worse.
+///  - collision response (Sec. 3.3, Eq. 3.9), when FkOptions::collision is active for the scene:
+///    detection and the spring rule run before the local step (every check_interval iterations
+///    and always before stopping); the spring targets join the right-hand side and their k the
+///    matrix, whose factor follows the spring set by CHOLMOD update/downdate. A change of the
+///    spring set restarts the Anderson history (the map G changed).
+///  - stop when every vertex moves less than tolerance * size in one iteration AND the residual
+///    ||2 (A X - B)|| has dropped below gradient_tolerance times its reference (the larger of its
+///    value at the warm start and at the rest shape for the same actuation).
+#include "softkin/solver/fk/fk_solver.hpp"
+
+#include <chrono>
+
+namespace softkin {
+
+class LocalGlobalSolver : public FkSolver {
+ public:
+  LocalGlobalSolver(std::shared_ptr<const Model> model, const FkOptions& options);
+  std::string name() const override { return options_.solver; }
+  FkResult Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
+                 const Eigen::MatrixX3d* warm_start = nullptr) override;
+  const FkOptions& options() const { return options_; }
+
+ private:
+  /// One continuation stage: iterate from X towards the solution for c; accumulates into r.
+  void SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X, FkResult* r);
+  FkOptions options_;
+  std::unique_ptr<CollisionResponse> response_;  // springs of Eq. 3.5-3.9, when active
+  std::vector<ElemRows> weighted_;  // per-element w Vol T, reused across iterations
+  std::vector<double> ratios_;
+  double total_weight_ = 0.0;  // sum of w_i Vol_i: the scale of the residual's round-off floor
+  const std::chrono::steady_clock::time_point* deadline_ = nullptr;  // during Solve(), or none
+  Eigen::VectorXd ref_c_;    // actuation of the cached reference residual
+  double ref_value_ = 0.0;   // ||2 (A X_rest - B(X_rest; ref_c_))||
+};
+
+}  // namespace softkin

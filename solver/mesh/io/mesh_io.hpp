@@ -1,0 +1,57 @@
+#pragma once
+/// \file mesh_io.hpp
+/// Mesh readers and writers. Every reader validates and orients the mesh (ValidateAndOrient) and
+/// throws std::runtime_error("<file>:<line>: <what was wrong>; expected <what>") on bad input:
+/// truncated files, indices out of range, NaN/Inf, degenerate elements, unknown element types.
+#include "softkin/solver/mesh/mesh.hpp"
+
+#include <string>
+#include <vector>
+
+namespace softkin {
+
+/// The thesis group's `.tet` format ("N vertices", "M tets", N lines "x y z", M lines "4 a b c d",
+/// 0-based). If `labels_path` is non-empty it holds one integer per tet (region tag).
+Mesh ReadTet(const std::string& path, const std::string& labels_path = "",
+             MeshReport* report = nullptr);
+void WriteTet(const std::string& path, const Mesh& mesh, const std::string& labels_path = "");
+
+/// TetGen `.node` + `.ele` (`base` without extension). The first element attribute is the region.
+Mesh ReadTetGen(const std::string& base, MeshReport* report = nullptr);
+void WriteTetGen(const std::string& base, const Mesh& mesh);
+
+/// Gmsh ASCII `.msh` 2.2 and 4.1: tetrahedra (type 4) and prisms (type 6); the physical group is
+/// the region tag. Lower-dimensional elements are skipped.
+Mesh ReadGmsh(const std::string& path, MeshReport* report = nullptr);
+/// Writes Gmsh 2.2 ASCII (version 2.2 or 4.1 accepted as `version`).
+void WriteGmsh(const std::string& path, const Mesh& mesh, const std::string& version = "2.2");
+
+/// Legacy ASCII VTK unstructured grid (cell types 10 tet, 13 wedge); the region is the cell-data
+/// scalar array named `tag_array` (or the first integer cell-data array if empty).
+Mesh ReadVtk(const std::string& path, const std::string& tag_array = "",
+             MeshReport* report = nullptr);
+void WriteVtk(const std::string& path, const Mesh& mesh);
+
+/// Picks the reader by extension: .tet, .node/.ele, .msh, .vtk.
+Mesh ReadMesh(const std::string& path, MeshReport* report = nullptr);
+
+/// ParaView `.vtu` (ASCII XML) of the mesh at positions X (#V x 3): point data "displacement"
+/// (X - rest), cell data "region", "element_type" (VTK type id) and "strain" (a per-element
+/// strain measure: ||F^T F - I||_F / 2 of the best-fit deformation gradient).
+/// `rest_regions` / `rest_positions` (#V x 3): elements of those regions measure their strain from
+/// rest_positions instead of mesh.vertices (a Scene's region_rest, e.g. a remeshed chamber).
+void WriteVtu(const std::string& path, const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+              const std::vector<int>& rest_regions = {}, const Eigen::MatrixX3d* rest_positions = nullptr);
+/// `.pvd` collection listing (time, file) pairs, files relative to the pvd's folder.
+void WritePvd(const std::string& path, const std::vector<std::pair<double, std::string>>& steps);
+/// Boundary surface (faces used by one element) as Wavefront `.obj` at positions X.
+void WriteSurfaceObj(const std::string& path, const Mesh& mesh,
+                     const Eigen::Ref<const Eigen::MatrixX3d>& X);
+
+/// Per-element strain measure used by WriteVtu (#E values; NaN for an element whose rest shape is
+/// degenerate). Elements of `rest_regions` take their rest shapes from `rest_positions` (#V x 3).
+std::vector<double> ElementStrain(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                                  const std::vector<int>& rest_regions = {},
+                                  const Eigen::MatrixX3d* rest_positions = nullptr);
+
+}  // namespace softkin

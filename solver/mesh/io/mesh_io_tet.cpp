@@ -1,0 +1,133 @@
+/// \file mesh_io_tet.cpp
+/// The thesis group's `.tet` format and its per-tet label file.
+#include "softkin/solver/mesh/io/mesh_io.hpp"
+#include "softkin/solver/mesh/io/mesh_io_detail.hpp"
+
+namespace softkin {
+
+namespace {
+
+using detail::Scanner;
+
+/// Reads "<count> <word>" where word must start with `word_prefix` (e.g. "vert", "tet").
+long long ReadCountLine(Scanner& s, const char* word_prefix, const char* expected) {
+  if (!s.SkipBlankLines()) s.FailHere("file ends before the header", expected);
+  const long long n = s.Integer("the count");
+  if (n < 0) s.FailHere("negative count " + std::to_string(n), expected);
+  const std::string_view w = s.Word();
+  if (w.substr(0, std::char_traits<char>::length(word_prefix)) != word_prefix)
+    s.FailHere(
+        "found " + (w.empty() ? std::string("end of line") : detail::Quote(w)) + " after the count",
+        expected);
+  s.ExpectEol(expected);
+  s.NextLine();
+  return n;
+}
+
+/// Reads one label per line (blank lines are skipped) and assigns them as regions.
+void ReadLabels(const std::string& labels_path, Mesh& mesh) {
+  Scanner s(labels_path, '#');
+  const int ne = mesh.num_elements();
+  int i = 0;
+  while (s.SkipBlankLines()) {
+    if (i == ne)
+      s.FailHere("label " + std::to_string(i + 1) + " but the mesh has only " + std::to_string(ne) +
+                     " tets",
+                 std::to_string(ne) + " labels, one per tet");
+    mesh.elements[i].region = s.Int("the label");
+    s.ExpectEol("one integer label per line");
+    ++i;
+    s.NextLine();
+  }
+  if (i < ne)
+    s.FailHere("file ends after " + std::to_string(i) + " of " + std::to_string(ne) + " labels",
+               std::to_string(ne) + " labels, one per tet");
+}
+
+}  // namespace
+
+Mesh ReadTet(const std::string& path, const std::string& labels_path, MeshReport* report) {
+  Scanner s(path);
+  const int header_line = s.line();
+  const long long nv = ReadCountLine(s, "vert", "'<N> vertices' on the first line");
+  const int tets_line = s.line();
+  const long long ne = ReadCountLine(s, "tet", "'<M> tets' on the second line");
+  if (nv > INT_MAX || ne > INT_MAX)
+    detail::Fail(detail::At(path, nv > INT_MAX ? header_line : tets_line), "count too large",
+                 "fewer than 2^31 vertices and tets");
+
+  Mesh mesh;
+  std::vector<int> vertex_lines, element_lines;
+  {
+    const long long cap = detail::SafeReserve(nv, s.size());
+    mesh.vertices.resize(cap, 3);
+    vertex_lines.reserve(static_cast<std::size_t>(cap));
+  }
+  for (long long j = 0; j < nv; ++j) {
+    if (!s.SkipBlankLines())
+      s.FailHere("file ends after " + std::to_string(j) + " of " + std::to_string(nv) +
+                     " vertices (count declared on line " + std::to_string(header_line) + ")",
+                 std::to_string(nv) + " vertex lines 'x y z'");
+    if (j >= mesh.vertices.rows())
+      mesh.vertices.conservativeResize(2 * j + 1, 3);  // guard only: every line takes >= 2 bytes
+    vertex_lines.push_back(s.line());
+    mesh.vertices(j, 0) = s.Double("x");
+    mesh.vertices(j, 1) = s.Double("y");
+    mesh.vertices(j, 2) = s.Double("z");
+    s.ExpectEol("3 coordinates 'x y z' per vertex line");
+    s.NextLine();
+  }
+  mesh.vertices.conservativeResize(nv, 3);
+
+  mesh.elements.reserve(static_cast<std::size_t>(detail::SafeReserve(ne, s.size())));
+  element_lines.reserve(mesh.elements.capacity());
+  for (long long i = 0; i < ne; ++i) {
+    if (!s.SkipBlankLines())
+      s.FailHere("file ends after " + std::to_string(i) + " of " + std::to_string(ne) +
+                     " tets (count declared on line " + std::to_string(tets_line) + ")",
+                 std::to_string(ne) + " tet lines '4 a b c d'");
+    element_lines.push_back(s.line());
+    const int k = s.Int("the vertex count");
+    if (k != 4)
+      s.FailHere("element with " + std::to_string(k) + " vertices",
+                 "4 (lines '4 a b c d'; .tet holds only tetrahedra)");
+    Element e;
+    e.type = ElementType::Tet;
+    for (int a = 0; a < 4; ++a) e.v[a] = s.Int("a vertex index");
+    s.ExpectEol("'4 a b c d': 4 vertex indices per tet");
+    mesh.elements.push_back(e);
+    s.NextLine();
+  }
+  MeshReport rep;
+  if (s.SkipBlankLines())
+    rep.warnings.push_back(s.Here() + ": ignoring data after the " + std::to_string(ne) +
+                           " declared tets");
+
+  if (!labels_path.empty()) ReadLabels(labels_path, mesh);
+
+  MeshReport v = ValidateAndOrient(mesh, path, element_lines, vertex_lines);
+  v.warnings.insert(v.warnings.begin(), rep.warnings.begin(), rep.warnings.end());
+  detail::Deliver(v, report);
+  return mesh;
+}
+
+void WriteTet(const std::string& path, const Mesh& mesh, const std::string& labels_path) {
+  if (mesh.num_prisms() > 0)
+    detail::Fail(path, "cannot write " + std::to_string(mesh.num_prisms()) + " prisms to .tet",
+                 "a tet-only mesh (use Gmsh or VTK for prisms)");
+  {
+    std::ofstream out = detail::OpenForWrite(path);
+    out << mesh.num_vertices() << " vertices\n" << mesh.num_elements() << " tets\n";
+    for (int j = 0; j < mesh.num_vertices(); ++j) detail::WriteRow(out, mesh.vertices, j) << '\n';
+    for (const auto& e : mesh.elements)
+      out << "4 " << e.v[0] << ' ' << e.v[1] << ' ' << e.v[2] << ' ' << e.v[3] << '\n';
+    detail::FinishWrite(out, path);
+  }
+  if (!labels_path.empty()) {
+    std::ofstream out = detail::OpenForWrite(labels_path);
+    for (const auto& e : mesh.elements) out << e.region << '\n';
+    detail::FinishWrite(out, labels_path);
+  }
+}
+
+}  // namespace softkin

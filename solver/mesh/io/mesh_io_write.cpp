@@ -1,0 +1,254 @@
+/// \file mesh_io_write.cpp
+/// ReadMesh (dispatch by extension), ParaView output (.vtu, .pvd), the boundary surface as .obj and
+/// the per-element strain measure.
+#include <algorithm>
+#include <Eigen/Dense>
+#include <cmath>
+#include <limits>
+
+#include "softkin/solver/mesh/io/mesh_io.hpp"
+#include "softkin/solver/mesh/io/mesh_io_detail.hpp"
+
+namespace softkin {
+
+namespace {
+
+void CheckPositions(const std::string& path, const Mesh& mesh,
+                    const Eigen::Ref<const Eigen::MatrixX3d>& X) {
+  if (X.rows() != mesh.num_vertices())
+    detail::Fail(path, "positions have " + std::to_string(X.rows()) + " rows",
+                 std::to_string(mesh.num_vertices()) + " rows (one per mesh vertex)");
+}
+
+std::string XmlEscape(const std::string& s) {
+  std::string r;
+  r.reserve(s.size());
+  for (char c : s) {
+    switch (c) {
+      case '&': r += "&amp;"; break;
+      case '<': r += "&lt;"; break;
+      case '>': r += "&gt;"; break;
+      case '"': r += "&quot;"; break;
+      case '\'': r += "&apos;"; break;
+      default: r += c;
+    }
+  }
+  return r;
+}
+
+/// Local faces of a positively oriented element, listed so that their normals (right-hand rule)
+/// point out of the element. Triangles have d = -1.
+struct LocalFace {
+  int a, b, c, d;
+};
+constexpr LocalFace kTetFaces[4] = {{0, 2, 1, -1}, {0, 1, 3, -1}, {1, 2, 3, -1}, {0, 3, 2, -1}};
+constexpr LocalFace kPrismFaces[5] = {
+    {0, 2, 1, -1}, {3, 4, 5, -1}, {0, 1, 4, 3}, {1, 2, 5, 4}, {2, 0, 3, 5}};
+
+}  // namespace
+
+Mesh ReadMesh(const std::string& path, MeshReport* report) {
+  const std::string ext = detail::LowerExtension(path);
+  if (ext == ".tet") return ReadTet(path, "", report);
+  if (ext == ".node" || ext == ".ele")
+    return ReadTetGen(path.substr(0, path.size() - ext.size()), report);
+  if (ext == ".msh") return ReadGmsh(path, report);
+  if (ext == ".vtk") return ReadVtk(path, "", report);
+  detail::Fail(path, "unknown mesh file extension " + detail::Quote(ext.empty() ? "(none)" : ext),
+               ".tet, .node/.ele (TetGen), .msh (Gmsh 2.2/4.1) or .vtk (legacy ASCII)");
+}
+
+std::vector<double> ElementStrain(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                                  const std::vector<int>& rest_regions, const Eigen::MatrixX3d* rest_positions) {
+  if (X.rows() != mesh.num_vertices())
+    throw std::invalid_argument("ElementStrain: positions have " + std::to_string(X.rows()) +
+                                " rows; expected " + std::to_string(mesh.num_vertices()));
+  if (!rest_regions.empty() && (!rest_positions || rest_positions->rows() != mesh.num_vertices()))
+    throw std::invalid_argument("ElementStrain: expected rest positions with one row per vertex (" +
+                                std::to_string(mesh.num_vertices()) + ") for regions with their own rest shape");
+  std::vector<double> strain(mesh.elements.size());
+  for (std::size_t i = 0; i < mesh.elements.size(); ++i) {
+    const Element& e = mesh.elements[i];
+    const int k = e.k();
+    const bool own = std::find(rest_regions.begin(), rest_regions.end(), e.region) != rest_regions.end();
+    const Eigen::MatrixX3d& rest = own ? *rest_positions : mesh.vertices;
+    // Centred rest (P) and deformed (Q) positions; F minimises sum ||F p - q||^2:
+    // F = (Q^T P) (P^T P)^{-1}. For a tet the affine map is exact, so this is the exact F.
+    Eigen::Vector3d pc = Eigen::Vector3d::Zero(), qc = Eigen::Vector3d::Zero();
+    for (int a = 0; a < k; ++a) {
+      pc += rest.row(e.v[a]).transpose();
+      qc += X.row(e.v[a]).transpose();
+    }
+    pc /= k;
+    qc /= k;
+    Eigen::Matrix3d PtP = Eigen::Matrix3d::Zero(), QtP = Eigen::Matrix3d::Zero();
+    for (int a = 0; a < k; ++a) {
+      const Eigen::Vector3d p = rest.row(e.v[a]).transpose() - pc;
+      const Eigen::Vector3d q = X.row(e.v[a]).transpose() - qc;
+      PtP.noalias() += p * p.transpose();
+      QtP.noalias() += q * p.transpose();
+    }
+    Eigen::Matrix3d inv;
+    bool ok = false;
+    double det = 0.0;
+    PtP.computeInverseAndDetWithCheck(inv, det, ok, 1e-300);
+    const double scale = PtP.trace();
+    if (!ok || !(std::abs(det) > 1e-14 * scale * scale * scale)) {
+      strain[i] = std::numeric_limits<double>::quiet_NaN();  // degenerate rest element
+      continue;
+    }
+    const Eigen::Matrix3d F = QtP * inv;
+    strain[i] = 0.5 * (F.transpose() * F - Eigen::Matrix3d::Identity()).norm();
+  }
+  return strain;
+}
+
+void WriteVtu(const std::string& path, const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+              const std::vector<int>& rest_regions, const Eigen::MatrixX3d* rest_positions) {
+  CheckPositions(path, mesh, X);
+  const std::vector<double> strain = ElementStrain(mesh, X, rest_regions, rest_positions);
+  std::ofstream out = detail::OpenForWrite(path);
+  const int nv = mesh.num_vertices(), ne = mesh.num_elements();
+  out << "<?xml version=\"1.0\"?>\n"
+      << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
+         "header_type=\"UInt64\">\n"
+      << "  <UnstructuredGrid>\n"
+      << "    <Piece NumberOfPoints=\"" << nv << "\" NumberOfCells=\"" << ne << "\">\n";
+  out << "      <PointData Vectors=\"displacement\">\n"
+      << "        <DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" "
+         "format=\"ascii\">\n";
+  for (int j = 0; j < nv; ++j)
+    out << "          " << detail::Num{X(j, 0) - mesh.vertices(j, 0)} << ' '
+        << detail::Num{X(j, 1) - mesh.vertices(j, 1)} << ' '
+        << detail::Num{X(j, 2) - mesh.vertices(j, 2)} << '\n';
+  out << "        </DataArray>\n      </PointData>\n";
+  out << "      <CellData Scalars=\"region\">\n"
+      << "        <DataArray type=\"Int32\" Name=\"region\" format=\"ascii\">\n";
+  for (const auto& e : mesh.elements) out << "          " << e.region << '\n';
+  out << "        </DataArray>\n"
+      << "        <DataArray type=\"UInt8\" Name=\"element_type\" format=\"ascii\">\n";
+  for (const auto& e : mesh.elements)
+    out << "          " << (e.type == ElementType::Tet ? 10 : 13) << '\n';
+  out << "        </DataArray>\n"
+      << "        <DataArray type=\"Float64\" Name=\"strain\" format=\"ascii\">\n";
+  for (double s : strain) {
+    if (std::isfinite(s))
+      out << "          " << detail::Num{s} << '\n';
+    else
+      out << "          nan\n";
+  }
+  out << "        </DataArray>\n      </CellData>\n";
+  out << "      <Points>\n"
+      << "        <DataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\" "
+         "format=\"ascii\">\n";
+  for (int j = 0; j < nv; ++j) detail::WriteRow(out << "          ", X, j) << '\n';
+  out << "        </DataArray>\n      </Points>\n";
+  out << "      <Cells>\n"
+      << "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+  for (const auto& e : mesh.elements) {
+    std::array<int, 6> v = e.v;
+    if (e.type == ElementType::Prism) detail::VtkWedgeSwap(v);
+    out << "         ";
+    for (int a = 0; a < e.k(); ++a) out << ' ' << v[a];
+    out << '\n';
+  }
+  out << "        </DataArray>\n"
+      << "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
+  long long off = 0;
+  for (const auto& e : mesh.elements) {
+    off += e.k();
+    out << "          " << off << '\n';
+  }
+  out << "        </DataArray>\n"
+      << "        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
+  for (const auto& e : mesh.elements)
+    out << "          " << (e.type == ElementType::Tet ? 10 : 13) << '\n';
+  out << "        </DataArray>\n      </Cells>\n";
+  out << "    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
+  detail::FinishWrite(out, path);
+}
+
+void WritePvd(const std::string& path, const std::vector<std::pair<double, std::string>>& steps) {
+  std::ofstream out = detail::OpenForWrite(path);
+  out << "<?xml version=\"1.0\"?>\n"
+      << "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+      << "  <Collection>\n";
+  for (const auto& [t, file] : steps)
+    out << "    <DataSet timestep=\"" << detail::Num{t} << "\" group=\"\" part=\"0\" file=\""
+        << XmlEscape(file) << "\"/>\n";
+  out << "  </Collection>\n</VTKFile>\n";
+  detail::FinishWrite(out, path);
+}
+
+void WriteSurfaceObj(const std::string& path, const Mesh& mesh,
+                     const Eigen::Ref<const Eigen::MatrixX3d>& X) {
+  CheckPositions(path, mesh, X);
+  // Every element face as (sorted vertex key, element, local face); faces that occur once are on
+  // the boundary. Sorting a flat array avoids hashing and per-face allocation.
+  struct FaceRec {
+    std::array<int, 4> key;  // sorted vertex ids, key[3] = INT_MAX for triangles
+    int element;
+    int local;
+  };
+  std::vector<FaceRec> faces;
+  faces.reserve(static_cast<std::size_t>(mesh.num_tets()) * 4 +
+                static_cast<std::size_t>(mesh.num_prisms()) * 5);
+  for (int i = 0; i < mesh.num_elements(); ++i) {
+    const Element& e = mesh.elements[i];
+    const bool tet = e.type == ElementType::Tet;
+    const LocalFace* lf = tet ? kTetFaces : kPrismFaces;
+    const int nf = tet ? 4 : 5;
+    for (int f = 0; f < nf; ++f) {
+      FaceRec r{
+          {e.v[lf[f].a], e.v[lf[f].b], e.v[lf[f].c], lf[f].d >= 0 ? e.v[lf[f].d] : INT_MAX}, i, f};
+      std::sort(r.key.begin(), r.key.end());
+      faces.push_back(r);
+    }
+  }
+  std::sort(faces.begin(), faces.end(),
+            [](const FaceRec& a, const FaceRec& b) { return a.key < b.key; });
+
+  std::vector<int> new_index(mesh.num_vertices(), -1);
+  std::vector<const FaceRec*> boundary;
+  int nused = 0;
+  for (std::size_t i = 0; i < faces.size();) {
+    std::size_t j = i + 1;
+    while (j < faces.size() && faces[j].key == faces[i].key) ++j;
+    if (j == i + 1) {
+      boundary.push_back(&faces[i]);
+      for (int a = 0; a < 4; ++a) {
+        const int v = faces[i].key[a];
+        if (v != INT_MAX && new_index[v] < 0) new_index[v] = nused++;
+      }
+    }
+    i = j;
+  }
+  // Keep the original vertex order among the used vertices.
+  std::vector<int> order;
+  order.reserve(nused);
+  nused = 0;
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    if (new_index[v] >= 0) {
+      new_index[v] = nused++;
+      order.push_back(v);
+    }
+  std::sort(boundary.begin(), boundary.end(), [](const FaceRec* a, const FaceRec* b) {
+    return a->element != b->element ? a->element < b->element : a->local < b->local;
+  });
+
+  std::ofstream out = detail::OpenForWrite(path);
+  out << "# SoftKin boundary surface: " << order.size() << " vertices, " << boundary.size()
+      << " faces\n";
+  for (int v : order) detail::WriteRow(out << "v ", X, v) << '\n';
+  for (const FaceRec* r : boundary) {
+    const Element& e = mesh.elements[r->element];
+    const LocalFace& lf = (e.type == ElementType::Tet ? kTetFaces : kPrismFaces)[r->local];
+    out << "f " << new_index[e.v[lf.a]] + 1 << ' ' << new_index[e.v[lf.b]] + 1 << ' '
+        << new_index[e.v[lf.c]] + 1;
+    if (lf.d >= 0) out << ' ' << new_index[e.v[lf.d]] + 1;
+    out << '\n';
+  }
+  detail::FinishWrite(out, path);
+}
+
+}  // namespace softkin

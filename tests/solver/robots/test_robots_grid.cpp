@@ -1,0 +1,291 @@
+// Every embedded robot converges over a grid across its actuation range on a coarse mesh, plus the
+// physics each new robot is built to show: the redundancy of finger_manipulator, the DEA crawler's
+// sliding foot and flat state, the bimaterial bar's interface, the two materials of the cable
+// gripper. The number of failed grid points is printed; the goal (and the assertion) is none.
+#include "softkin/solver/fk/fk_solver.hpp"
+#include "softkin/solver/fk/model.hpp"
+#include "softkin/solver/robots/robots.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <map>
+
+namespace softkin {
+namespace {
+
+/// Solves every point of the grid values[0] x values[1] x ... (one list per actuator) in
+/// serpentine order, each warm-started from the previous solution (as a sweep or a dataset
+/// generator would). `check` runs on every converged point. Returns the number of failures.
+int SolveGrid(const Scene& s, const std::vector<std::vector<double>>& values,
+              const std::function<void(const Eigen::VectorXd&, const FkResult&)>& check = nullptr) {
+  auto model = std::make_shared<const Model>(s);
+  auto solver = MakeFkSolver(model, s.solver);
+  const int m = s.num_actuators();
+  std::vector<int> idx(m, 0), dir(m, 1);
+  Eigen::MatrixX3d X = model->rest_positions();
+  int failed = 0, solves = 0;
+  while (true) {
+    Eigen::VectorXd c(m);
+    for (int a = 0; a < m; ++a) c[a] = values[a][idx[a]];
+    const FkResult r = solver->Solve(c, &X);
+    ++solves;
+    if (r.status != FkStatus::Converged) {
+      ++failed;
+      ADD_FAILURE() << s.name << " actuation " << c.transpose() << ": " << r.BriefReport();
+    } else {
+      X = r.positions;
+      if (check) check(c, r);
+    }
+    // Serpentine increment: the last actuator moves fastest and reverses direction at each end.
+    int a = m - 1;
+    while (a >= 0) {
+      const int next = idx[a] + dir[a];
+      if (next >= 0 && next < static_cast<int>(values[a].size())) {
+        idx[a] = next;
+        break;
+      }
+      dir[a] = -dir[a];
+      --a;
+    }
+    if (a < 0) break;
+  }
+  std::printf("  %s (%d tets, %d prisms): %d of %d grid points failed\n", s.name.c_str(),
+              s.mesh.num_tets(), s.mesh.num_prisms(), failed, solves);
+  return failed;
+}
+
+Eigen::Vector3d Marker(const Scene& s, const Eigen::MatrixX3d& X, const char* name) {
+  const int m = s.marker_index(name);
+  EXPECT_GE(m, 0) << name;
+  return s.marker_positions(X).row(m).transpose();
+}
+
+TEST(RobotGrid, PneumaticFinger) {
+  const Scene s = MakeRobot("pneumatic_finger", 6);
+  EXPECT_EQ(SolveGrid(s, {{1.0, 4.0, 7.0, 10.0}}), 0);
+}
+
+TEST(RobotGrid, ThreeChamber) {
+  const Scene s = MakeRobot("three_chamber", 3);
+  EXPECT_EQ(SolveGrid(s, {{1, 2, 3}, {1, 2, 3}, {1, 2, 3}}), 0);
+}
+
+TEST(RobotGrid, FingerManipulatorIsPlanarAndMirrorSymmetric) {
+  const Scene s = MakeRobot("finger_manipulator", 6);
+  const Eigen::Vector3d tip0 = Marker(s, s.mesh.vertices, "tip");
+  const double size = s.mesh.size();
+  std::map<std::vector<double>, Eigen::Vector3d> tips;
+  double turn1 = 0;  // section 1's turn at (3, 0, 0): the straight sections 2-3 point j1 -> tip
+  const int failed = SolveGrid(s, {{-3, 0, 3}, {-3, 0, 3}, {-3, 0, 3}},
+                               [&](const Eigen::VectorXd& c, const FkResult& r) {
+                                 const Eigen::Vector3d p = Marker(s, r.positions, "tip");
+                                 if (c == Eigen::Vector3d(3, 0, 0)) {
+                                   const Eigen::Vector3d d = p - Marker(s, r.positions, "j1");
+                                   turn1 = std::atan2(-d.y(), d.x()) * 180.0 / M_PI;
+                                 }
+                                 // Planar in x-y: the mesh is mirror-symmetric about z = mid
+                                 // thickness; bound: the stopping rule (1e-5 of the size).
+                                 EXPECT_NEAR(p.z(), tip0.z(), 1e-4 * size) << c.transpose();
+                                 tips[{c[0], c[1], c[2]}] = p;
+                               });
+  EXPECT_EQ(failed, 0);
+  // v and -v are mirror images about y = 10 (the section layout is mirror-symmetric).
+  for (const auto& [c, p] : tips) {
+    auto it = tips.find({-c[0], -c[1], -c[2]});
+    if (it == tips.end()) continue;
+    EXPECT_NEAR(p.x(), it->second.x(), 1e-3 * size);
+    EXPECT_NEAR(p.y() - tip0.y(), -(it->second.y() - tip0.y()), 1e-3 * size);
+  }
+  // Positive values bend towards -y.
+  const std::vector<double> pos{3, 0, 0};
+  EXPECT_LT(tips[pos].y(), tip0.y() - 10.0);
+  // About 43 degrees at this res 6 (3.3 mm walls), 73 at the default res 8 (2.5 mm walls); the
+  // thesis reaches up to 120.
+  std::printf("  section 1 turns %.1f degrees at (3, 0, 0)\n", turn1);
+  EXPECT_GT(turn1, 35.0);
+}
+
+TEST(RobotRedundancy, FingerManipulatorReachesOneTipWithTwoActuations) {
+  // m = 3 > n = 2: the tip of actuation (1, 1, 1) is the target; with the third section's value
+  // changed to 0 (straight), find (v1, v2) that put the tip back on the target by Newton's method
+  // with a finite-difference Jacobian. FK must converge at both actuations and at every Newton
+  // step, and the two actuations must differ clearly.
+  const Scene s = MakeRobot("finger_manipulator", 6);
+  auto model = std::make_shared<const Model>(s);
+  auto solver = MakeFkSolver(model, s.solver);
+  auto tip_of = [&](const Eigen::VectorXd& c, Eigen::MatrixX3d* X) {
+    const FkResult r = solver->Solve(c, X);
+    EXPECT_EQ(r.status, FkStatus::Converged) << c.transpose() << ": " << r.BriefReport();
+    *X = r.positions;
+    const Eigen::Vector3d p = Marker(s, r.positions, "tip");
+    return Eigen::Vector2d(p.x(), p.y());
+  };
+  Eigen::MatrixX3d X = model->rest_positions();
+  const Eigen::Vector3d ref(1.0, 1.0, 1.0);
+  const Eigen::Vector2d target = tip_of(ref, &X);
+  Eigen::VectorXd c(3);
+  c << 1.0, 1.0, 0.0;
+  Eigen::MatrixX3d Xc = model->rest_positions();
+  Eigen::Vector2d p = tip_of(c, &Xc);
+  for (int it = 0; it < 15 && (p - target).norm() > 0.05; ++it) {
+    Eigen::Matrix2d J;
+    for (int q = 0; q < 2; ++q) {
+      Eigen::VectorXd cq = c;
+      const double dv = c[q] > 0 ? -1e-2 : 1e-2;  // one-sided, towards the range's inside
+      cq[q] += dv;
+      Eigen::MatrixX3d Xq = Xc;
+      J.col(q) = (tip_of(cq, &Xq) - p) / dv;
+    }
+    Eigen::Vector2d step = J.fullPivLu().solve(target - p);
+    if (step.norm() > 0.5) step *= 0.5 / step.norm();  // trust region in actuation units
+    c.head<2>() = (c.head<2>() + step).cwiseMax(-3.0).cwiseMin(3.0);
+    p = tip_of(c, &Xc);
+  }
+  std::printf("  actuation (%.3f, %.3f, %.3f) puts the tip within %.3f mm of that of (1, 1, 1)\n",
+              c[0], c[1], c[2], (p - target).norm());
+  EXPECT_LT((p - target).norm(), 0.1);
+  EXPECT_GT((c - Eigen::VectorXd(ref)).norm(), 1.0) << "the two actuations coincide";
+}
+
+TEST(RobotGrid, MultiSegmentGripperCurlsInPlane) {
+  const Scene s = MakeRobot("multi_segment_gripper", 6);
+  const Eigen::Vector3d tip0 = Marker(s, s.mesh.vertices, "tip");
+  const double size = s.mesh.size();
+  EXPECT_EQ(SolveGrid(s, {{1, 4.5, 8}, {1, 4.5, 8}, {1, 4.5, 8}},
+                      [&](const Eigen::VectorXd& c, const FkResult& r) {
+                        const Eigen::Vector3d p = Marker(s, r.positions, "tip");
+                        EXPECT_NEAR(p.y(), tip0.y(), 1e-4 * size) << c.transpose();
+                        if (c.maxCoeff() > 1.0) {
+                          EXPECT_LT(p.z(), tip0.z() - 1.0) << c.transpose();
+                        }
+                      }),
+            0);
+  // The grip layer belongs to the third segment, beyond P0.
+  const Eigen::Vector3d p0 = Marker(s, s.mesh.vertices, "P0");
+  const Eigen::Vector3d grip = Marker(s, s.mesh.vertices, "grip_layer");
+  EXPECT_GT(grip.x(), p0.x());
+  EXPECT_LT(grip.z(), 2.0);
+}
+
+TEST(RobotGrid, DeaCrawlerSlidesOnTheGroundAndFlattens) {
+  const Scene s = MakeRobot("dea_crawler", 4);
+  const Model model(s);
+  const int front = s.marker_index("front_foot");
+  double last_spacing = 0, last_apex = 1e9;
+  EXPECT_EQ(SolveGrid(s, {{0.7, 0.775, 0.85, 0.925, 1.0}},
+                      [&](const Eigen::VectorXd& c, const FkResult& r) {
+                        // The front foot stays on the ground exactly (held z), the rear is pinned.
+                        for (int v : s.markers[front].vertices)
+                          EXPECT_EQ(r.positions(v, 2), s.mesh.vertices(v, 2));
+                        for (int v : s.fixed)
+                          EXPECT_EQ(r.positions.row(v), s.mesh.vertices.row(v));
+                        const double spacing = (Marker(s, r.positions, "front_foot") -
+                                                Marker(s, r.positions, "rear_foot")).norm();
+                        const double apex = Marker(s, r.positions, "apex").z();
+                        // Relaxing the membrane spreads the legs and lowers the arch.
+                        EXPECT_GT(spacing, last_spacing) << c.transpose();
+                        EXPECT_LT(apex, last_apex) << c.transpose();
+                        last_spacing = spacing;
+                        last_apex = apex;
+                        if (c[0] == 1.0) {
+                          // lambda = 1 is the flat fabricated state: zero energy, rest positions.
+                          EXPECT_LT(r.energy, 1e-8);
+                          EXPECT_LT((r.positions - s.mesh.vertices).cwiseAbs().maxCoeff(), 1e-3);
+                        }
+                      }),
+            0);
+  // The released state arches well above the flat strip and pulls the feet together.
+  const FkResult r = SolveFk(s, s.rest_actuation());
+  ASSERT_EQ(r.status, FkStatus::Converged);
+  EXPECT_GT(Marker(s, r.positions, "apex").z(), Marker(s, s.mesh.vertices, "apex").z() + 2.0);
+  EXPECT_NEAR(r.volume_ratios[0], 0.7, 0.1);
+}
+
+TEST(RobotGrid, BimaterialBarTwistAndStretch) {
+  const Scene s = MakeRobot("bimaterial_bar", 3);
+  const int tip = s.marker_index("tip");
+  // Twists of +-90 degrees over the 80 mm bar (the thesis's twisting test turns the end by a
+  // similar amount); the warm start jumps 90 degrees at a time.
+  EXPECT_EQ(SolveGrid(s, {{-90, 0, 90}, {0, 20, 40}},
+                      [&](const Eigen::VectorXd& c, const FkResult& r) {
+                        // The end face is where the motion puts it: its centre on the axis,
+                        // moved by the stretch.
+                        const Eigen::Vector3d p = s.marker_positions(r.positions).row(tip).transpose();
+                        const Eigen::Vector3d p0 = s.marker_positions(s.mesh.vertices).row(tip).transpose();
+                        EXPECT_NEAR((p - p0 - Eigen::Vector3d(c[1], 0, 0)).norm(), 0.0, 1e-9);
+                      }),
+            0);
+}
+
+TEST(RobotBimaterialBar, InterfaceFollowsTheParameterAndTheSofterSideStretchesMore) {
+  for (double iface : {0.3, 0.5}) {
+    for (double wb : {1.0, 4.0}) {
+      const Scene s = MakeRobot("bimaterial_bar", 3, {{"interface", iface}, {"weight_b", wb}});
+      Eigen::VectorXd c(2);
+      c << 0.0, 16.0;
+      const FkResult r = SolveFk(s, c);
+      ASSERT_EQ(r.status, FkStatus::Converged) << r.BriefReport();
+      const double L = s.mesh.vertices.col(0).maxCoeff();
+      const double xi0 = Marker(s, s.mesh.vertices, "interface").x();
+      const double xi = Marker(s, r.positions, "interface").x();
+      EXPECT_NEAR(xi0, iface * L, 0.5 * L / 27 + 1e-9);  // snapped to a cell face
+      const double strain_a = (xi - xi0) / xi0, strain_b = (L + 16.0 - xi - (L - xi0)) / (L - xi0);
+      // A uniform bar stretches uniformly; B four times heavier stretches about four times less
+      // (a series of two springs whose stiffness ratio is the weight ratio).
+      if (wb == 1.0) {
+        EXPECT_NEAR(strain_a / strain_b, 1.0, 0.02);
+      }
+      if (wb == 4.0) {
+        EXPECT_NEAR(strain_a / strain_b, 4.0, 0.4);
+      }
+    }
+  }
+}
+
+TEST(RobotGrid, CableGripperTwoMaterialDistributions) {
+  std::map<std::string, Eigen::Vector3d> m3;
+  for (const auto& [label, params] :
+       std::vector<std::pair<std::string, RobotParams>>{{"uniform", {}},
+                                                        {"stiff_links", {{"link_weight", 8.0}}}}) {
+    const Scene s = MakeRobot("cable_gripper", 4, params);
+    const Eigen::Vector3d tip0 = Marker(s, s.mesh.vertices, "tip");
+    Eigen::Vector3d last;
+    EXPECT_EQ(SolveGrid(s, {{1.0, 0.875, 0.75, 0.625, 0.5}},
+                        [&](const Eigen::VectorXd& c, const FkResult& r) {
+                          last = Marker(s, r.positions, "m3");
+                          if (c[0] < 1.0) {
+                            EXPECT_GT(Marker(s, r.positions, "tip").z(), tip0.z() + 1.0);
+                          }
+                        }),
+              0)
+        << label;
+    m3[label] = last;
+  }
+  // The material distribution changes the shape (Fig. 2.9).
+  EXPECT_GT((m3["uniform"] - m3["stiff_links"]).norm(), 2.0);
+}
+
+TEST(RobotParams, UnknownOrOutOfRangeParametersAreRejectedByName) {
+  try {
+    MakeRobot("bimaterial_bar", 3, {{"interfac", 0.3}});
+    ADD_FAILURE() << "no throw";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown parameter 'interfac'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("interface"), std::string::npos) << e.what();
+  }
+  try {
+    MakeRobot("dea_crawler", 4, {{"frame_thickness", -1}});
+    ADD_FAILURE() << "no throw";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'frame_thickness' must be in [0.2, 5]"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(MakeRobot("three_chamber", 3, {{"gain", 1}}), std::invalid_argument);
+  EXPECT_THROW(MakeRobot("finger_manipulator", 7), std::invalid_argument);  // odd res
+}
+
+}  // namespace
+}  // namespace softkin
