@@ -15,6 +15,7 @@
 //
 // See docs/benchmarks.md (section "Self-collision detection") for how to run them and results.
 #include "softkin/solver/collision/collision.hpp"
+#include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/fk/model.hpp"
 #include "softkin/solver/robots/robots.hpp"

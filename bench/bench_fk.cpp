@@ -9,6 +9,7 @@
 //
 // See docs/benchmarks.md for what each benchmark measures and how to run them.
 #include "softkin/solver/fk/anderson.hpp"
+#include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/fk/local_global.hpp"
 #include "softkin/solver/fk/model.hpp"

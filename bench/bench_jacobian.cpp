@@ -30,6 +30,7 @@
 // BM_PredictedFk: the forward solve c0 -> c from the first-order prediction X0 + dX/dc(c0) (c - c0)
 // (SimulatorKinematicsOptions::predict_warm_start) instead of X0.
 // Run with OMP_NUM_THREADS=1 (or 2 on a quiet machine; docs/kinematics.md).
+#include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/ik/simulator_kinematics.hpp"
 #include "softkin/solver/robots/robots.hpp"
 

@@ -16,6 +16,7 @@
 // per step at 28,198 tets over the time of one call (res 4 only).
 //
 // See docs/benchmarks.md (section "Mesh generation") for how to run them and results.
+#include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/fk/model.hpp"
 #include "softkin/solver/remesh/remesh.hpp"

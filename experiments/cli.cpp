@@ -7,6 +7,7 @@
 #include "softkin/experiments/results.hpp"
 #include "softkin/experiments/runner.hpp"
 #include "softkin/solver/materials/calibration.hpp"
+#include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/mesh/io/mesh_io.hpp"
 #include "softkin/solver/robots/robots.hpp"

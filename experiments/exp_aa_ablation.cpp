@@ -1,6 +1,7 @@
 // Ablation: plain local-global against Anderson-accelerated, at mid and full actuation.
 #include "softkin/experiments/results.hpp"
 #include "softkin/experiments/runner.hpp"
+#include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/robots/robots.hpp"
 

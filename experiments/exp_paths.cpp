@@ -1,6 +1,7 @@
 // Fig. 2.12: actuators of one robot driven alone and together, with the tip trajectory of each.
 #include "softkin/experiments/results.hpp"
 #include "softkin/experiments/runner.hpp"
+#include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/robots/robots.hpp"
 

@@ -1,6 +1,7 @@
 // Fig. 2.13: cost and convergence of the FK solve under mesh refinement.
 #include "softkin/experiments/results.hpp"
 #include "softkin/experiments/runner.hpp"
+#include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/robots/robots.hpp"
 

@@ -7,6 +7,7 @@
 #include "softkin/experiments/runner.hpp"
 #include "softkin/solver/baselines/calculix.hpp"
 #include "softkin/solver/fk/energy.hpp"
+#include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/robots/robots.hpp"
 

@@ -1,5 +1,7 @@
 #include "softkin/ik/simulator_kinematics.hpp"
 
+#include "softkin/solver/factory/fk_factory.hpp"
+
 #include "softkin/solver/mesh/mesh.hpp"
 
 #include <algorithm>
@@ -404,7 +406,7 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
   }
 
   // Implicit.
-  if (CollisionResponse::Active(model_->scene(), fk_.collision)) {
+  if (ContactHandlingActive(model_->scene(), fk_.collision)) {
     ev.message =
         "jacobian 'implicit' does not include collision springs, and collision response is "
         "active for scene '" + model_->scene().name + "'; use fd or fd-warm";

@@ -17,6 +17,7 @@ Usage: bash scripts/setup.sh [--help]
 Environment:
   SOFTKIN_BUILD_DIR   build folder (default: build)
   SOFTKIN_JOBS        parallel build jobs (default: nproc)
+  SOFTKIN_WERROR      ON: treat compiler warnings as errors (CI sets it; default OFF)
 USAGE
 }
 
@@ -30,6 +31,7 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$ROOT"
 BUILD_DIR="${SOFTKIN_BUILD_DIR:-build}"
 JOBS="${SOFTKIN_JOBS:-$(nproc)}"
+WERROR="${SOFTKIN_WERROR:-OFF}"
 
 # Debian packages. The compiler, CMake, GoogleTest and Google Benchmark are expected to be
 # present already; everything else comes from here. Ceres, Ipopt, NLopt and CGAL are listed
@@ -89,8 +91,8 @@ for tool in cmake c++; do
   fi
 done
 
-log "configuring: cmake -S . -B $BUILD_DIR -DCMAKE_BUILD_TYPE=Release"
-cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release
+log "configuring: cmake -S . -B $BUILD_DIR -DCMAKE_BUILD_TYPE=Release -DSOFTKIN_WERROR=$WERROR"
+cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DSOFTKIN_WERROR="$WERROR"
 log "building: cmake --build $BUILD_DIR -j$JOBS"
 cmake --build "$BUILD_DIR" -j"$JOBS"
 log "done: binaries are in $ROOT/$BUILD_DIR/bin"

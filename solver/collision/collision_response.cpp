@@ -31,10 +31,6 @@ SpringSystem::Method UpdateMethod(const CollisionOptions& o) {
 }
 }  // namespace
 
-bool CollisionResponse::Active(const Scene& scene, const CollisionOptions& o) {
-  return o.self || (o.obstacles && !scene.obstacles.empty());
-}
-
 CollisionResponse::CollisionResponse(const Model& model, const CollisionOptions& options)
     : model_(model), options_(options), system_(model, UpdateMethod(options)) {
   std::string why;

@@ -32,6 +32,7 @@
 /// weights are kept (delta absorbs the refreshed exit point), so the matrix changes only when a
 /// contact starts, ends, or slides to another face or by a fifth of the face.
 #include "softkin/solver/collision/collision.hpp"
+#include "softkin/solver/fk/contact_term.hpp"
 #include "softkin/solver/fk/model.hpp"
 #include "softkin/solver/collision/spring_system.hpp"
 
@@ -76,62 +77,31 @@ struct CollisionSpring {
   }
 };
 
-/// Result of an exact collision check of a state.
-struct CollisionCheck {
-  int self_contacts = 0;      ///< boundary vertices inside a non-incident tet (exact predicates)
-  int obstacle_contacts = 0;  ///< vertices strictly inside an obstacle
-  double max_penetration = 0; ///< largest depth among them, mm (0 if collision-free)
-  double self_penetration = 0;      ///< largest depth among the self contacts, mm
-  double obstacle_penetration = 0;  ///< largest depth among the obstacle contacts, mm
-  /// Elements with non-positive signed volume at the checked positions (CountInvertedElements):
-  /// where the mesh has folded through itself, which no spring on a boundary vertex can undo.
-  int inverted_elements = 0;
-  /// Those of them that are body elements (the rest belong to actuators, e.g. a chamber's gas).
-  int inverted_body_elements = 0;
-  /// Self contacts inside a tangle: the vertex belongs to an inverted element, or the tet it lies
-  /// in is inverted. Contacts between separate parts of the surface are self_contacts minus these.
-  int tangled_contacts = 0;
-  bool collision_free() const { return self_contacts == 0 && obstacle_contacts == 0; }
-};
-
-/// Timings and counts of the collision handling in one solve.
-struct CollisionStats {
-  int checks = 0;
-  int springs_added = 0, springs_released = 0;
-  int max_springs = 0;
-  int unresolved = 0;      ///< self contacts for which no exit point was found (no spring)
-  int stiffenings = 0;     ///< times k was raised (CollisionResponse::Stiffen)
-  double check_s = 0;      ///< detection (self + obstacles)
-  double response_s = 0;   ///< targets, release rule and the factor update
-};
-
-class CollisionResponse {
+class CollisionResponse : public ContactTerm {
  public:
   /// Builds the detectors for `model`'s mesh (self-collision needs a tet-only mesh: throws
   /// std::invalid_argument otherwise) and the obstacles of its scene. `model` must outlive it.
   CollisionResponse(const Model& model, const CollisionOptions& options);
-  ~CollisionResponse();
+  ~CollisionResponse() override;
 
-  /// Whether a scene with these options needs collision handling at all.
-  static bool Active(const Scene& scene, const CollisionOptions& options);
 
   /// Detection at positions X (#V x 3) and the spring rule: adds, refreshes and releases springs.
   /// Returns true if the set of spring vertices (hence the global matrix) changed.
-  bool Update(const Eigen::Ref<const Eigen::MatrixX3d>& X);
+  bool Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) override;
   /// Adds the springs' constant terms to the free right-hand side (layout of Model::GatherFree):
   /// k c_s (delta_s - c_s . x_prescribed) per spring, k v_c for a fixed target. X supplies the
   /// prescribed coordinates (of a pair spring's face).
-  void AddToRhs(const Eigen::Ref<const Eigen::MatrixX3d>& X, Eigen::VectorXd* Bf) const;
+  void AddToRhs(const Eigen::Ref<const Eigen::MatrixX3d>& X, Eigen::VectorXd* Bf) const override;
   /// Adds K x to y (x: free coordinates, layout of Model::GatherFree).
-  void AddSpringProduct(const Eigen::VectorXd& x, Eigen::VectorXd* y) const;
+  void AddSpringProduct(const Eigen::VectorXd& x, Eigen::VectorXd* y) const override;
   /// Releases every spring and zeroes the statistics (the start of a new solve).
-  void Reset();
+  void Reset() override;
   /// E_col = sum k ||v - v_c||^2 at positions X (v_c = CollisionSpring::TargetAt(X)).
-  double Energy(const Eigen::Ref<const Eigen::MatrixX3d>& X) const;
+  double Energy(const Eigen::Ref<const Eigen::MatrixX3d>& X) const override;
   /// Solves (A_ff + K) y = rhs (free layout). With plane obstacle springs, K also holds their
   /// k u_s u_s^T terms (u_s = n_s on the vertex's free coordinates), applied to the factored
   /// per-axis system by the Woodbury identity (the file comment).
-  Eigen::VectorXd Solve(const Eigen::VectorXd& rhs) const;
+  Eigen::VectorXd Solve(const Eigen::VectorXd& rhs) const override;
   /// (A_ff + K) x (free layout).
   Eigen::VectorXd Multiply(const Eigen::VectorXd& x) const;
   /// Number of plane (normal-only) obstacle springs in the current set.
@@ -140,22 +110,23 @@ class CollisionResponse {
   /// the shortest exit found along -n(v), away from the collided tet's centroid and the six axis
   /// directions: an upper bound on the distance to the collided region's surface), and the
   /// inverted elements and the self contacts among them (CollisionCheck::tangled_contacts).
-  CollisionCheck Check(const Eigen::Ref<const Eigen::MatrixX3d>& X) const;
+  CollisionCheck Check(const Eigen::Ref<const Eigen::MatrixX3d>& X) const override;
 
   /// Whether `check` has contacts of a kind this response handles (self contacts only count when
   /// options.self is on, obstacle contacts when it responds to obstacles).
-  bool HasHandledContacts(const CollisionCheck& check) const {
+  bool HasHandledContacts(const CollisionCheck& check) const override {
     return (options_.self && check.self_contacts > 0) ||
            (!obstacles_.empty() && check.obstacle_contacts > 0);
   }
   /// Penalty continuation: multiplies k by 4 (refactoring the system) unless it has already been
   /// raised `max_raises` times; returns whether it did. The solver calls it when it has converged
   /// with contacts left (finite springs yield by force / k).
-  bool Stiffen(int max_raises = 3);
+  bool Stiffen(int max_raises = 3) override;
 
   const std::vector<CollisionSpring>& springs() const { return springs_; }
   double stiffness() const { return k_; }
-  const CollisionStats& stats() const { return stats_; }
+  const CollisionStats& stats() const override { return stats_; }
+  int num_springs() const override { return static_cast<int>(springs_.size()); }
   const SpringSystem& system() const { return system_; }
   const std::vector<Obstacle>& obstacles() const { return obstacles_; }
 

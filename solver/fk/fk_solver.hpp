@@ -1,9 +1,10 @@
 #pragma once
 /// \file fk_solver.hpp
 /// The forward-kinematics solver interface: Solve(c, warm_start) -> FkResult. Implementations are
-/// chosen by name (FkOptions::solver). Two tiers: the one-shot SolveFk(scene, c) and a stateful
-/// solver (MakeFkSolver) that reuses the model's factorisation across calls.
-#include "softkin/solver/collision/collision_response.hpp"
+/// chosen by name (FkOptions::solver) in solver/factory/fk_factory.hpp, which offers the two tiers:
+/// the one-shot SolveFk(scene, c) and a stateful solver (MakeFkSolver) that reuses the model's
+/// factorisation across calls.
+#include "softkin/solver/fk/contact_term.hpp"
 #include "softkin/solver/fk/fk_options.hpp"
 #include "softkin/solver/fk/model.hpp"
 
@@ -67,15 +68,5 @@ class FkSolver {
 /// `model`; returns "" or the reason. Every solver's Solve() reports it as invalid_input.
 std::string SolveInputError(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& c,
                             const Eigen::MatrixX3d* warm_start);
-
-/// Names accepted by MakeFkSolver.
-std::vector<std::string> FkSolverNames();
-/// Builds the solver named options.solver; throws std::invalid_argument for an unknown name or
-/// invalid options (message from FkOptions::IsValid).
-std::unique_ptr<FkSolver> MakeFkSolver(std::shared_ptr<const Model> model, const FkOptions& options);
-
-/// One shot: builds the model and solves. Options default to the scene's.
-FkResult SolveFk(const Scene& scene, const Eigen::Ref<const Eigen::VectorXd>& c,
-                 const FkOptions* options = nullptr);
 
 }  // namespace softkin

@@ -18,8 +18,9 @@ double Seconds(Clock::time_point a, Clock::time_point b) {
 }
 }  // namespace
 
-LocalGlobalSolver::LocalGlobalSolver(std::shared_ptr<const Model> model, const FkOptions& options)
-    : FkSolver(std::move(model)), options_(options) {
+LocalGlobalSolver::LocalGlobalSolver(std::shared_ptr<const Model> model, const FkOptions& options,
+                                     ContactTermFactory contacts)
+    : FkSolver(std::move(model)), options_(options), contacts_(std::move(contacts)) {
   std::string why;
   if (!options_.IsValid(&why)) throw std::invalid_argument("solver options: " + why);
 }
@@ -46,7 +47,7 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
 
   Eigen::MatrixX3d B(m.num_vertices(), 3), Mv(m.num_vertices(), 3);
   Eigen::VectorXd Bf(nf), xf(nf), Gf(nf), Gprev(nf), step(nf), AX(nf);
-  CollisionResponse* resp = response_.get();
+  ContactTerm* resp = response_.get();
   auto local = [&](double* E) {
     const auto t0 = Clock::now();
     ComputeLocalRatios(m, X, c, &ratios_);
@@ -208,9 +209,15 @@ FkResult LocalGlobalSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
     deadline = t0 + std::chrono::duration_cast<Clock::duration>(
                         std::chrono::duration<double>(options_.time_limit_s));
   deadline_ = deadline ? &*deadline : nullptr;
-  if (CollisionResponse::Active(m.scene(), options_.collision)) {
+  if (ContactHandlingActive(m.scene(), options_.collision)) {
     try {
-      if (!response_) response_ = std::make_unique<CollisionResponse>(m, options_.collision);
+      if (!contacts_)
+        throw std::invalid_argument(
+            "scene '" + m.scene().name +
+            "' has collision handling on, and this solver was built without a contact term "
+            "(build it with MakeFkSolver, solver/factory/fk_factory.hpp, or turn "
+            "solver.collision off)");
+      if (!response_) response_ = contacts_(m, options_.collision);
     } catch (const std::exception& e) {
       r.status = FkStatus::InvalidInput;
       r.message = e.what();
@@ -230,9 +237,9 @@ FkResult LocalGlobalSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
   deadline_ = nullptr;
   ComputeLocalRatios(m, r.positions, c, &ratios_, &r.volume_ratios);
   r.energy = LocalStep(m, r.positions, ratios_, &weighted_, options_.threads);
-  if (response_ && CollisionResponse::Active(m.scene(), options_.collision)) {
+  if (response_ && ContactHandlingActive(m.scene(), options_.collision)) {
     r.collision_active = true;
-    r.springs = static_cast<int>(response_->springs().size());
+    r.springs = response_->num_springs();
     r.collision_stats = response_->stats();
     const auto tc = Clock::now();
     r.collision = response_->Check(r.positions);  // the exact check of the final state

@@ -25,6 +25,7 @@
 ///  - stop when every vertex moves less than tolerance * size in one iteration AND the residual
 ///    ||2 (A X - B)|| has dropped below gradient_tolerance times its reference (the larger of its
 ///    value at the warm start and at the rest shape for the same actuation).
+#include "softkin/solver/fk/contact_term.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 
 #include <chrono>
@@ -33,7 +34,11 @@ namespace softkin {
 
 class LocalGlobalSolver : public FkSolver {
  public:
-  LocalGlobalSolver(std::shared_ptr<const Model> model, const FkOptions& options);
+  /// `contacts` builds the contact term when FkOptions::collision is active for the scene
+  /// (ContactHandlingActive); without one such a scene is reported as invalid_input.
+  /// MakeFkSolver (solver/factory/fk_factory.hpp) passes the spring response of solver/collision/.
+  LocalGlobalSolver(std::shared_ptr<const Model> model, const FkOptions& options,
+                    ContactTermFactory contacts = {});
   std::string name() const override { return options_.solver; }
   FkResult Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
                  const Eigen::MatrixX3d* warm_start = nullptr) override;
@@ -43,7 +48,8 @@ class LocalGlobalSolver : public FkSolver {
   /// One continuation stage: iterate from X towards the solution for c; accumulates into r.
   void SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X, FkResult* r);
   FkOptions options_;
-  std::unique_ptr<CollisionResponse> response_;  // springs of Eq. 3.5-3.9, when active
+  ContactTermFactory contacts_;
+  std::unique_ptr<ContactTerm> response_;  // springs of Eq. 3.5-3.9, when active
   std::vector<ElemRows> weighted_;  // per-element w Vol T, reused across iterations
   std::vector<double> ratios_;
   double total_weight_ = 0.0;  // sum of w_i Vol_i: the scale of the residual's round-off floor

@@ -1,5 +1,7 @@
 #include "softkin/solver/materials/calibration.hpp"
 
+#include "softkin/solver/factory/fk_factory.hpp"
+
 #include "softkin/solver/fk/energy.hpp"
 #include "softkin/solver/mesh/mesh_gen.hpp"
 #include "softkin/solver/robots/robots.hpp"

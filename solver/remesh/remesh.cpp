@@ -1,5 +1,7 @@
 // Progressive chamber remeshing (thesis Sec. 3.3.2, Algorithm 2; remesh.hpp).
 #include "softkin/solver/remesh/remesh.hpp"
+
+#include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/common/text_format.hpp"
 
 #include "softkin/solver/collision/collision.hpp"

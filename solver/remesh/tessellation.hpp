@@ -15,7 +15,7 @@
 /// both the domain's random generator and CGAL's default one, and the sliver perturbation and
 /// exudation run without a time limit, so the same input and options give the same mesh.
 /// Units: millimetres throughout.
-#include "softkin/solver/collision/collision.hpp"
+#include "softkin/solver/mesh/surface.hpp"
 #include "softkin/solver/mesh/mesh.hpp"
 
 #include <Eigen/Core>

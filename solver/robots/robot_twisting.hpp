@@ -17,7 +17,7 @@
 /// hyperelastic = 0: Ch. 2 shape blending with R_omega = 1 (as-rigid-as-possible). Actuator
 /// "chamber": pneumatic, volume ratio in [1, 120]. Markers: tip (the z = 100 face), tip_rim (the
 /// tip-face vertex nearest (10, 0, 100)). Body region 0, chamber region 1.
-#include "softkin/solver/collision/collision.hpp"
+#include "softkin/solver/mesh/surface.hpp"
 #include "softkin/solver/robots/robots.hpp"
 #include "softkin/solver/scene/scene.hpp"
 #include "softkin/solver/remesh/tessellation.hpp"

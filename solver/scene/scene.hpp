@@ -3,7 +3,7 @@
 /// What the user describes: a mesh with region tags, the role of every region (body material or
 /// actuator), fixed vertices, markers and solver options. Built by an embedded robot generator
 /// (robots.hpp) or from a mesh file plus a scene JSON (scene_json.hpp).
-#include "softkin/solver/collision/collision.hpp"
+#include "softkin/solver/mesh/surface.hpp"
 #include "softkin/solver/fk/fk_options.hpp"
 #include "softkin/solver/mesh/mesh.hpp"
 

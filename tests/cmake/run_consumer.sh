@@ -60,4 +60,13 @@ if ! grep -Eq '^three_chamber res 3: [1-9][0-9]* tets' <<<"$out"; then
   echo "unexpected consumer output" >&2
   exit 1
 fi
+echo "== run the core-only consumer"
+core_out="$("$WORK/build/softkin_core_consumer")" || { echo "$core_out"; echo "core consumer failed" >&2; exit 1; }
+echo "$core_out"
+# The core library must not pull in CGAL, Ceres or Ipopt.
+if ldd "$WORK/build/softkin_core_consumer" | grep -Eiq 'ceres|ipopt|gmp|mpfr'; then
+  echo "softkin::core links a library it should not need:" >&2
+  ldd "$WORK/build/softkin_core_consumer" >&2
+  exit 1
+fi
 echo "cmake_package_consumer: OK"

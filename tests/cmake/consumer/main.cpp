@@ -1,4 +1,5 @@
-// Downstream use of an installed SoftKin: build an embedded robot scene and report its size.
+// Downstream use of an installed SoftKin (softkin::solver): build an embedded robot scene and
+// report its size.
 #include <softkin/solver/robots/robots.hpp>
 
 #include <cstdio>

@@ -3,6 +3,7 @@
 // displacement field bends the bar the way lg-aa does.
 #include "softkin/solver/baselines/calculix.hpp"
 
+#include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/robots/robots.hpp"
 #include "tests/solver/test_util.hpp"

@@ -3,6 +3,7 @@
 // vertices, signed actuators), the fixed-ratio gradient they use is checked against finite
 // differences, and what they cannot express is rejected with a clear status.
 #include "softkin/solver/fk/energy.hpp"
+#include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/baselines/nlp_solvers.hpp"
 #include "softkin/solver/robots/robots.hpp"

@@ -5,6 +5,7 @@
 // with it, for self-collision and for an obstacle.
 #include "softkin/solver/collision/collision_response.hpp"
 
+#include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/fk/energy.hpp"
 #include "softkin/solver/mesh/mesh_gen.hpp"

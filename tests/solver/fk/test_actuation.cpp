@@ -3,6 +3,7 @@
 // solver on free specimens.
 #include "softkin/solver/fk/actuation.hpp"
 #include "softkin/solver/fk/energy.hpp"
+#include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/fk/model.hpp"
 #include "softkin/solver/robots/robots.hpp"

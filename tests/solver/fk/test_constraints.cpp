@@ -7,6 +7,7 @@
 // The physics tests use small voxel bars (<= 1.2k tets) solved to a tight tolerance, and check
 // identities that follow from symmetry or from the boundary conditions themselves.
 #include "softkin/solver/fk/energy.hpp"
+#include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/mesh/mesh_gen.hpp"
 #include "softkin/solver/fk/model.hpp"

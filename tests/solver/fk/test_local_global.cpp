@@ -4,6 +4,7 @@
 // with a tightly converged reference), not stored numbers.
 #include "softkin/solver/fk/anderson.hpp"
 #include "softkin/solver/fk/energy.hpp"
+#include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/fk/local_global.hpp"
 #include "softkin/solver/robots/robots.hpp"

@@ -1,6 +1,7 @@
 // Progressive chamber remeshing (solver/remesh/remesh.hpp, thesis Algorithm 2) and the twisting robot
 // (solver/robots/robot_twisting.hpp).
 #include "softkin/solver/fk/energy.hpp"
+#include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/fk/model.hpp"
 #include "softkin/solver/remesh/remesh.hpp"

@@ -2,6 +2,7 @@
 // physics each new robot is built to show: the redundancy of finger_manipulator, the DEA crawler's
 // sliding foot and flat state, the bimaterial bar's interface, the two materials of the cable
 // gripper. The number of failed grid points is printed; the goal (and the assertion) is none.
+#include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/fk/model.hpp"
 #include "softkin/solver/robots/robots.hpp"

@@ -3,6 +3,7 @@
 // against central differences on every supported element kind, dX/dc against differences of
 // tightly converged forward solves, and the failure paths (unsupported law, GMRES budget).
 #include "softkin/solver/sensitivity/equilibrium_jacobian.hpp"
+#include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/robots/robots.hpp"
 #include "softkin/solver/fk/targets.hpp"

@@ -1,0 +1,49 @@
+#include "softkin/solver/factory/fk_factory.hpp"
+
+#include "softkin/solver/baselines/calculix.hpp"
+#include "softkin/solver/baselines/nlp_solvers.hpp"
+#include "softkin/solver/collision/collision_response.hpp"
+#include "softkin/solver/fk/local_global.hpp"
+
+#include <stdexcept>
+
+namespace softkin {
+
+namespace {
+
+/// The contact term of the local-global solvers: the spring response of Sec. 3.3.
+std::unique_ptr<ContactTerm> SpringResponse(const Model& model, const CollisionOptions& options) {
+  return std::make_unique<CollisionResponse>(model, options);
+}
+
+}  // namespace
+
+std::vector<std::string> FkSolverNames() {
+  return {"lg",         "lg-aa",           "ceres",           "ipopt-lbfgs",
+          "ipopt-newton", "ipopt-hard", "calculix-linear", "calculix-nonlinear"};
+}
+
+std::unique_ptr<FkSolver> MakeFkSolver(std::shared_ptr<const Model> model, const FkOptions& options) {
+  std::string why;
+  if (!options.IsValid(&why)) throw std::invalid_argument("solver options: " + why);
+  if (options.solver == "lg" || options.solver == "lg-aa")
+    return std::make_unique<LocalGlobalSolver>(std::move(model), options, SpringResponse);
+  if (options.solver == "ceres" || options.solver == "ipopt-lbfgs" ||
+      options.solver == "ipopt-newton" || options.solver == "ipopt-hard")
+    return MakeNlpSolver(std::move(model), options);
+  if (options.solver == "calculix-linear" || options.solver == "calculix-nonlinear") {
+    CalculixOptions co;
+    co.law = options.solver == "calculix-linear" ? "linear" : "neo-hooke";
+    return std::make_unique<CalculixSolver>(std::move(model), options, co);
+  }
+  throw std::invalid_argument("unknown FK solver '" + options.solver + "'");
+}
+
+FkResult SolveFk(const Scene& scene, const Eigen::Ref<const Eigen::VectorXd>& c,
+                 const FkOptions* options) {
+  auto model = std::make_shared<const Model>(scene);
+  auto solver = MakeFkSolver(model, options ? *options : scene.solver);
+  return solver->Solve(c);
+}
+
+}  // namespace softkin
