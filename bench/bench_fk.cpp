@@ -306,9 +306,9 @@ BENCHMARK(BM_LocalStepLaw)
 
 /// The hyperelastic target's volume guard (HyperelasticBlendWeight, Eq. 3.6-3.7) on inverted
 /// tets, where it searches for the blend weight that lifts the blend's volume to the floor.
-/// method 0: the library's (the volume sampled four times, then bisection on that cubic);
-/// method 1: the bisection that re-blends the element and takes its volume at every halving (the
-/// library's method until session 20). Counter over_cubic: method 1's time over method 0's in
+/// method 0: the library's (the volume sampled four times, then Newton's method on that cubic,
+/// kept inside [rho, 1]); method 1: the former method, a bisection that re-blends the element and
+/// takes its volume at every halving. Counter over_cubic: method 1's time over method 0's in
 /// this run; max_dt: the largest difference of the two weights.
 void BM_HyperelasticGuard(benchmark::State& state) {
   constexpr int kTets = 4096;
