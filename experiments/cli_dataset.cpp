@@ -83,21 +83,19 @@ int DefaultResolution(const std::string& robot) {
   return 0;
 }
 
-}  // namespace
+/// --merge: joins complete shard files into --out.
+int MergeCommand(const DatasetCommandArgs& a) {
+  if (!a.robot.empty() || !a.twin.empty() || !a.shard.empty())
+    throw std::invalid_argument("--merge: give only the shard files and --out");
+  const long long n = MergeDatasets(a.merge, a.out);
+  if (!a.quiet)
+    std::cerr << "softkin dataset: merged " << a.merge.size() << " shard(s), " << n
+              << " samples, into " << a.out << "\n";
+  return 0;
+}
 
-int RunDatasetCommand(const DatasetCommandArgs& a, const std::string& command_line) {
-  if (!a.merge.empty()) {
-    if (!a.robot.empty() || !a.twin.empty() || !a.shard.empty())
-      throw std::invalid_argument("--merge: give only the shard files and --out");
-    const long long n = MergeDatasets(a.merge, a.out);
-    if (!a.quiet)
-      std::cerr << "softkin dataset: merged " << a.merge.size() << " shard(s), " << n
-                << " samples, into " << a.out << "\n";
-    return 0;
-  }
-  if (a.robot.empty() == a.twin.empty())
-    throw std::invalid_argument("dataset: give exactly one of --robot NAME or --twin NAME");
-  if (a.res < 0) throw std::invalid_argument("--res: expected a positive integer");
+/// --grid or --random (with --seed), and --block.
+DatasetSampling SamplingFromArgs(const DatasetCommandArgs& a) {
   DatasetSampling sampling;
   if (a.random != 0) {
     if (a.random < 1)
@@ -114,6 +112,95 @@ int RunDatasetCommand(const DatasetCommandArgs& a, const std::string& command_li
   }
   if (a.block < 1) throw std::invalid_argument("--block: expected an integer >= 1, got " + std::to_string(a.block));
   sampling.block = a.block;
+  return sampling;
+}
+
+/// The kinematics a dataset samples, and the "source" object of its sidecar.
+struct DatasetSource {
+  std::unique_ptr<Kinematics> kin;
+  nlohmann::json json;
+};
+
+/// --robot: the robot's simulator tracking `points` (ko: the Jacobian mode); sets run->reset.
+DatasetSource RobotSource(const DatasetCommandArgs& a, SimulatorKinematicsOptions ko,
+                          const std::vector<std::string>& points, DatasetRunOptions* run) {
+  const bool with_j = a.jacobian != "none";
+  const RobotParams params = ParseRobotParams(a.params);
+  const Scene scene = MakeRobot(a.robot, a.res, params);
+  FkOptions fk = scene.solver;
+  if (a.gradient_tolerance > 0) fk.gradient_tolerance = a.gradient_tolerance;
+  std::string why;
+  if (!fk.IsValid(&why)) throw std::invalid_argument("--gradient-tolerance: " + why);
+  ko.points = points;
+  std::unique_ptr<SimulatorKinematics> sim;
+  try {
+    sim = std::make_unique<SimulatorKinematics>(scene, ko, &fk);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("--points / --jacobian: ") + e.what());
+  }
+  SimulatorKinematics* raw = sim.get();
+  run->reset = [raw] { raw->Reset(); };
+  nlohmann::json pj = nlohmann::json::object();
+  for (const auto& [k, v] : params) pj[k] = v;
+  DatasetSource out;
+  out.json = {{"kind", "robot"}, {"robot", a.robot},
+              {"res", a.res > 0 ? a.res : DefaultResolution(a.robot)}, {"params", pj},
+              {"fk_solver", fk.solver}, {"gradient_tolerance", fk.gradient_tolerance},
+              {"jacobian_mode", with_j ? a.jacobian : "none"}};
+  out.kin = std::move(sim);
+  return out;
+}
+
+/// --twin: the 'hardware' twin tracking `points`; sets run->reset.
+DatasetSource TwinSource(const DatasetCommandArgs& a, const std::vector<std::string>& points,
+                         DatasetRunOptions* run) {
+  TwinSpec spec;
+  try {
+    spec = GetTwinSpec(a.twin);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("--twin: ") + e.what());
+  }
+  TwinOptions to;
+  to.res = a.res;
+  to.points = points;
+  to.gradient_tolerance = a.gradient_tolerance;
+  std::unique_ptr<TwinKinematics> twin;
+  try {
+    twin = std::make_unique<TwinKinematics>(spec, to);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("--twin / --points: ") + e.what());
+  }
+  TwinKinematics* raw = twin.get();
+  run->reset = [raw] { raw->Reset(); };
+  DatasetSource out;
+  out.json = {{"kind", "twin"}, {"twin", "twin:" + spec.name}, {"robot", spec.robot},
+              {"res", a.res > 0 ? a.res : DefaultResolution(spec.robot)},
+              {"twin_doc", spec.doc}, {"noise_sigma_mm", spec.noise_sigma_mm},
+              {"gradient_tolerance", twin->simulator().fk_options().gradient_tolerance},
+              {"noise_seed", spec.noise_seed}};
+  out.kin = std::move(twin);
+  return out;
+}
+
+/// The run's counts and times on stderr.
+void ReportSummary(const DatasetRunSummary& s) {
+  char line[300];
+  std::snprintf(line, sizeof line,
+                "softkin dataset: samples [%lld, %lld): %lld already in the file, %lld written "
+                "(%lld failed) in %.1f s (%.1f ms/sample, %lld forward solves)\n",
+                s.first, s.first + s.count, s.already, s.written, s.failed, s.time_s,
+                s.written > 0 ? 1e3 * s.time_s / s.written : 0.0, s.fk_solves);
+  std::cerr << line;
+}
+
+}  // namespace
+
+int RunDatasetCommand(const DatasetCommandArgs& a) {
+  if (!a.merge.empty()) return MergeCommand(a);
+  if (a.robot.empty() == a.twin.empty())
+    throw std::invalid_argument("dataset: give exactly one of --robot NAME or --twin NAME");
+  if (a.res < 0) throw std::invalid_argument("--res: expected a positive integer");
+  const DatasetSampling sampling = SamplingFromArgs(a);
   const bool with_j = a.jacobian != "none";
   SimulatorKinematicsOptions ko;
   if (with_j && !JacobianModeFromString(a.jacobian, &ko.jacobian))
@@ -137,77 +224,18 @@ int RunDatasetCommand(const DatasetCommandArgs& a, const std::string& command_li
     run.shards = n;
   }
   const std::vector<std::string> points = SplitComma(a.points, "--points");
+  DatasetSource source = a.robot.empty() ? TwinSource(a, points, &run) : RobotSource(a, ko, points, &run);
+  run.source = source.json;
+  run.provenance = {{"git_commit", GitCommit()}, {"command", a.command_line}};
 
-  std::unique_ptr<Kinematics> kin;
-  nlohmann::json source;
-  if (!a.robot.empty()) {
-    const RobotParams params = ParseRobotParams(a.params);
-    const Scene scene = MakeRobot(a.robot, a.res, params);
-    FkOptions fk = scene.solver;
-    if (a.gradient_tolerance > 0) fk.gradient_tolerance = a.gradient_tolerance;
-    std::string why;
-    if (!fk.IsValid(&why)) throw std::invalid_argument("--gradient-tolerance: " + why);
-    ko.points = points;
-    std::unique_ptr<SimulatorKinematics> sim;
-    try {
-      sim = std::make_unique<SimulatorKinematics>(scene, ko, &fk);
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(std::string("--points / --jacobian: ") + e.what());
-    }
-    SimulatorKinematics* raw = sim.get();
-    run.reset = [raw] { raw->Reset(); };
-    nlohmann::json pj = nlohmann::json::object();
-    for (const auto& [k, v] : params) pj[k] = v;
-    source = {{"kind", "robot"}, {"robot", a.robot},
-              {"res", a.res > 0 ? a.res : DefaultResolution(a.robot)}, {"params", pj},
-              {"fk_solver", fk.solver}, {"gradient_tolerance", fk.gradient_tolerance},
-              {"jacobian_mode", with_j ? a.jacobian : "none"}};
-    kin = std::move(sim);
-  } else {
-    TwinSpec spec;
-    try {
-      spec = GetTwinSpec(a.twin);
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(std::string("--twin: ") + e.what());
-    }
-    TwinOptions to;
-    to.res = a.res;
-    to.points = points;
-    to.gradient_tolerance = a.gradient_tolerance;
-    std::unique_ptr<TwinKinematics> twin;
-    try {
-      twin = std::make_unique<TwinKinematics>(spec, to);
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(std::string("--twin / --points: ") + e.what());
-    }
-    TwinKinematics* raw = twin.get();
-    run.reset = [raw] { raw->Reset(); };
-    source = {{"kind", "twin"}, {"twin", "twin:" + spec.name}, {"robot", spec.robot},
-              {"res", a.res > 0 ? a.res : DefaultResolution(spec.robot)},
-              {"twin_doc", spec.doc}, {"noise_sigma_mm", spec.noise_sigma_mm},
-              {"gradient_tolerance", twin->simulator().fk_options().gradient_tolerance},
-              {"noise_seed", spec.noise_seed}};
-    kin = std::move(twin);
-  }
-  run.source = source;
-  run.provenance = {{"git_commit", GitCommit()}, {"command", command_line}};
-
-  const long long total = DatasetSize(sampling, kin->num_actuators());
+  const long long total = DatasetSize(sampling, source.kin->num_actuators());
   if (!a.quiet)
-    std::cerr << "softkin dataset: " << kin->name() << " of "
+    std::cerr << "softkin dataset: " << source.kin->name() << " of "
               << (a.robot.empty() ? a.twin : a.robot) << ", " << total << " samples"
               << (run.shards > 1 ? " (shard " + a.shard + ")" : "") << ", points " << a.points
               << ", jacobian " << a.jacobian << " -> " << a.out << "\n";
-  const DatasetRunSummary s = GenerateDataset(*kin, sampling, run);
-  if (!a.quiet) {
-    char line[300];
-    std::snprintf(line, sizeof line,
-                  "softkin dataset: samples [%lld, %lld): %lld already in the file, %lld written "
-                  "(%lld failed) in %.1f s (%.1f ms/sample, %lld forward solves)\n",
-                  s.first, s.first + s.count, s.already, s.written, s.failed, s.time_s,
-                  s.written > 0 ? 1e3 * s.time_s / s.written : 0.0, s.fk_solves);
-    std::cerr << line;
-  }
+  const DatasetRunSummary s = GenerateDataset(*source.kin, sampling, run);
+  if (!a.quiet) ReportSummary(s);
   return s.failed > 0 ? 1 : 0;
 }
 

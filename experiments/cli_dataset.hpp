@@ -26,6 +26,7 @@ struct DatasetCommandArgs {
   std::vector<std::string> merge;
   std::string out;
   bool quiet = false;
+  std::string command_line;         ///< the whole command line, for the sidecar (set by RunCli)
 };
 
 /// Adds the `dataset` subcommand to `app`, bound to *args; returns it.
@@ -34,6 +35,6 @@ CLI::App* AddDatasetCommand(CLI::App* app, DatasetCommandArgs* args);
 /// Runs `softkin dataset`. Throws std::invalid_argument for bad input (naming the option, or the
 /// file and line) and std::runtime_error when a file cannot be written; returns the exit code
 /// (0: every sample evaluated, 1: some samples failed and were recorded as failed).
-int RunDatasetCommand(const DatasetCommandArgs& args, const std::string& command_line);
+int RunDatasetCommand(const DatasetCommandArgs& args);
 
 }  // namespace softkin

@@ -187,52 +187,37 @@ IkOptions ParseIkOptions(const IkCommandArgs& a, const std::string& method) {
   return ik;
 }
 
-}  // namespace
-
-int RunLearnedIk(const IkCommandArgs& a);
-
-int RunIkCommand(const IkCommandArgs& a) {
-  if (!a.nets.empty() || a.method == "learned" || a.method == "direct") return RunLearnedIk(a);
-  if (a.interactive) throw std::invalid_argument("--interactive: needs --nets DIR (learned kinematics)");
-  if (a.s2r) throw std::invalid_argument("--s2r: needs --nets DIR (learned kinematics)");
-  if (a.out.empty()) throw std::invalid_argument("--out: required (the output CSV)");
-  // ---- options ----
-  if (a.robot.empty() == a.scene.empty())
-    throw std::invalid_argument("ik: give exactly one of --robot NAME or --scene FILE");
-  if (a.target.empty() == a.trajectory.empty())
-    throw std::invalid_argument("ik: give exactly one of --target x,y,z or --trajectory FILE");
-  if (a.res < 0) throw std::invalid_argument("--res: expected a positive integer");
-  IkOptions ik = ParseIkOptions(a, a.method);
-  SimulatorKinematicsOptions ko;
-  ko.trace = a.trace_fk;
-  if (!JacobianModeFromString(a.jacobian, &ko.jacobian))
-    throw std::invalid_argument("--jacobian: unknown mode '" + a.jacobian + "' (expected one of " +
-                                JacobianModeNames() + ")");
-  if (a.point.find("[*]") != std::string::npos)
-    throw std::invalid_argument("--point: expected one point (a marker or 'marker[i]'), got the group '" +
-                                a.point + "'");
-  if (a.gradient_tolerance < 0 || !std::isfinite(a.gradient_tolerance))
-    throw std::invalid_argument("--gradient-tolerance: expected a fraction > 0, got " +
-                                std::to_string(a.gradient_tolerance));
-
-  // ---- waypoints ----
-  Eigen::MatrixX3d waypoints;
-  std::string source;
+/// The waypoints of --target or --trajectory; *source names them in messages.
+Eigen::MatrixX3d ReadTargets(const IkCommandArgs& a, std::string* source) {
   if (!a.target.empty()) {
     const Eigen::VectorXd t = ParseNumberList(a.target, "--target");
     if (t.size() != 3)
       throw std::invalid_argument("--target: expected x,y,z (3 numbers, mm), got " +
                                   std::to_string(t.size()) + " number(s) in '" + a.target + "'");
-    waypoints = t.transpose();
-    source = "--target";
-  } else {
-    waypoints = ReadWaypoints(a.trajectory);
-    source = a.trajectory;
+    *source = "--target";
+    return t.transpose();
   }
+  *source = a.trajectory;
+  return ReadWaypoints(a.trajectory);
+}
 
-  // ---- robot and kinematics ----
-  const Scene scene = a.robot.empty() ? LoadSceneJson(a.scene)
-                                      : MakeRobot(a.robot, a.res, ParseRobotParams(a.params));
+// ---- IK with the simulator in the loop ----
+
+/// Checks which of the options the simulator IK needs are given.
+void CheckSimulatorArgs(const IkCommandArgs& a) {
+  if (a.interactive) throw std::invalid_argument("--interactive: needs --nets DIR (learned kinematics)");
+  if (a.s2r) throw std::invalid_argument("--s2r: needs --nets DIR (learned kinematics)");
+  if (a.out.empty()) throw std::invalid_argument("--out: required (the output CSV)");
+  if (a.robot.empty() == a.scene.empty())
+    throw std::invalid_argument("ik: give exactly one of --robot NAME or --scene FILE");
+  if (a.target.empty() == a.trajectory.empty())
+    throw std::invalid_argument("ik: give exactly one of --target x,y,z or --trajectory FILE");
+  if (a.res < 0) throw std::invalid_argument("--res: expected a positive integer");
+}
+
+/// The simulator of `scene` tracking --point, with --gradient-tolerance applied.
+std::unique_ptr<SimulatorKinematics> MakeSimulatorKinematics(const IkCommandArgs& a, const Scene& scene,
+                                                             SimulatorKinematicsOptions ko) {
   const std::string marker = a.point.substr(0, a.point.find('['));
   if (scene.marker_index(marker) < 0) {
     std::string names;
@@ -246,31 +231,37 @@ int RunIkCommand(const IkCommandArgs& a) {
   if (a.gradient_tolerance > 0) fk.gradient_tolerance = a.gradient_tolerance;
   std::string why;
   if (!fk.IsValid(&why)) throw std::invalid_argument("--gradient-tolerance: " + why);
-  std::unique_ptr<SimulatorKinematics> kin;
   try {
-    kin = std::make_unique<SimulatorKinematics>(scene, ko, &fk);
+    return std::make_unique<SimulatorKinematics>(scene, ko, &fk);
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument("--point " + a.point + ": " + e.what());
   }
-  const int n = kin->num_actuators();
+}
 
+/// Algorithm 4's options: the first waypoint's sampling (and its cache key) or the rest start.
+TrajectoryOptions SimulatorTrajectoryOptions(const IkCommandArgs& a, const SimulatorKinematics& kin,
+                                             const IkOptions& ik) {
   TrajectoryOptions to;
-  to.point = kin->point_names().front();
+  to.point = kin.point_names().front();
   to.ik = ik;
   to.sampling.samples_per_axis = a.samples == 0 ? 2 : a.samples;
   to.first_waypoint_starts = a.first_starts;
   to.sampling.cache_file = a.cache;
-  {
-    std::ostringstream key;
-    if (a.robot.empty()) key << "scene=" << fs::absolute(a.scene).string();
-    else key << "robot=" << a.robot << " res=" << a.res;
-    for (const auto& p : a.params) key << " " << p;
-    key << " fk=" << kin->fk_options().solver;
-    to.sampling.cache_key = key.str();
-  }
-  if (a.samples == 0) to.warm_start = kin->rest();
+  std::ostringstream key;
+  if (a.robot.empty()) key << "scene=" << fs::absolute(a.scene).string();
+  else key << "robot=" << a.robot << " res=" << a.res;
+  for (const auto& p : a.params) key << " " << p;
+  key << " fk=" << kin.fk_options().solver;
+  to.sampling.cache_key = key.str();
+  if (a.samples == 0) to.warm_start = kin.rest();
+  return to;
+}
 
-  // ---- output (resume) ----
+/// Opens --out for the rows: a new file with its header or, with --resume, after the complete rows
+/// of an interrupted run (the waypoints continue from there: sets to->first_waypoint and
+/// to->warm_start). Returns false when the file already holds every waypoint.
+bool OpenWaypointCsv(const IkCommandArgs& a, const Eigen::MatrixX3d& waypoints, const std::string& source,
+                     int n, TrajectoryOptions* to, std::ofstream* csv) {
   std::ios::openmode mode = std::ios::out | std::ios::trunc;
   bool write_header = true;
   if (a.resume && fs::exists(a.out)) {
@@ -281,11 +272,11 @@ int RunIkCommand(const IkCommandArgs& a) {
       if (!a.quiet)
         std::cerr << "softkin ik: " << a.out << " already holds all " << waypoints.rows()
                   << " waypoint(s); nothing to do\n";
-      return 0;
+      return false;
     }
     if (r.next_index > 0) {
-      to.first_waypoint = r.next_index;
-      to.warm_start = r.last_c;
+      to->first_waypoint = r.next_index;
+      to->warm_start = r.last_c;
     }
     mode = std::ios::out | std::ios::app;
     write_header = false;
@@ -295,22 +286,63 @@ int RunIkCommand(const IkCommandArgs& a) {
   } else if (a.resume && !a.quiet) {
     std::cerr << "softkin ik: --resume: " << a.out << " does not exist yet; starting at waypoint 0\n";
   }
-  std::ofstream csv(a.out, mode);
-  if (!csv) throw std::runtime_error("cannot write " + a.out);
-  if (write_header) csv << WaypointCsvHeader(n) << "\n" << std::flush;
+  csv->open(a.out, mode);
+  if (!*csv) throw std::runtime_error("cannot write " + a.out);
+  if (write_header) *csv << WaypointCsvHeader(n) << "\n" << std::flush;
+  return true;
+}
 
-  if (!a.quiet) {
-    std::cerr << "softkin ik: " << (a.robot.empty() ? a.scene : a.robot) << " ("
-              << scene.mesh.num_vertices() << " vertices, " << n << " actuators), point "
-              << a.point << ", " << a.method << ", jacobian " << a.jacobian << ", lambda "
-              << a.lambda_mm << " mm, " << waypoints.rows() << " waypoint(s)\n";
-    if (to.warm_start.size() == 0) {
-      long long total = 1;
-      for (int i = 0; i < n; ++i) total *= to.sampling.samples_per_axis;
-      std::cerr << "softkin ik: sampling the configuration space (" << total << " samples"
-                << (a.cache.empty() ? "" : ", cache " + a.cache) << ")\n";
-    }
+void ReportSimulatorStart(const IkCommandArgs& a, const Scene& scene, int n,
+                          const Eigen::MatrixX3d& waypoints, const TrajectoryOptions& to) {
+  std::cerr << "softkin ik: " << (a.robot.empty() ? a.scene : a.robot) << " ("
+            << scene.mesh.num_vertices() << " vertices, " << n << " actuators), point "
+            << a.point << ", " << a.method << ", jacobian " << a.jacobian << ", lambda "
+            << a.lambda_mm << " mm, " << waypoints.rows() << " waypoint(s)\n";
+  if (to.warm_start.size() == 0) {
+    long long total = 1;
+    for (int i = 0; i < n; ++i) total *= to.sampling.samples_per_axis;
+    std::cerr << "softkin ik: sampling the configuration space (" << total << " samples"
+              << (a.cache.empty() ? "" : ", cache " + a.cache) << ")\n";
   }
+}
+
+void ReportSimulatorEnd(const IkCommandArgs& a, const TrajectoryResult& r) {
+  if (!r.samples.cache_status.empty())
+    std::cerr << "softkin ik: samples " << r.samples.cache_status << " (" << r.samples.c.rows()
+              << " samples, " << r.samples.time_s << " s)\n";
+  std::cerr << "softkin ik: " << r.converged << " of " << r.waypoints.size()
+            << " waypoint(s) within lambda; error mean " << r.mean_error_mm << " mm, max "
+            << r.max_error_mm << " mm; largest actuation jump " << r.max_jump << " ("
+            << 100.0 * r.max_jump_fraction << " % of the range); " << r.total_time_s
+            << " s; wrote " << a.out << "\n";
+}
+
+/// `softkin ik` on the simulator (no --nets).
+int RunSimulatorIk(const IkCommandArgs& a) {
+  CheckSimulatorArgs(a);
+  const IkOptions ik = ParseIkOptions(a, a.method);
+  SimulatorKinematicsOptions ko;
+  ko.trace = a.trace_fk;
+  if (!JacobianModeFromString(a.jacobian, &ko.jacobian))
+    throw std::invalid_argument("--jacobian: unknown mode '" + a.jacobian + "' (expected one of " +
+                                JacobianModeNames() + ")");
+  if (a.point.find("[*]") != std::string::npos)
+    throw std::invalid_argument("--point: expected one point (a marker or 'marker[i]'), got the group '" +
+                                a.point + "'");
+  if (a.gradient_tolerance < 0 || !std::isfinite(a.gradient_tolerance))
+    throw std::invalid_argument("--gradient-tolerance: expected a fraction > 0, got " +
+                                std::to_string(a.gradient_tolerance));
+  std::string source;
+  const Eigen::MatrixX3d waypoints = ReadTargets(a, &source);
+  const Scene scene = a.robot.empty() ? LoadSceneJson(a.scene)
+                                      : MakeRobot(a.robot, a.res, ParseRobotParams(a.params));
+  const std::unique_ptr<SimulatorKinematics> kin = MakeSimulatorKinematics(a, scene, ko);
+  const int n = kin->num_actuators();
+  TrajectoryOptions to = SimulatorTrajectoryOptions(a, *kin, ik);
+  std::ofstream csv;
+  if (!OpenWaypointCsv(a, waypoints, source, n, &to, &csv)) return 0;
+  if (!a.quiet) ReportSimulatorStart(a, scene, n, waypoints, to);
+
   int failed = 0;
   const int total = static_cast<int>(waypoints.rows());
   auto on_waypoint = [&](const WaypointResult& w) {
@@ -326,33 +358,11 @@ int RunIkCommand(const IkCommandArgs& a) {
     }
   };
   const TrajectoryResult r = FollowTrajectory(*kin, waypoints, to, on_waypoint);
-  if (!a.quiet) {
-    if (!r.samples.cache_status.empty())
-      std::cerr << "softkin ik: samples " << r.samples.cache_status << " (" << r.samples.c.rows()
-                << " samples, " << r.samples.time_s << " s)\n";
-    std::cerr << "softkin ik: " << r.converged << " of " << r.waypoints.size()
-              << " waypoint(s) within lambda; error mean " << r.mean_error_mm << " mm, max "
-              << r.max_error_mm << " mm; largest actuation jump " << r.max_jump << " ("
-              << 100.0 * r.max_jump_fraction << " % of the range); " << r.total_time_s
-              << " s; wrote " << a.out << "\n";
-  }
+  if (!a.quiet) ReportSimulatorEnd(a, r);
   return failed > 0 ? 1 : 0;
 }
 
-namespace {
-
-Eigen::MatrixX3d ReadTargets(const IkCommandArgs& a, std::string* source) {
-  if (!a.target.empty()) {
-    const Eigen::VectorXd t = ParseNumberList(a.target, "--target");
-    if (t.size() != 3)
-      throw std::invalid_argument("--target: expected x,y,z (3 numbers, mm), got " +
-                                  std::to_string(t.size()) + " number(s) in '" + a.target + "'");
-    *source = "--target";
-    return t.transpose();
-  }
-  *source = a.trajectory;
-  return ReadWaypoints(a.trajectory);
-}
+// ---- IK on the learned kinematics (--nets) ----
 
 /// One target with the direct-IK network: c = N_ik(t), the point predicted by the kinematics.
 WaypointResult DirectWaypoint(const LearnedNets& nets, NetKinematics& kin, int index,
@@ -379,9 +389,8 @@ WaypointResult DirectWaypoint(const LearnedNets& nets, NetKinematics& kin, int i
   return w;
 }
 
-}  // namespace
-
-int RunLearnedIk(const IkCommandArgs& a) {
+/// Checks the learned IK's own options; returns --jacobian-source.
+JacobianSource CheckLearnedArgs(const IkCommandArgs& a) {
   if (a.nets.empty())
     throw std::invalid_argument("--method " + a.method + ": needs --nets DIR (from `softkin train`)");
   if (!a.robot.empty() || !a.scene.empty())
@@ -395,9 +404,11 @@ int RunLearnedIk(const IkCommandArgs& a) {
   if (!JacobianSourceFromString(a.jacobian_source, &source))
     throw std::invalid_argument("--jacobian-source: unknown source '" + a.jacobian_source +
                                 "' (expected network or fk-derivative)");
-  const bool direct = a.method == "direct";
-  const std::string method = a.method == "learned" || direct ? "gauss-newton" : a.method;
-  IkOptions ik = ParseIkOptions(a, method);
+  return source;
+}
+
+/// The networks of --nets, checked to have what the method, Jacobian source and --s2r need.
+LearnedNets LoadCheckedNets(const IkCommandArgs& a, bool direct, JacobianSource source) {
   LearnedNets nets;
   try {
     nets = LearnedNets::Load(a.nets);
@@ -414,67 +425,67 @@ int RunLearnedIk(const IkCommandArgs& a) {
     throw std::invalid_argument("--s2r: " + a.nets + " has no s2r network (train it with `softkin train --s2r`)");
   if (a.point != "tip" && a.point != nets.points.front())
     throw std::invalid_argument("--point: the networks track '" + nets.points.front() + "' first; got '" + a.point + "'");
-  NetKinematics kin(nets, source, a.s2r);
+  return nets;
+}
+
+/// --interactive: targets from stdin, one CSV row per target to stdout (Fig. 5.13).
+int RunInteractiveIk(const IkCommandArgs& a, const LearnedNets& nets, NetKinematics& kin,
+                     const TrajectoryOptions& to, bool direct) {
   const int n = kin.num_actuators();
   const Eigen::VectorXd range = kin.upper() - kin.lower();
-
-  TrajectoryOptions to;
-  to.point = nets.points.front();
-  to.ik = ik;
-  to.sampling.samples_per_axis = a.samples == 0 ? 2 : a.samples;
-  to.first_waypoint_starts = a.first_starts;
-  if (a.samples == 0) to.warm_start = kin.rest();
-
-  if (a.interactive) {
-    std::cout << WaypointCsvHeader(n) << "\n" << std::flush;
-    if (!a.quiet)
-      std::cerr << "softkin ik: " << kin.name() << " from " << a.nets
-                << "; type a target 'x y z' (mm) per line, 'quit' to stop\n";
-    Eigen::VectorXd previous;
-    std::string line;
-    int index = 0, lineno = 0;
-    while (std::getline(std::cin, line)) {
-      ++lineno;
-      const size_t b = line.find_first_not_of(" \t\r");
-      if (b == std::string::npos || line[b] == '#') continue;
-      if (line.compare(b, 4, "quit") == 0 || line.compare(b, 4, "exit") == 0) break;
-      std::string norm = line;
-      for (char& ch : norm)
-        if (ch == ',' || ch == '\t') ch = ' ';
-      std::istringstream ss(norm);
-      Eigen::Vector3d t;
-      std::string extra;
-      if (!(ss >> t.x() >> t.y() >> t.z()) || (ss >> extra) || !t.allFinite()) {
-        std::cerr << "softkin ik: stdin:" << lineno << ": expected a target 'x y z' (3 finite numbers, mm), got '"
-                  << line << "'\n";
-        continue;
-      }
-      WaypointResult w;
-      if (direct) {
-        w = DirectWaypoint(nets, kin, index, t, previous, range);
-      } else {
-        TrajectoryOptions one = to;
-        if (previous.size() == n) one.warm_start = previous;
-        const TrajectoryResult r = FollowTrajectory(kin, t.transpose(), one);
-        w = r.waypoints.front();
-        w.index = index;
-        if (previous.size() == n) {
-          w.jump = (w.c - previous).cwiseAbs().maxCoeff();
-          w.jump_fraction = (w.c - previous).cwiseAbs().cwiseQuotient(range).maxCoeff();
-        }
-      }
-      previous = w.c;
-      ++index;
-      std::cout << WaypointCsvRow(w) << "\n" << std::flush;
+  std::cout << WaypointCsvHeader(n) << "\n" << std::flush;
+  if (!a.quiet)
+    std::cerr << "softkin ik: " << kin.name() << " from " << a.nets
+              << "; type a target 'x y z' (mm) per line, 'quit' to stop\n";
+  Eigen::VectorXd previous;
+  std::string line;
+  int index = 0, lineno = 0;
+  while (std::getline(std::cin, line)) {
+    ++lineno;
+    const size_t b = line.find_first_not_of(" \t\r");
+    if (b == std::string::npos || line[b] == '#') continue;
+    if (line.compare(b, 4, "quit") == 0 || line.compare(b, 4, "exit") == 0) break;
+    std::string norm = line;
+    for (char& ch : norm)
+      if (ch == ',' || ch == '\t') ch = ' ';
+    std::istringstream ss(norm);
+    Eigen::Vector3d t;
+    std::string extra;
+    if (!(ss >> t.x() >> t.y() >> t.z()) || (ss >> extra) || !t.allFinite()) {
+      std::cerr << "softkin ik: stdin:" << lineno << ": expected a target 'x y z' (3 finite numbers, mm), got '"
+                << line << "'\n";
+      continue;
     }
-    return 0;
+    WaypointResult w;
+    if (direct) {
+      w = DirectWaypoint(nets, kin, index, t, previous, range);
+    } else {
+      TrajectoryOptions one = to;
+      if (previous.size() == n) one.warm_start = previous;
+      const TrajectoryResult r = FollowTrajectory(kin, t.transpose(), one);
+      w = r.waypoints.front();
+      w.index = index;
+      if (previous.size() == n) {
+        w.jump = (w.c - previous).cwiseAbs().maxCoeff();
+        w.jump_fraction = (w.c - previous).cwiseAbs().cwiseQuotient(range).maxCoeff();
+      }
+    }
+    previous = w.c;
+    ++index;
+    std::cout << WaypointCsvRow(w) << "\n" << std::flush;
   }
+  return 0;
+}
 
+/// --target or --trajectory on the learned kinematics, rows into --out.
+int RunLearnedWaypoints(const IkCommandArgs& a, const LearnedNets& nets, NetKinematics& kin,
+                        const TrajectoryOptions& to, bool direct, const std::string& method) {
+  const Eigen::VectorXd range = kin.upper() - kin.lower();
   std::string source_name;
   const Eigen::MatrixX3d waypoints = ReadTargets(a, &source_name);
   std::ofstream csv(a.out);
   if (!csv) throw std::runtime_error("cannot write " + a.out);
-  csv << WaypointCsvHeader(n) << "\n";
+  csv << WaypointCsvHeader(kin.num_actuators()) << "\n";
   if (!a.quiet)
     std::cerr << "softkin ik: " << kin.name() << " from " << a.nets << ", "
               << (direct ? std::string("direct") : method) << ", " << waypoints.rows()
@@ -491,7 +502,7 @@ int RunLearnedIk(const IkCommandArgs& a) {
       worst = std::max(worst, w.error_mm);
       total_time += w.time_s;
       max_jump = std::max(max_jump, w.jump);
-      converged += w.error_mm * w.error_mm <= ik.lambda;
+      converged += w.error_mm * w.error_mm <= to.ik.lambda;
     }
   } else {
     const TrajectoryResult r = FollowTrajectory(kin, waypoints, to, [&](const WaypointResult& w) {
@@ -513,6 +524,31 @@ int RunLearnedIk(const IkCommandArgs& a) {
               << 1e3 * total_time / N << " ms per waypoint; wrote " << a.out << "\n";
   }
   return 0;
+}
+
+/// `softkin ik --nets DIR` (thesis Ch. 5): learned Jacobian IK, or the direct-IK network.
+int RunLearnedIk(const IkCommandArgs& a) {
+  const JacobianSource source = CheckLearnedArgs(a);
+  const bool direct = a.method == "direct";
+  const std::string method = a.method == "learned" || direct ? "gauss-newton" : a.method;
+  const IkOptions ik = ParseIkOptions(a, method);
+  const LearnedNets nets = LoadCheckedNets(a, direct, source);
+  NetKinematics kin(nets, source, a.s2r);
+  TrajectoryOptions to;
+  to.point = nets.points.front();
+  to.ik = ik;
+  to.sampling.samples_per_axis = a.samples == 0 ? 2 : a.samples;
+  to.first_waypoint_starts = a.first_starts;
+  if (a.samples == 0) to.warm_start = kin.rest();
+  if (a.interactive) return RunInteractiveIk(a, nets, kin, to, direct);
+  return RunLearnedWaypoints(a, nets, kin, to, direct, method);
+}
+
+}  // namespace
+
+int RunIkCommand(const IkCommandArgs& a) {
+  if (!a.nets.empty() || a.method == "learned" || a.method == "direct") return RunLearnedIk(a);
+  return RunSimulatorIk(a);
 }
 
 }  // namespace softkin

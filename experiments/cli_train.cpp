@@ -90,9 +90,8 @@ Eigen::VectorXd RestFromSidecar(const Dataset& d) {
   }
 }
 
-}  // namespace
-
-int RunTrainCommand(const TrainCommandArgs& a, const std::string& command_line) {
+/// Checks the options and returns the trainer's (Levenberg-Marquardt) options.
+LmOptions LmFromArgs(const TrainCommandArgs& a) {
   if (a.dataset.empty() == a.s2r.empty())
     throw std::invalid_argument("train: give exactly one of --dataset FILE or --s2r TWIN_FILE");
   if (a.epochs < 0) throw std::invalid_argument("--epochs: expected an integer >= 0");
@@ -107,30 +106,35 @@ int RunTrainCommand(const TrainCommandArgs& a, const std::string& command_line) 
   lm.num_threads = a.threads;
   lm.verbose = !a.quiet;
   lm.progress_every = 10;
+  return lm;
+}
 
-  if (!a.s2r.empty()) {
-    LearnedNets nets;
-    try {
-      nets = LearnedNets::Load(a.out);
-    } catch (const std::runtime_error& e) {
-      throw std::invalid_argument(std::string("--out (the networks to add N_s2r to): ") + e.what());
-    }
-    const Dataset twin = LoadDataset(a.s2r);
-    if (!a.quiet)
-      std::cerr << "softkin train: sim-to-real layer from " << a.s2r << " (" << twin.inputs.rows()
-                << " samples, eta " << a.eta << ")\n";
-    const NetTrainResult r = TrainS2r(nets, twin, a.s2r, a.eta, lm, a.seed);
-    nets.info["s2r"]["command"] = command_line;
-    nets.info["s2r"]["git_commit"] = GitCommit();
-    nets.Save(a.out);
-    const auto& j = nets.info["s2r"];
-    std::cout << "softkin train: s2r " << j["layers"].dump() << ": test mean error "
-              << r.test.mean_dist << " mm (without s2r " << j["test_without_s2r"]["mean_dist"].get<double>()
-              << " mm, " << j["improvement"].get<double>() << "x better); wrote " << a.out << "\n";
-    return 0;
+/// --s2r: trains N_s2r on the twin dataset and adds it to the networks in --out.
+int TrainS2rCommand(const TrainCommandArgs& a, const LmOptions& lm) {
+  LearnedNets nets;
+  try {
+    nets = LearnedNets::Load(a.out);
+  } catch (const std::runtime_error& e) {
+    throw std::invalid_argument(std::string("--out (the networks to add N_s2r to): ") + e.what());
   }
+  const Dataset twin = LoadDataset(a.s2r);
+  if (!a.quiet)
+    std::cerr << "softkin train: sim-to-real layer from " << a.s2r << " (" << twin.inputs.rows()
+              << " samples, eta " << a.eta << ")\n";
+  const NetTrainResult r = TrainS2r(nets, twin, a.s2r, a.eta, lm, a.seed);
+  nets.info["s2r"]["command"] = a.command_line;
+  nets.info["s2r"]["git_commit"] = GitCommit();
+  nets.Save(a.out);
+  const auto& j = nets.info["s2r"];
+  std::cout << "softkin train: s2r " << j["layers"].dump() << ": test mean error "
+            << r.test.mean_dist << " mm (without s2r " << j["test_without_s2r"]["mean_dist"].get<double>()
+            << " mm, " << j["improvement"].get<double>() << "x better); wrote " << a.out << "\n";
+  return 0;
+}
 
-  const Dataset d = LoadDataset(a.dataset);
+/// The networks to train (--what) and their layers, trainer and split from the command line.
+NetsFromDatasetOptions NetsOptionsFromArgs(const TrainCommandArgs& a, const Dataset& d,
+                                           const LmOptions& lm) {
   NetsFromDatasetOptions o;
   o.fk = o.ik = true;
   o.jac = d.jacobians.cols() > 0;
@@ -154,13 +158,24 @@ int RunTrainCommand(const TrainCommandArgs& a, const std::string& command_line) 
   o.fk_options.split_seed = o.jac_options.split_seed = o.ik_options.split_seed = a.seed;
   o.split_seed = a.seed;
   o.rest = RestFromSidecar(d);
+  return o;
+}
+
+}  // namespace
+
+int RunTrainCommand(const TrainCommandArgs& a) {
+  const LmOptions lm = LmFromArgs(a);
+  if (!a.s2r.empty()) return TrainS2rCommand(a, lm);
+
+  const Dataset d = LoadDataset(a.dataset);
+  const NetsFromDatasetOptions o = NetsOptionsFromArgs(a, d, lm);
   if (!a.quiet)
     std::cerr << "softkin train: " << a.dataset << ": " << d.inputs.rows() << " samples, "
               << d.num_actuators << " actuators, " << d.point_names.size() << " point(s)"
               << (d.jacobians.cols() ? ", Jacobians" : "") << "; training"
               << (o.fk ? " fk" : "") << (o.jac ? " jac" : "") << (o.ik ? " ik" : "") << "\n";
   LearnedNets nets = TrainNetsFromDataset(d, a.dataset, o);
-  nets.info["command"] = command_line;
+  nets.info["command"] = a.command_line;
   nets.info["git_commit"] = GitCommit();
   nets.info["machine"] = MachineInfo();
   nets.Save(a.out);

@@ -1,5 +1,5 @@
 #pragma once
-/// \file
+/// \file cli_train.hpp
 /// `softkin train`: the networks of Sec. 5.3 from a dataset CSV (`softkin dataset`), into a
 /// network directory (learn/net_kinematics.hpp) that `softkin ik --nets DIR` uses.
 
@@ -10,6 +10,7 @@
 
 namespace softkin {
 
+/// The values of `softkin train`'s options, filled in by CLI11.
 struct TrainCommandArgs {
   std::string dataset;           ///< simulator dataset (N_fk, N_J, N_ik)
   std::string s2r;               ///< twin dataset: add N_s2r to an existing --out directory
@@ -24,10 +25,14 @@ struct TrainCommandArgs {
   std::uint64_t seed = 1;
   int threads = 0;
   bool quiet = false;
+  std::string command_line;      ///< the whole command line, for nets.json (set by RunCli)
 };
 
+/// Adds the `train` subcommand to `app`, bound to *args; returns it.
 CLI::App* AddTrainCommand(CLI::App* app, TrainCommandArgs* args);
 
-int RunTrainCommand(const TrainCommandArgs& args, const std::string& command_line);
+/// Runs `softkin train`. Throws std::invalid_argument for bad input (naming the option) and
+/// std::runtime_error when a file cannot be read or written; returns the exit code (0).
+int RunTrainCommand(const TrainCommandArgs& args);
 
 }  // namespace softkin

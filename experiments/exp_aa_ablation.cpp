@@ -11,11 +11,27 @@
 
 namespace softkin {
 
-nlohmann::json RunAaAblation(const Config& cfg, const std::string& dir, bool verbose) {
-  const std::vector<std::string> robots =
-      cfg.StringList("robots", {"pneumatic_finger", "three_chamber"});
-  const std::vector<int> res = cfg.IntList("resolutions", {});
-  const std::vector<double> levels = cfg.NumberList("levels", {0.5, 1.0});
+namespace {
+
+/// A solver variant: plain local-global or Anderson with a window and a safeguard.
+struct Variant {
+  std::string label;
+  FkOptions opts;
+};
+
+/// The keys of an aa_ablation config.
+struct AaAblationParams {
+  std::vector<std::string> robots;
+  std::vector<int> res;        ///< per robot (empty: the defaults)
+  std::vector<double> levels;  ///< fractions of the way from rest to the far end of each range
+  std::vector<Variant> variants;  ///< lg first, then every (window, safeguard) pair
+};
+
+AaAblationParams ReadAaAblationParams(const Config& cfg) {
+  AaAblationParams p;
+  p.robots = cfg.StringList("robots", {"pneumatic_finger", "three_chamber"});
+  p.res = cfg.IntList("resolutions", {});
+  p.levels = cfg.NumberList("levels", {0.5, 1.0});
   // Anderson variants: every (window, safeguard) pair, each against plain local-global.
   const std::vector<int> windows = cfg.IntList("windows", {6});
   const std::vector<std::string> guards = cfg.StringList("safeguards", {"hybrid"});
@@ -23,12 +39,8 @@ nlohmann::json RunAaAblation(const Config& cfg, const std::string& dir, bool ver
   cfg.CheckNoUnknownKeys();
   if (windows.empty()) cfg.Fail("windows", "a non-empty array of Anderson windows");
   if (guards.empty()) cfg.Fail("safeguards", "a non-empty array of safeguard names");
-  struct Variant {
-    std::string label;
-    FkOptions opts;
-  };
-  std::vector<Variant> variants{{"lg", base}};
-  variants[0].opts.solver = "lg";
+  p.variants = {{"lg", base}};
+  p.variants[0].opts.solver = "lg";
   for (int m : windows)
     for (const auto& g : guards) {
       Variant v{"lg-aa m=" + std::to_string(m) + " " + g, base};
@@ -40,71 +52,84 @@ nlohmann::json RunAaAblation(const Config& cfg, const std::string& dir, bool ver
         if (m < 1 || m > 50) cfg.Fail("windows", "Anderson windows, integers in [1, 50]");
         cfg.Fail("safeguards", "safeguard names, each one of hybrid, energy, none");
       }
-      variants.push_back(v);
+      p.variants.push_back(v);
     }
-  if (!res.empty() && res.size() != robots.size())
+  if (!p.res.empty() && p.res.size() != p.robots.size())
     cfg.Fail("resolutions", "one resolution per robot (or none for the defaults)");
+  return p;
+}
 
+/// Every variant on one robot at one actuation level: rows of aa_ablation.csv and the case's
+/// entry; the Anderson variants' iteration ratios at full actuation go into *min_ratio.
+nlohmann::json RunCase(const AaAblationParams& p, const std::string& robot, const Scene& scene,
+                       const std::shared_ptr<const Model>& model, double level, CsvWriter* csv,
+                       std::map<std::string, double>* min_ratio, bool verbose) {
+  // All actuators driven the same fraction of the way from rest to the far end of their range
+  // (the max volume ratio of a chamber, the min length ratio of a cable).
+  Eigen::VectorXd c = scene.rest_actuation();
+  for (int a = 0; a < c.size(); ++a) {
+    const Actuator& act = scene.actuators[a];
+    c[a] = act.rest + level * (act.FarEnd() - act.rest);
+  }
+  nlohmann::json row{{"robot", robot}, {"level", level}};
+  double lg_iters = 0, lg_time = 0;
+  bool lg_capped = false;
+  for (const Variant& v : p.variants) {
+    FkResult r = MakeFkSolver(model, v.opts)->Solve(c);
+    const bool plain = v.opts.solver == "lg";
+    if (plain) {
+      lg_iters = r.iterations;
+      lg_time = r.time_s;
+      lg_capped = r.status != FkStatus::Converged;
+    }
+    const double it_ratio = lg_iters / std::max(1, r.iterations);
+    const double t_ratio = lg_time / std::max(1e-12, r.time_s);
+    csv->RowStrings({robot, std::to_string(level), v.label, std::to_string(r.iterations),
+                     std::to_string(r.time_s), std::to_string(r.energy),
+                     FkStatusToString(r.status), std::to_string(r.aa_accepted),
+                     std::to_string(r.aa_rejected), std::to_string(it_ratio),
+                     std::to_string(t_ratio)});
+    nlohmann::json rj{{"iterations", r.iterations}, {"time_s", r.time_s}, {"energy", r.energy},
+                      {"status", FkStatusToString(r.status)}};
+    if (!plain) {
+      rj["aa_accepted"] = r.aa_accepted;
+      rj["aa_rejected"] = r.aa_rejected;
+      rj["iteration_ratio"] = it_ratio;
+      rj["time_ratio"] = t_ratio;
+      // Plain lg stopped at the cap: its true count is higher, the ratio a lower bound.
+      rj["ratio_is_lower_bound"] = lg_capped;
+      if (level == 1.0) {
+        auto it = min_ratio->find(v.label);
+        (*min_ratio)[v.label] = it == min_ratio->end() ? it_ratio : std::min(it->second, it_ratio);
+      }
+    }
+    row[v.label] = rj;
+    if (verbose)
+      std::fprintf(stderr, "  %s level %.2f %s: %s\n", robot.c_str(), level,
+                   v.label.c_str(), r.BriefReport().c_str());
+  }
+  return row;
+}
+
+}  // namespace
+
+nlohmann::json RunAaAblation(const Config& cfg, const std::string& dir, bool verbose) {
+  const AaAblationParams p = ReadAaAblationParams(cfg);
   CsvWriter csv(dir + "/aa_ablation.csv",
                 {"robot", "level", "variant", "iterations", "time_s", "energy", "status",
                  "aa_accepted", "aa_rejected", "iteration_ratio", "time_ratio"});
   nlohmann::json cases = nlohmann::json::array();
   std::map<std::string, double> min_ratio;  // per Anderson variant, at full actuation
-  for (size_t ri = 0; ri < robots.size(); ++ri) {
-    Scene scene = MakeRobot(robots[ri], res.empty() ? 0 : res[ri]);
+  for (size_t ri = 0; ri < p.robots.size(); ++ri) {
+    Scene scene = MakeRobot(p.robots[ri], p.res.empty() ? 0 : p.res[ri]);
     auto model = std::make_shared<const Model>(scene);
-    for (double level : levels) {
-      // All actuators driven the same fraction of the way from rest to the far end of their range
-      // (the max volume ratio of a chamber, the min length ratio of a cable).
-      Eigen::VectorXd c = scene.rest_actuation();
-      for (int a = 0; a < c.size(); ++a) {
-        const Actuator& act = scene.actuators[a];
-        c[a] = act.rest + level * (act.FarEnd() - act.rest);
-      }
-      nlohmann::json row{{"robot", robots[ri]}, {"level", level}};
-      double lg_iters = 0, lg_time = 0;
-      bool lg_capped = false;
-      for (const Variant& v : variants) {
-        FkResult r = MakeFkSolver(model, v.opts)->Solve(c);
-        const bool plain = v.opts.solver == "lg";
-        if (plain) {
-          lg_iters = r.iterations;
-          lg_time = r.time_s;
-          lg_capped = r.status != FkStatus::Converged;
-        }
-        const double it_ratio = lg_iters / std::max(1, r.iterations);
-        const double t_ratio = lg_time / std::max(1e-12, r.time_s);
-        csv.RowStrings({robots[ri], std::to_string(level), v.label, std::to_string(r.iterations),
-                        std::to_string(r.time_s), std::to_string(r.energy),
-                        FkStatusToString(r.status), std::to_string(r.aa_accepted),
-                        std::to_string(r.aa_rejected), std::to_string(it_ratio),
-                        std::to_string(t_ratio)});
-        nlohmann::json rj{{"iterations", r.iterations}, {"time_s", r.time_s}, {"energy", r.energy},
-                          {"status", FkStatusToString(r.status)}};
-        if (!plain) {
-          rj["aa_accepted"] = r.aa_accepted;
-          rj["aa_rejected"] = r.aa_rejected;
-          rj["iteration_ratio"] = it_ratio;
-          rj["time_ratio"] = t_ratio;
-          // Plain lg stopped at the cap: its true count is higher, the ratio a lower bound.
-          rj["ratio_is_lower_bound"] = lg_capped;
-          if (level == 1.0) {
-            auto it = min_ratio.find(v.label);
-            min_ratio[v.label] = it == min_ratio.end() ? it_ratio : std::min(it->second, it_ratio);
-          }
-        }
-        row[v.label] = rj;
-        if (verbose)
-          std::fprintf(stderr, "  %s level %.2f %s: %s\n", robots[ri].c_str(), level,
-                       v.label.c_str(), r.BriefReport().c_str());
-      }
-      cases.push_back(row);
-    }
+    for (double level : p.levels)
+      cases.push_back(RunCase(p, p.robots[ri], scene, model, level, &csv, &min_ratio, verbose));
   }
   nlohmann::json j;
   j["cases"] = cases;
   // Headline: the first Anderson variant (the defaults unless the config says otherwise).
-  const std::string head = variants[1].label;
+  const std::string head = p.variants[1].label;
   j["headline_variant"] = head;
   j["min_iteration_ratio_full_actuation"] =
       min_ratio.count(head) ? nlohmann::json(min_ratio[head]) : nlohmann::json(nullptr);

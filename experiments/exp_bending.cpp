@@ -16,31 +16,35 @@
 
 namespace softkin {
 
-nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bool verbose) {
-  const std::string robot = cfg.String("robot", "pneumatic_finger");
-  const int res = cfg.Int("res", 0);
+namespace {
+
+/// The keys of a pneumatic_bending config, checked against the robot.
+struct BendingParams {
+  std::string robot;
+  int steps = 40;
+  int vtu_every = 0;
+  // Secant predictor: start each step from X_k + (X_k - X_{k-1}) (equal actuation steps) instead
+  // of X_k. It is a better first guess along a smooth sweep; the solution is the same.
+  bool predictor = true;
+  // Actuation spacing: "linear" (equal steps) or "geometric" (equal ratios, so smaller steps at
+  // the start, where the bend angle grows fastest with the volume ratio).
+  std::string spacing = "linear";
+  std::vector<double> milestones;  ///< bend angles whose times are reported, degrees
+  Scene scene;
+  double robot_build_s = 0;  ///< the robot's generation, s
+  FkOptions opts;
   // The swept actuators ("actuators": [names], or "actuator": name; default the first one), all
   // set to the same value, from their common rest value to "end_value" (default: the end of their
   // range away from rest, e.g. the max volume ratio or the min cable shortening ratio).
-  const std::string act_name = cfg.String("actuator", "");
-  const std::vector<std::string> act_names = cfg.StringList("actuators", {});
-  const int steps = cfg.Int("steps", 40);
-  const double end_value_cfg = cfg.Number("end_value", 0.0);
-  const int vtu_every = cfg.Int("vtu_every", 0);
-  // Secant predictor: start each step from X_k + (X_k - X_{k-1}) (equal actuation steps) instead
-  // of X_k. It is a better first guess along a smooth sweep; the solution is the same.
-  const bool predictor = cfg.Bool("predictor", true);
-  // Actuation spacing: "linear" (equal steps) or "geometric" (equal ratios, so smaller steps at
-  // the start, where the bend angle grows fastest with the volume ratio).
-  const std::string spacing = cfg.String("spacing", "linear");
-  std::vector<double> milestones = cfg.NumberList("milestones_deg", {});
-  const auto t_build0 = std::chrono::steady_clock::now();
-  Scene scene = ConfigRobot(cfg, robot, res);
-  FkOptions opts = cfg.Solver(scene.solver);
-  cfg.CheckNoUnknownKeys();
-  if (steps < 1) cfg.Fail("steps", "an integer >= 1");
-  if (spacing != "linear" && spacing != "geometric") cfg.Fail("spacing", "linear or geometric");
-  if (vtu_every < 0) cfg.Fail("vtu_every", "an integer >= 0");
+  std::vector<int> swept;
+  double vmax = 0;
+  bool has_bend = false;  ///< the robot has tip_top / tip_bottom markers
+  int tip = -1;
+};
+
+/// The swept actuators, checked to share their rest value and range.
+std::vector<int> SweptActuators(const Config& cfg, const Scene& scene, const std::string& robot,
+                                const std::string& act_name, const std::vector<std::string>& act_names) {
   if (!act_name.empty() && !act_names.empty())
     cfg.Fail("actuators", "either 'actuator' or 'actuators', not both");
   std::vector<int> swept;
@@ -54,76 +58,110 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
     }
     swept.push_back(i);
   }
-  const int a = swept[0];
-  const Actuator& act = scene.actuators[a];
+  const Actuator& act = scene.actuators[swept[0]];
   for (int i : swept)
     if (scene.actuators[i].rest != act.rest || scene.actuators[i].min != act.min ||
         scene.actuators[i].max != act.max)
       cfg.Fail("actuators", "actuators with the same rest value and range");
-  const double vmax = end_value_cfg > 0 ? end_value_cfg : act.FarEnd();
-  if (vmax > act.max || vmax < act.min || vmax == act.rest)
+  return swept;
+}
+
+BendingParams ReadBendingParams(const Config& cfg) {
+  BendingParams p;
+  p.robot = cfg.String("robot", "pneumatic_finger");
+  const int res = cfg.Int("res", 0);
+  const std::string act_name = cfg.String("actuator", "");
+  const std::vector<std::string> act_names = cfg.StringList("actuators", {});
+  p.steps = cfg.Int("steps", 40);
+  const double end_value_cfg = cfg.Number("end_value", 0.0);
+  p.vtu_every = cfg.Int("vtu_every", 0);
+  p.predictor = cfg.Bool("predictor", true);
+  p.spacing = cfg.String("spacing", "linear");
+  p.milestones = cfg.NumberList("milestones_deg", {});
+  const auto t_build0 = std::chrono::steady_clock::now();
+  p.scene = ConfigRobot(cfg, p.robot, res);
+  p.robot_build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_build0).count();
+  p.opts = cfg.Solver(p.scene.solver);
+  cfg.CheckNoUnknownKeys();
+  if (p.steps < 1) cfg.Fail("steps", "an integer >= 1");
+  if (p.spacing != "linear" && p.spacing != "geometric") cfg.Fail("spacing", "linear or geometric");
+  if (p.vtu_every < 0) cfg.Fail("vtu_every", "an integer >= 0");
+  p.swept = SweptActuators(cfg, p.scene, p.robot, act_name, act_names);
+  const Actuator& act = p.scene.actuators[p.swept[0]];
+  p.vmax = end_value_cfg > 0 ? end_value_cfg : act.FarEnd();
+  if (p.vmax > act.max || p.vmax < act.min || p.vmax == act.rest)
     cfg.Fail("end_value", "a value in [min, max] of actuator '" + act.name + "', not its rest value");
-
-  auto model = std::make_shared<const Model>(scene);
-  const double build_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_build0).count();
-  auto solver = MakeFkSolver(model, opts);
   // The bend angle needs the tip_top / tip_bottom markers; without them it is not reported.
-  const bool has_bend = scene.marker_index("tip_top") >= 0 && scene.marker_index("tip_bottom") >= 0;
-  std::unique_ptr<BendAngle> bend;
-  if (has_bend) bend = std::make_unique<BendAngle>(scene);
-  if (!has_bend && !milestones.empty())
-    cfg.Fail("milestones_deg", "no milestones: robot '" + robot +
+  p.has_bend = p.scene.marker_index("tip_top") >= 0 && p.scene.marker_index("tip_bottom") >= 0;
+  if (!p.has_bend && !p.milestones.empty())
+    cfg.Fail("milestones_deg", "no milestones: robot '" + p.robot +
                                    "' has no tip_top / tip_bottom markers, so no bend angle is measured");
-  if (has_bend && milestones.empty()) milestones = {90, 180, 240};
-  const int tip = scene.marker_index("tip");
-  if (tip < 0) throw std::invalid_argument("robot '" + robot + "' has no 'tip' marker");
+  if (p.has_bend && p.milestones.empty()) p.milestones = {90, 180, 240};
+  p.tip = p.scene.marker_index("tip");
+  if (p.tip < 0) throw std::invalid_argument("robot '" + p.robot + "' has no 'tip' marker");
+  if (p.spacing == "geometric" && !(act.rest > 0))
+    cfg.Fail("spacing", "linear (geometric spacing needs a positive rest value)");
+  return p;
+}
 
+/// What the sweep measured.
+struct BendingSweep {
+  double cumulative = 0.0, max_bend = 0.0;
+  int total_iters = 0, failures = 0;
+  std::vector<double> reach;  ///< solve time to each milestone, -1: not reached
+  nlohmann::json tips = nlohmann::json::array(), step_times = nlohmann::json::array();
+};
+
+/// Bends the robot through `steps` warm-started steps: rows of trajectory.csv, VTU frames.
+BendingSweep Sweep(const BendingParams& p, const std::shared_ptr<const Model>& model,
+                   const std::string& dir, bool verbose) {
+  const Scene& scene = p.scene;
+  const int steps = p.steps, tip = p.tip, a = p.swept[0];
+  const Actuator& act = scene.actuators[a];
+  auto solver = MakeFkSolver(model, p.opts);
+  std::unique_ptr<BendAngle> bend;
+  if (p.has_bend) bend = std::make_unique<BendAngle>(scene);
   CsvWriter csv(dir + "/trajectory.csv",
                 {"step", "actuation", "bend_deg", "tip_x", "tip_y", "tip_z", "iterations",
                  "time_s", "cumulative_s", "energy", "volume_ratio", "residual_ratio", "converged"});
   std::vector<std::pair<double, std::string>> frames;
-  if (vtu_every > 0) std::filesystem::create_directories(dir + "/frames");
+  if (p.vtu_every > 0) std::filesystem::create_directories(dir + "/frames");
   const Eigen::MatrixX3d rest_tip = scene.marker_positions(scene.mesh.vertices);
   csv.Row({0, act.rest, 0.0, rest_tip(tip, 0), rest_tip(tip, 1), rest_tip(tip, 2), 0, 0, 0, 0,
            1.0, 0, 1});
 
   Eigen::VectorXd c = scene.rest_actuation();
   Eigen::MatrixX3d X = scene.mesh.vertices, X_prev = X, guess;
-  double cumulative = 0.0, max_bend = 0.0;
-  int total_iters = 0, failures = 0;
-  std::vector<double> reach(milestones.size(), -1.0);
-  nlohmann::json tips = nlohmann::json::array(), step_times = nlohmann::json::array();
-  if (spacing == "geometric" && !(act.rest > 0))
-    cfg.Fail("spacing", "linear (geometric spacing needs a positive rest value)");
+  BendingSweep b;
+  b.reach.assign(p.milestones.size(), -1.0);
   auto value = [&](int s) {
     const double t = double(s) / steps;
-    return spacing == "geometric" ? act.rest * std::pow(vmax / act.rest, t)
-                                  : act.rest + (vmax - act.rest) * t;
+    return p.spacing == "geometric" ? act.rest * std::pow(p.vmax / act.rest, t)
+                                    : act.rest + (p.vmax - act.rest) * t;
   };
   for (int s = 1; s <= steps; ++s) {
-    for (int i : swept) c[i] = value(s);
+    for (int i : p.swept) c[i] = value(s);
     // Secant predictor, scaled by the ratio of this step to the previous one.
     const double q = s > 1 ? (value(s) - value(s - 1)) / (value(s - 1) - value(s - 2)) : 0.0;
-    guess = (predictor && s > 1) ? Eigen::MatrixX3d(X + q * (X - X_prev)) : X;
+    guess = (p.predictor && s > 1) ? Eigen::MatrixX3d(X + q * (X - X_prev)) : X;
     FkResult r = solver->Solve(c, &guess);
     if (r.status == FkStatus::InvalidInput) throw std::runtime_error(r.message);
     X_prev = X;
     X = r.positions;
-    cumulative += r.time_s;
-    total_iters += r.iterations;
+    b.cumulative += r.time_s;
+    b.total_iters += r.iterations;
     const bool ok = r.status == FkStatus::Converged;
-    if (!ok) ++failures;
-    const double ang = has_bend ? (*bend)(X) : 0.0;
-    max_bend = std::max(max_bend, ang);
-    for (size_t q = 0; q < milestones.size(); ++q)
-      if (reach[q] < 0 && ang >= milestones[q]) reach[q] = cumulative;
+    if (!ok) ++b.failures;
+    const double ang = p.has_bend ? (*bend)(X) : 0.0;
+    b.max_bend = std::max(b.max_bend, ang);
+    for (size_t m = 0; m < p.milestones.size(); ++m)
+      if (b.reach[m] < 0 && ang >= p.milestones[m]) b.reach[m] = b.cumulative;
     const Eigen::MatrixX3d P = scene.marker_positions(X);
-    tips.push_back({P(tip, 0), P(tip, 1), P(tip, 2)});
-    step_times.push_back(r.time_s);
+    b.tips.push_back({P(tip, 0), P(tip, 1), P(tip, 2)});
+    b.step_times.push_back(r.time_s);
     csv.Row({double(s), c[a], ang, P(tip, 0), P(tip, 1), P(tip, 2), double(r.iterations), r.time_s,
-             cumulative, r.energy, r.volume_ratios[a], r.gradient_ratio, ok ? 1.0 : 0.0});
-    if (vtu_every > 0 && (s % vtu_every == 0 || s == steps)) {
+             b.cumulative, r.energy, r.volume_ratios[a], r.gradient_ratio, ok ? 1.0 : 0.0});
+    if (p.vtu_every > 0 && (s % p.vtu_every == 0 || s == steps)) {
       char name[64];
       std::snprintf(name, sizeof(name), "frames/step_%04d.vtu", s);
       WriteVtu(dir + "/" + name, scene.mesh, X);
@@ -131,41 +169,54 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
     }
     if (verbose) {
       char bend_txt[40] = "";
-      if (has_bend) std::snprintf(bend_txt, sizeof(bend_txt), "bend %.1f deg  ", ang);
+      if (p.has_bend) std::snprintf(bend_txt, sizeof(bend_txt), "bend %.1f deg  ", ang);
       std::fprintf(stderr, "  [%d/%d] %s = %.3f  %s%s\n", s, steps, act.name.c_str(), c[a],
                    bend_txt, r.BriefReport().c_str());
     }
   }
   if (!frames.empty()) WritePvd(dir + "/frames.pvd", frames);
+  return b;
+}
+
+}  // namespace
+
+nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bool verbose) {
+  const BendingParams p = ReadBendingParams(cfg);
+  const Scene& scene = p.scene;
+  const auto t_model0 = std::chrono::steady_clock::now();
+  auto model = std::make_shared<const Model>(scene);
+  const double build_s =
+      p.robot_build_s + std::chrono::duration<double>(std::chrono::steady_clock::now() - t_model0).count();
+  const BendingSweep b = Sweep(p, model, dir, verbose);
 
   nlohmann::json j;
-  j["robot"] = robot;
+  j["robot"] = p.robot;
   j["n_vertices"] = scene.mesh.num_vertices();
   j["n_elements"] = scene.mesh.num_elements();
   j["n_tets"] = scene.mesh.num_tets();
-  j["steps"] = steps;
+  j["steps"] = p.steps;
   j["actuators"] = nlohmann::json::array();
-  for (int i : swept) j["actuators"].push_back(scene.actuators[i].name);
-  j["end_value"] = vmax;
-  j["bend_measured"] = has_bend;
-  j["max_bend_deg"] = max_bend;
-  j["total_solve_s"] = cumulative;
-  j["total_iterations"] = total_iters;
+  for (int i : p.swept) j["actuators"].push_back(scene.actuators[i].name);
+  j["end_value"] = p.vmax;
+  j["bend_measured"] = p.has_bend;
+  j["max_bend_deg"] = b.max_bend;
+  j["total_solve_s"] = b.cumulative;
+  j["total_iterations"] = b.total_iters;
   j["model_build_s"] = build_s;
   j["factor_s"] = model->factor_time_s();
-  j["non_converged_steps"] = failures;
-  j["solver"] = opts.solver;
-  j["anderson_window"] = opts.anderson_window;
-  j["predictor"] = predictor;
-  j["spacing"] = spacing;
-  for (size_t q = 0; q < milestones.size(); ++q) {
+  j["non_converged_steps"] = b.failures;
+  j["solver"] = p.opts.solver;
+  j["anderson_window"] = p.opts.anderson_window;
+  j["predictor"] = p.predictor;
+  j["spacing"] = p.spacing;
+  for (size_t q = 0; q < p.milestones.size(); ++q) {
     char key[32];
-    std::snprintf(key, sizeof(key), "t%.0f_s", milestones[q]);
-    j[key] = reach[q] >= 0 ? nlohmann::json(reach[q]) : nlohmann::json(nullptr);
+    std::snprintf(key, sizeof(key), "t%.0f_s", p.milestones[q]);
+    j[key] = b.reach[q] >= 0 ? nlohmann::json(b.reach[q]) : nlohmann::json(nullptr);
   }
-  j["tips"] = tips;
-  j["step_times_s"] = step_times;
-  if (robot == "pneumatic_finger")
+  j["tips"] = b.tips;
+  j["step_times_s"] = b.step_times;
+  if (p.robot == "pneumatic_finger")
     j["thesis_table_2_2"] = {{"t90_s", 8.5}, {"t180_s", 15.2}, {"t240_s", 23.2}, {"elements", 45802}};
   return j;
 }

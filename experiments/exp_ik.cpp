@@ -137,24 +137,134 @@ ConfigurationSamples Sample(SimulatorKinematics& kin, const IkExperimentSetup& s
   return samples;
 }
 
-}  // namespace
-
 // ---- Fig. 4.1: the objective against iteration from rest and from the sampled initial guess ----
-nlohmann::json RunIkInitialGuess(const Config& cfg, const std::string& dir, bool verbose) {
-  IkExperimentSetup s = ReadIkSetup(cfg, "cable_finger");
-  const std::vector<double> ta = cfg.NumberList("target_actuation", {});
+
+/// The keys of an ik_initial_guess config.
+struct InitialGuessParams {
+  IkExperimentSetup s;
+  std::vector<double> target_actuation;  ///< the target is the point it reaches
+};
+
+InitialGuessParams ReadInitialGuessParams(const Config& cfg) {
+  InitialGuessParams p;
+  p.s = ReadIkSetup(cfg, "cable_finger");
+  p.target_actuation = cfg.NumberList("target_actuation", {});
   cfg.CheckNoUnknownKeys();
-  SimulatorKinematics kin(s.scene, s.KinematicsFor({s.point}), &s.fk);
+  return p;
+}
+
+/// The target: the point that target_actuation reaches (checked against the kinematics).
+Eigen::Vector3d TargetPoint(const Config& cfg, const std::vector<double>& ta, SimulatorKinematics& kin,
+                            Eigen::VectorXd* c_target) {
   if (static_cast<int>(ta.size()) != kin.num_actuators())
     cfg.Fail("target_actuation", std::to_string(kin.num_actuators()) +
                                      " actuation values (the target is the point they reach)");
-  const Eigen::VectorXd c_target = Eigen::Map<const Eigen::VectorXd>(ta.data(), ta.size());
-  const std::string why = CheckKinematicsInput(kin, c_target);
+  *c_target = Eigen::Map<const Eigen::VectorXd>(ta.data(), ta.size());
+  const std::string why = CheckKinematicsInput(kin, *c_target);
   if (!why.empty()) cfg.Fail("target_actuation", "values inside the box (" + why + ")");
   kin.Reset();
-  const KinematicsEval te = kin.Evaluate(c_target, false);
+  const KinematicsEval te = kin.Evaluate(*c_target, false);
   if (!te.ok) throw std::runtime_error("the forward solve at target_actuation failed: " + te.message);
-  const Eigen::Vector3d target = te.p.row(0).transpose();
+  return te.p.row(0).transpose();
+}
+
+// ---- Fig. 4.2, 4.3, 4.5: trajectory following (Algorithm 4) ----
+
+/// The keys of an ik_trajectory config.
+struct TrajectoryParams {
+  IkExperimentSetup s;
+  nlohmann::json paths;  ///< a non-empty array of path objects (ik_config.hpp)
+};
+
+TrajectoryParams ReadTrajectoryParams(const Config& cfg) {
+  TrajectoryParams p;
+  p.s = ReadIkSetup(cfg, "cable_finger");
+  p.paths = cfg.Raw("paths");
+  cfg.CheckNoUnknownKeys();
+  if (!p.paths.is_array() || p.paths.empty()) cfg.Fail("paths", "a non-empty array of path objects");
+  return p;
+}
+
+// ---- every IK method x Jacobian mode on the same waypoints ----
+
+/// The keys of an ik_methods config.
+struct IkMethodsParams {
+  IkExperimentSetup s;
+  nlohmann::json path_spec;
+  std::vector<IkMethod> methods;
+  std::vector<JacobianMode> jmodes;
+  /// The config but its method and Jacobian lists: what a journaled row was computed with.
+  nlohmann::json settings;
+};
+
+IkMethodsParams ReadIkMethodsParams(const Config& cfg) {
+  IkMethodsParams p;
+  p.s = ReadIkSetup(cfg, "cable_finger");
+  p.path_spec = cfg.Raw("path");
+  std::vector<std::string> method_names;
+  for (IkMethod m : AllIkMethods()) method_names.push_back(IkMethodToString(m));
+  method_names = cfg.StringList("methods", method_names);
+  const std::vector<std::string> modes = cfg.StringList("jacobians", {"fd", "fd-warm", "implicit"});
+  cfg.CheckNoUnknownKeys();
+  for (const auto& m : method_names) {
+    IkMethod x;
+    if (!StringToIkMethod(m, &x)) cfg.Fail("methods", "names out of " + IkMethodNames() + " ('" + m + "' is not)");
+    p.methods.push_back(x);
+  }
+  for (const auto& m : modes) {
+    JacobianMode x;
+    if (!JacobianModeFromString(m, &x)) cfg.Fail("jacobians", "names out of " + JacobianModeNames() + " ('" + m + "' is not)");
+    p.jmodes.push_back(x);
+  }
+  p.settings = cfg.json();
+  for (const char* k : {"methods", "jacobians", "description", "name"}) p.settings.erase(k);
+  p.settings["quick"] = cfg.quick();
+  return p;
+}
+
+/// One method with one Jacobian mode on the path; returns its row of methods.csv.
+nlohmann::json MethodRow(const IkMethodsParams& p, const std::shared_ptr<const Model>& model, IkMethod m,
+                         JacobianMode jmode, const std::string& jname, const IkPath& path,
+                         const ConfigurationSamples& samples, const std::string& dir, bool verbose) {
+  const IkExperimentSetup& s = p.s;
+  SimulatorKinematicsOptions ko = s.KinematicsFor({s.point});
+  ko.jacobian = jmode;
+  SimulatorKinematics kin(model, ko, &s.fk);
+  IkOptions ik = s.ik;
+  ik.method = m;
+  const std::string label = IkMethodToString(m) + "/" + jname;
+  const TrajectoryResult r = Follow(kin, path.waypoints, samples, s, ik,
+                                    dir + "/path_" + IkMethodToString(m) + "_" + jname + ".csv",
+                                    label, verbose);
+  const PathStats st = Stats(r.waypoints, kin, s.lambda_mm);
+  const double ms = st.n ? 1e3 * st.time_s / st.n : 0.0;
+  if (verbose)
+    std::fprintf(stderr, "  %s: %d/%d converged, %.1f ms/waypoint, mean %.3f mm, max %.3f mm, %lld FK\n",
+                 label.c_str(), st.converged, st.n, ms, st.mean_err, st.max_err, st.fk);
+  return {{"method", IkMethodToString(m)},
+          {"jacobian", jname},
+          {"waypoints", st.n},
+          {"converged", st.converged},
+          {"ms_per_waypoint", ms},
+          {"mean_err_mm", st.mean_err},
+          {"max_err_mm", st.max_err},
+          {"fk_calls", st.fk},
+          {"fk_calls_per_waypoint", st.n ? double(st.fk) / st.n : 0.0},
+          {"evaluations", st.evals},
+          {"mean_iterations", st.mean_iter},
+          {"failures", st.failed},
+          {"initial_sample", r.initial_sample},
+          {"initial_starts_tried", r.initial_starts_tried}};
+}
+
+}  // namespace
+
+nlohmann::json RunIkInitialGuess(const Config& cfg, const std::string& dir, bool verbose) {
+  const InitialGuessParams p = ReadInitialGuessParams(cfg);
+  const IkExperimentSetup& s = p.s;
+  SimulatorKinematics kin(s.scene, s.KinematicsFor({s.point}), &s.fk);
+  Eigen::VectorXd c_target;
+  const Eigen::Vector3d target = TargetPoint(cfg, p.target_actuation, kin, &c_target);
 
   const ConfigurationSamples samples = Sample(kin, s, verbose);
   WriteSamples(dir + "/samples.csv", samples);
@@ -195,12 +305,10 @@ nlohmann::json RunIkInitialGuess(const Config& cfg, const std::string& dir, bool
   return j;
 }
 
-// ---- Fig. 4.2, 4.3, 4.5: trajectory following (Algorithm 4) ----
 nlohmann::json RunIkTrajectory(const Config& cfg, const std::string& dir, bool verbose) {
-  IkExperimentSetup s = ReadIkSetup(cfg, "cable_finger");
-  const nlohmann::json paths = cfg.Raw("paths");
-  cfg.CheckNoUnknownKeys();
-  if (!paths.is_array() || paths.empty()) cfg.Fail("paths", "a non-empty array of path objects");
+  const TrajectoryParams p = ReadTrajectoryParams(cfg);
+  const IkExperimentSetup& s = p.s;
+  const nlohmann::json& paths = p.paths;
   SimulatorKinematics kin(s.scene, s.KinematicsFor({s.point}), &s.fk);
   const ConfigurationSamples samples = Sample(kin, s, verbose);
   WriteSamples(dir + "/samples.csv", samples);
@@ -236,32 +344,14 @@ nlohmann::json RunIkTrajectory(const Config& cfg, const std::string& dir, bool v
   return j;
 }
 
-// ---- every IK method x Jacobian mode on the same waypoints ----
 nlohmann::json RunIkMethods(const Config& cfg, const std::string& dir, bool verbose) {
-  IkExperimentSetup s = ReadIkSetup(cfg, "cable_finger");
-  const nlohmann::json path_spec = cfg.Raw("path");
-  std::vector<std::string> method_names;
-  for (IkMethod m : AllIkMethods()) method_names.push_back(IkMethodToString(m));
-  method_names = cfg.StringList("methods", method_names);
-  const std::vector<std::string> modes = cfg.StringList("jacobians", {"fd", "fd-warm", "implicit"});
-  cfg.CheckNoUnknownKeys();
-  std::vector<IkMethod> methods;
-  for (const auto& m : method_names) {
-    IkMethod x;
-    if (!StringToIkMethod(m, &x)) cfg.Fail("methods", "names out of " + IkMethodNames() + " ('" + m + "' is not)");
-    methods.push_back(x);
-  }
-  std::vector<JacobianMode> jmodes;
-  for (const auto& m : modes) {
-    JacobianMode x;
-    if (!JacobianModeFromString(m, &x)) cfg.Fail("jacobians", "names out of " + JacobianModeNames() + " ('" + m + "' is not)");
-    jmodes.push_back(x);
-  }
+  const IkMethodsParams p = ReadIkMethodsParams(cfg);
+  const IkExperimentSetup& s = p.s;
   auto model = std::make_shared<const Model>(s.scene);
   SimulatorKinematics probe(model, s.KinematicsFor({s.point}), &s.fk);
   const ConfigurationSamples samples = Sample(probe, s, verbose);
   probe.Reset();
-  const IkPath path = MakeIkPath(path_spec, cfg.path() + ": path", probe, samples);
+  const IkPath path = MakeIkPath(p.path_spec, cfg.path() + ": path", probe, samples);
   const Eigen::VectorXd closest =
       samples.c.row(ClosestSample(samples, path.waypoints.row(0).transpose())).transpose();
 
@@ -273,52 +363,22 @@ nlohmann::json RunIkMethods(const Config& cfg, const std::string& dir, bool verb
   // Resume: each finished method x Jacobian row is journaled with every setting that produced it
   // (the config but its method and Jacobian lists); a rerun reuses matching rows.
   ResumeJournal journal(dir + "/methods.jsonl");
-  nlohmann::json settings = cfg.json();
-  for (const char* k : {"methods", "jacobians", "description", "name"}) settings.erase(k);
-  settings["quick"] = cfg.quick();
-  for (IkMethod m : methods) {
+  for (IkMethod m : p.methods) {
     // BOBYQA never asks for J: one run, whatever the mode.
     const bool derivative_free = m == IkMethod::kNloptBobyqa;
-    for (size_t k = 0; k < jmodes.size(); ++k) {
+    for (size_t k = 0; k < p.jmodes.size(); ++k) {
       if (derivative_free && k > 0) break;
-      const std::string jname = derivative_free ? "none" : JacobianModeToString(jmodes[k]);
-      const nlohmann::json key = {{"settings", settings}, {"method", IkMethodToString(m)}, {"jacobian", jname}};
+      const std::string jname = derivative_free ? "none" : JacobianModeToString(p.jmodes[k]);
+      const nlohmann::json key = {{"settings", p.settings}, {"method", IkMethodToString(m)}, {"jacobian", jname}};
       if (const nlohmann::json* done = journal.Reuse(key)) {
         rows.push_back(*done);
         csv.RowJson(*done);
         if (verbose) std::fprintf(stderr, "  %s/%s: resumed from methods.jsonl\n", IkMethodToString(m).c_str(), jname.c_str());
         continue;
       }
-      SimulatorKinematicsOptions ko = s.KinematicsFor({s.point});
-      ko.jacobian = jmodes[k];
-      SimulatorKinematics kin(model, ko, &s.fk);
-      IkOptions ik = s.ik;
-      ik.method = m;
-      const std::string label = IkMethodToString(m) + "/" + jname;
-      const TrajectoryResult r = Follow(kin, path.waypoints, samples, s, ik,
-                                        dir + "/path_" + IkMethodToString(m) + "_" + jname + ".csv",
-                                        label, verbose);
-      const PathStats st = Stats(r.waypoints, kin, s.lambda_mm);
-      const double ms = st.n ? 1e3 * st.time_s / st.n : 0.0;
-      rows.push_back({{"method", IkMethodToString(m)},
-                      {"jacobian", jname},
-                      {"waypoints", st.n},
-                      {"converged", st.converged},
-                      {"ms_per_waypoint", ms},
-                      {"mean_err_mm", st.mean_err},
-                      {"max_err_mm", st.max_err},
-                      {"fk_calls", st.fk},
-                      {"fk_calls_per_waypoint", st.n ? double(st.fk) / st.n : 0.0},
-                      {"evaluations", st.evals},
-                      {"mean_iterations", st.mean_iter},
-                      {"failures", st.failed},
-                      {"initial_sample", r.initial_sample},
-                      {"initial_starts_tried", r.initial_starts_tried}});
+      rows.push_back(MethodRow(p, model, m, p.jmodes[k], jname, path, samples, dir, verbose));
       journal.Append(key, rows.back());
       csv.RowJson(rows.back());
-      if (verbose)
-        std::fprintf(stderr, "  %s: %d/%d converged, %.1f ms/waypoint, mean %.3f mm, max %.3f mm, %lld FK\n",
-                     label.c_str(), st.converged, st.n, ms, st.mean_err, st.max_err, st.fk);
     }
   }
   nlohmann::json j = s.Json();

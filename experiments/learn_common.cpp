@@ -241,4 +241,47 @@ LearnedNets CachedNets(const Dataset& d, const std::string& dataset_path, const 
   return out;
 }
 
+LmOptions ReadLm(const Config& cfg) {
+  LmOptions lm;
+  lm.max_epochs = cfg.Int("epochs", 1000);
+  lm.num_threads = cfg.Int("threads", 0);
+  lm.max_time_s = cfg.Number("max_train_time_s", 0.0);
+  lm.seed = cfg.seed();
+  if (lm.max_epochs < 1) cfg.Fail("epochs", "an integer >= 1");
+  if (lm.num_threads < 0) cfg.Fail("threads", "an integer >= 0 (0: OpenMP's default)");
+  if (!(lm.max_time_s >= 0)) cfg.Fail("max_train_time_s", "a time >= 0 s (0: none)");
+  return lm;
+}
+
+std::vector<int> Layers(const Config& cfg, const std::string& key, const std::vector<int>& def) {
+  const std::vector<int> v = cfg.IntList(key, def);
+  if (v.empty()) cfg.Fail(key, "a non-empty list of neuron counts");
+  for (int b : v)
+    if (b < 1) cfg.Fail(key, "neuron counts >= 1");
+  return v;
+}
+
+DatasetSpec SpecFromConfig(const Config& cfg, const std::string& key) {
+  const nlohmann::json j = cfg.Raw(key);
+  if (j.is_null()) cfg.Fail(key, "a dataset object {\"robot\", \"res\", \"grid\", ...}");
+  return ParseDatasetSpec(j, cfg.path() + ": " + key);
+}
+
+std::unique_ptr<PccChamberKinematics> FitPccBaseline(const Dataset& d, nlohmann::json* info) {
+  if (d.num_actuators != 3)
+    throw std::invalid_argument("the PCC baseline models three_chamber (3 actuators), the dataset has " +
+                                std::to_string(d.num_actuators));
+  PccChamberParams start;
+  if (d.meta.is_object() && d.meta.contains("config") && d.meta["config"].contains("actuator_bounds")) {
+    start.lower = d.meta["config"]["actuator_bounds"][0][0].get<double>();
+    start.upper = d.meta["config"]["actuator_bounds"][0][1].get<double>();
+    start.rest = start.lower;
+  }
+  const PccFitResult f = FitPccChamber(d.inputs, d.positions.leftCols(3), start);
+  if (info)
+    *info = {{"gain", f.params.gain}, {"offset_mm", f.params.offset}, {"cap_mm", f.params.cap},
+             {"fit_rms_mm", f.rms_mm}, {"start_rms_mm", f.rms_start_mm}, {"fit_samples", d.inputs.rows()}};
+  return std::make_unique<PccChamberKinematics>(f.params);
+}
+
 }  // namespace softkin

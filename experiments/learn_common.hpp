@@ -3,11 +3,15 @@
 /// What the Chapter 5 experiments share: dataset specs read from a config, generated once into a
 /// cache beside the results (resumable: an interrupted run continues where it stopped, and a
 /// finished dataset is reused by every experiment that asks for the same one), and the kinematics
-/// they come from (a robot's simulator, or a labelled "hardware" twin).
+/// they come from (a robot's simulator, or a labelled "hardware" twin); networks trained once into
+/// a cache likewise; the config keys the experiments share (trainer, layers, dataset objects) and
+/// the PCC baseline.
 
 #include "softkin/experiments/config.hpp"
 #include "softkin/ik/kinematics.hpp"
+#include "softkin/ik/pcc_chamber_kinematics.hpp"
 #include "softkin/learn/dataset.hpp"
+#include "softkin/learn/lm_trainer.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -63,5 +67,27 @@ LearnedNets CachedNets(const Dataset& d, const std::string& dataset_path, const 
 
 /// The shared network cache directory of an experiment's result dir: <dir>/../_nets.
 std::string NetsCacheDir(const std::string& result_dir);
+
+}  // namespace softkin
+
+namespace softkin {
+
+// ---- config keys shared by the Chapter 5 experiments ----
+
+/// The trainer's options: "epochs" (1000), "threads" (0: OpenMP's), "max_train_time_s" (0: none),
+/// seeded with the config's seed.
+LmOptions ReadLm(const Config& cfg);
+
+/// A list of hidden-layer sizes at `key` (each >= 1, not empty).
+std::vector<int> Layers(const Config& cfg, const std::string& key, const std::vector<int>& def);
+
+/// The dataset object at `key` (required).
+DatasetSpec SpecFromConfig(const Config& cfg, const std::string& key);
+
+/// The PCC baseline of three_chamber calibrated on a dataset's tip positions (gain, chamber
+/// offset and cap length fitted; the thesis calibrates its PCC model on measurements likewise).
+/// *info (if given) receives the fit. Throws std::invalid_argument unless the dataset has 3
+/// actuators.
+std::unique_ptr<PccChamberKinematics> FitPccBaseline(const Dataset& d, nlohmann::json* info);
 
 }  // namespace softkin

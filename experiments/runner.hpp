@@ -52,7 +52,7 @@ nlohmann::json RunIkInitialGuess(const Config& cfg, const std::string& dir, bool
 nlohmann::json RunIkTrajectory(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunIkMethods(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunIkPickAndPlace(const Config& cfg, const std::string& dir, bool verbose);
-// Chapter 5 (experiments/exp_learn.cpp).
+// Chapter 5 (experiments/exp_learn.cpp; the sim-to-real ones in exp_learn_s2r.cpp).
 nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunLearnIkMethods(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunLearnDataSource(const Config& cfg, const std::string& dir, bool verbose);

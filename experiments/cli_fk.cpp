@@ -1,0 +1,136 @@
+#include "softkin/experiments/cli_fk.hpp"
+
+#include "softkin/experiments/cli_args.hpp"
+#include "softkin/experiments/results.hpp"
+#include "softkin/solver/factory/fk_factory.hpp"
+#include "softkin/solver/fk/fk_solver.hpp"
+#include "softkin/solver/mesh/io/mesh_io.hpp"
+#include "softkin/solver/robots/robots.hpp"
+#include "softkin/solver/scene/scene_json.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <iostream>
+#include <memory>
+#include <stdexcept>
+
+namespace softkin {
+
+CLI::App* AddFkCommand(CLI::App* app, FkCommandArgs* a) {
+  auto* fk = app->add_subcommand("fk", "Solve forward kinematics for one actuation");
+  auto* o_robot = fk->add_option("--robot", a->robot, "Embedded robot name (see `softkin robots`)");
+  auto* o_scene = fk->add_option("--scene", a->scene, "Scene JSON file (see `softkin scene --schema`)");
+  o_robot->excludes(o_scene);
+  fk->add_option("--res", a->res, "Robot resolution (default: the robot's own)")->needs(o_robot);
+  fk->add_option("--param", a->params,
+                 "Robot design parameter NAME=VALUE (repeatable; see `softkin robots`)")
+      ->needs(o_robot);
+  fk->add_option("--actuation", a->actuation, "Actuation values v1,v2,... in actuator order")->required();
+  fk->add_option("--solver", a->solver,
+                 "FK solver: lg (plain local-global), lg-aa (Anderson), ceres, ipopt-lbfgs, "
+                 "ipopt-newton, ipopt-hard, calculix-linear or calculix-nonlinear (docs/solvers.md)");
+  fk->add_option("--continuation", a->continuation, "Apply the actuation in this many steps");
+  fk->add_option("--max-iterations", a->max_iterations, "Iteration cap");
+  fk->add_option("--tolerance", a->tolerance, "Per-iteration vertex move tolerance, relative to model size");
+  fk->add_option("--gradient-tolerance", a->gradient_tolerance,
+                 "Residual tolerance, relative to its reference value");
+  fk->add_option("--aa-safeguard", a->safeguard,
+                 "Anderson safeguard: hybrid (energy or residual), energy, or none");
+  fk->add_option("--json", a->json_out, "Write the result as JSON to this file");
+  fk->add_option("--vtu", a->vtu_out, "Write the deformed mesh as ParaView .vtu");
+  fk->add_option("--obj", a->obj_out, "Write the deformed surface as .obj");
+  // Which overriding options were given, once the command line is parsed.
+  fk->callback([a, fk] {
+    a->continuation_given = fk->count("--continuation") > 0;
+    a->max_iterations_given = fk->count("--max-iterations") > 0;
+    a->tolerance_given = fk->count("--tolerance") > 0;
+    a->gradient_tolerance_given = fk->count("--gradient-tolerance") > 0;
+    a->safeguard_given = fk->count("--aa-safeguard") > 0;
+  });
+  return fk;
+}
+
+namespace {
+
+/// The scene's solver options with the command line's overrides, validated.
+FkOptions FkOptionsFromArgs(const FkCommandArgs& a, const Scene& scene) {
+  FkOptions opt = scene.solver;
+  if (!a.solver.empty()) opt.solver = a.solver;
+  if (a.continuation_given) opt.continuation_steps = a.continuation;
+  if (a.max_iterations_given) opt.max_iterations = a.max_iterations;
+  if (a.tolerance_given) opt.tolerance = a.tolerance;
+  if (a.gradient_tolerance_given) opt.gradient_tolerance = a.gradient_tolerance;
+  if (a.safeguard_given) opt.anderson_safeguard = a.safeguard;
+  std::string why;
+  if (!opt.IsValid(&why)) throw std::invalid_argument("option " + why);
+  return opt;
+}
+
+/// The result as `softkin fk --json` writes it.
+nlohmann::json FkResultJson(const Scene& scene, const Eigen::VectorXd& c, const FkResult& r) {
+  nlohmann::json j;
+  j["status"] = FkStatusToString(r.status);
+  j["message"] = r.message;
+  j["solver"] = r.solver;
+  j["iterations"] = r.iterations;
+  j["energy"] = r.energy;
+  j["time_s"] = r.time_s;
+  j["local_time_s"] = r.local_time_s;
+  j["global_time_s"] = r.global_time_s;
+  j["n_vertices"] = scene.mesh.num_vertices();
+  j["n_elements"] = scene.mesh.num_elements();
+  j["actuation"] = std::vector<double>(c.data(), c.data() + c.size());
+  j["volume_ratios"] = r.volume_ratios;
+  j["residual_ratio"] = r.gradient_ratio;
+  const Eigen::MatrixX3d P = scene.marker_positions(r.positions);
+  nlohmann::json markers = nlohmann::json::object();
+  for (size_t i = 0; i < scene.markers.size(); ++i)
+    markers[scene.markers[i].name] = {P(i, 0), P(i, 1), P(i, 2)};
+  j["markers"] = markers;
+  if (r.collision_active) {
+    // The exact check of the final state (docs/collision_response.md, "Stopping and the final
+    // check") and the response's work.
+    nlohmann::json col = CollisionCheckJson(r.collision);
+    col["springs"] = r.springs;
+    col["unresolved_contacts"] = r.collision_stats.unresolved;
+    col["check_s"] = r.collision_stats.check_s;
+    col["response_s"] = r.collision_stats.response_s;
+    j["collision"] = col;
+  }
+  return j;
+}
+
+}  // namespace
+
+int RunFkCommand(const FkCommandArgs& a) {
+  if (a.robot.empty() == a.scene.empty())
+    throw std::invalid_argument("fk: give exactly one of --robot NAME or --scene FILE");
+  if (a.res < 0) throw std::invalid_argument("--res: expected a positive integer");
+  const RobotParams params = ParseRobotParams(a.params);
+  Scene scene = a.robot.empty() ? LoadSceneJson(a.scene) : MakeRobot(a.robot, a.res, params);
+  FkOptions opt = FkOptionsFromArgs(a, scene);
+  const Eigen::VectorXd c = ParseNumberList(a.actuation, "--actuation");
+  if (opt.continuation_steps > 1)
+    opt.on_step = [](int step, int steps, const std::string& status, int iterations, double sec) {
+      std::cerr << "fk: step " << step << "/" << steps << ": " << status << ", " << iterations
+                << " iterations so far, " << sec << " s\n";
+    };
+  auto model = std::make_shared<const Model>(scene);
+  FkResult r = MakeFkSolver(model, opt)->Solve(c);
+  if (r.status == FkStatus::InvalidInput) {
+    // Bad values are the actuation's; anything else (a scene a solver cannot express, a missing
+    // ccx) is the solver's.
+    const bool actuation = r.message.rfind("actuation", 0) == 0;
+    throw std::invalid_argument((actuation ? "--actuation: " : "--solver " + opt.solver + ": ") +
+                                r.message);
+  }
+  std::cerr << r.BriefReport() << "\n";
+  const nlohmann::json j = FkResultJson(scene, c, r);
+  if (!a.json_out.empty()) WriteJson(a.json_out, j);
+  else std::cout << j.dump(2) << "\n";
+  if (!a.vtu_out.empty()) WriteVtu(a.vtu_out, scene.mesh, r.positions);
+  if (!a.obj_out.empty()) WriteSurfaceObj(a.obj_out, scene.mesh, r.positions);
+  return r.status == FkStatus::Converged ? 0 : 1;
+}
+
+}  // namespace softkin
