@@ -4,7 +4,7 @@
 /// analytical" baseline, and the analytical data source of Fig. 5.14; refs. [129, 80] there):
 /// chamber extensions -> arc parameters (kappa, phi, l) -> tip position, in closed form.
 ///
-/// Frame as in solver/robots/robots.cpp: y is the long axis (base face y = 0), the cross-section is the
+/// Frame as in solver/robots/three_chamber.cpp: y is the long axis (base face y = 0), the cross-section is the
 /// x-z plane, chamber k (actuator c_{k+1}, k = 0, 1, 2) sits at distance d from the axis in the
 /// direction u_k = (cos psi_k, sin psi_k) of the (x, z) plane, psi_k = 180 + 120 k degrees.
 ///

@@ -251,6 +251,38 @@ CalculixSolver::CalculixSolver(std::shared_ptr<const Model> model, const FkOptio
   if (fk.continuation_steps > 1) options_.increments = fk.continuation_steps;
 }
 
+namespace {
+
+/// Starts `ccx -i job` in folder `work` (no shell), its output going to `log`; returns the child's
+/// pid, or -1 if fork failed.
+pid_t StartCcx(const std::string& ccx, const fs::path& work, const std::string& log) {
+  const pid_t pid = ::fork();
+  if (pid != 0) return pid;
+  if (::chdir(work.c_str()) != 0) ::_exit(126);
+  const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (fd >= 0) {
+    ::dup2(fd, 1);
+    ::dup2(fd, 2);
+    ::close(fd);
+  }
+  ::setenv("OMP_NUM_THREADS", "2", 0);
+  char* const argv[] = {const_cast<char*>("ccx"), const_cast<char*>("-i"),
+                        const_cast<char*>("job"), nullptr};
+  ::execv(ccx.c_str(), argv);
+  ::_exit(127);
+}
+
+/// The last line of file `log` that mentions an error ("" if none).
+std::string LastErrorLine(const std::string& log) {
+  std::ifstream lg(log);
+  std::string line, last;
+  while (std::getline(lg, line))
+    if (line.find("ERROR") != std::string::npos || line.find("error") != std::string::npos) last = line;
+  return last;
+}
+
+}  // namespace
+
 FkResult CalculixSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c, const Eigen::MatrixX3d*) {
   const Model& m = *model_;
   const auto t0 = Clock::now();
@@ -295,22 +327,8 @@ FkResult CalculixSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c, const
   }
   // Run ccx -i job in the work folder, output to ccx.log; no shell is involved.
   const std::string log = (work / "ccx.log").string();
-  const pid_t pid = ::fork();
+  const pid_t pid = StartCcx(ccx, work, log);
   if (pid < 0) return finish(FkStatus::Diverged, "fork failed");
-  if (pid == 0) {
-    if (::chdir(work.c_str()) != 0) ::_exit(126);
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (fd >= 0) {
-      ::dup2(fd, 1);
-      ::dup2(fd, 2);
-      ::close(fd);
-    }
-    ::setenv("OMP_NUM_THREADS", "2", 0);
-    char* const argv[] = {const_cast<char*>("ccx"), const_cast<char*>("-i"),
-                          const_cast<char*>("job"), nullptr};
-    ::execv(ccx.c_str(), argv);
-    ::_exit(127);
-  }
   int wstatus = 0;
   bool timed_out = false;
   // Time-stamp each converged increment as it appears in job.sta (re-read only when it grows).
@@ -359,10 +377,7 @@ FkResult CalculixSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c, const
   const bool reached = !history_.empty() && std::abs(history_.back().load - 1.0) < 1e-6;
   if (reached && r.positions.allFinite()) return finish(FkStatus::Converged, "");
   // The last error line of the log says why.
-  std::ifstream lg(log);
-  std::string line, last;
-  while (std::getline(lg, line))
-    if (line.find("ERROR") != std::string::npos || line.find("error") != std::string::npos) last = line;
+  const std::string last = LastErrorLine(log);
   if (!r.positions.allFinite()) r.positions = m.rest_positions();
   char buf[64];
   std::snprintf(buf, sizeof(buf), "ccx stopped at time %.4g of 1",

@@ -468,111 +468,158 @@ void SelfCollisionDetector::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) 
   build_s_ = Seconds(t0);
 }
 
+namespace {
+
+using TetList = std::vector<std::array<int, 4>>;
+
+/// The exact test of the CGAL methods: whether vertex v is in the closed tet t, which is not
+/// incident to it. Returns -1 for an incident tet (no test), else 0 or 1.
+int InsideNonIncident(const std::vector<std::vector<int>>& incident, const TetList& tets,
+                      const RowX3& X, int v, int t) {
+  if (std::binary_search(incident[v].begin(), incident[v].end(), t)) return -1;
+  const auto& tt = tets[t];
+  const K::Tetrahedron_3 tet(P(X, tt[0]), P(X, tt[1]), P(X, tt[2]), P(X, tt[3]));
+  return !tet.is_degenerate() && !tet.has_on_unbounded_side(P(X, v)) ? 1 : 0;
+}
+
+/// kGrid: hit[q] = the lowest id of a tet containing boundary vertex q (box, incidence, then the
+/// filtered exact test), or -1. Adds the narrow-phase and exact tests to *narrow_out, *exact_out.
+void DetectInGrid(const UniformTetGrid& G, const TetList& tets, const RowX3& X,
+                  const std::vector<int>& boundary, std::vector<int>* hit_out,
+                  long long* narrow_out, long long* exact_out) {
+  const int nb = static_cast<int>(boundary.size());
+  std::vector<int>& hit = *hit_out;
+  long long narrow = 0, exact = 0;
+#pragma omp parallel for schedule(dynamic, 64) reduction(+ : narrow, exact) if (nb >= kParallelVertices)
+  for (int q = 0; q < nb; ++q) {
+    const int v = boundary[q];
+    const double* p = &X(v, 0);
+    long long my_narrow = 0, my_exact = 0;
+    // Does tet t contain p (box, incidence, then the filtered exact test)?
+    auto test = [&](int t) {
+      const double* b = &G.box[6 * static_cast<size_t>(t)];
+      if (p[0] < b[0] || p[1] < b[1] || p[2] < b[2] || p[0] > b[3] || p[1] > b[4] || p[2] > b[5]) return false;
+      const auto& tt = tets[t];
+      if (tt[0] == v || tt[1] == v || tt[2] == v || tt[3] == v) return false;
+      ++my_narrow;
+      bool ex = false;
+      const bool in = ContainsFiltered(&X(tt[0], 0), &X(tt[1], 0), &X(tt[2], 0), &X(tt[3], 0), p, &ex);
+      my_exact += ex;
+      return in;
+    };
+    // Both lists are ascending: the first hit of each, the lower of the two, is the lowest id.
+    int best = -1;
+    const int c = G.Cell(p);
+    for (int k = G.start[c]; k < G.start[c + 1]; ++k)
+      if (test(G.cell_tets[k])) {
+        best = G.cell_tets[k];
+        break;
+      }
+    for (int t : G.large) {
+      if (best >= 0 && t > best) break;
+      if (test(t)) {
+        best = t;
+        break;
+      }
+    }
+    hit[q] = best;
+    narrow += my_narrow;
+    exact += my_exact;
+  }
+  *narrow_out += narrow;
+  *exact_out += exact;
+}
+
+/// kAabbTree: hit[q] = the lowest id of a non-incident tet of the tree containing boundary
+/// vertex q, or -1. Adds the tests to *narrow_out, *exact_out.
+void DetectInAabbTree(const TetTree& tree, const std::vector<std::vector<int>>& incident,
+                      const TetList& tets, const RowX3& X, const std::vector<int>& boundary,
+                      std::vector<int>* hit_out, long long* narrow_out, long long* exact_out) {
+  const int nb = static_cast<int>(boundary.size());
+  std::vector<int>& hit = *hit_out;
+  long long narrow = 0, exact = 0;
+#pragma omp parallel for schedule(dynamic, 64) reduction(+ : narrow, exact)
+  for (int q = 0; q < nb; ++q) {
+    const int v = boundary[q];
+    std::vector<int> cand;
+    tree.all_intersected_primitives(P(X, v), std::back_inserter(cand));
+    std::sort(cand.begin(), cand.end());
+    for (int t : cand) {
+      const int in = InsideNonIncident(incident, tets, X, v, t);
+      if (in < 0) continue;
+      ++narrow;
+      ++exact;
+      if (in) {
+        hit[q] = t;
+        break;
+      }
+    }
+  }
+  *narrow_out += narrow;
+  *exact_out += exact;
+}
+
+/// kBoxIntersection: hit[q] = the lowest id of a non-incident tet containing boundary vertex q,
+/// or -1, by CGAL's box intersection of the vertices' points with the tets' boxes. Adds the tests
+/// to *narrow_out, *exact_out.
+void DetectByBoxIntersection(const std::vector<std::vector<int>>& incident, const TetList& tets,
+                             const RowX3& X, const std::vector<int>& boundary,
+                             std::vector<int>* hit_out, long long* narrow_out,
+                             long long* exact_out) {
+  const int nb = static_cast<int>(boundary.size());
+  std::vector<int>& hit = *hit_out;
+  long long narrow = 0;
+  // Broad phase: boxes of the boundary vertices (points) against boxes of the tets.
+  using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, int,
+                                                         CGAL::Box_intersection_d::ID_FROM_BOX_ADDRESS>;
+  std::vector<Box> vb, tb;
+  vb.reserve(nb);
+  for (int q = 0; q < nb; ++q) {
+    const int v = boundary[q];
+    vb.emplace_back(CGAL::Bbox_3(X(v, 0), X(v, 1), X(v, 2), X(v, 0), X(v, 1), X(v, 2)), q);
+  }
+  tb.reserve(tets.size());
+  for (int t = 0; t < static_cast<int>(tets.size()); ++t) {
+    const auto& tt = tets[t];
+    Eigen::Vector3d lo = X.row(tt[0]).transpose(), hi = lo;
+    for (int k = 1; k < 4; ++k) {
+      lo = lo.cwiseMin(X.row(tt[k]).transpose());
+      hi = hi.cwiseMax(X.row(tt[k]).transpose());
+    }
+    tb.emplace_back(CGAL::Bbox_3(lo.x(), lo.y(), lo.z(), hi.x(), hi.y(), hi.z()), t);
+  }
+  std::vector<std::pair<int, int>> pairs;  // (boundary index, tet)
+  CGAL::box_intersection_d(vb.begin(), vb.end(), tb.begin(), tb.end(),
+                           [&](const Box& a, const Box& b) { pairs.emplace_back(a.info(), b.info()); });
+  std::sort(pairs.begin(), pairs.end());
+  const int np = static_cast<int>(pairs.size());
+  std::vector<signed char> ok(np, 0);
+#pragma omp parallel for schedule(static) reduction(+ : narrow)
+  for (int k = 0; k < np; ++k) {
+    ok[k] = static_cast<signed char>(
+        InsideNonIncident(incident, tets, X, boundary[pairs[k].first], pairs[k].second));
+    narrow += ok[k] >= 0;
+  }
+  for (int k = 0; k < np; ++k)
+    if (ok[k] > 0 && hit[pairs[k].first] < 0) hit[pairs[k].first] = pairs[k].second;
+  *narrow_out += narrow;
+  *exact_out += narrow;
+}
+
+}  // namespace
+
 std::vector<SelfContact> SelfCollisionDetector::Detect() const {
   const auto t0 = Clock::now();
   const auto& I = *impl_;
   const int nb = static_cast<int>(boundary_.size());
   long long narrow = 0, exact = 0;
-  // The exact test of the CGAL methods: the vertex is in the closed tet, which is not incident
-  // to it. Returns -1 for an incident tet (no test), else 0 or 1.
-  auto inside = [&](int v, int t) {
-    if (std::binary_search(I.incident[v].begin(), I.incident[v].end(), t)) return -1;
-    const auto& tt = I.tets[t];
-    const K::Tetrahedron_3 tet(P(I.X, tt[0]), P(I.X, tt[1]), P(I.X, tt[2]), P(I.X, tt[3]));
-    return !tet.is_degenerate() && !tet.has_on_unbounded_side(P(I.X, v)) ? 1 : 0;
-  };
   std::vector<int> hit(nb, -1);
-  if (method_ == Method::kGrid) {
-    const UniformTetGrid& G = I.grid;
-#pragma omp parallel for schedule(dynamic, 64) reduction(+ : narrow, exact) if (nb >= kParallelVertices)
-    for (int q = 0; q < nb; ++q) {
-      const int v = boundary_[q];
-      const double* p = &I.X(v, 0);
-      long long my_narrow = 0, my_exact = 0;
-      // Does tet t contain p (box, incidence, then the filtered exact test)?
-      auto test = [&](int t) {
-        const double* b = &G.box[6 * static_cast<size_t>(t)];
-        if (p[0] < b[0] || p[1] < b[1] || p[2] < b[2] || p[0] > b[3] || p[1] > b[4] || p[2] > b[5]) return false;
-        const auto& tt = I.tets[t];
-        if (tt[0] == v || tt[1] == v || tt[2] == v || tt[3] == v) return false;
-        ++my_narrow;
-        bool ex = false;
-        const bool in = ContainsFiltered(&I.X(tt[0], 0), &I.X(tt[1], 0), &I.X(tt[2], 0), &I.X(tt[3], 0), p, &ex);
-        my_exact += ex;
-        return in;
-      };
-      // Both lists are ascending: the first hit of each, the lower of the two, is the lowest id.
-      int best = -1;
-      const int c = G.Cell(p);
-      for (int k = G.start[c]; k < G.start[c + 1]; ++k)
-        if (test(G.cell_tets[k])) {
-          best = G.cell_tets[k];
-          break;
-        }
-      for (int t : G.large) {
-        if (best >= 0 && t > best) break;
-        if (test(t)) {
-          best = t;
-          break;
-        }
-      }
-      hit[q] = best;
-      narrow += my_narrow;
-      exact += my_exact;
-    }
-  } else if (method_ == Method::kAabbTree) {
-#pragma omp parallel for schedule(dynamic, 64) reduction(+ : narrow, exact)
-    for (int q = 0; q < nb; ++q) {
-      const int v = boundary_[q];
-      std::vector<int> cand;
-      I.tree.all_intersected_primitives(P(I.X, v), std::back_inserter(cand));
-      std::sort(cand.begin(), cand.end());
-      for (int t : cand) {
-        const int in = inside(v, t);
-        if (in < 0) continue;
-        ++narrow;
-        ++exact;
-        if (in) {
-          hit[q] = t;
-          break;
-        }
-      }
-    }
-  } else {
-    // Broad phase: boxes of the boundary vertices (points) against boxes of the tets.
-    using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, int,
-                                                           CGAL::Box_intersection_d::ID_FROM_BOX_ADDRESS>;
-    std::vector<Box> vb, tb;
-    vb.reserve(nb);
-    for (int q = 0; q < nb; ++q) {
-      const int v = boundary_[q];
-      vb.emplace_back(CGAL::Bbox_3(I.X(v, 0), I.X(v, 1), I.X(v, 2), I.X(v, 0), I.X(v, 1), I.X(v, 2)), q);
-    }
-    tb.reserve(I.tets.size());
-    for (int t = 0; t < static_cast<int>(I.tets.size()); ++t) {
-      const auto& tt = I.tets[t];
-      Eigen::Vector3d lo = I.X.row(tt[0]).transpose(), hi = lo;
-      for (int k = 1; k < 4; ++k) {
-        lo = lo.cwiseMin(I.X.row(tt[k]).transpose());
-        hi = hi.cwiseMax(I.X.row(tt[k]).transpose());
-      }
-      tb.emplace_back(CGAL::Bbox_3(lo.x(), lo.y(), lo.z(), hi.x(), hi.y(), hi.z()), t);
-    }
-    std::vector<std::pair<int, int>> pairs;  // (boundary index, tet)
-    CGAL::box_intersection_d(vb.begin(), vb.end(), tb.begin(), tb.end(),
-                             [&](const Box& a, const Box& b) { pairs.emplace_back(a.info(), b.info()); });
-    std::sort(pairs.begin(), pairs.end());
-    const int np = static_cast<int>(pairs.size());
-    std::vector<signed char> ok(np, 0);
-#pragma omp parallel for schedule(static) reduction(+ : narrow)
-    for (int k = 0; k < np; ++k) {
-      ok[k] = static_cast<signed char>(inside(boundary_[pairs[k].first], pairs[k].second));
-      narrow += ok[k] >= 0;
-    }
-    exact = narrow;
-    for (int k = 0; k < np; ++k)
-      if (ok[k] > 0 && hit[pairs[k].first] < 0) hit[pairs[k].first] = pairs[k].second;
-  }
+  if (method_ == Method::kGrid)
+    DetectInGrid(I.grid, I.tets, I.X, boundary_, &hit, &narrow, &exact);
+  else if (method_ == Method::kAabbTree)
+    DetectInAabbTree(I.tree, I.incident, I.tets, I.X, boundary_, &hit, &narrow, &exact);
+  else
+    DetectByBoxIntersection(I.incident, I.tets, I.X, boundary_, &hit, &narrow, &exact);
   std::vector<SelfContact> out;
   for (int q = 0; q < nb; ++q)
     if (hit[q] >= 0) out.push_back({boundary_[q], hit[q]});

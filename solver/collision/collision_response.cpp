@@ -435,6 +435,63 @@ void CollisionResponse::ObstacleTarget(const Eigen::Vector3d& p, int obstacle,
   s->target = c + options_.epsilon * n;
 }
 
+namespace {
+
+/// Springs for the obstacle contacts (target: the closest point pushed epsilon out along the
+/// obstacle's normal), appended to *next; *obst_vertex receives their vertices, sorted.
+void AddObstacleSprings(const std::vector<ObstacleContact>& obst, double epsilon,
+                        std::vector<CollisionSpring>* next, std::vector<int>* obst_vertex) {
+  obst_vertex->reserve(obst.size());
+  for (const auto& c : obst) {
+    CollisionSpring s;
+    s.vertex = c.vertex;
+    s.kind = CollisionSpring::Kind::Obstacle;
+    s.other = c.obstacle;
+    s.normal = c.normal;
+    s.target = c.closest + epsilon * c.normal;
+    s.depth = c.depth;
+    next->push_back(s);
+    obst_vertex->push_back(c.vertex);
+  }
+  std::sort(obst_vertex->begin(), obst_vertex->end());
+}
+
+/// A pair spring of *next (sorted by vertex) whose contact persists on the same face of
+/// `springs` (the previous set, sorted by vertex), its point moved by less than a fifth of the
+/// face, keeps its weights (so its column of the matrix): the offset takes up the refreshed
+/// target.
+void KeepPairWeights(const std::vector<CollisionSpring>& springs,
+                     const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                     std::vector<CollisionSpring>* next) {
+  for (auto& s : *next) {
+    if (!s.pair()) continue;
+    const auto it = std::lower_bound(
+        springs.begin(), springs.end(), s.vertex,
+        [](const CollisionSpring& a, int v) { return a.vertex < v; });
+    if (it == springs.end() || it->vertex != s.vertex || it->face != s.face) continue;
+    if ((it->weights - s.weights).cwiseAbs().maxCoeff() > 0.2) continue;
+    s.weights = it->weights;
+    s.offset = s.target - s.FacePoint(X);
+  }
+}
+
+/// Where the release test (Eq. 3.8) of self spring s, whose vertex is at p, finds the contact
+/// surface: p moved along s.normal onto the current plane of the face it was pushed out through
+/// (s.exit_face), plus epsilon; its fixed target if that face is (nearly) parallel to s.normal.
+Eigen::Vector3d ExitFaceTarget(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                               const CollisionSpring& s, const Eigen::Vector3d& p, double epsilon) {
+  const auto& e = mesh.elements[s.exit_face / 4].v;
+  const int j = s.exit_face % 4;
+  const Eigen::Vector3d a = X.row(e[kFace[j][0]]), b = X.row(e[kFace[j][1]]),
+                        c = X.row(e[kFace[j][2]]);
+  const Eigen::Vector3d m = (b - a).cross(c - a);
+  const double mn = m.dot(s.normal);
+  if (std::abs(mn) > 1e-3 * m.norm()) return p + (m.dot(a - p) / mn + epsilon) * s.normal;
+  return s.target;
+}
+
+}  // namespace
+
 bool CollisionResponse::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) {
   const auto t0 = Clock::now();
   std::vector<SelfContact> self;
@@ -452,19 +509,7 @@ bool CollisionResponse::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) {
   next.reserve(self.size() + obst.size() + springs_.size());
   // An obstacle contact wins over a self contact of the same vertex: the obstacle does not move.
   std::vector<int> obst_vertex;
-  obst_vertex.reserve(obst.size());
-  for (const auto& c : obst) {
-    CollisionSpring s;
-    s.vertex = c.vertex;
-    s.kind = CollisionSpring::Kind::Obstacle;
-    s.other = c.obstacle;
-    s.normal = c.normal;
-    s.target = c.closest + options_.epsilon * c.normal;
-    s.depth = c.depth;
-    next.push_back(s);
-    obst_vertex.push_back(c.vertex);
-  }
-  std::sort(obst_vertex.begin(), obst_vertex.end());
+  AddObstacleSprings(obst, options_.epsilon, &next, &obst_vertex);
   std::vector<char> fresh(body_faces_.size(), 0);
   for (const auto& c : self) {
     if (std::binary_search(obst_vertex.begin(), obst_vertex.end(), c.vertex)) continue;
@@ -490,19 +535,7 @@ bool CollisionResponse::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) {
   }
   std::sort(next.begin(), next.end(),
             [](const CollisionSpring& a, const CollisionSpring& b) { return a.vertex < b.vertex; });
-  // A pair spring whose contact persists on the same face, its point moved by less than a fifth
-  // of the face, keeps its weights (so its column of the matrix): the offset takes up the
-  // refreshed target.
-  for (auto& s : next) {
-    if (!s.pair()) continue;
-    const auto it = std::lower_bound(
-        springs_.begin(), springs_.end(), s.vertex,
-        [](const CollisionSpring& a, int v) { return a.vertex < v; });
-    if (it == springs_.end() || it->vertex != s.vertex || it->face != s.face) continue;
-    if ((it->weights - s.weights).cwiseAbs().maxCoeff() > 0.2) continue;
-    s.weights = it->weights;
-    s.offset = s.target - s.FacePoint(X);
-  }
+  KeepPairWeights(springs_, X, &next);
   // Springs of vertices no longer in collision: release by Eq. 3.8, else keep (obstacle targets
   // follow the closest point as the vertex slides).
   std::vector<CollisionSpring> kept;
@@ -526,14 +559,7 @@ bool CollisionResponse::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) {
       ObstacleTarget(p, s.other, &s);
       surface_target = s.target;
     } else if (s.exit_face >= 0) {
-      const auto& e = model_.mesh().elements[s.exit_face / 4].v;
-      const int j = s.exit_face % 4;
-      const Eigen::Vector3d a = X.row(e[kFace[j][0]]), b = X.row(e[kFace[j][1]]),
-                            c = X.row(e[kFace[j][2]]);
-      const Eigen::Vector3d m = (b - a).cross(c - a);
-      const double mn = m.dot(s.normal);
-      if (std::abs(mn) > 1e-3 * m.norm())
-        surface_target = p + (m.dot(a - p) / mn + options_.epsilon) * s.normal;
+      surface_target = ExitFaceTarget(model_.mesh(), X, s, p, options_.epsilon);
     }
     if (s.normal.dot(p - surface_target) > options_.epsilon) {
       ++stats_.springs_released;

@@ -1,6 +1,6 @@
 #pragma once
 /// \file mesh_gen.hpp
-/// Structured tetrahedral mesh generators used by the embedded robots (robots.cpp):
+/// Structured tetrahedral mesh generators used by the embedded robots (solver/robots/):
 ///  - VoxelTetMesh: cubic cells on a regular grid, each kept cell split into 6 tets (Kuhn split);
 ///  - MakeConcentricDisk + ExtrudedDiskTetMesh: a disk triangulated in concentric rings, exactly
 ///    invariant under rotation by 120 degrees, extruded into layers of prisms split into 3 tets.

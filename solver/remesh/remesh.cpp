@@ -1,4 +1,5 @@
-// Progressive chamber remeshing (thesis Sec. 3.3.2, Algorithm 2; remesh.hpp).
+// Progressive chamber remeshing (thesis Sec. 3.3.2, Algorithm 2; remesh.hpp): the remesh checks
+// and RemeshChamber. The driver, SolveProgressive, is in progressive.cpp.
 #include "softkin/solver/remesh/remesh.hpp"
 
 #include "softkin/solver/factory/fk_factory.hpp"
@@ -29,12 +30,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 using Rows4 = Eigen::Matrix<double, 4, 3>;
-
-/// SolveProgressive treats a solution whose bounding-box diagonal exceeds this multiple of the
-/// rest one as a runaway (diverged)...
-constexpr double kRunawayExtent = 5.0;
-/// ... or whose chamber volume ratio exceeds this multiple of the ratio asked for.
-constexpr double kRunawayRatio = 2.0;
 
 double Seconds(Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); }
 
@@ -447,16 +442,12 @@ int UntangleTets(Mesh& m, const std::vector<char>& held) {
   return moves;
 }
 
-/// The whole re-tessellation T(S_c^k, S_b^k) and the interpolated state (remesh.hpp).
-void RemeshWhole(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX3d>& X, int region,
-                 const ChamberRemeshOptions& opt, ChamberRemesh* out) {
-  const Mesh& mesh = scene.mesh;
-  if (!scene.fixed_axis[0].empty() || !scene.fixed_axis[1].empty() || !scene.fixed_axis[2].empty())
-    throw std::invalid_argument("RemeshChamber: the whole re-tessellation does not support fixed_axis "
-                                "constraints (scene '" + scene.name + "')");
-  TriangleSurface sc, sb;
-  std::vector<int> sc_old, sb_old;
-  DeformedSurfaces(mesh, X, region, &sc, &sc_old, &sb, &sb_old);
+/// Mesh_3 sizing of the whole re-tessellation: opt.tessellation, or where it leaves the cell size
+/// unset, a facet size of the mean edge length of the deformed outer surface `sb` (cell size
+/// twice that, facet distance 0.05 of the cell size). Tags body 0, chamber 1: temporary ones, the
+/// body tets' final regions come from the old tets containing them.
+TessellationOptions WholeTessellationOptions(const TriangleSurface& sb,
+                                             const ChamberRemeshOptions& opt) {
   TessellationOptions topt = opt.tessellation;
   if (!(topt.cell_size > 0)) {
     double sum = 0;
@@ -467,30 +458,36 @@ void RemeshWhole(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX3d>& X
     topt.cell_size = 2.0 * topt.facet_size;
     topt.facet_distance = 0.05 * topt.cell_size;
   }
-  // Temporary tags; the body tets' final regions come from the old tets containing them.
   topt.body_region = 0;
   topt.chamber_region = 1;
-  Mesh fresh;
-  try {
-    fresh = Tessellate(sc, sb, topt);
-  } catch (const std::invalid_argument& e) {
-    throw std::runtime_error(std::string("RemeshChamber (whole): the deformed surfaces cannot be meshed: ") + e.what());
-  }
-  const int nv = fresh.num_vertices();
-  out->positions = fresh.vertices;
+  return topt;
+}
 
+/// The new vertices' rest positions, pulled back through the old deformation (PullBack).
+struct PulledBack {
+  Eigen::MatrixX3d rest;                  ///< #V' x 3, mm (rows of unknown vertices 0)
+  std::vector<char> known;                ///< per new vertex: whether `rest` holds its position
+  std::vector<int> fixed;                 ///< new vertices held: on faces of old fixed vertices
+  std::vector<std::vector<int>> markers;  ///< per marker: new vertices on faces of its vertices
+};
+
+/// Pulls the new mesh `fresh` (deformed positions *positions) back into the old rest frame. A
+/// vertex of a body tet goes through the old body tet `locate` finds for it; it is fixed (and
+/// moved to its rest position) or in a marker if every old vertex with a barycentric weight
+/// above kSupport is. A chamber-interior vertex goes through an old chamber tet that is not
+/// inverted at X, where one covers it; the rest stay unknown.
+PulledBack PullBack(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX3d>& X, int region,
+                    const Mesh& fresh, const TetLocator& locate, Eigen::MatrixX3d* positions) {
+  const Mesh& mesh = scene.mesh;
+  const int nv = fresh.num_vertices();
   // Which new vertices touch a body tet.
   std::vector<char> in_body(nv, 0);
   for (const auto& e : fresh.elements)
     if (e.region == 0)
       for (int j = 0; j < 4; ++j) in_body[e.v[j]] = 1;
-  std::vector<int> old_body;
-  for (int i = 0; i < mesh.num_elements(); ++i)
-    if (mesh.elements[i].region != region) old_body.push_back(i);
-  TetLocator locate(mesh, X, old_body);
   // The old chamber tets that are not inverted at X: where they cover a new chamber vertex, it is
   // pulled back through them like the body's; the rest (inside tangled parts) are extended
-  // harmonically below.
+  // harmonically (ExtendHarmonically).
   std::vector<int> old_chamber_ok;
   for (int i = 0; i < mesh.num_elements(); ++i)
     if (mesh.elements[i].region == region && SignedVolume(mesh.elements[i], X) > 0) old_chamber_ok.push_back(i);
@@ -501,25 +498,26 @@ void RemeshWhole(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX3d>& X
   for (size_t m = 0; m < scene.markers.size(); ++m)
     for (int v : scene.markers[m].vertices) marker_old[m][v] = 1;
 
-  Eigen::MatrixX3d rest = Eigen::MatrixX3d::Zero(nv, 3);
-  std::vector<char> known(nv, 0);
-  std::vector<int> fixed;
-  std::vector<std::vector<int>> markers(scene.markers.size());
+  PulledBack out;
+  out.rest = Eigen::MatrixX3d::Zero(nv, 3);
+  out.known.assign(nv, 0);
+  out.markers.resize(scene.markers.size());
   constexpr double kSupport = 1e-7;  // barycentric weights below this are "on the face"
   for (int v = 0; v < nv; ++v) {
     if (!in_body[v]) {
       Eigen::Vector4d b;
-      const int t = old_chamber_ok.empty() ? -1 : locate_chamber.Locate(out->positions.row(v).transpose(), &b);
+      const int t =
+          old_chamber_ok.empty() ? -1 : locate_chamber.Locate(positions->row(v).transpose(), &b);
       if (t >= 0 && b.minCoeff() >= -1e-9) {
         Eigen::RowVector3d r = Eigen::RowVector3d::Zero();
         for (int j = 0; j < 4; ++j) r += b[j] * mesh.vertices.row(mesh.elements[t].v[j]);
-        rest.row(v) = r;
-        known[v] = 1;
+        out.rest.row(v) = r;
+        out.known[v] = 1;
       }
       continue;
     }
     Eigen::Vector4d b;
-    const int t = locate.Locate(out->positions.row(v).transpose(), &b);
+    const int t = locate.Locate(positions->row(v).transpose(), &b);
     const Element& e = mesh.elements[t];
     Eigen::RowVector3d r = Eigen::RowVector3d::Zero();
     bool all_fixed = true;
@@ -528,48 +526,118 @@ void RemeshWhole(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX3d>& X
       r += b[j] * mesh.vertices.row(e.v[j]);
       if (b[j] > kSupport) {
         all_fixed = all_fixed && fixed_old[e.v[j]];
-        for (size_t m = 0; m < markers.size(); ++m) all_marker[m] = all_marker[m] && marker_old[m][e.v[j]];
+        for (size_t m = 0; m < out.markers.size(); ++m)
+          all_marker[m] = all_marker[m] && marker_old[m][e.v[j]];
       }
     }
-    rest.row(v) = r;
-    known[v] = 1;
+    out.rest.row(v) = r;
+    out.known[v] = 1;
     if (all_fixed) {
-      fixed.push_back(v);
-      out->positions.row(v) = r;  // a held vertex sits at its rest position
+      out.fixed.push_back(v);
+      positions->row(v) = r;  // a held vertex sits at its rest position
     }
-    for (size_t m = 0; m < markers.size(); ++m)
-      if (all_marker[m]) markers[m].push_back(v);
+    for (size_t m = 0; m < out.markers.size(); ++m)
+      if (all_marker[m]) out.markers[m].push_back(v);
   }
-  // Chamber-interior vertices not covered by an untangled old chamber tet: harmonic extension of
-  // the known rest positions (uniform weights).
+  return out;
+}
+
+/// Chamber-interior vertices not covered by an untangled old chamber tet: harmonic extension of
+/// the known rest positions (uniform weights over the edges of `fresh`) into the unknown rows of
+/// *rest.
+void ExtendHarmonically(const Mesh& fresh, const std::vector<char>& known, Eigen::MatrixX3d* rest) {
+  const int nv = fresh.num_vertices();
   std::vector<int> unknown_index(nv, -1);
   int nu = 0;
   for (int v = 0; v < nv; ++v)
     if (!known[v]) unknown_index[v] = nu++;
-  if (nu > 0) {
-    std::set<std::pair<int, int>> edges;
-    for (const auto& e : fresh.elements)
-      for (int a = 0; a < 4; ++a)
-        for (int b = a + 1; b < 4; ++b) edges.insert(std::minmax(e.v[a], e.v[b]));
-    std::vector<Eigen::Triplet<double>> trip;
-    Eigen::MatrixX3d rhs = Eigen::MatrixX3d::Zero(nu, 3);
-    for (const auto& [p, q] : edges)
-      for (auto [u, w] : {std::make_pair(p, q), std::make_pair(q, p)}) {
-        const int iu = unknown_index[u];
-        if (iu < 0) continue;
-        trip.emplace_back(iu, iu, 1.0);
-        if (unknown_index[w] >= 0) trip.emplace_back(iu, unknown_index[w], -1.0);
-        else rhs.row(iu) += rest.row(w);
-      }
-    Eigen::SparseMatrix<double> L(nu, nu);
-    L.setFromTriplets(trip.begin(), trip.end());
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(L);
-    if (ldlt.info() != Eigen::Success)
-      throw std::runtime_error("RemeshChamber (whole): a part of the new chamber has no vertex on its boundary");
-    const Eigen::MatrixX3d r = ldlt.solve(rhs);
-    for (int v = 0; v < nv; ++v)
-      if (unknown_index[v] >= 0) rest.row(v) = r.row(unknown_index[v]);
+  if (nu == 0) return;
+  std::set<std::pair<int, int>> edges;
+  for (const auto& e : fresh.elements)
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) edges.insert(std::minmax(e.v[a], e.v[b]));
+  std::vector<Eigen::Triplet<double>> trip;
+  Eigen::MatrixX3d rhs = Eigen::MatrixX3d::Zero(nu, 3);
+  for (const auto& [p, q] : edges)
+    for (auto [u, w] : {std::make_pair(p, q), std::make_pair(q, p)}) {
+      const int iu = unknown_index[u];
+      if (iu < 0) continue;
+      trip.emplace_back(iu, iu, 1.0);
+      if (unknown_index[w] >= 0) trip.emplace_back(iu, unknown_index[w], -1.0);
+      else rhs.row(iu) += rest->row(w);
+    }
+  Eigen::SparseMatrix<double> L(nu, nu);
+  L.setFromTriplets(trip.begin(), trip.end());
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(L);
+  if (ldlt.info() != Eigen::Success)
+    throw std::runtime_error("RemeshChamber (whole): a part of the new chamber has no vertex on its boundary");
+  const Eigen::MatrixX3d r = ldlt.solve(rhs);
+  for (int v = 0; v < nv; ++v)
+    if (unknown_index[v] >= 0) rest->row(v) = r.row(unknown_index[v]);
+}
+
+/// Interpolated rest shapes of thin new tets can come out inverted where the old deformation
+/// bends sharply (near old inverted tets). Untangles them locally (UntangleTets) with the fixed
+/// vertices held, and checks every rest volume; returns the number of vertex moves. With
+/// ChamberRest::Remeshed (chamber_too false) the chamber's tets take their new (deformed) shapes
+/// as rest shapes, so only the body's interpolated rest shapes need to be valid; the
+/// chamber-interior vertices' pulled-back positions in fresh->vertices are then only a picture of
+/// the chamber in the original frame.
+int UntangleRestShapes(const std::vector<int>& fixed, int region, bool chamber_too, Mesh* fresh) {
+  const int nv = fresh->num_vertices();
+  int untangled = 0;
+  {
+    std::vector<char> held(nv, 0);
+    for (int v : fixed) held[v] = 1;
+    if (chamber_too) {
+      untangled = UntangleTets(*fresh, held);
+    } else {
+      Mesh body;
+      body.vertices = std::move(fresh->vertices);
+      for (const auto& e : fresh->elements)
+        if (e.region != region) body.elements.push_back(e);
+      untangled = UntangleTets(body, held);
+      fresh->vertices = std::move(body.vertices);
+    }
   }
+  const Eigen::MatrixX3d rest = fresh->vertices;
+  for (int i = 0; i < fresh->num_elements(); ++i) {
+    if (!chamber_too && fresh->elements[i].region == region) continue;
+    const double v = SignedVolume(fresh->elements[i], rest);
+    if (!(v > 0))
+      throw std::runtime_error("RemeshChamber (whole): new tet " + std::to_string(i) + " (region " +
+                               std::to_string(fresh->elements[i].region) + ") has interpolated rest volume " +
+                               FormatNumber(v) + " mm^3; expected positive");
+  }
+  return untangled;
+}
+
+/// The whole re-tessellation T(S_c^k, S_b^k) and the interpolated state (remesh.hpp).
+void RemeshWhole(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX3d>& X, int region,
+                 const ChamberRemeshOptions& opt, ChamberRemesh* out) {
+  const Mesh& mesh = scene.mesh;
+  if (!scene.fixed_axis[0].empty() || !scene.fixed_axis[1].empty() || !scene.fixed_axis[2].empty())
+    throw std::invalid_argument("RemeshChamber: the whole re-tessellation does not support fixed_axis "
+                                "constraints (scene '" + scene.name + "')");
+  TriangleSurface sc, sb;
+  std::vector<int> sc_old, sb_old;
+  DeformedSurfaces(mesh, X, region, &sc, &sc_old, &sb, &sb_old);
+  const TessellationOptions topt = WholeTessellationOptions(sb, opt);
+  Mesh fresh;
+  try {
+    fresh = Tessellate(sc, sb, topt);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(std::string("RemeshChamber (whole): the deformed surfaces cannot be meshed: ") + e.what());
+  }
+  const int nv = fresh.num_vertices();
+  out->positions = fresh.vertices;
+
+  std::vector<int> old_body;
+  for (int i = 0; i < mesh.num_elements(); ++i)
+    if (mesh.elements[i].region != region) old_body.push_back(i);
+  TetLocator locate(mesh, X, old_body);
+  PulledBack pb = PullBack(scene, X, region, fresh, locate, &out->positions);
+  ExtendHarmonically(fresh, pb.known, &pb.rest);
   // Body tets take the region (material) of the old tet containing their centroid.
   for (auto& e : fresh.elements) {
     if (e.region == 1) {
@@ -581,40 +649,13 @@ void RemeshWhole(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX3d>& X
     Eigen::Vector4d b;
     e.region = mesh.elements[locate.Locate(c, &b)].region;
   }
-  fresh.vertices = rest;
-  // Interpolated rest shapes of thin new tets can come out inverted where the old deformation
-  // bends sharply (near old inverted tets). Untangle locally (UntangleTets). With
-  // ChamberRest::Remeshed the chamber's tets take their new (deformed) shapes as rest shapes, so
-  // only the body's interpolated rest shapes need to be valid; the chamber-interior vertices'
-  // pulled-back positions in mesh.vertices are then only a picture of the chamber in the original
-  // frame.
-  const bool chamber_too = opt.rest == ChamberRest::Original;
-  {
-    std::vector<char> held(nv, 0);
-    for (int v : fixed) held[v] = 1;
-    if (chamber_too) {
-      out->untangled_vertices = UntangleTets(fresh, held);
-    } else {
-      Mesh body;
-      body.vertices = std::move(fresh.vertices);
-      for (const auto& e : fresh.elements)
-        if (e.region != region) body.elements.push_back(e);
-      out->untangled_vertices = UntangleTets(body, held);
-      fresh.vertices = std::move(body.vertices);
-    }
-  }
-  rest = fresh.vertices;
-  for (int i = 0; i < fresh.num_elements(); ++i) {
-    if (!chamber_too && fresh.elements[i].region == region) continue;
-    const double v = SignedVolume(fresh.elements[i], rest);
-    if (!(v > 0))
-      throw std::runtime_error("RemeshChamber (whole): new tet " + std::to_string(i) + " (region " +
-                               std::to_string(fresh.elements[i].region) + ") has interpolated rest volume " +
-                               FormatNumber(v) + " mm^3; expected positive");
-  }
+  fresh.vertices = pb.rest;
+  out->untangled_vertices =
+      UntangleRestShapes(pb.fixed, region, opt.rest == ChamberRest::Original, &fresh);
   out->scene = scene;
   out->scene.mesh = std::move(fresh);
-  out->scene.fixed = fixed;
+  out->scene.fixed = pb.fixed;
+  std::vector<std::vector<int>>& markers = pb.markers;
   for (size_t m = 0; m < markers.size(); ++m) {
     if (markers[m].empty()) {
       // No new vertex on the old marker's faces (e.g. a single-vertex marker): the new vertex
@@ -637,6 +678,115 @@ void RemeshWhole(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX3d>& X
     out->outer_volume_after = EnclosedVolume(nb);
     out->outer_deviation = std::max(OneSidedDeviation(nb, sb), OneSidedDeviation(sb, nb));
   }
+}
+
+/// Positions the chamber-only re-tessellation can start from: X with the chamber's interior
+/// vertices (those no body tet uses) moved by UntangleTets so that no chamber tet is inverted.
+/// They carry no physics (the chamber is the gas inside its boundary), and the chamber's volume,
+/// being that of its boundary, does not change. Sets *Xc to them if that succeeded and
+/// *untangled to the number of vertex moves; returns the number of chamber tets still inverted.
+int UntangleChamberInterior(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                            int region, Eigen::MatrixX3d* Xc, int* untangled) {
+  Mesh ch;
+  ch.vertices = X;
+  std::vector<char> held(mesh.num_vertices(), 0);
+  for (const auto& e : mesh.elements) {
+    if (e.region == region) ch.elements.push_back(e);
+    else
+      for (int j = 0; j < e.k(); ++j) held[e.v[j]] = 1;
+  }
+  *untangled = UntangleTets(ch, held);
+  int still_inverted = 0;
+  for (const auto& e : ch.elements) still_inverted += SignedVolume(e, ch.vertices) > 0 ? 0 : 1;
+  if (still_inverted == 0) *Xc = ch.vertices;
+  return still_inverted;
+}
+
+/// Rest positions of the re-tessellated chamber's vertices (`fresh`, new numbering, deformed
+/// positions `positions`): kept vertices keep theirs (old_index); created ones are pulled back
+/// through the old piecewise-linear deformation of the chamber at Xc.
+void PullBackChamberVertices(const Mesh& mesh, const Eigen::MatrixX3d& Xc, int region,
+                             const std::vector<int>& old_index, const Eigen::MatrixX3d& positions,
+                             Mesh* fresh) {
+  std::vector<int> old_chamber;
+  for (int i = 0; i < mesh.num_elements(); ++i)
+    if (mesh.elements[i].region == region) old_chamber.push_back(i);
+  TetLocator locate(mesh, Xc, old_chamber);
+  double worst_outside = 0;
+  for (int v = 0; v < fresh->num_vertices(); ++v) {
+    const int o = old_index[v];
+    if (o >= 0) {
+      fresh->vertices.row(v) = mesh.vertices.row(o);
+      continue;
+    }
+    Eigen::Vector4d b;
+    const int t = locate.Locate(positions.row(v).transpose(), &b);
+    if (t < 0) throw std::runtime_error("RemeshChamber: the old chamber has no tets to locate a new vertex in");
+    worst_outside = std::min(worst_outside, b.minCoeff());
+    const Element& e = mesh.elements[t];
+    Eigen::RowVector3d r = Eigen::RowVector3d::Zero();
+    for (int j = 0; j < 4; ++j) r += b[j] * mesh.vertices.row(e.v[j]);
+    fresh->vertices.row(v) = r;
+  }
+  if (worst_outside < -1e-6)
+    throw std::runtime_error("RemeshChamber: a created vertex lies outside the old chamber (barycentric " +
+                             FormatNumber(worst_outside) + "); expected every created vertex inside it");
+}
+
+/// The chamber-only re-tessellation (RemeshRegionInterior of the chamber at Xc) and the state on
+/// it: rest positions, the scene's vertex lists renumbered, the outer surface's volume.
+void RemeshChamberOnly(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                       const Eigen::MatrixX3d& Xc, int region, const ChamberRemeshOptions& options,
+                       ChamberRemesh* out) {
+  const Mesh& mesh = scene.mesh;
+  RegionRemeshResult rr = RemeshRegionInterior(mesh, Xc, region, options.region);
+  out->old_index = rr.old_index;
+  out->new_vertices = rr.new_vertices;
+  out->removed_vertices = rr.removed_vertices;
+  out->target_edge = rr.target_edge;
+  out->positions = rr.mesh.vertices;
+
+  Mesh fresh = rr.mesh;
+  PullBackChamberVertices(mesh, Xc, region, out->old_index, out->positions, &fresh);
+  // With ChamberRest::Remeshed the new chamber tets' rest shapes are their shapes at X (set
+  // by RemeshChamber), and the pulled-back positions are only a picture of the chamber in the
+  // original frame; they need not be valid tets.
+  if (options.rest == ChamberRest::Original) {
+    // Where the old deformation bends sharply, a thin new tet's pulled-back rest shape can come
+    // out inverted: untangle by moving created vertices only (UntangleTets).
+    // Held: the vertices of body tets (their rest positions are the body's memory). The
+    // chamber's own vertices, kept or created, may move.
+    std::vector<char> held(fresh.num_vertices(), 0);
+    for (const auto& e : fresh.elements)
+      if (e.region != region)
+        for (int j = 0; j < 4; ++j) held[e.v[j]] = 1;
+    out->untangled_vertices = UntangleTets(fresh, held);
+    for (int i = 0; i < fresh.num_elements(); ++i) {
+      const Element& e = fresh.elements[i];
+      if (e.region != region) continue;
+      const double v = SignedVolume(e, fresh.vertices);
+      if (!(v > 0))
+        throw std::runtime_error("RemeshChamber: the pulled-back rest shape of new chamber tet " + std::to_string(i) +
+                                 " has volume " + FormatNumber(v) + " mm^3; expected positive (the previous deformation "
+                                 "varies too much across it; remesh earlier, i.e. lower alpha_max / d_max)");
+    }
+  }
+  std::vector<int> new_of_old(mesh.num_vertices(), -1);
+  for (int v = 0; v < fresh.num_vertices(); ++v)
+    if (out->old_index[v] >= 0) new_of_old[out->old_index[v]] = v;
+  out->scene = scene;
+  out->scene.mesh = std::move(fresh);
+  out->scene.fixed = Remap(scene.fixed, new_of_old, "the fixed set");
+  for (int d = 0; d < 3; ++d) out->scene.fixed_axis[d] = Remap(scene.fixed_axis[d], new_of_old, "fixed_axis");
+  for (auto& m : out->scene.markers) m.vertices = Remap(m.vertices, new_of_old, "marker '" + m.name + "'");
+  for (auto& act : out->scene.actuators)
+    if (act.is_motion()) act.vertices = Remap(act.vertices, new_of_old, "actuator '" + act.name + "'");
+  for (auto* ids : {&out->scene.fixed, &out->scene.fixed_axis[0], &out->scene.fixed_axis[1], &out->scene.fixed_axis[2]})
+    std::sort(ids->begin(), ids->end());
+  TriangleSurface sc, sb;
+  std::vector<int> u, w;
+  DeformedSurfaces(mesh, X, region, &sc, &u, &sb, &w);
+  out->outer_volume_before = out->outer_volume_after = EnclosedVolume(sb);
 }
 
 }  // namespace
@@ -662,26 +812,11 @@ ChamberRemesh RemeshChamber(const Scene& scene, const Eigen::Ref<const Eigen::Ma
   out.chamber_rest_volume_before = RegionVolume(mesh, scene.rest_positions_of(region), regions);
   out.chamber_volume_before = RegionVolume(mesh, X, regions);
 
-  // Positions the chamber-only re-tessellation starts from: X with the chamber's interior
-  // vertices (those no body tet uses) moved, if needed, so that no chamber tet is inverted. They
-  // carry no physics (the chamber is the gas inside its boundary), and the chamber's volume,
-  // being that of its boundary, does not change.
+  // Positions the chamber-only re-tessellation starts from (UntangleChamberInterior).
   Eigen::MatrixX3d Xc = X;
   int still_inverted = out.inverted_chamber_tets;
-  if (options.method != RemeshMethod::Whole && out.inverted_chamber_tets > 0) {
-    Mesh ch;
-    ch.vertices = X;
-    std::vector<char> held(mesh.num_vertices(), 0);
-    for (const auto& e : mesh.elements) {
-      if (e.region == region) ch.elements.push_back(e);
-      else
-        for (int j = 0; j < e.k(); ++j) held[e.v[j]] = 1;
-    }
-    out.untangled_chamber_vertices = UntangleTets(ch, held);
-    still_inverted = 0;
-    for (const auto& e : ch.elements) still_inverted += SignedVolume(e, ch.vertices) > 0 ? 0 : 1;
-    if (still_inverted == 0) Xc = ch.vertices;
-  }
+  if (options.method != RemeshMethod::Whole && out.inverted_chamber_tets > 0)
+    still_inverted = UntangleChamberInterior(mesh, X, region, &Xc, &out.untangled_chamber_vertices);
   RemeshMethod method = options.method;
   if (method == RemeshMethod::Auto) {
     method = still_inverted > 0 ? RemeshMethod::Whole : RemeshMethod::ChamberOnly;
@@ -704,82 +839,10 @@ ChamberRemesh RemeshChamber(const Scene& scene, const Eigen::Ref<const Eigen::Ma
       out.reason = std::string("chamber-only failed: ") + e.what();
     }
   }
-  if (method == RemeshMethod::Whole) {
+  if (method == RemeshMethod::Whole)
     RemeshWhole(scene, X, region, options, &out);
-  } else {
-    RegionRemeshResult rr = RemeshRegionInterior(mesh, Xc, region, options.region);
-    out.old_index = rr.old_index;
-    out.new_vertices = rr.new_vertices;
-    out.removed_vertices = rr.removed_vertices;
-    out.target_edge = rr.target_edge;
-    out.positions = rr.mesh.vertices;
-
-    // Rest positions: kept vertices keep theirs; created ones are pulled back through the old
-    // piecewise-linear deformation of the chamber.
-    Mesh fresh = rr.mesh;
-    std::vector<int> old_chamber;
-    for (int i = 0; i < mesh.num_elements(); ++i)
-      if (mesh.elements[i].region == region) old_chamber.push_back(i);
-    TetLocator locate(mesh, Xc, old_chamber);
-    double worst_outside = 0;
-    for (int v = 0; v < fresh.num_vertices(); ++v) {
-      const int o = out.old_index[v];
-      if (o >= 0) {
-        fresh.vertices.row(v) = mesh.vertices.row(o);
-        continue;
-      }
-      Eigen::Vector4d b;
-      const int t = locate.Locate(out.positions.row(v).transpose(), &b);
-      if (t < 0) throw std::runtime_error("RemeshChamber: the old chamber has no tets to locate a new vertex in");
-      worst_outside = std::min(worst_outside, b.minCoeff());
-      const Element& e = mesh.elements[t];
-      Eigen::RowVector3d r = Eigen::RowVector3d::Zero();
-      for (int j = 0; j < 4; ++j) r += b[j] * mesh.vertices.row(e.v[j]);
-      fresh.vertices.row(v) = r;
-    }
-    if (worst_outside < -1e-6)
-      throw std::runtime_error("RemeshChamber: a created vertex lies outside the old chamber (barycentric " +
-                               FormatNumber(worst_outside) + "); expected every created vertex inside it");
-    // With ChamberRest::Remeshed the new chamber tets' rest shapes are their shapes at X (set
-    // below), and the pulled-back positions are only a picture of the chamber in the original
-    // frame; they need not be valid tets.
-    if (options.rest == ChamberRest::Original) {
-      // Where the old deformation bends sharply, a thin new tet's pulled-back rest shape can come
-      // out inverted: untangle by moving created vertices only (UntangleTets).
-      // Held: the vertices of body tets (their rest positions are the body's memory). The
-      // chamber's own vertices, kept or created, may move.
-      std::vector<char> held(fresh.num_vertices(), 0);
-      for (const auto& e : fresh.elements)
-        if (e.region != region)
-          for (int j = 0; j < 4; ++j) held[e.v[j]] = 1;
-      out.untangled_vertices = UntangleTets(fresh, held);
-      for (int i = 0; i < fresh.num_elements(); ++i) {
-        const Element& e = fresh.elements[i];
-        if (e.region != region) continue;
-        const double v = SignedVolume(e, fresh.vertices);
-        if (!(v > 0))
-          throw std::runtime_error("RemeshChamber: the pulled-back rest shape of new chamber tet " + std::to_string(i) +
-                                   " has volume " + FormatNumber(v) + " mm^3; expected positive (the previous deformation "
-                                   "varies too much across it; remesh earlier, i.e. lower alpha_max / d_max)");
-      }
-    }
-    std::vector<int> new_of_old(mesh.num_vertices(), -1);
-    for (int v = 0; v < fresh.num_vertices(); ++v)
-      if (out.old_index[v] >= 0) new_of_old[out.old_index[v]] = v;
-    out.scene = scene;
-    out.scene.mesh = std::move(fresh);
-    out.scene.fixed = Remap(scene.fixed, new_of_old, "the fixed set");
-    for (int d = 0; d < 3; ++d) out.scene.fixed_axis[d] = Remap(scene.fixed_axis[d], new_of_old, "fixed_axis");
-    for (auto& m : out.scene.markers) m.vertices = Remap(m.vertices, new_of_old, "marker '" + m.name + "'");
-    for (auto& act : out.scene.actuators)
-      if (act.is_motion()) act.vertices = Remap(act.vertices, new_of_old, "actuator '" + act.name + "'");
-    for (auto* ids : {&out.scene.fixed, &out.scene.fixed_axis[0], &out.scene.fixed_axis[1], &out.scene.fixed_axis[2]})
-      std::sort(ids->begin(), ids->end());
-    TriangleSurface sc, sb;
-    std::vector<int> u, w;
-    DeformedSurfaces(mesh, X, region, &sc, &u, &sb, &w);
-    out.outer_volume_before = out.outer_volume_after = EnclosedVolume(sb);
-  }
+  else
+    RemeshChamberOnly(scene, X, Xc, region, options, &out);
   // The chamber's rest shape (ChamberRest): its shape at the remesh, or the pulled-back one now in
   // mesh.vertices.
   out.scene.region_rest = {};
@@ -792,190 +855,6 @@ ChamberRemesh RemeshChamber(const Scene& scene, const Eigen::Ref<const Eigen::Ma
   out.chamber_volume_after = RegionVolume(out.scene.mesh, out.positions, regions);
   out.seconds = Seconds(t0);
   return out;
-}
-
-// ---- SolveProgressive ------------------------------------------------------------------------------
-
-bool ProgressiveOptions::IsValid(std::string* why) const {
-  if (!criteria.IsValid(why)) return false;
-  auto fail = [&](const std::string& m) {
-    if (why) *why = m;
-    return false;
-  };
-  if (!(step >= 0) || !std::isfinite(step)) return fail("step: expected >= 0 (0: alpha_max), got " + FormatNumber(step));
-  if (max_remeshes_per_step < 1) return fail("max_remeshes_per_step: expected an integer >= 1");
-  if (!remesh_options.IsValid(why)) return false;
-  for (double s : snapshots)
-    if (!(s > 1) || !std::isfinite(s)) return fail("snapshots: expected volume ratios > 1, got " + FormatNumber(s));
-  for (size_t i = 0; i < ladder.size(); ++i)
-    if (!(ladder[i] > 1) || !std::isfinite(ladder[i]) || (i > 0 && !(ladder[i] > ladder[i - 1])))
-      return fail("ladder: expected increasing volume ratios > 1, got " + FormatNumber(ladder[i]) + " at position " +
-                  std::to_string(i));
-  return true;
-}
-
-std::string ProgressiveResult::BriefReport() const {
-  std::ostringstream os;
-  os << FkStatusToString(status) << ": " << steps.size() << " steps, " << remeshes << " remeshes, chamber volume ratio "
-     << chamber_volume_ratio << ", " << scene.mesh.num_tets() << " tets; mesh " << mesh_seconds << " s, solver "
-     << solver_seconds << " s";
-  if (remesh_failures > 0) os << "; " << remesh_failures << " remesh(es) failed, first at " << first_remesh_failure;
-  if (!completed) os << "; stopped early";
-  if (!message.empty()) os << " (" << message << ")";
-  return os.str();
-}
-
-ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target, const ProgressiveOptions& opt) {
-  std::string why;
-  if (!opt.IsValid(&why)) throw std::invalid_argument("progressive remeshing option " + why);
-  scene.validate();
-  const int a = ChamberActuator(scene);
-  const Actuator& act = scene.actuators[a];
-  if (!(alpha_target > 1) || alpha_target > act.max || alpha_target < act.min)
-    throw std::invalid_argument("SolveProgressive: alpha_target " + FormatNumber(alpha_target) + " is outside (1, " +
-                                FormatNumber(act.max) + "], the range of actuator '" + act.name + "'");
-  for (double s : opt.snapshots)
-    if (s > alpha_target)
-      throw std::invalid_argument("SolveProgressive: snapshot " + FormatNumber(s) + " is beyond alpha_target " +
-                                  FormatNumber(alpha_target) + "; expected snapshots in (1, alpha_target]");
-  if (!opt.ladder.empty() && opt.ladder.back() > alpha_target)
-    throw std::invalid_argument("SolveProgressive: ladder value " + FormatNumber(opt.ladder.back()) +
-                                " is beyond alpha_target " + FormatNumber(alpha_target) +
-                                "; expected ladder values in (1, alpha_target]");
-  const std::vector<int> regions = act.regions;
-  const double step = opt.step > 0 ? opt.step : opt.criteria.alpha_max;
-
-  // The ladder: k * step below the target (or the explicit values), the snapshot values, and the
-  // target.
-  std::vector<double> ladder = opt.ladder;
-  if (ladder.empty())
-    for (int k = 1; k * step < alpha_target - 1e-12; ++k)
-      if (k * step > 1) ladder.push_back(k * step);
-  for (double s : opt.snapshots)
-    if (s < alpha_target) ladder.push_back(s);
-  ladder.push_back(alpha_target);
-  std::sort(ladder.begin(), ladder.end());
-  ladder.erase(std::unique(ladder.begin(), ladder.end(), [](double x, double y) { return std::abs(x - y) < 1e-12; }),
-               ladder.end());
-
-  ProgressiveResult res;
-  res.scene = scene;
-  Eigen::MatrixX3d X = scene.mesh.vertices, Xref = X;
-  const double rest_extent = scene.mesh.size();
-  const double V0 = RegionVolume(scene.mesh, scene.rest_positions_of(regions[0]), regions);
-  auto build = [&](const Scene& s) {
-    auto model = std::make_shared<const Model>(s);
-    return MakeFkSolver(model, s.solver);
-  };
-  auto tb = Clock::now();
-  std::unique_ptr<FkSolver> solver = build(res.scene);
-  double build_s = Seconds(tb);
-
-  // The actuator value that asks for chamber volume alpha * V0 from the current chamber, whose
-  // rest volume a whole re-tessellation may change slightly.
-  // After a remesh the actuator's range is widened by the same factor (before the model is built).
-  auto value_for = [&](double alpha) {
-    return alpha * V0 / RegionVolume(res.scene.mesh, res.scene.rest_positions_of(regions[0]), regions);
-  };
-  auto widen = [&]() {
-    res.scene.actuators[a].max = std::max(act.max, value_for(act.max));
-    res.scene.actuators[a].min = std::min(act.min, value_for(act.min));
-  };
-
-  for (size_t k = 0; k < ladder.size(); ++k) {
-    ProgressiveStep st;
-    st.k = static_cast<int>(k) + 1;
-    st.alpha = ladder[k];
-    st.solver_seconds = build_s;
-    build_s = 0;
-    bool stop = false;
-    for (int round = 0;; ++round) {
-      Eigen::VectorXd c = res.scene.rest_actuation();
-      c[a] = value_for(st.alpha);
-      FkResult r = solver->Solve(c, &X);
-      st.solver_seconds += r.time_s;
-      st.iterations += r.iterations;
-      st.status = r.status;
-      st.check_seconds += r.collision_stats.check_s;
-      st.response_seconds += r.collision_stats.response_s;
-      st.local_global_seconds += r.local_time_s + r.global_time_s;
-      st.collision_active = r.collision_active;
-      st.collision = r.collision;
-      st.springs = r.springs;
-      // A state that has grown far beyond any inflation is a runaway of the iteration, not a
-      // shape: treat it as diverged (and keep the previous state). The soft actuation of the
-      // local-global solver reaches less than the ratio asked for, so a chamber beyond twice it
-      // has run away too.
-      if (r.status != FkStatus::Diverged && r.status != FkStatus::InvalidInput) {
-        const double extent = (r.positions.colwise().maxCoeff() - r.positions.colwise().minCoeff()).norm();
-        const double ratio = RegionVolume(res.scene.mesh, r.positions, regions) / V0;
-        if (!(extent <= kRunawayExtent * rest_extent) || !(ratio <= kRunawayRatio * st.alpha)) {
-          r.message = "runaway: the chamber reached " + FormatNumber(ratio) + " times its volume for alpha " +
-                      FormatNumber(st.alpha) + ", the bounding box " + FormatNumber(extent / rest_extent) + " times the rest one (" +
-                      FkStatusToString(r.status) + "); treated as diverged";
-          r.status = FkStatus::Diverged;
-          st.status = r.status;
-        }
-      }
-      if (r.status == FkStatus::Diverged || r.status == FkStatus::InvalidInput) {
-        res.status = r.status;
-        res.completed = false;
-        res.message = "alpha " + FormatNumber(st.alpha) + ": " + r.message;
-        stop = true;
-        break;
-      }
-      X = r.positions;
-      const RemeshCheck check = CheckRemesh(res.scene.mesh, Xref, X, regions, opt.criteria);
-      if (round == 0) {
-        st.max_volume_ratio = check.max_volume_ratio;
-        st.max_distortion = check.max_distortion;
-      }
-      if (!opt.remesh || !check.needed || round >= opt.max_remeshes_per_step) break;
-      ChamberRemesh rm;
-      const auto tr = Clock::now();
-      try {
-        rm = RemeshChamber(res.scene, X, opt.remesh_options);
-      } catch (const std::runtime_error& e) {
-        // Keep the state on the current mesh and go on up the ladder; the next check will try again.
-        // The failed attempt's time is mesh generation time too.
-        st.mesh_seconds += Seconds(tr);
-        ++st.remesh_failures;
-        ++res.remesh_failures;
-        if (res.first_remesh_failure.empty()) res.first_remesh_failure = "alpha " + FormatNumber(st.alpha) + ": " + e.what();
-        break;
-      }
-      st.mesh_seconds += rm.seconds;
-      ++st.remeshes;
-      ++res.remeshes;
-      st.methods += (st.methods.empty() ? "" : "+") + std::string(RemeshMethodToString(rm.method));
-      res.scene = std::move(rm.scene);
-      X = std::move(rm.positions);
-      Xref = X;
-      widen();
-      tb = Clock::now();
-      solver = build(res.scene);
-      st.solver_seconds += Seconds(tb);
-    }
-    if (st.status != FkStatus::Converged && res.status == FkStatus::Converged) {
-      res.status = st.status;
-      if (res.message.empty()) res.message = "alpha " + FormatNumber(st.alpha) + ": " + FkStatusToString(st.status);
-    }
-    st.tets = res.scene.mesh.num_tets();
-    st.chamber_tets = 0;
-    for (const auto& e : res.scene.mesh.elements)
-      if (InRegions(e.region, regions)) ++st.chamber_tets;
-    st.chamber_volume_ratio = RegionVolume(res.scene.mesh, X, regions) / V0;
-    res.mesh_seconds += st.mesh_seconds;
-    res.solver_seconds += st.solver_seconds;
-    res.steps.push_back(st);
-    if (opt.on_step) opt.on_step(st, res.scene, X);
-    for (double s : opt.snapshots)
-      if (std::abs(s - st.alpha) < 1e-12) res.snapshots.push_back({st.alpha, res.scene, X, st.chamber_volume_ratio});
-    if (stop) break;
-  }
-  res.positions = X;
-  res.chamber_volume_ratio = RegionVolume(res.scene.mesh, X, regions) / V0;
-  return res;
 }
 
 }  // namespace softkin

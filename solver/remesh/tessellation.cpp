@@ -313,11 +313,12 @@ struct SubdomainSelector {
   bool operator()(RemeshTr::Cell_handle c) const { return c->subdomain_index() == subdomain; }
 };
 
-}  // namespace
+using CoordIndex = std::unordered_map<CoordKey, int, CoordHash>;
 
-RegionRemeshResult RemeshRegionInterior(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X,
-                                        int region, const RegionRemeshOptions& opt) {
-  const auto t0 = Clock::now();
+/// Throws std::invalid_argument unless the options are valid, X has one finite row per vertex of
+/// `mesh`, the mesh has only tets and some of them have region tag `region`.
+void CheckRegionRemeshInput(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                            int region, const RegionRemeshOptions& opt) {
   std::string why;
   if (!opt.IsValid(&why)) throw std::invalid_argument("region remesh option " + why);
   const int nv = mesh.num_vertices();
@@ -331,27 +332,35 @@ RegionRemeshResult RemeshRegionInterior(const Mesh& mesh, const Eigen::Ref<const
   const auto tag_it = std::find(tags.begin(), tags.end(), region);
   if (tag_it == tags.end())
     throw std::invalid_argument("RemeshRegionInterior: no element has region tag " + std::to_string(region));
-  // Subdomain indices of the CGAL triangulation: 1 for the region, 0 ("outside the domain", like
-  // the cells Mesh_3 leaves outside) for every other tet. CGAL's remesher treats every cell with a
-  // non-zero index as part of the complex and remeshes it whatever the cell selector says
-  // (measured with CGAL 5.5: a box body around a remeshed box chamber went from 2,075 to 72,112
-  // tets), so the other regions must not carry one.
-  auto subdomain_of = [region](int tag) { return tag == region ? 1 : 0; };
-  const int selected = 1;
+}
 
-  std::unordered_map<CoordKey, int, CoordHash> by_coord;
-  by_coord.reserve(nv * 2);
+/// The points of X for CGAL's triangulation, and *by_coord: each position's vertex (throws
+/// std::invalid_argument if two vertices share a position).
+std::vector<RemeshTr::Point> TriangulationPoints(const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                                                 CoordIndex* by_coord) {
+  const int nv = static_cast<int>(X.rows());
+  by_coord->reserve(nv * 2);
   std::vector<RemeshTr::Point> pts;
   pts.reserve(nv);
   for (int i = 0; i < nv; ++i) {
     pts.emplace_back(X(i, 0), X(i, 1), X(i, 2));
-    if (!by_coord.emplace(KeyOf(X(i, 0), X(i, 1), X(i, 2)), i).second)
-      throw std::invalid_argument("RemeshRegionInterior: vertices " + std::to_string(by_coord[KeyOf(X(i, 0), X(i, 1), X(i, 2))]) +
+    const CoordKey key = KeyOf(X(i, 0), X(i, 1), X(i, 2));
+    if (!by_coord->emplace(key, i).second)
+      throw std::invalid_argument("RemeshRegionInterior: vertices " + std::to_string((*by_coord)[key]) +
                                   " and " + std::to_string(i) + " are at the same position; expected distinct positions");
   }
+  return pts;
+}
+
+/// The tets as CGAL cells (4 vertices and a subdomain index: 1 for the region, 0 for every other
+/// tet); *region_tets counts the region's. Throws std::invalid_argument for a non-tet element or
+/// a region tet not positively oriented at X.
+std::vector<std::array<int, 5>> TriangulationCells(const Mesh& mesh,
+                                                   const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                                                   int region, int* region_tets) {
   std::vector<std::array<int, 5>> cells;
   cells.reserve(mesh.elements.size());
-  int region_before = 0;
+  *region_tets = 0;
   for (int i = 0; i < mesh.num_elements(); ++i) {
     const Element& e = mesh.elements[i];
     if (e.type != ElementType::Tet)
@@ -362,9 +371,116 @@ RegionRemeshResult RemeshRegionInterior(const Mesh& mesh, const Eigen::Ref<const
       throw std::invalid_argument("RemeshRegionInterior: tet " + std::to_string(i) + " (region " +
                                   std::to_string(e.region) + ") has volume " + FormatNumber(vol) +
                                   " mm^3 at the given positions; expected the region's tets positively oriented");
-    cells.push_back({e.v[0], e.v[1], e.v[2], e.v[3], subdomain_of(e.region)});
-    if (e.region == region) ++region_before;
+    cells.push_back({e.v[0], e.v[1], e.v[2], e.v[3], e.region == region ? 1 : 0});
+    if (e.region == region) ++*region_tets;
   }
+  return cells;
+}
+
+/// The remeshed region's cells read back from CGAL's triangulation.
+struct RemeshedCells {
+  std::vector<Eigen::Vector3d> fresh;        ///< positions of created vertices
+  std::vector<std::array<int, 4>> tets;      ///< old vertex index >= 0, or -(1 + fresh id)
+  std::map<int, int> other_count;            ///< cells per subdomain index outside the region
+};
+
+/// Reads the cells of subdomain `selected` back from `tr`: vertices at a position of the input
+/// (by_coord) keep their index, the others are created (in the order of first use).
+RemeshedCells ReadRemeshedCells(const RemeshTr& tr, int selected, const CoordIndex& by_coord) {
+  RemeshedCells out;
+  std::map<RemeshTr::Vertex_handle, int> fresh_index;
+  for (auto c : tr.finite_cell_handles()) {
+    const int sub = c->subdomain_index();
+    if (sub != selected) {
+      ++out.other_count[sub];
+      continue;
+    }
+    std::array<int, 4> t{};
+    for (int j = 0; j < 4; ++j) {
+      const auto vh = c->vertex(j);
+      const auto& p = vh->point();
+      auto it = by_coord.find(KeyOf(p.x(), p.y(), p.z()));
+      if (it != by_coord.end()) {
+        t[j] = it->second;
+      } else {
+        auto [f, isnew] = fresh_index.emplace(vh, static_cast<int>(out.fresh.size()));
+        if (isnew) out.fresh.emplace_back(p.x(), p.y(), p.z());
+        t[j] = -(1 + f->second);
+      }
+    }
+    out.tets.push_back(t);
+  }
+  return out;
+}
+
+/// Back to a Mesh: the vertices still used (kept, in their order) and the created ones, the other
+/// regions' elements as they were, then the region's new tets (each checked positive).
+void AssembleRemeshedMesh(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X, int region,
+                          const RemeshedCells& cells, RegionRemeshResult* out) {
+  const int nv = mesh.num_vertices();
+  std::vector<int> new_of_old(nv, -1);
+  std::vector<char> used(nv, 0);
+  for (const auto& e : mesh.elements)
+    if (e.region != region)
+      for (int j = 0; j < 4; ++j) used[e.v[j]] = 1;
+  for (const auto& t : cells.tets)
+    for (int j = 0; j < 4; ++j)
+      if (t[j] >= 0) used[t[j]] = 1;
+  int n = 0;
+  for (int i = 0; i < nv; ++i)
+    if (used[i]) {
+      new_of_old[i] = n++;
+      out->old_index.push_back(i);
+    }
+  out->kept_vertices = n;
+  out->removed_vertices = nv - n;
+  out->new_vertices = static_cast<int>(cells.fresh.size());
+  for (int f = 0; f < out->new_vertices; ++f) out->old_index.push_back(-1);
+  out->mesh.vertices.resize(n + out->new_vertices, 3);
+  for (int i = 0; i < nv; ++i)
+    if (new_of_old[i] >= 0) out->mesh.vertices.row(new_of_old[i]) = X.row(i);
+  for (int f = 0; f < out->new_vertices; ++f)
+    out->mesh.vertices.row(n + f) = cells.fresh[f].transpose();
+  for (const auto& e : mesh.elements) {
+    if (e.region == region) continue;
+    Element m = e;
+    for (int j = 0; j < 4; ++j) m.v[j] = new_of_old[e.v[j]];
+    out->mesh.elements.push_back(m);
+  }
+  for (const auto& t : cells.tets) {
+    Element m;
+    m.type = ElementType::Tet;
+    m.region = region;
+    for (int j = 0; j < 4; ++j) m.v[j] = t[j] >= 0 ? new_of_old[t[j]] : n + (-t[j] - 1);
+    const Eigen::MatrixX3d& V = out->mesh.vertices;
+    const double vol = TetVolume(V.row(m.v[0]).transpose(), V.row(m.v[1]).transpose(),
+                                 V.row(m.v[2]).transpose(), V.row(m.v[3]).transpose());
+    if (!(vol > 0))
+      throw std::runtime_error("RemeshRegionInterior: CGAL's remesher produced a tet of volume " + FormatNumber(vol) +
+                               " mm^3 in region " + std::to_string(region) + "; expected positive volumes");
+    out->mesh.elements.push_back(m);
+  }
+  out->region_tets_after = static_cast<int>(cells.tets.size());
+}
+
+}  // namespace
+
+RegionRemeshResult RemeshRegionInterior(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                                        int region, const RegionRemeshOptions& opt) {
+  const auto t0 = Clock::now();
+  CheckRegionRemeshInput(mesh, X, region, opt);
+  // Subdomain indices of the CGAL triangulation: 1 for the region, 0 ("outside the domain", like
+  // the cells Mesh_3 leaves outside) for every other tet. CGAL's remesher treats every cell with a
+  // non-zero index as part of the complex and remeshes it whatever the cell selector says
+  // (measured with CGAL 5.5: a box body around a remeshed box chamber went from 2,075 to 72,112
+  // tets), so the other regions must not carry one (TriangulationCells).
+  auto subdomain_of = [region](int tag) { return tag == region ? 1 : 0; };
+  const int selected = 1;
+
+  CoordIndex by_coord;
+  const std::vector<RemeshTr::Point> pts = TriangulationPoints(X, &by_coord);
+  int region_before = 0;
+  const std::vector<std::array<int, 5>> cells = TriangulationCells(mesh, X, region, &region_before);
 
   const std::vector<std::array<int, 3>> boundary_before = RegionBoundaryFaces(mesh, region);
   double target = opt.target_edge;
@@ -393,92 +509,26 @@ RegionRemeshResult RemeshRegionInterior(const Mesh& mesh, const Eigen::Ref<const
                                               .cell_is_selected_map(SubdomainSelector{selected}));
   }
 
-  // Back to a Mesh: the other regions' elements as they were, then the region's new tets.
-  RegionRemeshResult out;
-  out.target_edge = target;
-  out.region_tets_before = region_before;
-  std::vector<int> new_of_old(nv, -1);
-  std::vector<Eigen::Vector3d> fresh;  // positions of created vertices
-  std::map<RemeshTr::Vertex_handle, int> fresh_index;
-  std::vector<std::array<int, 4>> region_tets;  // old index >= 0, or -(1 + fresh id)
-  std::map<int, int> other_count;
-  for (auto c : tr.finite_cell_handles()) {
-    const int sub = c->subdomain_index();
-    if (sub != selected) {
-      ++other_count[sub];
-      continue;
-    }
-    std::array<int, 4> t{};
-    for (int j = 0; j < 4; ++j) {
-      const auto vh = c->vertex(j);
-      const auto& p = vh->point();
-      auto it = by_coord.find(KeyOf(p.x(), p.y(), p.z()));
-      if (it != by_coord.end()) {
-        t[j] = it->second;
-      } else {
-        auto [f, isnew] = fresh_index.emplace(vh, static_cast<int>(fresh.size()));
-        if (isnew) fresh.emplace_back(p.x(), p.y(), p.z());
-        t[j] = -(1 + f->second);
-      }
-    }
-    region_tets.push_back(t);
-  }
+  const RemeshedCells remeshed = ReadRemeshedCells(tr, selected, by_coord);
   // The other regions' cells must be untouched.
   std::map<int, int> other_before;
   for (const auto& e : mesh.elements)
     if (e.region != region) ++other_before[subdomain_of(e.region)];
-  if (other_count != other_before) {
+  if (remeshed.other_count != other_before) {
     std::ostringstream os;
     os << "RemeshRegionInterior: CGAL's remesher changed tets outside region " << region
        << "; expected them kept (tets per subdomain before:";
     for (const auto& [k, n] : other_before) os << " " << k << ":" << n;
     os << ", after:";
-    for (const auto& [k, n] : other_count) os << " " << k << ":" << n;
+    for (const auto& [k, n] : remeshed.other_count) os << " " << k << ":" << n;
     os << ")";
     throw std::runtime_error(os.str());
   }
 
-  std::vector<char> used(nv, 0);
-  for (const auto& e : mesh.elements)
-    if (e.region != region)
-      for (int j = 0; j < 4; ++j) used[e.v[j]] = 1;
-  for (const auto& t : region_tets)
-    for (int j = 0; j < 4; ++j)
-      if (t[j] >= 0) used[t[j]] = 1;
-  int n = 0;
-  for (int i = 0; i < nv; ++i)
-    if (used[i]) {
-      new_of_old[i] = n++;
-      out.old_index.push_back(i);
-    }
-  out.kept_vertices = n;
-  out.removed_vertices = nv - n;
-  out.new_vertices = static_cast<int>(fresh.size());
-  for (int f = 0; f < out.new_vertices; ++f) out.old_index.push_back(-1);
-  out.mesh.vertices.resize(n + out.new_vertices, 3);
-  for (int i = 0; i < nv; ++i)
-    if (new_of_old[i] >= 0) out.mesh.vertices.row(new_of_old[i]) = X.row(i);
-  for (int f = 0; f < out.new_vertices; ++f) out.mesh.vertices.row(n + f) = fresh[f].transpose();
-  for (const auto& e : mesh.elements) {
-    if (e.region == region) continue;
-    Element m = e;
-    for (int j = 0; j < 4; ++j) m.v[j] = new_of_old[e.v[j]];
-    out.mesh.elements.push_back(m);
-  }
-  for (const auto& t : region_tets) {
-    Element m;
-    m.type = ElementType::Tet;
-    m.region = region;
-    for (int j = 0; j < 4; ++j) m.v[j] = t[j] >= 0 ? new_of_old[t[j]] : n + (-t[j] - 1);
-    const Eigen::MatrixX3d& V = out.mesh.vertices;
-    const double vol = TetVolume(V.row(m.v[0]).transpose(), V.row(m.v[1]).transpose(),
-                                 V.row(m.v[2]).transpose(), V.row(m.v[3]).transpose());
-    if (!(vol > 0))
-      throw std::runtime_error("RemeshRegionInterior: CGAL's remesher produced a tet of volume " + FormatNumber(vol) +
-                               " mm^3 in region " + std::to_string(region) + "; expected positive volumes");
-    out.mesh.elements.push_back(m);
-  }
-  out.region_tets_after = static_cast<int>(region_tets.size());
+  RegionRemeshResult out;
+  out.target_edge = target;
+  out.region_tets_before = region_before;
+  AssembleRemeshedMesh(mesh, X, region, remeshed, &out);
 
   // Conformity: the region's boundary triangles are exactly the ones it had.
   std::vector<std::array<int, 3>> after = RegionBoundaryFaces(out.mesh, region);

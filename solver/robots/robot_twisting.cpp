@@ -4,6 +4,7 @@
 
 #include "softkin/solver/materials/hyperelastic.hpp"
 #include "softkin/solver/fk/rotation.hpp"
+#include "softkin/solver/robots/robot_parts.hpp"
 
 #include <Eigen/Geometry>
 
@@ -199,6 +200,35 @@ Scene MakeTwistingRobot(int res, const RobotParams& P) {
   s.validate();
   return s;
 }
+
+namespace robots_detail {
+
+RobotEntry TwistingRobotEntry() {
+  const RobotInfo info = {
+      "twisting_robot",
+      "Plant-inspired twisting robot (thesis Sec. 3.4.1, Fig. 3.7-3.8): a 100 mm long cylinder of "
+      "radius 10 mm (z = long axis, z = 0 fixed, tip face z = 100) of Ecoflex 00-30 (Mooney-Rivlin "
+      "c1 = 0.0418, c2 = 0.0106 MPa; region 0) with a spiral tube chamber (region 1, pneumatic "
+      "actuator 'chamber', volume ratio in [1, 120]) around the helix of radius helix_radius from "
+      "z = 8 to 92, meshed by CGAL Mesh_3 from generated surfaces, T(S_c, S_b) "
+      "(solver/remesh/tessellation.hpp). For large ratios use progressive remeshing (solver/remesh/remesh.hpp). "
+      "Markers: tip (face z = 100), tip_rim (its vertex nearest (10, 0, 100)).",
+      kTwistDefaultRes,
+      "Mesh_3 cell size 8/res mm (facet size the same, facet distance 0.05 of it), integer in "
+      "[1, 6]; 6.2k / 10.8k / 18.0k / 29.2k tets at res 1 / 2 / 3 / 4 (docs/remeshing.md)",
+      {{"helix_radius", 5.0, 2.0, 7.0, "radius of the chamber's helical centreline, mm"},
+       {"tube_radius", 2.5, 1.0, 4.0, "radius of the chamber tube, mm (helix_radius + tube_radius <= 9)"},
+       {"turns", kTwistDefaultTurns, 1.0, 8.0, "turns of the helix between z = 8 and z = 92"},
+       {"hyperelastic", 1.0, 0.0, 1.0,
+        "1: Ecoflex 00-30 Mooney-Rivlin body (Eq. 3.6-3.7); 0: Ch. 2 shape blending with R_omega = 1"},
+       {"strip", 0.0, 0.0, 6.0,
+        "thickness (mm, from the +x side) of a strain-limiting strip along the body (region 2); 0: none. "
+        "With a strip the robot bends toward +x as it twists, and coils (Fig. 3.8)"},
+       {"strip_weight", 20.0, 1.0, 1000.0, "the strip's element weight, relative to the body's"}}};
+  return {info, kTwistMinRes, kTwistMaxRes, &MakeTwistingRobot};
+}
+
+}  // namespace robots_detail
 
 double TwistAboutAxisDegrees(const Eigen::Ref<const Eigen::MatrixX3d>& P,
                              const Eigen::Ref<const Eigen::MatrixX3d>& Q, const Eigen::Vector3d& axis) {

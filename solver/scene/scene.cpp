@@ -83,6 +83,78 @@ const Eigen::MatrixX3d& Scene::rest_positions_of(int region) const {
   return mesh.vertices;
 }
 
+namespace {
+
+/// The first problem of body material `mat` of region `tag` ("" if none).
+std::string BodyMaterialError(int tag, const Material& mat) {
+  if (!(mat.r_omega >= 0.0 && mat.r_omega <= 1.0))
+    return "body region " + std::to_string(tag) + ": r_omega must be in [0, 1], got " +
+           std::to_string(mat.r_omega);
+  if (!(mat.weight > 0.0))
+    return "body region " + std::to_string(tag) + ": weight must be > 0";
+  if (mat.law != "blend" && mat.law != "mooney-rivlin")
+    return "body region " + std::to_string(tag) +
+           ": law must be \"blend\" or \"mooney-rivlin\", got \"" + mat.law + "\"";
+  if (mat.hyperelastic() && !(mat.c1 >= 0 && mat.c2 >= 0 && mat.c1 + mat.c2 > 0 && mat.r_omega > 0))
+    return "body region " + std::to_string(tag) + ": a mooney-rivlin material needs c1, c2 >= 0 "
+           "with c1 + c2 > 0 (MPa) and r_omega > 0, got c1 = " + std::to_string(mat.c1) +
+           ", c2 = " + std::to_string(mat.c2) + ", r_omega = " + std::to_string(mat.r_omega);
+  return "";
+}
+
+/// The first problem of actuator `a` on its own ("" if none): its range, weight and kind-specific
+/// data (a motion actuator's moved vertices, which are added to *moved, of a mesh with
+/// num_vertices vertices; a signed actuator's gain; a cable's path).
+std::string ActuatorError(const Actuator& a, int num_vertices, std::set<int>* moved) {
+  const std::string what = std::string(ActuatorTypeToString(a.type)) + " actuator '" + a.name + "'";
+  if (!(a.min <= a.rest && a.rest <= a.max))
+    return what + ": expected min <= rest <= max, got " + std::to_string(a.min) + ", " +
+           std::to_string(a.rest) + ", " + std::to_string(a.max);
+  if (!(a.weight > 0.0)) return what + ": weight must be > 0";
+  if (!a.path.empty() && a.type != ActuatorType::Cable)
+    return what + ": only cable actuators have a path";
+  if (a.is_signed() && a.type != ActuatorType::Pneumatic)
+    return what + ": only pneumatic actuators can be signed (have negative_regions)";
+  if (!a.vertices.empty() && !a.is_motion())
+    return what + ": only displacement and twist actuators move vertices";
+  if (a.is_motion()) {
+    if (!a.regions.empty()) return what + ": a motion actuator has no regions";
+    if (a.vertices.empty()) return what + ": expected at least one moved vertex";
+    std::set<int> own;
+    for (int v : a.vertices) {
+      if (v < 0 || v >= num_vertices)
+        return what + ": moved vertex " + std::to_string(v) + " is out of range";
+      if (!own.insert(v).second)
+        return what + ": vertex " + std::to_string(v) + " is listed twice";
+      moved->insert(v);
+    }
+    if (!(a.axis.allFinite() && a.axis.norm() > 0)) return what + ": expected a non-zero axis";
+    if (!a.centre.allFinite()) return what + ": the centre must be finite";
+    if (!(std::isfinite(a.min) && std::isfinite(a.max)))
+      return what + ": expected a finite range";
+    return "";
+  }
+  if (a.is_signed()) {
+    if (!(a.min <= 0.0 && a.max >= 0.0 && a.rest == 0.0))
+      return what + ": a signed actuator has rest 0 and min <= 0 <= max";
+    if (!(a.gain > 0.0 && std::isfinite(a.gain))) return what + ": gain must be > 0";
+  } else if (!(a.min > 0.0)) {
+    return what + ": expected 0 < min <= rest <= max (the value is a ratio)";
+  }
+  if (a.regions.empty()) return what + " has no regions";
+  if (a.type == ActuatorType::Cable) {
+    if (a.path.size() < 2) return "cable '" + a.name + "': expected a path of at least 2 points";
+    for (const auto& p : a.path)
+      if (!p.allFinite()) return "cable '" + a.name + "': path points must be finite";
+    double len = 0;
+    for (size_t q = 1; q < a.path.size(); ++q) len += (a.path[q] - a.path[q - 1]).norm();
+    if (!(len > 0)) return "cable '" + a.name + "': the path has zero length";
+  }
+  return "";
+}
+
+}  // namespace
+
 void Scene::validate() const {
   auto fail = [&](const std::string& m) {
     throw std::invalid_argument("scene '" + name + "': " + m);
@@ -91,68 +163,17 @@ void Scene::validate() const {
   std::map<int, std::string> role;
   for (const auto& [tag, mat] : body) {
     role[tag] = "body material '" + mat.name + "'";
-    if (!(mat.r_omega >= 0.0 && mat.r_omega <= 1.0))
-      fail("body region " + std::to_string(tag) + ": r_omega must be in [0, 1], got " +
-           std::to_string(mat.r_omega));
-    if (!(mat.weight > 0.0))
-      fail("body region " + std::to_string(tag) + ": weight must be > 0");
-    if (mat.law != "blend" && mat.law != "mooney-rivlin")
-      fail("body region " + std::to_string(tag) + ": law must be \"blend\" or \"mooney-rivlin\", got \"" +
-           mat.law + "\"");
-    if (mat.hyperelastic() && !(mat.c1 >= 0 && mat.c2 >= 0 && mat.c1 + mat.c2 > 0 && mat.r_omega > 0))
-      fail("body region " + std::to_string(tag) + ": a mooney-rivlin material needs c1, c2 >= 0 "
-           "with c1 + c2 > 0 (MPa) and r_omega > 0, got c1 = " + std::to_string(mat.c1) +
-           ", c2 = " + std::to_string(mat.c2) + ", r_omega = " + std::to_string(mat.r_omega));
+    const std::string error = BodyMaterialError(tag, mat);
+    if (!error.empty()) fail(error);
   }
   std::set<std::string> names;
   std::set<int> moved;
   for (const auto& a : actuators) {
     if (a.name.empty()) fail("an actuator has an empty name");
     if (!names.insert(a.name).second) fail("actuator name '" + a.name + "' is used twice");
-    const std::string what = std::string(ActuatorTypeToString(a.type)) + " actuator '" + a.name + "'";
-    if (!(a.min <= a.rest && a.rest <= a.max))
-      fail(what + ": expected min <= rest <= max, got " + std::to_string(a.min) + ", " +
-           std::to_string(a.rest) + ", " + std::to_string(a.max));
-    if (!(a.weight > 0.0)) fail(what + ": weight must be > 0");
-    if (!a.path.empty() && a.type != ActuatorType::Cable)
-      fail(what + ": only cable actuators have a path");
-    if (a.is_signed() && a.type != ActuatorType::Pneumatic)
-      fail(what + ": only pneumatic actuators can be signed (have negative_regions)");
-    if (!a.vertices.empty() && !a.is_motion())
-      fail(what + ": only displacement and twist actuators move vertices");
-    if (a.is_motion()) {
-      if (!a.regions.empty()) fail(what + ": a motion actuator has no regions");
-      if (a.vertices.empty()) fail(what + ": expected at least one moved vertex");
-      std::set<int> own;
-      for (int v : a.vertices) {
-        if (v < 0 || v >= mesh.num_vertices())
-          fail(what + ": moved vertex " + std::to_string(v) + " is out of range");
-        if (!own.insert(v).second)
-          fail(what + ": vertex " + std::to_string(v) + " is listed twice");
-        moved.insert(v);
-      }
-      if (!(a.axis.allFinite() && a.axis.norm() > 0)) fail(what + ": expected a non-zero axis");
-      if (!a.centre.allFinite()) fail(what + ": the centre must be finite");
-      if (!(std::isfinite(a.min) && std::isfinite(a.max)))
-        fail(what + ": expected a finite range");
-      continue;
-    }
-    if (a.is_signed()) {
-      if (!(a.min <= 0.0 && a.max >= 0.0 && a.rest == 0.0))
-        fail(what + ": a signed actuator has rest 0 and min <= 0 <= max");
-      if (!(a.gain > 0.0 && std::isfinite(a.gain))) fail(what + ": gain must be > 0");
-    } else if (!(a.min > 0.0)) {
-      fail(what + ": expected 0 < min <= rest <= max (the value is a ratio)");
-    }
-    if (a.regions.empty()) fail(what + " has no regions");
-    if (a.type == ActuatorType::Cable) {
-      if (a.path.size() < 2) fail("cable '" + a.name + "': expected a path of at least 2 points");
-      for (const auto& p : a.path)
-        if (!p.allFinite()) fail("cable '" + a.name + "': path points must be finite");
-      double len = 0;
-      for (size_t q = 1; q < a.path.size(); ++q) len += (a.path[q] - a.path[q - 1]).norm();
-      if (!(len > 0)) fail("cable '" + a.name + "': the path has zero length");
-    }
+    const std::string error = ActuatorError(a, mesh.num_vertices(), &moved);
+    if (!error.empty()) fail(error);
+    if (a.is_motion()) continue;
     std::vector<int> all = a.regions;
     all.insert(all.end(), a.negative_regions.begin(), a.negative_regions.end());
     for (int r : all) {

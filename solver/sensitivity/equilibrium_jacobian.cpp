@@ -1,3 +1,7 @@
+/// \file equilibrium_jacobian.cpp
+/// The implicit Jacobian dX/dc (equilibrium_jacobian.hpp): the operator H on the free
+/// coordinates, the "local" preconditioner, the Krylov solvers (GMRES, BiCGSTAB) and
+/// ComputeEquilibriumJacobian. The linearization they apply is in equilibrium_linearization.cpp.
 #include "softkin/solver/sensitivity/equilibrium_jacobian.hpp"
 
 #include "softkin/solver/fk/actuation.hpp"
@@ -7,57 +11,14 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
-#include <cassert>
 #include <chrono>
 #include <cmath>
-#include <functional>
 #include <sstream>
 #include <tuple>
 
 #include <omp.h>
 
 namespace softkin {
-
-namespace {
-
-/// Axial vector a of the skew part Z - Z^T: [a]_x = Z - Z^T.
-inline Eigen::Vector3d AxialOfSkewPart(const Eigen::Matrix3d& Z) {
-  return Eigen::Vector3d(Z(2, 1) - Z(1, 2), Z(0, 2) - Z(2, 0), Z(1, 0) - Z(0, 1));
-}
-
-inline Eigen::Matrix3d Skew(const Eigen::Vector3d& w) {
-  Eigen::Matrix3d W;
-  W << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
-  return W;
-}
-
-/// Rows of element e from X, centred.
-inline void Gather(const ModelElement& e, const Eigen::Ref<const Eigen::MatrixX3d>& X, ElemRows* D) {
-  for (int j = 0; j < e.k; ++j) D->row(j) = X.row(e.v[j]);
-  CenterRows(*D, e.k);
-}
-
-/// Per-element polar-factor data: R = BestRotation(M), Sinv = (tr(S) I - S)^-1 with S = R^T M.
-/// Returns false if tr(S) I - S is (numerically) singular.
-bool PolarData(const Eigen::Matrix3d& M, Eigen::Matrix3d* R, Eigen::Matrix3d* Sinv) {
-  *R = BestRotation(M);
-  Eigen::Matrix3d S = R->transpose() * M;
-  S = 0.5 * (S + S.transpose()).eval();
-  const Eigen::Matrix3d Q = S.trace() * Eigen::Matrix3d::Identity() - S;
-  const double det = Q.determinant();
-  const double scale = std::max(1e-300, S.norm());
-  if (!(std::abs(det) > 1e-12 * scale * scale * scale)) return false;
-  *Sinv = Q.inverse();
-  return true;
-}
-
-/// W = R^T dR = [w]_x for a change dM of M (callers form P dR^T = -P W R^T).
-inline Eigen::Matrix3d PolarDerivativeW(const Eigen::Matrix3d& R, const Eigen::Matrix3d& Sinv,
-                                        const Eigen::Matrix3d& dM) {
-  return Skew(Sinv * AxialOfSkewPart(R.transpose() * dM));
-}
-
-}  // namespace
 
 bool EquilibriumJacobianOptions::IsValid(std::string* why) const {
   auto bad = [&](const std::string& m) { if (why) *why = m; return false; };
@@ -80,291 +41,6 @@ std::string EquilibriumJacobianUnsupported(const Model& model) {
              " has a hyperelastic (Mooney-Rivlin) body material, which implicit differentiation "
              "does not support; use the fd or fd-warm Jacobian";
   return "";
-}
-
-bool EquilibriumLinearization::Setup(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
-                                     const Eigen::Ref<const Eigen::VectorXd>& c, std::string* why,
-                                     int threads) {
-  model_ = &model;
-  threads_ = threads;
-  const std::string unsupported = EquilibriumJacobianUnsupported(model);
-  if (!unsupported.empty()) {
-    if (why) *why = unsupported;
-    return false;
-  }
-  X_ = X;
-  ComputeLocalRatios(model, X_, c, &ratios_);
-  const auto& els = model.elements();
-  const int ne = static_cast<int>(els.size());
-  cache_.resize(ne);
-  measure_.assign(ne, 0.0);
-  measure_active_.assign(ne, 0);
-  if (static_cast<int>(measure_grad_.size()) != ne) measure_grad_.resize(ne);
-  if (static_cast<int>(rows_.size()) != ne) rows_.resize(ne);
-  if (static_cast<int>(vol_grad_.size()) != ne) vol_grad_.resize(ne);
-
-  // Groups: current measures and the normalisation of ComputeLocalRatios.
-  groups_.assign(model.num_groups(), GroupCache());
-  for (int g = 0; g < model.num_groups(); ++g) {
-    GroupCache& gc = groups_[g];
-    const int a = model.group_actuator(g), side = model.group_side(g);
-    gc.vented = side != 0 && !(side * c[a] > 0.0);
-    const double M = model.group_rest_measure(g), LR = model.group_offset(g);
-    double Md = 0.0;
-    for (int i : model.group_elements(g)) {
-      ElemRows D;
-      Gather(els[i], X_, &D);
-      const double m = ActuationMeasure(els[i], D), floor = kMinMeasure * els[i].measure0;
-      measure_active_[i] = m > floor;
-      measure_[i] = std::max(m, floor);
-      measure_grad_[i] = ActuationMeasureGradient(els[i], D);
-      Md += measure_[i];
-    }
-    gc.Md = Md;
-    const double rho = model.GroupRatio(g, c);
-    const double num = rho * (M + LR) - LR;
-    gc.num_active = num > kMinMeasure * M;
-    gc.sigma = std::max(num, kMinMeasure * M) / Md;
-    // d rho / d c[a] (Actuator::SideRatio): 1 for an unsigned actuator, gain * side on the
-    // active side of a signed one.
-    const Actuator& act = model.scene().actuators[a];
-    gc.drho = side == 0 ? 1.0 : (side * c[a] > 0.0 ? act.gain * side : 0.0);
-  }
-
-  // Elements: rotations and polar-derivative data.
-  int bad = -1;
-  const int nt = threads_ > 0 ? threads_ : omp_get_max_threads();
-#pragma omp parallel for schedule(static) num_threads(nt)
-  for (int i = 0; i < ne; ++i) {
-    const ModelElement& e = els[i];
-    ElementCache& ec = cache_[i];
-    const double r = ratios_[i];
-    if (e.role != ElementRole::Body && r == kVented) continue;
-    ElemRows D;
-    Gather(e, X_, &D);
-    const auto P = e.rest.topRows(e.k);
-    Eigen::Matrix3d M;
-    if (e.role == ElementRole::Body || e.role == ElementRole::Pneumatic) {
-      M = D.topRows(e.k).transpose() * P;
-    } else {
-      const Eigen::Matrix<double, Eigen::Dynamic, 3, 0, 6, 3> Ps =
-          P * ActuationShape(e, r).transpose();
-      M = D.topRows(e.k).transpose() * Ps;
-    }
-    if (!PolarData(M, &ec.R, &ec.Sinv)) {
-#pragma omp critical
-      bad = std::max(bad, i);
-      continue;
-    }
-    if (e.role != ElementRole::Body || e.r_omega < 1.0) rows_[i] = D;
-    if (e.role == ElementRole::Body && e.r_omega < 1.0) {
-      const double vd = RowsVolume(D, e.k);
-      ec.vol = vd;
-      if (vd > 1e-9 * e.rest_volume) {
-        const double s = std::cbrt(e.rest_volume / vd);
-        ec.s = std::min(s, 10.0);
-        ec.s_active = s < 10.0;
-        if (ec.s_active) vol_grad_[i] = RowsVolumeGradient(D, e.k);
-      } else {
-        ec.s = 1.0;  // as ElementTarget: a collapsed or inverted element keeps s = 1
-        ec.s_active = false;
-      }
-    }
-  }
-  if (bad >= 0) {
-    if (why)
-      *why = "element " + std::to_string(bad) +
-             " is degenerate at this state (flat or inverted: its best rotation is not "
-             "differentiable); implicit differentiation is not defined here";
-    return false;
-  }
-  return true;
-}
-
-void EquilibriumLinearization::ApplyRhsDerivative(const Eigen::Ref<const Eigen::MatrixX3d>& dX,
-                                                  const Eigen::Ref<const Eigen::VectorXd>& dc,
-                                                  Eigen::MatrixX3d* dB) {
-  const Eigen::MatrixXd dXm = dX, dcm = dc;
-  Eigen::MatrixXd out;
-  ApplyRhsDerivativeBatch(dXm, dcm, &out);
-  *dB = out;
-}
-
-void EquilibriumLinearization::ElementTargetDerivative(int i, bool vented, const ElemRows& dD,
-                                                       double dr, const ElemRows& Ps,
-                                                       const ElemRows& dPs0, ElemRows* dT) const {
-  const ModelElement& e = model_->elements()[i];
-  const ElementCache& ec = cache_[i];
-  const double r = ratios_[i];
-  const ElemRows& P = e.rest;
-  const Eigen::Matrix3d Rt = ec.R.transpose();
-  if (vented) {
-    *dT = dD;  // vented: T = D
-  } else if (e.role == ElementRole::Body) {
-    const Eigen::Matrix3d dM = dD.transpose() * P;
-    const Eigen::Matrix3d W = PolarDerivativeW(ec.R, ec.Sinv, dM);
-    // T = r_w P R^T + (1 - r_w) s D; d(P R^T) = P dR^T = -P W R^T.
-    const Eigen::Matrix3d WRt = W * Rt;
-    dT->noalias() = (-e.r_omega) * (P * WRt);
-    if (e.r_omega < 1.0) {
-      const ElemRows& D = rows_[i];
-      double ds = 0.0;
-      if (ec.s_active) ds = -(ec.s / 3.0) * vol_grad_[i].cwiseProduct(dD).sum() / ec.vol;
-      *dT += (1.0 - e.r_omega) * (ds * D + ec.s * dD);
-    }
-  } else if (e.role == ElementRole::Pneumatic) {
-    // T = q P R^T, q = cbrt(r).
-    const double q = std::cbrt(r), dq = q * dr / (3.0 * r);
-    const Eigen::Matrix3d dM = dD.transpose() * P;
-    const Eigen::Matrix3d W = PolarDerivativeW(ec.R, ec.Sinv, dM);
-    const Eigen::Matrix3d G = dq * Rt - q * (W * Rt);
-    dT->noalias() = P * G;
-  } else {
-    const ElemRows& D = rows_[i];
-    const ElemRows dPs = dr * dPs0;
-    const Eigen::Matrix3d dM = dD.transpose() * Ps + D.transpose() * dPs;
-    const Eigen::Matrix3d W = PolarDerivativeW(ec.R, ec.Sinv, dM);
-    dT->noalias() = dPs * Rt - Ps * (W * Rt);
-  }
-}
-
-void EquilibriumLinearization::ForEachLocalBlock(
-    const std::function<void(int element, const LocalBlock& block, int thread)>& f) const {
-  const Model& model = *model_;
-  const auto& els = model.elements();
-  const int ne = static_cast<int>(els.size());
-  const int nt = threads_ > 0 ? threads_ : omp_get_max_threads();
-#pragma omp parallel for schedule(static) num_threads(nt)
-  for (int i = 0; i < ne; ++i) {
-    const ModelElement& e = els[i];
-    const double r = ratios_[i];
-    const bool vented = e.role != ElementRole::Body && r == kVented;
-    ElemRows Ps, dPs0;
-    if (!vented && (e.role == ElementRole::Cable || e.role == ElementRole::Dea)) {
-      Ps.noalias() = e.rest * ActuationShape(e, r).transpose();
-      dPs0.noalias() = e.rest * ActuationShapeDerivative(e, r).transpose();
-    }
-    // The element's own share of its ratio's derivative (the group's d sigma is left out).
-    double sigma = 0.0;
-    if (e.role != ElementRole::Body && !vented && e.group >= 0 && !groups_[e.group].vented)
-      sigma = groups_[e.group].sigma;
-    LocalBlock Kb = LocalBlock::Zero(3 * e.k, 3 * e.k);
-    for (int qc = 0; qc < e.k; ++qc)
-      for (int dc = 0; dc < 3; ++dc) {
-        ElemRows dD = ElemRows::Zero(), dT;
-        dD(qc, dc) = 1.0;
-        CenterRows(dD, e.k);
-        double dr = 0.0;
-        if (sigma > 0.0 && measure_active_[i])
-          dr = sigma * measure_grad_[i].topRows(e.k).cwiseProduct(dD.topRows(e.k)).sum() / e.measure0;
-        ElementTargetDerivative(i, vented, dD, dr, Ps, dPs0, &dT);
-        for (int q = 0; q < e.k; ++q)
-          for (int d = 0; d < 3; ++d) Kb(3 * q + d, 3 * qc + dc) = e.wv * dT(q, d);
-      }
-    f(i, Kb, omp_get_thread_num());
-  }
-}
-
-Eigen::SparseMatrix<double> EquilibriumLinearization::LocalStiffness() const {
-  const int nt = threads_ > 0 ? threads_ : omp_get_max_threads();
-  std::vector<std::vector<Eigen::Triplet<double>>> parts(nt);
-  const auto& els = model_->elements();
-  ForEachLocalBlock([&](int i, const LocalBlock& Kb, int t) {
-    const ModelElement& e = els[i];
-    for (int a = 0; a < 3 * e.k; ++a)
-      for (int b = 0; b < 3 * e.k; ++b)
-        if (Kb(a, b) != 0.0) parts[t].emplace_back(3 * e.v[a / 3] + a % 3, 3 * e.v[b / 3] + b % 3, Kb(a, b));
-  });
-  std::vector<Eigen::Triplet<double>> all;
-  for (const auto& p : parts) all.insert(all.end(), p.begin(), p.end());
-  const int nv = model_->num_vertices();
-  Eigen::SparseMatrix<double> K(3 * nv, 3 * nv);
-  K.setFromTriplets(all.begin(), all.end());
-  return K;
-}
-
-void EquilibriumLinearization::ApplyRhsDerivativeBatch(const Eigen::Ref<const Eigen::MatrixXd>& dX,
-                                                       const Eigen::Ref<const Eigen::MatrixXd>& dc,
-                                                       Eigen::MatrixXd* dB) {
-  const Model& model = *model_;
-  const auto& els = model.elements();
-  const int ne = static_cast<int>(els.size());
-  const int nv = model.num_vertices();
-  const int m = static_cast<int>(dc.cols());
-  assert(dX.rows() == nv && dX.cols() == 3 * m && dc.rows() == model.num_actuators());
-  dratio_.assign(static_cast<size_t>(ne) * m, 0.0);
-  if (weighted_.size() != static_cast<size_t>(ne) * m) weighted_.resize(static_cast<size_t>(ne) * m);
-  // Rows of element e in direction j, centred.
-  auto gather = [&](const ModelElement& e, int j, ElemRows* D) {
-    for (int q = 0; q < e.k; ++q)
-      for (int d = 0; d < 3; ++d) (*D)(q, d) = dX(e.v[q], 3 * j + d);
-    CenterRows(*D, e.k);
-  };
-
-  // Pass 1: ratio derivatives, group by group (the rank-one coupling through sum_j m_j).
-  for (int g = 0; g < model.num_groups(); ++g) {
-    const GroupCache& gc = groups_[g];
-    const auto& ids = model.group_elements(g);
-    if (gc.vented) continue;  // dratio_ stays 0
-    const double M = model.group_rest_measure(g), LR = model.group_offset(g);
-    for (int j = 0; j < m; ++j) {
-      double dMd = 0.0;
-      for (int i : ids) {
-        double dm = 0.0;
-        if (measure_active_[i]) {
-          ElemRows dD;
-          gather(els[i], j, &dD);
-          dm = measure_grad_[i].topRows(els[i].k).cwiseProduct(dD.topRows(els[i].k)).sum();
-        }
-        dratio_[static_cast<size_t>(i) * m + j] = dm;  // holds dm_i until dsigma is known
-        dMd += dm;
-      }
-      const double drho = gc.drho * dc(model.group_actuator(g), j);
-      const double dsigma =
-          -gc.sigma * dMd / gc.Md + (gc.num_active ? (M + LR) * drho / gc.Md : 0.0);
-      for (int i : ids) {
-        double& r = dratio_[static_cast<size_t>(i) * m + j];
-        r = (gc.sigma * r + measure_[i] * dsigma) / els[i].measure0;
-      }
-    }
-  }
-
-  // Pass 2: per-element target derivatives dT (already in the current frame, centred), every
-  // direction while the element's cached data is at hand. Products use the fixed 6 x 3 row
-  // blocks: rows k..5 of the rest and centred rows are zero.
-  const int nt = threads_ > 0 ? threads_ : omp_get_max_threads();
-#pragma omp parallel for schedule(static) num_threads(nt)
-  for (int i = 0; i < ne; ++i) {
-    const ModelElement& e = els[i];
-    const double r = ratios_[i];
-    const ElemRows& P = e.rest;
-    const bool vented = e.role != ElementRole::Body && r == kVented;
-    // Cable / DEA: T = Ps R^T, Ps = P S(r)^T, R = polar(D^T Ps).
-    ElemRows Ps, dPs0;
-    if (!vented && (e.role == ElementRole::Cable || e.role == ElementRole::Dea)) {
-      Ps.noalias() = P * ActuationShape(e, r).transpose();
-      dPs0.noalias() = P * ActuationShapeDerivative(e, r).transpose();
-    }
-    for (int j = 0; j < m; ++j) {
-      ElemRows dD, dT;
-      gather(e, j, &dD);
-      ElementTargetDerivative(i, vented, dD, dratio_[static_cast<size_t>(i) * m + j], Ps, dPs0, &dT);
-      weighted_[static_cast<size_t>(i) * m + j] = e.wv * dT;
-    }
-  }
-  // Gather sum_i w_i Vol_i S_i^T dT_i per vertex and direction (AssembleRhs, batched).
-  dB->resize(nv, 3 * m);
-  const auto& off = model.incidence_offset();
-  const auto& inc = model.incidence();
-#pragma omp parallel for schedule(static) num_threads(nt)
-  for (int v = 0; v < nv; ++v) {
-    for (int j = 0; j < m; ++j) {
-      Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
-      for (int q = off[v]; q < off[v + 1]; ++q)
-        sum += weighted_[static_cast<size_t>(inc[q] / 6) * m + j].row(inc[q] % 6);
-      for (int d = 0; d < 3; ++d) (*dB)(v, 3 * j + d) = sum[d];
-    }
-  }
 }
 
 Eigen::MatrixX3d PrescribedDerivative(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& c,
@@ -792,6 +468,142 @@ int BiCgStab(FreeOperator* op, const Eigen::VectorXd& rhs, int max_it, double to
   return total;
 }
 
+/// The message for an invalid call of ComputeEquilibriumJacobian ("" if none): invalid options,
+/// positions or actuation of the wrong size or not finite, a column that is no actuator. Sets
+/// *columns to columns_in, or every actuator if it is empty.
+std::string JacobianInputError(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                               const Eigen::Ref<const Eigen::VectorXd>& c,
+                               const std::vector<int>& columns_in,
+                               const EquilibriumJacobianOptions& options,
+                               std::vector<int>* columns) {
+  std::string why;
+  if (!options.IsValid(&why)) return why;
+  const int nv = model.num_vertices(), na = model.num_actuators();
+  if (X.rows() != nv || !X.allFinite() || c.size() != na || !c.allFinite())
+    return "ComputeEquilibriumJacobian: expected finite positions (" + std::to_string(nv) +
+           " x 3) and actuation (" + std::to_string(na) + ")";
+  *columns = columns_in;
+  if (columns->empty())
+    for (int a = 0; a < na; ++a) columns->push_back(a);
+  for (int a : *columns)
+    if (a < 0 || a >= na)
+      return "ComputeEquilibriumJacobian: column " + std::to_string(a) + " is not an actuator";
+  return "";
+}
+
+/// The local preconditioner of op: the workspace's factor of an earlier state (if allow_reuse
+/// and the options and workspace allow it), else factored now; A_ff if the local one is not
+/// positive definite. Records what preconditions in res->preconditioner and adds the time.
+/// Returns whether the earlier factor was reused.
+bool SetLocalPreconditioner(const Model& model, const EquilibriumLinearization& lin,
+                            const EquilibriumJacobianOptions& options, bool allow_reuse,
+                            EquilibriumJacobianWorkspace::Impl* ws, FreeOperator* op,
+                            EquilibriumJacobianResult* res) {
+  const auto tp = std::chrono::steady_clock::now();
+  const bool reused = allow_reuse && options.reuse_preconditioner && ws->model == &model &&
+                      ws->has_factor && !ws->stale;
+  if (reused || FactorLocalPreconditioner(model, lin, options.threads, ws)) {
+    op->SetPreconditioner(&ws->llt);
+    res->preconditioner = std::string(reused ? "local (reused)" : "local") +
+                          (ws->project ? ", projected" : "");
+  } else {
+    op->SetPreconditioner(nullptr);
+    res->preconditioner = "A_ff (the local preconditioner is not positive definite)";
+  }
+  res->preconditioner_time_s +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - tp).count();
+  return reused;
+}
+
+/// The right-hand sides of the free systems, all columns in one pass: dB/dc_a + (K_fc - A_fc)
+/// dx_c/dc_a (#free x #columns). *dXc receives each column's derivative dx_c/dc_a of the
+/// prescribed coordinates (#V x 3), *Y0 the initial guesses: zero, or the free coordinates of
+/// initial_guess (3 #V x #columns, vertex-major) if it is not null.
+Eigen::MatrixXd JacobianRhs(const Model& model, EquilibriumLinearization* lin,
+                            const FreeOperator& op, const Eigen::Ref<const Eigen::VectorXd>& c,
+                            const std::vector<int>& columns, const Eigen::MatrixXd* initial_guess,
+                            std::vector<Eigen::MatrixX3d>* dXc, Eigen::MatrixXd* Y0) {
+  const int nv = model.num_vertices(), na = model.num_actuators(), nf = model.num_free_dofs();
+  const int nc = static_cast<int>(columns.size());
+  dXc->assign(nc, Eigen::MatrixX3d());
+  Eigen::MatrixXd dXcb(nv, 3 * nc), dcb = Eigen::MatrixXd::Zero(na, nc), dBb;
+  for (int j = 0; j < nc; ++j) {
+    (*dXc)[j] = PrescribedDerivative(model, c, columns[j]);
+    dXcb.middleCols(3 * j, 3) = (*dXc)[j];
+    dcb(columns[j], j) = 1.0;
+  }
+  lin->ApplyRhsDerivativeBatch(dXcb, dcb, &dBb);
+  dBb.noalias() -= model.A() * dXcb;
+  Eigen::MatrixXd rhs(nf, nc);
+  *Y0 = Eigen::MatrixXd::Zero(nf, nc);
+  for (int j = 0; j < nc; ++j) {
+    op.Gather(dBb.middleCols(3 * j, 3), rhs.col(j));
+    if (initial_guess) {
+      Eigen::MatrixX3d G(nv, 3);
+      for (int v = 0; v < nv; ++v)
+        for (int d = 0; d < 3; ++d) G(v, d) = (*initial_guess)(3 * v + d, j);
+      op.Gather(G, Y0->col(j));
+    }
+  }
+  return rhs;
+}
+
+/// GMRES for every column from Y0 (RunGmres; lockstep as the options say): the solutions into
+/// *Yf, the preconditioned relative residuals into *rels; adds the rounds and each column's
+/// products to res. Returns whether every column converged, and the number of rounds.
+std::pair<bool, int> SolveGmresColumns(FreeOperator* op, const Eigen::MatrixXd& rhs,
+                                       const Eigen::MatrixXd& Y0,
+                                       const EquilibriumJacobianOptions& options,
+                                       Eigen::MatrixXd* Yf, std::vector<double>* rels,
+                                       EquilibriumJacobianResult* res) {
+  const int nc = static_cast<int>(rhs.cols());
+  const Eigen::MatrixXd B = op->Precondition(rhs);
+  std::vector<GmresColumn> cols;
+  cols.reserve(nc);
+  for (int j = 0; j < nc; ++j)
+    cols.emplace_back(B.col(j), Y0.col(j), options.restart, options.max_iterations,
+                      options.tolerance);
+  const int rounds = RunGmres(op, &cols, options.lockstep);
+  res->rounds += rounds;
+  bool converged = true;
+  for (int j = 0; j < nc; ++j) {
+    Yf->col(j) = cols[j].y();
+    (*rels)[j] = cols[j].rel();
+    res->iterations[j] += cols[j].products();
+    converged = converged && Yf->col(j).allFinite() && (*rels)[j] <= options.tolerance;
+  }
+  return std::make_pair(converged, rounds);
+}
+
+/// res->dXdc (3 #V x #columns, vertex-major): each column's prescribed part dXc[j] with its free
+/// coordinates from Yf. false, with res->message and an empty dXdc, if a column's solve did not
+/// converge.
+bool AssembleDxdc(const Model& model, const FreeOperator& op, const std::vector<int>& columns,
+                  const std::vector<Eigen::MatrixX3d>& dXc, const Eigen::MatrixXd& Yf,
+                  const std::vector<double>& rels, const EquilibriumJacobianOptions& options,
+                  EquilibriumJacobianResult* res) {
+  const int nv = model.num_vertices(), nc = static_cast<int>(columns.size());
+  res->dXdc.setZero(3 * nv, nc);
+  for (int j = 0; j < nc; ++j) {
+    const int a = columns[j];
+    if (!Yf.col(j).allFinite() || !(rels[j] <= options.tolerance)) {
+      std::ostringstream s;
+      s << "implicit Jacobian: " << (options.krylov == "bicgstab" ? "BiCGSTAB" : "GMRES")
+        << " for actuator '" << model.scene().actuators[a].name
+        << "' stopped at relative residual " << rels[j] << " after " << res->iterations[j]
+        << " iterations (tolerance " << options.tolerance << ")";
+      res->message = s.str();
+      res->dXdc.resize(0, 0);
+      return false;
+    }
+    Eigen::MatrixX3d dX = dXc[j];
+    op.Scatter(Yf.col(j), dX);
+    for (int v = 0; v < nv; ++v)
+      for (int d = 0; d < 3; ++d) res->dXdc(3 * v + d, j) = dX(v, d);
+  }
+  return true;
+}
+
 }  // namespace
 
 EquilibriumJacobianResult ComputeEquilibriumJacobian(const Model& model,
@@ -807,30 +619,16 @@ EquilibriumJacobianResult ComputeEquilibriumJacobian(const Model& model,
     res.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return res;
   };
-  std::string why;
-  if (!options.IsValid(&why)) {
-    res.message = why;
-    return finish();
-  }
-  const int nv = model.num_vertices(), na = model.num_actuators();
-  if (X.rows() != nv || !X.allFinite() || c.size() != na || !c.allFinite()) {
-    res.message = "ComputeEquilibriumJacobian: expected finite positions (" + std::to_string(nv) +
-                  " x 3) and actuation (" + std::to_string(na) + ")";
-    return finish();
-  }
-  std::vector<int> columns = columns_in;
-  if (columns.empty())
-    for (int a = 0; a < na; ++a) columns.push_back(a);
-  for (int a : columns)
-    if (a < 0 || a >= na) {
-      res.message = "ComputeEquilibriumJacobian: column " + std::to_string(a) + " is not an actuator";
-      return finish();
-    }
+  std::vector<int> columns;
+  res.message = JacobianInputError(model, X, c, columns_in, options, &columns);
+  if (!res.message.empty()) return finish();
+  const int nv = model.num_vertices();
   const int nc = static_cast<int>(columns.size());
   const bool use_guess = initial_guess && initial_guess->rows() == 3 * nv &&
                          initial_guess->cols() == nc && initial_guess->allFinite();
 
   EquilibriumLinearization lin;
+  std::string why;
   if (!lin.Setup(model, X, c, &why, options.threads)) {
     res.message = why;
     return finish();
@@ -843,49 +641,18 @@ EquilibriumJacobianResult ComputeEquilibriumJacobian(const Model& model,
   res.preconditioner = "A_ff";
   bool reused = false;
   // The local preconditioner: factored now, or the workspace's factor of an earlier state.
-  auto set_local = [&](bool allow_reuse) {
-    const auto tp = std::chrono::steady_clock::now();
-    reused = allow_reuse && options.reuse_preconditioner && ws->model == &model && ws->has_factor &&
-             !ws->stale;
-    if (reused || FactorLocalPreconditioner(model, lin, options.threads, ws)) {
-      op.SetPreconditioner(&ws->llt);
-      res.preconditioner = std::string(reused ? "local (reused)" : "local") +
-                           (ws->project ? ", projected" : "");
-    } else {
-      op.SetPreconditioner(nullptr);
-      res.preconditioner = "A_ff (the local preconditioner is not positive definite)";
-    }
-    res.preconditioner_time_s +=
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - tp).count();
-  };
   if (options.preconditioner == "local") {
     if (options.reuse_preconditioner && ws->model == &model && ws->not_positive_definite)
       res.preconditioner = "A_ff (the local preconditioner was not positive definite earlier)";
     else
-      set_local(true);
+      reused = SetLocalPreconditioner(model, lin, options, true, ws, &op, &res);
   }
 
-  // Right-hand sides, all columns in one pass: dB/dc_a + (K_fc - A_fc) dx_c/dc_a.
-  std::vector<Eigen::MatrixX3d> dXc(nc);
-  Eigen::MatrixXd dXcb(nv, 3 * nc), dcb = Eigen::MatrixXd::Zero(na, nc), dBb;
-  for (int j = 0; j < nc; ++j) {
-    dXc[j] = PrescribedDerivative(model, c, columns[j]);
-    dXcb.middleCols(3 * j, 3) = dXc[j];
-    dcb(columns[j], j) = 1.0;
-  }
-  lin.ApplyRhsDerivativeBatch(dXcb, dcb, &dBb);
-  dBb.noalias() -= model.A() * dXcb;
-  Eigen::MatrixXd rhs(nf, nc), Y0 = Eigen::MatrixXd::Zero(nf, nc), Yf(nf, nc);
-  for (int j = 0; j < nc; ++j) {
-    op.Gather(dBb.middleCols(3 * j, 3), rhs.col(j));
-    if (use_guess) {
-      Eigen::MatrixX3d G(nv, 3);
-      for (int v = 0; v < nv; ++v)
-        for (int d = 0; d < 3; ++d) G(v, d) = (*initial_guess)(3 * v + d, j);
-      op.Gather(G, Y0.col(j));
-    }
-  }
-
+  std::vector<Eigen::MatrixX3d> dXc;
+  Eigen::MatrixXd Y0;
+  const Eigen::MatrixXd rhs =
+      JacobianRhs(model, &lin, op, c, columns, use_guess ? initial_guess : nullptr, &dXc, &Y0);
+  Eigen::MatrixXd Yf(nf, nc);
   std::vector<double> rels(nc, 0.0);
   res.iterations.assign(nc, 0);
   if (options.krylov == "bicgstab") {
@@ -897,32 +664,14 @@ EquilibriumJacobianResult ComputeEquilibriumJacobian(const Model& model,
       Yf.col(j) = y;
     }
   } else {
-    auto run = [&]() {
-      const Eigen::MatrixXd B = op.Precondition(rhs);
-      std::vector<GmresColumn> cols;
-      cols.reserve(nc);
-      for (int j = 0; j < nc; ++j)
-        cols.emplace_back(B.col(j), Y0.col(j), options.restart, options.max_iterations,
-                          options.tolerance);
-      const int rounds = RunGmres(&op, &cols, options.lockstep);
-      res.rounds += rounds;
-      bool converged = true;
-      for (int j = 0; j < nc; ++j) {
-        Yf.col(j) = cols[j].y();
-        rels[j] = cols[j].rel();
-        res.iterations[j] += cols[j].products();
-        converged = converged && Yf.col(j).allFinite() && rels[j] <= options.tolerance;
-      }
-      return std::make_pair(converged, rounds);
-    };
-    auto [converged, rounds] = run();
+    auto [converged, rounds] = SolveGmresColumns(&op, rhs, Y0, options, &Yf, &rels, &res);
     if (options.preconditioner == "local" && res.preconditioner.rfind("local (reused)", 0) == 0) {
       // A factor of an earlier state that no longer helps: factor now, and retry if it failed.
       const int limit = std::max(2 * ws->fresh_rounds, ws->fresh_rounds + 10);
       if (!converged || rounds > limit) ws->stale = true;
       if (!converged) {
-        set_local(false);
-        std::tie(converged, rounds) = run();
+        reused = SetLocalPreconditioner(model, lin, options, false, ws, &op, &res);
+        std::tie(converged, rounds) = SolveGmresColumns(&op, rhs, Y0, options, &Yf, &rels, &res);
       }
     }
     if (res.preconditioner.rfind("local", 0) == 0 && !reused) ws->fresh_rounds = rounds;
@@ -933,24 +682,7 @@ EquilibriumJacobianResult ComputeEquilibriumJacobian(const Model& model,
     const double rn = rhs.col(j).norm();
     res.residuals.push_back(rn > 0 ? (HY.col(j) - rhs.col(j)).norm() / rn : 0.0);
   }
-  res.dXdc.setZero(3 * nv, nc);
-  for (int j = 0; j < nc; ++j) {
-    const int a = columns[j];
-    if (!Yf.col(j).allFinite() || !(rels[j] <= options.tolerance)) {
-      std::ostringstream s;
-      s << "implicit Jacobian: " << (options.krylov == "bicgstab" ? "BiCGSTAB" : "GMRES")
-        << " for actuator '" << model.scene().actuators[a].name
-        << "' stopped at relative residual " << rels[j] << " after " << res.iterations[j]
-        << " iterations (tolerance " << options.tolerance << ")";
-      res.message = s.str();
-      res.dXdc.resize(0, 0);
-      return finish();
-    }
-    Eigen::MatrixX3d dX = dXc[j];
-    op.Scatter(Yf.col(j), dX);
-    for (int v = 0; v < nv; ++v)
-      for (int d = 0; d < 3; ++d) res.dXdc(3 * v + d, j) = dX(v, d);
-  }
+  if (!AssembleDxdc(model, op, columns, dXc, Yf, rels, options, &res)) return finish();
   res.ok = true;
   return finish();
 }

@@ -1,0 +1,107 @@
+/// \file cable_finger.cpp
+/// cable_finger (thesis Fig. 2.8, Fig. 4.1): a four-tooth finger closed by three tendons.
+#include "softkin/solver/robots/robot_parts.hpp"
+
+#include "softkin/solver/mesh/mesh_gen.hpp"
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace softkin {
+namespace robots_detail {
+namespace {
+
+// ================================================================================================
+// cable_finger (thesis Fig. 2.8, Fig. 4.1): a 120 x 25 x 25 mm finger of four teeth on a
+// continuous base, with three knuckles (the gaps between teeth) each pulled by its own tendon.
+//
+// Axes: x = long axis (x = 0 fixed, tip face x = 120), y = width [0, 25], z = height [0, 25];
+// motion is planar in x-z. Layout (mm): base z in [0, 5] along the whole length (body); teeth
+// z in [5, 25] at x in [0, 15], [25, 50], [60, 85], [95, 120] (body); knuckle k (k = 1, 2, 3) is
+// the gap x in [15, 25], [50, 60], [85, 95]. In each gap the cable bridge z in [17.5, 25], full
+// width, holds the cable's actuation elements (region k, actuator "t<k>"); the rest of the gap
+// is empty, so the thin base under it is the flexure that bends.
+// How a tendon is tied to the mesh: tendon k runs straight along x through its bridge, at the
+// bridge's mid-height, from one tooth to the next (the segment anchored in the two teeth), so its
+// path lies entirely in its actuation elements: L = sum l_i = 10 mm and L_R = 0. Shortening it to
+// s L shortens the bridge along x, pulls the teeth's tops together and closes the knuckle: the
+// shortened top side becomes the concave one and the tip curls up, towards +z. Range s in
+// [0.5, 1] (rest 1): up to 50 % shortening.
+// Resolution: cells across the 25 mm width (cell size 25/res); features snap to the cells whose
+// centres they contain.
+// ================================================================================================
+
+constexpr int kCableMinRes = 5, kCableMaxRes = 30, kCableDefaultRes = 10;
+constexpr double kCableLength = 120.0, kCableWidth = 25.0, kCableHeight = 25.0;
+constexpr double kCableBase = 5.0, kCableBridgeFloor = 17.5;
+constexpr double kCableGaps[3][2] = {{15.0, 25.0}, {50.0, 60.0}, {85.0, 95.0}};
+constexpr double kCableMinShortening = 0.5;
+
+Scene MakeCableFinger(int res, const RobotParams&) {
+  const double h = kCableWidth / res;
+  const int nx = static_cast<int>(std::lround(kCableLength / h));
+  const int nz = static_cast<int>(std::lround(kCableHeight / h));
+  auto cell = [&](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
+    const double x = (c[0] + 0.5) * h, z = (c[2] + 0.5) * h;
+    if (z < kCableBase) return 0;
+    for (int k = 0; k < 3; ++k)
+      if (x > kCableGaps[k][0] && x < kCableGaps[k][1]) return z > kCableBridgeFloor ? k + 1 : -1;
+    return 0;
+  };
+  Scene s;
+  s.name = "cable_finger";
+  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, res, nz), cell);
+  s.body[0] = Material{"body", 1.0, 1.0};
+  // Bridge cells actually present (snapped): the path spans them at their mid-height.
+  const double zmax = nz * h;
+  const double zmid = 0.5 * (std::ceil(kCableBridgeFloor / h - 0.5) * h + zmax);
+  for (int k = 0; k < 3; ++k) {
+    double x0 = kInf, x1 = -kInf;
+    for (int i = 0; i < nx; ++i) {
+      const double x = (i + 0.5) * h;
+      if (x > kCableGaps[k][0] && x < kCableGaps[k][1]) {
+        x0 = std::min(x0, i * h);
+        x1 = std::max(x1, (i + 1) * h);
+      }
+    }
+    if (!(x1 > x0))
+      throw std::invalid_argument("cable_finger: knuckle " + std::to_string(k + 1) +
+                                  " vanished at res " + std::to_string(res));
+    Actuator a;
+    a.name = "t" + std::to_string(k + 1);
+    a.type = ActuatorType::Cable;
+    a.regions = {k + 1};
+    a.rest = 1.0;
+    a.min = kCableMinShortening;
+    a.max = 1.0;
+    a.path = {Eigen::Vector3d(x0, 0.5 * kCableWidth, zmid), Eigen::Vector3d(x1, 0.5 * kCableWidth, zmid)};
+    s.actuators.push_back(a);
+  }
+  const double eps = 1e-6 * h, xmax = nx * h;
+  s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
+  AddDistalFaceMarkers(xmax, zmax, eps, &s);
+  s.validate();
+  return s;
+}
+
+}  // namespace
+
+RobotEntry CableFingerEntry() {
+  const RobotInfo info = {
+      "cable_finger",
+      "Cable-driven finger (thesis Fig. 2.8, Fig. 4.1): 120 x 25 x 25 mm, four teeth on a 5 mm "
+      "base; x = long axis (x = 0 fixed), z = height, planar motion in x-z. Three knuckles (gaps "
+      "x in [15, 25], [50, 60], [85, 95]) each bridged at the top (z >= 17.5) by the actuation "
+      "elements of its own tendon t1, t2, t3 (cable, shortening ratio in [0.5, 1]; regions 1-3; "
+      "each tendon's path runs along x through its bridge). Markers: tip (face x = 120), tip_top / "
+      "tip_bottom (top / bottom quarter of that face).",
+      kCableDefaultRes, "cells across the 25 mm width (cell size 25/res mm), integer in [5, 30]", {}};
+  return {info, kCableMinRes, kCableMaxRes, &MakeCableFinger};
+}
+
+}  // namespace robots_detail
+}  // namespace softkin

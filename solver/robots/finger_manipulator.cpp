@@ -1,0 +1,147 @@
+/// \file finger_manipulator.cpp
+/// finger_manipulator (thesis Sec. 5.3.1, Fig. 5.3b): three finger sections with signed pneumatic
+/// actuators.
+#include "softkin/solver/robots/robot_parts.hpp"
+
+#include "softkin/solver/mesh/mesh_gen.hpp"
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace softkin {
+namespace robots_detail {
+namespace {
+
+// ================================================================================================
+// finger_manipulator (thesis Sec. 5.3.1, Fig. 5.3b): three finger sections joined rigidly, each
+// with two opposite rows of chambers; one signed actuation value per section.
+//
+// Axes: x = long axis (x = 0 fixed), y = width [0, 20], z = thickness [0, 12]; the motion is planar
+// in x-y. Layout (mm, snapped to cells of h = 20 / res): a 6 mm base block; then three 40 mm
+// sections, the first two followed by a 6 mm connector (region 8, weight 20: rigid joints); a
+// 3 mm tip cap. In each section, a central spine along x (region 7, inextensible, weight 20; the
+// cells between the two cavity rows) and two rows of 4 mm cavities between 1.5 mm walls, one on
+// the +y side (region 1 + 2 s), one on the -y side (region 2 + 2 s), 1.5 mm side walls, floor and
+// roof (region 0). Section s is the signed pneumatic actuator "s<s+1>": value v in [-3, 3]
+// (the thesis's pressure in bar, its sign picking the side); v > 0 drives the +y chambers to
+// volume ratio 1 + gain v and bends the section towards -y, v < 0 the -y chambers and bends it
+// towards +y. The thesis's sections bend up to 120 degrees; this geometric model reaches less.
+// At the defaults (gain 4, chamber weight 20) section 1 turns at v = 3 by 43 / 73 / 95 degrees
+// at res 6 / 8 / 12: walls snap to whole cells (3.3 / 2.5 / 1.7 mm for the 1.5 mm design), and
+// thinner walls let the chambers grow more (at res 8 they reach volume ratio 9.8 of the 13
+// asked: the actuation elements are soft constraints, Eq. 2.10, held back by the rigid walls,
+// floor and roof). With the thesis's weight 5 and gain 2 it is 38 degrees at res 8. A
+// PneuNet-style variant with gaps between the chamber boxes did not bend more (50). The mesh is mirror-symmetric about y = 10 (res is even), so v and -v give
+// mirror images. Markers: tip (distal face x = L), j1, j2 (the connectors' distal faces: the
+// ends of sections 1 and 2).
+// ================================================================================================
+
+constexpr int kManipMinRes = 6, kManipMaxRes = 24, kManipDefaultRes = 8;
+constexpr double kManipWidth = 20.0, kManipThick = 12.0, kManipBase = 6.0, kManipSection = 40.0,
+                 kManipJoint = 6.0, kManipCap = 3.0, kManipWall = 1.5, kManipCavity = 4.0,
+                 kManipSpine = 3.0, kManipGain = 4.0, kManipRange = 3.0,
+                 kManipChamberWeight = 20.0;
+
+Scene MakeFingerManipulator(int res, const RobotParams& P) {
+  if (res % 2 != 0)
+    throw std::invalid_argument("finger_manipulator: --res must be even (mirror symmetry about "
+                                "the mid-plane y = 10), got " + std::to_string(res));
+  const double h = kManipWidth / res;
+  const int ny = res, nz = static_cast<int>(std::lround(kManipThick / h));
+  const int wall = Cells(kManipWall, h), cav = Cells(kManipCavity, h);
+  const int side_cav = std::max(1, (ny - 2 * wall - Cells(kManipSpine, h)) / 2);
+  const int base = Cells(kManipBase, h), sec = Cells(kManipSection, h), joint = Cells(kManipJoint, h),
+            cap = Cells(kManipCap, h);
+  const int nx = base + 3 * sec + 2 * joint + cap;
+  if (nz < 2 * wall + 1 || ny < 2 * wall + 2 * side_cav + 1)
+    throw std::invalid_argument("finger_manipulator: res " + std::to_string(res) + " too coarse");
+  std::vector<ChamberRow> rows;
+  std::vector<std::pair<int, int>> joints;
+  int x = base;
+  for (int q = 0; q < 3; ++q) {
+    rows.push_back(MakeChamberRow(x, x + sec, wall, cav, wall));
+    x += sec;
+    if (q < 2) {
+      joints.emplace_back(x, x + joint);
+      x += joint;
+    }
+  }
+  auto cell = [&](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
+    const int i = c[0], j = c[1], k = c[2];
+    for (const auto& jt : joints)
+      if (i >= jt.first && i < jt.second) return 8;
+    for (int q = 0; q < 3; ++q) {
+      const ChamberRow& r = rows[q];
+      if (i < r.x0 || i >= r.x1) continue;
+      const bool zin = k >= wall && k < nz - wall;
+      if (InCavity(r, i) && zin) {
+        if (j >= wall && j < wall + side_cav) return 2 + 2 * q;           // -y side
+        if (j >= ny - wall - side_cav && j < ny - wall) return 1 + 2 * q;  // +y side
+      }
+      if (j >= wall + side_cav && j < ny - wall - side_cav && i >= r.first) return 7;  // spine
+      return 0;
+    }
+    return 0;
+  };
+  Scene s;
+  s.name = "finger_manipulator";
+  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz), cell);
+  s.body[0] = Material{"body", P.at("body_r_omega"), 1.0};
+  s.body[7] = Material{"spine", 1.0, P.at("spine_weight")};
+  s.body[8] = Material{"joint", 1.0, 20.0};
+  const double gain = P.at("gain");
+  for (int q = 0; q < 3; ++q) {
+    Actuator a;
+    a.name = "s" + std::to_string(q + 1);
+    a.type = ActuatorType::Pneumatic;
+    a.regions = {1 + 2 * q};
+    a.negative_regions = {2 + 2 * q};
+    a.gain = gain;
+    a.weight = P.at("chamber_weight");
+    a.rest = 0.0;
+    a.min = -kManipRange;
+    a.max = kManipRange;
+    s.actuators.push_back(a);
+  }
+  const double eps = 1e-6 * h, xmax = nx * h;
+  s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
+  s.markers.push_back({"tip", VerticesOnPlane(s.mesh, Eigen::Vector3d(xmax, 0, 0),
+                                              Eigen::Vector3d::UnitX(), eps)});
+  for (int q = 0; q < 2; ++q)
+    s.markers.push_back({"j" + std::to_string(q + 1),
+                         VerticesOnPlane(s.mesh, Eigen::Vector3d(joints[q].second * h, 0, 0),
+                                         Eigen::Vector3d::UnitX(), eps)});
+  s.validate();
+  return s;
+}
+
+}  // namespace
+
+RobotEntry FingerManipulatorEntry() {
+  const RobotInfo info = {
+      "finger_manipulator",
+      "Planar finger manipulator (thesis Sec. 5.3.1): three 40 mm finger sections joined by rigid "
+      "6 mm connectors; x = long axis (x = 0 fixed), y = width [0, 20], z = thickness [0, 12]; "
+      "planar motion in x-y. Each section has a row of chambers on each side of a central "
+      "inextensible spine; its signed pneumatic actuator s1, s2, s3 takes a value in [-3, 3]: "
+      "v > 0 inflates the +y chambers to volume ratio 1 + gain v (bending towards -y), v < 0 the "
+      "-y chambers. Redundant: m = 3, n = 2. Markers: tip, j1, j2 (ends of sections 1 and 2).",
+      kManipDefaultRes,
+      "cells across the 20 mm width (cell size 20/res mm), even integer in [6, 24]",
+      {{"gain", kManipGain, 0.1, 10.0,
+        "volume ratio per unit of actuation: a chamber side reaches 1 + gain |v|"},
+       {"spine_weight", 20.0, 0.01, 100.0, "element weight of the central spine"},
+       {"chamber_weight", kManipChamberWeight, 0.01, 100.0,
+        "element weight of the chambers' actuation elements"},
+       {"body_r_omega", 1.0, 0.0, 1.0, "R_omega of the body material (walls, floor, roof)"}}};
+  return {info, kManipMinRes, kManipMaxRes, &MakeFingerManipulator};
+}
+
+}  // namespace robots_detail
+}  // namespace softkin

@@ -1,0 +1,81 @@
+/// \file scene_json_mesh.cpp
+/// Scene JSON: the mesh section (format, file, labels, tag array, scale) and the mesh reader it
+/// picks (mesh_io.hpp).
+#include "softkin/solver/mesh/io/mesh_io.hpp"
+#include "softkin/solver/scene/scene_parser.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <string>
+
+namespace softkin {
+namespace scene_json_detail {
+
+namespace fs = std::filesystem;
+
+void SceneParser::ReadMeshSection(const json& m, Scene* scene) const {
+  CheckObject(m, "mesh", "mesh");
+  const std::string file_key = m.at("file").get<std::string>();
+  if (file_key.empty()) Fail("mesh.file: expected a file name, got \"\"");
+  const fs::path file = Resolve(file_key);
+  std::string format = Get(m, "mesh", "format").get<std::string>();
+  const std::string labels = Get(m, "mesh", "labels").get<std::string>();
+  const std::string tag_array = Get(m, "mesh", "tag_array").get<std::string>();
+  if (format == "auto") {
+    std::string ext = file.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (ext == ".tet") format = "tet";
+    else if (ext == ".node" || ext == ".ele") format = "tetgen";
+    else if (ext == ".msh") format = "gmsh";
+    else if (ext == ".vtk") format = "vtk";
+    else if (ext.empty() && fs::exists(file.string() + ".node")) format = "tetgen";
+    else
+      Fail("mesh.format: cannot tell the mesh format of '" + file.string() +
+           "' from its extension; expected a .tet, .node, .ele, .msh or .vtk file, or mesh.format "
+           "set to one of: tet, tetgen, gmsh, vtk");
+  }
+  if (!labels.empty() && format != "tet")
+    Fail("mesh.labels: only used by the tet format (the mesh is read as " + format + ")");
+  if (!tag_array.empty() && format != "vtk")
+    Fail("mesh.tag_array: only used by the vtk format (the mesh is read as " + format + ")");
+
+  fs::path read_path = file;
+  if (format == "tetgen") {
+    const std::string ext = file.extension().string();
+    fs::path base = (ext == ".node" || ext == ".ele") ? fs::path(file).replace_extension() : file;
+    for (const char* e : {".node", ".ele"})
+      if (!fs::is_regular_file(base.string() + e))
+        Fail("mesh.file: file not found: '" + base.string() + e + "' (from mesh.file \"" + file_key +
+             "\"; expected an existing TetGen .node and .ele pair)");
+    read_path = base;
+  } else if (!fs::is_regular_file(file)) {
+    Fail("mesh.file: file not found: '" + file.string() + "' (from mesh.file \"" + file_key +
+         "\", relative to '" + (base_.empty() ? std::string(".") : base_) + "')");
+  }
+  fs::path labels_path;
+  if (!labels.empty()) {
+    labels_path = Resolve(labels);
+    if (!fs::is_regular_file(labels_path))
+      Fail("mesh.labels: file not found: '" + labels_path.string() + "' (from mesh.labels \"" +
+           labels + "\")");
+  }
+
+  try {
+    if (format == "tet") scene->mesh = ReadTet(read_path.string(), labels_path.string());
+    else if (format == "tetgen") scene->mesh = ReadTetGen(read_path.string());
+    else if (format == "gmsh") scene->mesh = ReadGmsh(read_path.string());
+    else scene->mesh = ReadVtk(read_path.string(), tag_array);
+  } catch (const std::exception& e) {
+    // Keep the reader's "<file>:<line>: ..." message intact; add the key it came from.
+    const std::string what = e.what();
+    const bool from_labels = !labels_path.empty() && what.rfind(labels_path.string(), 0) == 0;
+    Fail(std::string(from_labels ? "mesh.labels" : "mesh.file") + ": cannot read the " + format +
+         " mesh: " + what);
+  }
+  const double scale = Get(m, "mesh", "scale").get<double>();
+  if (scale != 1.0) scene->mesh.vertices *= scale;
+}
+
+}  // namespace scene_json_detail
+}  // namespace softkin
