@@ -16,6 +16,23 @@ using Clock = std::chrono::steady_clock;
 double Seconds(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double>(b - a).count();
 }
+
+/// The prescribed coordinates' contribution A_fc x_c to the global system for actuation c (motion
+/// actuators move theirs with c): A X restricted to the free rows, every free coordinate zero.
+Eigen::VectorXd PrescribedRhs(const Model& m, const Eigen::VectorXd& c) {
+  Eigen::MatrixX3d Xc = Eigen::MatrixX3d::Zero(m.num_vertices(), 3);
+  m.ApplyConstraints(c, &Xc);
+  Eigen::VectorXd Cfix;
+  m.GatherFree(m.A() * Xc, &Cfix);
+  return Cfix;
+}
+
+/// The largest vertex move of a step (free layout) relative to the model size; Mv is scratch.
+double MaxRelativeMove(const Model& m, const Eigen::VectorXd& step, Eigen::MatrixX3d* Mv) {
+  Mv->setZero();
+  m.ScatterFree(step, Mv);
+  return Mv->rowwise().norm().maxCoeff() / m.size();
+}
 }  // namespace
 
 LocalGlobalSolver::LocalGlobalSolver(std::shared_ptr<const Model> model, const FkOptions& options,
@@ -34,16 +51,8 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
   const double tol = options_.tolerance;
   const double gtol = options_.gradient_tolerance;
 
-  // Prescribed coordinates for this actuation (motion actuators move theirs with c), and their
-  // contribution A_fc x_c to the global system: A X restricted to the free rows, with every free
-  // coordinate zero.
-  m.ApplyConstraints(c, &X);
-  Eigen::VectorXd Cfix;
-  {
-    Eigen::MatrixX3d Xc = Eigen::MatrixX3d::Zero(m.num_vertices(), 3);
-    m.ApplyConstraints(c, &Xc);
-    m.GatherFree(m.A() * Xc, &Cfix);
-  }
+  m.ApplyConstraints(c, &X);  // the prescribed coordinates for this actuation
+  const Eigen::VectorXd Cfix = PrescribedRhs(m, c);
 
   Eigen::MatrixX3d B(m.num_vertices(), 3), Mv(m.num_vertices(), 3);
   Eigen::VectorXd Bf(nf), xf(nf), Gf(nf), Gprev(nf), step(nf), AX(nf);
@@ -158,9 +167,7 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
       ref = std::max({ref, grad, 1e-8 * total_weight_ * m.size()});
     }
     r->gradient_ratio = ref > 0 ? grad / ref : 0.0;
-    Mv.setZero();
-    m.ScatterFree(step, &Mv);
-    const double move = Mv.rowwise().norm().maxCoeff() / m.size();
+    const double move = MaxRelativeMove(m, step, &Mv);
     r->max_move = move;
     // A residual at round-off level (e.g. at the rest actuation, where the reference is itself
     // round-off) counts as converged whatever the ratio.
