@@ -1,4 +1,5 @@
-// Google Benchmark suite for collision detection (solver/collision/collision.hpp, thesis Sec. 3.2.2).
+// Google Benchmark suite for collision detection (solver/collision/collision.hpp, thesis
+// Sec. 3.2.2).
 //
 // The meshes are pneumatic_finger at resolution `res` (cells across the 20 mm width, 27 res^3
 // tets). The deformed configuration is the one bench_fk uses: alpha = 3 on the chamber, 40 lg-aa
@@ -67,7 +68,8 @@ const Fixture& GetFixture(int res) {
   const FkResult r = MakeFkSolver(f->model, opts)->Solve(c);
   f->X = r.positions;
   std::fprintf(stderr, "[fixture] res %d: %d tets, %d vertices; setup solve %s\n", res,
-               f->model->scene().mesh.num_elements(), f->model->num_vertices(), r.BriefReport().c_str());
+               f->model->scene().mesh.num_elements(), f->model->num_vertices(),
+               r.BriefReport().c_str());
   return *cache.emplace(res, std::move(f)).first->second;
 }
 
@@ -117,7 +119,8 @@ void RunPasses(benchmark::State& state, const Mesh& mesh, const Eigen::MatrixX3d
 /// intersection, 1 AABB tree, 2 grid), same exact answer.
 void BM_SelfCollision(benchmark::State& state) {
   const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
-  RunPasses(state, f.model->scene().mesh, f.X, kMethods[state.range(1)], "res" + std::to_string(f.res));
+  RunPasses(state, f.model->scene().mesh, f.X, kMethods[state.range(1)],
+            "res" + std::to_string(f.res));
 }
 
 void MethodResolutionSweep(benchmark::internal::Benchmark* b) {
@@ -125,7 +128,10 @@ void MethodResolutionSweep(benchmark::internal::Benchmark* b) {
   for (int r : kResolutions)
     for (int m = 0; m < 3; ++m) b->Args({r, m});  // box intersection first: the reference of vs_box
 }
-BENCHMARK(BM_SelfCollision)->Apply(MethodResolutionSweep)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SelfCollision)
+    ->Apply(MethodResolutionSweep)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 /// The same on a penetrating state (560 contacts at res 12).
 void BM_SelfCollisionPenetrating(benchmark::State& state) {
@@ -148,13 +154,16 @@ BENCHMARK(BM_SelfCollisionPenetrating)
 void BM_ObstacleContacts(benchmark::State& state) {
   const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
   const Eigen::MatrixX3d& X = f.X;
-  const Eigen::Vector3d lo = X.colwise().minCoeff().transpose(), hi = X.colwise().maxCoeff().transpose();
+  const Eigen::Vector3d lo = X.colwise().minCoeff().transpose(),
+                        hi = X.colwise().maxCoeff().transpose();
   std::vector<Obstacle> obs;
   if (state.range(1)) {
     const Eigen::Vector3d tip_lo(hi.x() - 10.0, lo.y() - 50.0, lo.z() - 50.0);
-    obs.emplace_back(MakeBoxSurface(tip_lo, Eigen::Vector3d(hi.x() + 50.0, hi.y() + 50.0, hi.z() + 50.0)));
+    obs.emplace_back(
+        MakeBoxSurface(tip_lo, Eigen::Vector3d(hi.x() + 50.0, hi.y() + 50.0, hi.z() + 50.0)));
   } else {
-    obs.emplace_back(MakeBoxSurface(hi + Eigen::Vector3d(100, 100, 100), hi + Eigen::Vector3d(150, 150, 150)));
+    obs.emplace_back(
+        MakeBoxSurface(hi + Eigen::Vector3d(100, 100, 100), hi + Eigen::Vector3d(150, 150, 150)));
   }
   size_t contacts = 0;
   for (auto _ : state) contacts = DetectObstacleContacts(obs, X).size();

@@ -1,7 +1,8 @@
 // Google Benchmark suite for the forward-kinematics solver (local-global + Anderson acceleration).
 //
 // Every benchmark except BM_FullBend sweeps the pneumatic_finger resolution (the `res` argument:
-// cells across the 20 mm width, 27 res^3 tets for the 120 x 20 x 15 mm finger) and reports the counters
+// cells across the 20 mm width, 27 res^3 tets for the 120 x 20 x 15 mm finger) and reports the
+// counters
 //   tets, vertices, free      mesh size (elements, vertices, non-fixed vertices)
 //   per_vertex                wall time per vertex (per iteration of the benchmark)
 //   per_tet                   wall time per element (element loops only)
@@ -51,9 +52,9 @@ constexpr int kSetupIterations = 40;
 struct Fixture {
   int res = 0;
   std::shared_ptr<const Model> model;
-  Eigen::VectorXd c;             ///< actuation of the deformed configuration
-  Eigen::MatrixX3d X;            ///< deformed positions (#V x 3), a partly converged lg-aa solve
-  Eigen::VectorXd rhs_free;      ///< B_f - A_fc X_c at X: the right-hand side of the global step
+  Eigen::VectorXd c;               ///< actuation of the deformed configuration
+  Eigen::MatrixX3d X;              ///< deformed positions (#V x 3), a partly converged lg-aa solve
+  Eigen::VectorXd rhs_free;        ///< B_f - A_fc X_c at X: the right-hand side of the global step
   std::vector<Eigen::Matrix3d> M;  ///< per-element cross-covariance D^T P at X
   int tets = 0, vertices = 0, free = 0;
 };
@@ -276,7 +277,8 @@ void BM_LocalStepLaw(benchmark::State& state) {
   auto& hm = hyper[f.res];
   if (!hm) {
     Scene s = f.model->scene();
-    for (auto& [tag, mat] : s.body) mat = Material{"ecoflex-00-30", 1.0, mat.weight, "mooney-rivlin", 0.0418, 0.0106};
+    for (auto& [tag, mat] : s.body)
+      mat = Material{"ecoflex-00-30", 1.0, mat.weight, "mooney-rivlin", 0.0418, 0.0106};
     hm = std::make_shared<const Model>(s);
   }
   static std::map<int, double> blend_time;
@@ -294,7 +296,8 @@ void BM_LocalStepLaw(benchmark::State& state) {
   }
   const double per = Since(t0) / std::max<int64_t>(n, 1);
   if (!state.range(1)) blend_time[f.res] = per;
-  if (state.range(1) && blend_time.count(f.res)) state.counters["law_cost"] = per / blend_time[f.res];
+  if (state.range(1) && blend_time.count(f.res))
+    state.counters["law_cost"] = per / blend_time[f.res];
   SizeCounters(state, f, true);
 }
 BENCHMARK(BM_LocalStepLaw)
@@ -366,11 +369,17 @@ void BM_HyperelasticGuard(benchmark::State& state) {
   if (ref && cubic_time > 0) state.counters["over_cubic"] = per / cubic_time;
   double max_dt = 0;
   for (int i = 0; i < kTets; ++i)
-    max_dt = std::max(max_dt, std::abs(reference(i) - HyperelasticBlendWeight(Rr[i], D[i], 4, rho, rest[i])));
+    max_dt = std::max(
+        max_dt, std::abs(reference(i) - HyperelasticBlendWeight(Rr[i], D[i], 4, rho, rest[i])));
   state.counters["max_dt"] = max_dt;
   state.counters["ns_per_tet"] = 1e9 * per / kTets;
 }
-BENCHMARK(BM_HyperelasticGuard)->ArgNames({"method"})->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_HyperelasticGuard)
+    ->ArgNames({"method"})
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
 
 /// Right-hand side gather sum_i w_i Vol_i S_i^T T_i (#V x 3).
 void BM_AssembleRhs(benchmark::State& state) {
@@ -445,7 +454,10 @@ void BM_PolarPassBatch(benchmark::State& state) {
   state.counters["eigen_vs_batch"] = Median(te) / Median(tb);
   SizeCounters(state, f, true);
 }
-BENCHMARK(BM_PolarPassBatch)->Apply(ResolutionThreadSweep)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_PolarPassBatch)
+    ->Apply(ResolutionThreadSweep)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 /// One full local-global iteration through the public solver API: LocalGlobalSolver::Solve with
 /// max_iterations = 1 from a warm start (nothing subtracted, so the per-call overhead of Solve is
@@ -682,8 +694,8 @@ void BM_SolverCompare(benchmark::State& state) {
     r = solver->Solve(c);
   }
   if (name == "lg-aa") lg_aa_time[which] = r.time_s;
-  state.SetLabel(std::string(which == 0 ? "three_chamber res 3" : "pneumatic_finger res 5") +
-                 ", " + name + " (" + FkStatusToString(r.status) + ")");
+  state.SetLabel(std::string(which == 0 ? "three_chamber res 3" : "pneumatic_finger res 5") + ", " +
+                 name + " (" + FkStatusToString(r.status) + ")");
   state.counters["elements"] = model->mesh().num_elements();
   state.counters["iterations"] = r.iterations;
   state.counters["solve_s"] = r.time_s;

@@ -52,10 +52,10 @@ using Clock = std::chrono::steady_clock;
 struct Fixture {
   std::shared_ptr<const Model> model;
   Eigen::VectorXd c0, c;
-  Eigen::MatrixX3d X0;       ///< converged state at c0
-  Eigen::MatrixX3d Xc;       ///< converged state at c (warm from X0)
-  Eigen::MatrixXd dXdc0;     ///< implicit dX/dc at c0 (3 #V x #actuators)
-  double warm_fk_s = 0.0;    ///< median time of the warm solve c0 -> c
+  Eigen::MatrixX3d X0;     ///< converged state at c0
+  Eigen::MatrixX3d Xc;     ///< converged state at c (warm from X0)
+  Eigen::MatrixXd dXdc0;   ///< implicit dX/dc at c0 (3 #V x #actuators)
+  double warm_fk_s = 0.0;  ///< median time of the warm solve c0 -> c
   int warm_fk_iterations = 0;
 };
 
@@ -217,7 +217,8 @@ void BM_ImplicitSolve(benchmark::State& state) {
   // SimulatorKinematics keeps them along a path); a first call at c0, untimed, sets them up and
   // leaves c0's factor, which range(3) = 2 reuses at c.
   auto ws = std::make_unique<EquilibriumJacobianWorkspace>();
-  if (o.preconditioner == "local") ComputeEquilibriumJacobian(*f.model, f.X0, f.c0, {}, o, nullptr, ws.get());
+  if (o.preconditioner == "local")
+    ComputeEquilibriumJacobian(*f.model, f.X0, f.c0, {}, o, nullptr, ws.get());
   EquilibriumJacobianResult r;
   int products = 0;
   if (!TimeImplicit(state, f, o, guess ? &f.dXdc0 : nullptr, ws.get(), &r, &products)) return;
@@ -246,7 +247,8 @@ void BM_ImplicitTolerance(benchmark::State& state) {
     tight.preconditioner = "A_ff";
     tight.tolerance = 1e-12;
     tight.max_iterations = 3000;
-    const EquilibriumJacobianResult ref = ComputeEquilibriumJacobian(*f.model, f.Xc, f.c, {}, tight);
+    const EquilibriumJacobianResult ref =
+        ComputeEquilibriumJacobian(*f.model, f.Xc, f.c, {}, tight);
     if (!ref.ok) {
       state.SkipWithError(ref.message.c_str());
       return;
@@ -260,8 +262,8 @@ void BM_ImplicitTolerance(benchmark::State& state) {
   EquilibriumJacobianResult r;
   int products = 0;
   if (!TimeImplicit(state, f, o, nullptr, nullptr, &r, &products)) return;
-  state.SetLabel(std::string(kRobots[state.range(0)]) + " tolerance 1e-" + std::to_string(state.range(1)) +
-                 " " + r.preconditioner);
+  state.SetLabel(std::string(kRobots[state.range(0)]) + " tolerance 1e-" +
+                 std::to_string(state.range(1)) + " " + r.preconditioner);
   state.counters["products"] = products;
   state.counters["rel_err"] = (r.dXdc - J_ref).norm() / J_ref.norm();
   state.counters["ratio_warm_fk"] = r.time_s / f.warm_fk_s;

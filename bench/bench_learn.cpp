@@ -163,7 +163,8 @@ void BM_LearnedIkWaypoint(benchmark::State& state) {
     d.positions.resize(N * N * N, 3);
     d.jacobians.resize(N * N * N, 9);
     for (int i = 0; i < N * N * N; ++i) {
-      const Eigen::Vector3d c(1 + 2.0 * (i % N) / (N - 1), 1 + 2.0 * (i / N % N) / (N - 1), 1 + 2.0 * (i / (N * N)) / (N - 1));
+      const Eigen::Vector3d c(1 + 2.0 * (i % N) / (N - 1), 1 + 2.0 * (i / N % N) / (N - 1),
+                              1 + 2.0 * (i / (N * N)) / (N - 1));
       const KinematicsEval e = pcc.Evaluate(c, true);
       d.inputs.row(i) = c.transpose();
       d.positions.row(i) = e.p.row(0);
@@ -195,7 +196,8 @@ void BM_LearnedIkWaypoint(benchmark::State& state) {
   IkOptions io;
   io.method = IkMethod::kGaussNewton;
   io.lambda = std::pow(1e-4 * width, 2);
-  const Eigen::Vector3d target = kin.Evaluate(Eigen::Vector3d(2.37, 1.42, 1.11), false).p.row(0).transpose();
+  const Eigen::Vector3d target =
+      kin.Evaluate(Eigen::Vector3d(2.37, 1.42, 1.11), false).p.row(0).transpose();
   const Eigen::VectorXd c0 = samples.c.row(ClosestSample(samples, target)).transpose();
   PointTrackingObjective obj(kin.point_names(), "tip", target);
   double err = 0;

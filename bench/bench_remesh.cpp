@@ -59,12 +59,16 @@ const Fixture& GetFixture(int res) {
   f->scene = MakeRobot("twisting_robot", res, kParams);
   Eigen::VectorXd c = f->scene.rest_actuation();
   c[0] = kAlpha;
-  const FkResult r = MakeFkSolver(std::make_shared<const Model>(f->scene), f->scene.solver)->Solve(c);
+  const FkResult r =
+      MakeFkSolver(std::make_shared<const Model>(f->scene), f->scene.solver)->Solve(c);
   f->X = r.positions;
-  const RemeshCheck chk = CheckRemesh(f->scene.mesh, f->scene.mesh.vertices, f->X, f->scene.actuators[0].regions);
-  std::fprintf(stderr, "[fixture] res %d: %d tets; alpha %g: %s; remesh test %s (volume ratio %.2f, distortion %.2f)\n",
-               res, f->scene.mesh.num_tets(), kAlpha, r.BriefReport().c_str(), chk.needed ? "fires" : "quiet",
-               chk.max_volume_ratio, chk.max_distortion);
+  const RemeshCheck chk =
+      CheckRemesh(f->scene.mesh, f->scene.mesh.vertices, f->X, f->scene.actuators[0].regions);
+  std::fprintf(stderr,
+               "[fixture] res %d: %d tets; alpha %g: %s; remesh test %s (volume ratio %.2f, "
+               "distortion %.2f)\n",
+               res, f->scene.mesh.num_tets(), kAlpha, r.BriefReport().c_str(),
+               chk.needed ? "fires" : "quiet", chk.max_volume_ratio, chk.max_distortion);
   return *cache.emplace(res, std::move(f)).first->second;
 }
 
@@ -85,9 +89,14 @@ void BM_Tessellate(benchmark::State& state) {
     ++n;
   }
   state.counters["tets"] = tets;
-  if (res == kThesisRes && n > 0) state.counters["thesis_over_ours"] = kThesisMeshGenS / (seconds / n);
+  if (res == kThesisRes && n > 0)
+    state.counters["thesis_over_ours"] = kThesisMeshGenS / (seconds / n);
 }
-BENCHMARK(BM_Tessellate)->ArgsProduct({kResolutions})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK(BM_Tessellate)
+    ->ArgsProduct({kResolutions})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(2);
 
 void BM_ChamberRemesh(benchmark::State& state) {
   const int res = static_cast<int>(state.range(0));

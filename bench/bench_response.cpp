@@ -66,7 +66,8 @@ void BM_SpringUpdate(benchmark::State& state) {
   const bool refactor = state.range(2) != 0;
   const bool pair = state.range(3) != 0;
   auto model = FingerModel(res);
-  SpringSystem sys(*model, refactor ? SpringSystem::Method::kRefactor : SpringSystem::Method::kUpdown);
+  SpringSystem sys(*model,
+                   refactor ? SpringSystem::Method::kRefactor : SpringSystem::Method::kUpdown);
   sys.set_refactor_after(0);
   const double k = 20.0 * model->A().diagonal().mean();
   // Boundary-ish candidates: vertices of the top face (z = max), as contacts would be.
@@ -115,7 +116,8 @@ void BM_CollisionResponseUpdate(benchmark::State& state) {
   const int res = static_cast<int>(state.range(0));
   const bool plane = state.range(1) != 0;
   Scene s = MakeRobot("pneumatic_finger", res);
-  s.obstacles.push_back(MakeBoxSurface(Eigen::Vector3d(100, -10, -10), Eigen::Vector3d(140, 30, 2)));
+  s.obstacles.push_back(
+      MakeBoxSurface(Eigen::Vector3d(100, -10, -10), Eigen::Vector3d(140, 30, 2)));
   s.solver.collision.obstacle_spring = plane ? "plane" : "point";
   const Model model(s);
   CollisionResponse resp(model, s.solver.collision);
@@ -143,7 +145,8 @@ void BM_CollisionResponseUpdate(benchmark::State& state) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count() / reps;
   };
   const double solve_s = time_solves([&](const Eigen::VectorXd& b) { return resp.Solve(b); });
-  const double base_s = time_solves([&](const Eigen::VectorXd& b) { return resp.system().Solve(b); });
+  const double base_s =
+      time_solves([&](const Eigen::VectorXd& b) { return resp.system().Solve(b); });
   state.counters["tets"] = model.mesh().num_elements();
   state.counters["springs"] = static_cast<double>(resp.springs().size());
   state.counters["check_ms"] = 1e3 * resp.stats().check_s / std::max(1, resp.stats().checks);

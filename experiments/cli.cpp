@@ -38,8 +38,9 @@ struct Command {
 }  // namespace
 
 int RunCli(int argc, char** argv) {
-  CLI::App app{"SoftKin: geometry-based kinematics of soft robots (forward kinematics, "
-               "experiments). Units: mm."};
+  CLI::App app{
+      "SoftKin: geometry-based kinematics of soft robots (forward kinematics, "
+      "experiments). Units: mm."};
   app.require_subcommand(1);
   app.set_help_all_flag("--help-all", "Help for every command");
 

@@ -40,10 +40,10 @@ RobotParams ParseRobotParams(const std::vector<std::string>& items) {
     char* end = nullptr;
     const std::string value = eq == std::string::npos ? "" : text.substr(eq + 1);
     const double v = value.empty() ? 0.0 : std::strtod(value.c_str(), &end);
-    if (eq == std::string::npos || eq == 0 || value.empty() || end != value.c_str() + value.size() ||
-        !std::isfinite(v))
-      throw std::invalid_argument("--param: expected NAME=VALUE with a finite number, got '" + text +
-                                  "'");
+    if (eq == std::string::npos || eq == 0 || value.empty() ||
+        end != value.c_str() + value.size() || !std::isfinite(v))
+      throw std::invalid_argument("--param: expected NAME=VALUE with a finite number, got '" +
+                                  text + "'");
     params[text.substr(0, eq)] = v;
   }
   return params;

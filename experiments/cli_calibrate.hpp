@@ -13,9 +13,9 @@ namespace softkin {
 
 /// The values of `softkin calibrate`'s options, filled in by CLI11.
 struct CalibrateCommandArgs {
-  double rm = 0;        ///< measured elasticity ratio R_m = E_A / E_B
-  BarTestOptions bar;   ///< res, interface, stretch_mm, twist_deg
-  bool twist = false;   ///< also run the twisting test
+  double rm = 0;       ///< measured elasticity ratio R_m = E_A / E_B
+  BarTestOptions bar;  ///< res, interface, stretch_mm, twist_deg
+  bool twist = false;  ///< also run the twisting test
   std::string json_out;
 };
 

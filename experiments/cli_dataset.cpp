@@ -22,38 +22,42 @@ CLI::App* AddDatasetCommand(CLI::App* app, DatasetCommandArgs* a) {
       "Generate a learning dataset (thesis Sec. 5.3.2): evaluate a robot's simulator, or a "
       "'hardware' twin, on a grid of N^m actuations visited in serpentine order (each sample one "
       "grid step from the previous, so the simulator warm-starts next to its answer) or on seeded "
-      "random actuations. Writes a CSV (index, status, c0.., <point>_x/_y/_z, J_<point>_<coord>_c<a> "
+      "random actuations. Writes a CSV (index, status, c0.., <point>_x/_y/_z, "
+      "J_<point>_<coord>_c<a> "
       "with --jacobian, message), one line per sample as it is computed, and a sidecar FILE.json "
       "(robot, res, params, points, sampling, git commit; twin label). Running the same command "
       "again on a partial file resumes it; --shard k/n computes the k-th of n contiguous slices; "
       "--merge joins the shards. Exit 0 when every sample succeeded, 1 when some were recorded as "
       "failed, 2 for bad input. Units: mm. See docs/datasets.md");
   auto* o_robot = ds->add_option("--robot", a->robot, "Embedded robot name (see `softkin robots`)");
-  auto* o_twin = ds->add_option("--twin", a->twin,
-                                "A 'hardware' twin (docs/twins.md): " + [] {
-                                  std::string s;
-                                  for (const auto& n : TwinNames()) s += (s.empty() ? "" : ", ") + n;
-                                  return s;
-                                }());
+  auto* o_twin = ds->add_option(
+      "--twin", a->twin, "A 'hardware' twin (docs/twins.md): " + [] {
+        std::string s;
+        for (const auto& n : TwinNames()) s += (s.empty() ? "" : ", ") + n;
+        return s;
+      }());
   o_robot->excludes(o_twin);
   ds->add_option("--res", a->res, "Robot resolution (default: the robot's own)");
   ds->add_option("--param", a->params,
                  "Robot design parameter NAME=VALUE (repeatable; see `softkin robots`)")
       ->needs(o_robot);
-  auto* o_grid = ds->add_option("--grid", a->grid, "N samples per actuator: a grid of N^m (default 16)");
+  auto* o_grid =
+      ds->add_option("--grid", a->grid, "N samples per actuator: a grid of N^m (default 16)");
   auto* o_random = ds->add_option("--random", a->random, "Number of uniform random samples");
   o_grid->excludes(o_random);
   ds->add_option("--seed", a->seed, "Seed of --random (required with it)")->needs(o_random);
   ds->add_option("--block", a->block,
                  "Warm-start block: the simulator restarts from rest every this many samples, so "
                  "a resumed or sharded run equals an uninterrupted one bit for bit (default 64)");
-  ds->add_option("--points", a->points,
-                 "Tracked points, comma-separated markers (or marker[i]) of the robot (default tip)");
+  ds->add_option(
+      "--points", a->points,
+      "Tracked points, comma-separated markers (or marker[i]) of the robot (default tip)");
   ds->add_option("--jacobian", a->jacobian,
                  "Record J = dp/dc too: none (default), implicit (exact, cheapest), fd, fd-warm "
                  "(a twin has none)");
-  ds->add_option("--shard", a->shard, "Compute shard k of n (k = 0..n-1): a contiguous slice of "
-                                      "the serpentine order, into its own --out file");
+  ds->add_option("--shard", a->shard,
+                 "Compute shard k of n (k = 0..n-1): a contiguous slice of "
+                 "the serpentine order, into its own --out file");
   ds->add_option("--gradient-tolerance", a->gradient_tolerance,
                  "Forward solves stop when the energy gradient falls below this fraction of its "
                  "starting value (default: the scene's)");
@@ -71,9 +75,12 @@ std::vector<std::string> SplitComma(const std::string& s, const std::string& opt
   std::stringstream ss(s);
   std::string item;
   while (std::getline(ss, item, ','))
-    if (item.empty()) throw std::invalid_argument(option + ": empty item in '" + s + "'");
-    else out.push_back(item);
-  if (out.empty() || s.back() == ',') throw std::invalid_argument(option + ": expected comma-separated names, got '" + s + "'");
+    if (item.empty())
+      throw std::invalid_argument(option + ": empty item in '" + s + "'");
+    else
+      out.push_back(item);
+  if (out.empty() || s.back() == ',')
+    throw std::invalid_argument(option + ": expected comma-separated names, got '" + s + "'");
   return out;
 }
 
@@ -99,7 +106,8 @@ DatasetSampling SamplingFromArgs(const DatasetCommandArgs& a) {
   DatasetSampling sampling;
   if (a.random != 0) {
     if (a.random < 1)
-      throw std::invalid_argument("--random: expected a number of samples >= 1, got " + std::to_string(a.random));
+      throw std::invalid_argument("--random: expected a number of samples >= 1, got " +
+                                  std::to_string(a.random));
     if (a.seed < 0) throw std::invalid_argument("--seed: required with --random (an integer >= 0)");
     sampling.kind = DatasetSampling::Kind::kRandom;
     sampling.random = a.random;
@@ -110,7 +118,9 @@ DatasetSampling SamplingFromArgs(const DatasetCommandArgs& a) {
       throw std::invalid_argument("--grid: expected N in [2, 1000] samples per actuator, got " +
                                   std::to_string(sampling.grid));
   }
-  if (a.block < 1) throw std::invalid_argument("--block: expected an integer >= 1, got " + std::to_string(a.block));
+  if (a.block < 1)
+    throw std::invalid_argument("--block: expected an integer >= 1, got " +
+                                std::to_string(a.block));
   sampling.block = a.block;
   return sampling;
 }
@@ -143,9 +153,12 @@ DatasetSource RobotSource(const DatasetCommandArgs& a, SimulatorKinematicsOption
   nlohmann::json pj = nlohmann::json::object();
   for (const auto& [k, v] : params) pj[k] = v;
   DatasetSource out;
-  out.json = {{"kind", "robot"}, {"robot", a.robot},
-              {"res", a.res > 0 ? a.res : DefaultResolution(a.robot)}, {"params", pj},
-              {"fk_solver", fk.solver}, {"gradient_tolerance", fk.gradient_tolerance},
+  out.json = {{"kind", "robot"},
+              {"robot", a.robot},
+              {"res", a.res > 0 ? a.res : DefaultResolution(a.robot)},
+              {"params", pj},
+              {"fk_solver", fk.solver},
+              {"gradient_tolerance", fk.gradient_tolerance},
               {"jacobian_mode", with_j ? a.jacobian : "none"}};
   out.kin = std::move(sim);
   return out;
@@ -173,9 +186,12 @@ DatasetSource TwinSource(const DatasetCommandArgs& a, const std::vector<std::str
   TwinKinematics* raw = twin.get();
   run->reset = [raw] { raw->Reset(); };
   DatasetSource out;
-  out.json = {{"kind", "twin"}, {"twin", "twin:" + spec.name}, {"robot", spec.robot},
+  out.json = {{"kind", "twin"},
+              {"twin", "twin:" + spec.name},
+              {"robot", spec.robot},
               {"res", a.res > 0 ? a.res : DefaultResolution(spec.robot)},
-              {"twin_doc", spec.doc}, {"noise_sigma_mm", spec.noise_sigma_mm},
+              {"twin_doc", spec.doc},
+              {"noise_sigma_mm", spec.noise_sigma_mm},
               {"gradient_tolerance", twin->simulator().fk_options().gradient_tolerance},
               {"noise_seed", spec.noise_seed}};
   out.kin = std::move(twin);
@@ -204,11 +220,12 @@ int RunDatasetCommand(const DatasetCommandArgs& a) {
   const bool with_j = a.jacobian != "none";
   SimulatorKinematicsOptions ko;
   if (with_j && !JacobianModeFromString(a.jacobian, &ko.jacobian))
-    throw std::invalid_argument("--jacobian: unknown mode '" + a.jacobian +
-                                "' (expected none, " + JacobianModeNames() + ")");
+    throw std::invalid_argument("--jacobian: unknown mode '" + a.jacobian + "' (expected none, " +
+                                JacobianModeNames() + ")");
   if (!a.twin.empty() && with_j)
-    throw std::invalid_argument("--jacobian: a twin gives positions only (hardware has no "
-                                "Jacobian); use --jacobian none with --twin");
+    throw std::invalid_argument(
+        "--jacobian: a twin gives positions only (hardware has no "
+        "Jacobian); use --jacobian none with --twin");
   if (a.gradient_tolerance < 0 || !std::isfinite(a.gradient_tolerance))
     throw std::invalid_argument("--gradient-tolerance: expected a fraction > 0");
   DatasetRunOptions run;
@@ -219,12 +236,14 @@ int RunDatasetCommand(const DatasetCommandArgs& a) {
     int k = -1, n = -1;
     char tail = 0;
     if (std::sscanf(a.shard.c_str(), "%d/%d%c", &k, &n, &tail) != 2 || n < 1 || k < 0 || k >= n)
-      throw std::invalid_argument("--shard: expected k/n with integers 0 <= k < n, got '" + a.shard + "'");
+      throw std::invalid_argument("--shard: expected k/n with integers 0 <= k < n, got '" +
+                                  a.shard + "'");
     run.shard = k;
     run.shards = n;
   }
   const std::vector<std::string> points = SplitComma(a.points, "--points");
-  DatasetSource source = a.robot.empty() ? TwinSource(a, points, &run) : RobotSource(a, ko, points, &run);
+  DatasetSource source =
+      a.robot.empty() ? TwinSource(a, points, &run) : RobotSource(a, ko, points, &run);
   run.source = source.json;
   run.provenance = {{"git_commit", GitCommit()}, {"command", a.command_line}};
 

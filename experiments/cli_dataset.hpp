@@ -15,18 +15,18 @@ struct DatasetCommandArgs {
   std::string robot, twin;
   int res = 0;
   std::vector<std::string> params;
-  int grid = 0;                     ///< 0: not given
-  long long random = 0;             ///< 0: not given
-  long long seed = -1;              ///< -1: not given
+  int grid = 0;          ///< 0: not given
+  long long random = 0;  ///< 0: not given
+  long long seed = -1;   ///< -1: not given
   int block = 64;
   std::string points = "tip";
   std::string jacobian = "none";
-  std::string shard;                ///< "k/n", empty: the whole dataset
-  double gradient_tolerance = 0;    ///< 0: the scene's FK setting
+  std::string shard;              ///< "k/n", empty: the whole dataset
+  double gradient_tolerance = 0;  ///< 0: the scene's FK setting
   std::vector<std::string> merge;
   std::string out;
   bool quiet = false;
-  std::string command_line;         ///< the whole command line, for the sidecar (set by RunCli)
+  std::string command_line;  ///< the whole command line, for the sidecar (set by RunCli)
 };
 
 /// Adds the `dataset` subcommand to `app`, bound to *args; returns it.

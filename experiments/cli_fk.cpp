@@ -19,19 +19,23 @@ namespace softkin {
 CLI::App* AddFkCommand(CLI::App* app, FkCommandArgs* a) {
   auto* fk = app->add_subcommand("fk", "Solve forward kinematics for one actuation");
   auto* o_robot = fk->add_option("--robot", a->robot, "Embedded robot name (see `softkin robots`)");
-  auto* o_scene = fk->add_option("--scene", a->scene, "Scene JSON file (see `softkin scene --schema`)");
+  auto* o_scene =
+      fk->add_option("--scene", a->scene, "Scene JSON file (see `softkin scene --schema`)");
   o_robot->excludes(o_scene);
   fk->add_option("--res", a->res, "Robot resolution (default: the robot's own)")->needs(o_robot);
   fk->add_option("--param", a->params,
                  "Robot design parameter NAME=VALUE (repeatable; see `softkin robots`)")
       ->needs(o_robot);
-  fk->add_option("--actuation", a->actuation, "Actuation values v1,v2,... in actuator order")->required();
-  fk->add_option("--solver", a->solver,
-                 "FK solver: lg (plain local-global), lg-aa (Anderson), ceres, ipopt-lbfgs, "
-                 "ipopt-newton, ipopt-hard, calculix-linear or calculix-nonlinear (docs/solvers.md)");
+  fk->add_option("--actuation", a->actuation, "Actuation values v1,v2,... in actuator order")
+      ->required();
+  fk->add_option(
+      "--solver", a->solver,
+      "FK solver: lg (plain local-global), lg-aa (Anderson), ceres, ipopt-lbfgs, "
+      "ipopt-newton, ipopt-hard, calculix-linear or calculix-nonlinear (docs/solvers.md)");
   fk->add_option("--continuation", a->continuation, "Apply the actuation in this many steps");
   fk->add_option("--max-iterations", a->max_iterations, "Iteration cap");
-  fk->add_option("--tolerance", a->tolerance, "Per-iteration vertex move tolerance, relative to model size");
+  fk->add_option("--tolerance", a->tolerance,
+                 "Per-iteration vertex move tolerance, relative to model size");
   fk->add_option("--gradient-tolerance", a->gradient_tolerance,
                  "Residual tolerance, relative to its reference value");
   fk->add_option("--aa-safeguard", a->safeguard,
@@ -126,8 +130,10 @@ int RunFkCommand(const FkCommandArgs& a) {
   }
   std::cerr << r.BriefReport() << "\n";
   const nlohmann::json j = FkResultJson(scene, c, r);
-  if (!a.json_out.empty()) WriteJson(a.json_out, j);
-  else std::cout << j.dump(2) << "\n";
+  if (!a.json_out.empty())
+    WriteJson(a.json_out, j);
+  else
+    std::cout << j.dump(2) << "\n";
   if (!a.vtu_out.empty()) WriteVtu(a.vtu_out, scene.mesh, r.positions);
   if (!a.obj_out.empty()) WriteSurfaceObj(a.obj_out, scene.mesh, r.positions);
   return r.status == FkStatus::Converged ? 0 : 1;

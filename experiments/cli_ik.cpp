@@ -36,21 +36,23 @@ CLI::App* AddIkCommand(CLI::App* app, IkCommandArgs* a) {
       "workspace gives the closest point found), 1 when the simulator failed at a waypoint, 2 for "
       "bad input. Units: mm. See docs/ik.md");
   auto* o_robot = ik->add_option("--robot", a->robot, "Embedded robot name (see `softkin robots`)");
-  auto* o_scene = ik->add_option("--scene", a->scene, "Scene JSON file (see `softkin scene --schema`)");
+  auto* o_scene =
+      ik->add_option("--scene", a->scene, "Scene JSON file (see `softkin scene --schema`)");
   o_robot->excludes(o_scene);
   ik->add_option("--res", a->res, "Robot resolution (default: the robot's own)")->needs(o_robot);
   ik->add_option("--param", a->params,
                  "Robot design parameter NAME=VALUE (repeatable; see `softkin robots`)")
       ->needs(o_robot);
   auto* o_target = ik->add_option("--target", a->target, "One target point x,y,z (mm)");
-  auto* o_traj = ik->add_option(
-      "--trajectory", a->trajectory,
-      "Waypoint file: one 'x y z' (mm) per line, separated by spaces, tabs or commas; '#' comments, "
-      "blank lines and an 'x y z' header line are allowed");
+  auto* o_traj = ik->add_option("--trajectory", a->trajectory,
+                                "Waypoint file: one 'x y z' (mm) per line, separated by spaces, "
+                                "tabs or commas; '#' comments, "
+                                "blank lines and an 'x y z' header line are allowed");
   o_target->excludes(o_traj);
-  ik->add_option("--point", a->point,
-                 "Tracked point: a marker of the scene (its vertices' mean), or 'marker[i]' for its "
-                 "vertex i (default tip)");
+  ik->add_option(
+      "--point", a->point,
+      "Tracked point: a marker of the scene (its vertices' mean), or 'marker[i]' for its "
+      "vertex i (default tip)");
   ik->add_option("--method", a->method,
                  "IK method: " + IkMethodNames() +
                      " (default softls, thesis Algorithm 3); with --nets also 'learned' "
@@ -68,12 +70,13 @@ CLI::App* AddIkCommand(CLI::App* app, IkCommandArgs* a) {
   ik->add_option("--max-evaluations", a->max_evaluations,
                  "Kinematics evaluations per waypoint, every method (default 300)");
   ik->add_option("--max-time", a->max_time_s, "Wall-time limit per waypoint, s (default 600)");
-  ik->add_option("--gradient-tolerance", a->gradient_tolerance,
-                 "Forward solves stop when the energy gradient falls below this fraction of its "
-                 "starting value (default: the scene's, 1e-6). 1e-4 saves about half the iterations "
-                 "but its error depends on the robot: micrometres on cable_finger, ~0.1 mm on "
-                 "three_chamber, up to 4 mm on finger_manipulator (a soft lateral mode); check "
-                 "yours against a tight solve first");
+  ik->add_option(
+      "--gradient-tolerance", a->gradient_tolerance,
+      "Forward solves stop when the energy gradient falls below this fraction of its "
+      "starting value (default: the scene's, 1e-6). 1e-4 saves about half the iterations "
+      "but its error depends on the robot: micrometres on cable_finger, ~0.1 mm on "
+      "three_chamber, up to 4 mm on finger_manipulator (a soft lateral mode); check "
+      "yours against a tight solve first");
   ik->add_option("--samples", a->samples,
                  "Configuration-space samples per actuator for the first waypoint's initial guess "
                  "(default 5: 5^3 = 125 for three actuators); 0 starts from the rest actuation");
@@ -85,7 +88,8 @@ CLI::App* AddIkCommand(CLI::App* app, IkCommandArgs* a) {
   ik->add_option("--cache", a->cache,
                  "CSV cache of the configuration-space samples: loaded if it was built for the "
                  "same robot, point, Jacobian mode and grid, else (re)built and written");
-  ik->add_option("--out", a->out, "Output CSV, one row per waypoint (required unless --interactive)");
+  ik->add_option("--out", a->out,
+                 "Output CSV, one row per waypoint (required unless --interactive)");
   ik->add_option("--nets", a->nets,
                  "Network directory from `softkin train`: IK on the learned kinematics instead of "
                  "the simulator (no --robot/--scene; the reached point is the networks' "
@@ -150,8 +154,9 @@ size_t CheckResumeRows(const std::string& out, const Eigen::MatrixX3d& waypoints
     const Eigen::Vector3d t(std::stod(f[1]), std::stod(f[2]), std::stod(f[3]));
     const Eigen::Vector3d w = waypoints.row(index).transpose();
     if ((t - w).norm() > 1e-6 * (1.0 + w.norm()))
-      throw std::invalid_argument("--resume: " + where + "target " + Vec3(t) + " differs from waypoint " +
-                                  std::to_string(index) + " " + Vec3(w) + " of " + source +
+      throw std::invalid_argument("--resume: " + where + "target " + Vec3(t) +
+                                  " differs from waypoint " + std::to_string(index) + " " +
+                                  Vec3(w) + " of " + source +
                                   " (was the file written for another path?)");
     ++expected;
   }
@@ -163,9 +168,11 @@ IkOptions ParseIkOptions(const IkCommandArgs& a, const std::string& method) {
   IkOptions ik;
   if (!StringToIkMethod(method, &ik.method))
     throw std::invalid_argument("--method: unknown method '" + method + "' (expected one of " +
-                                IkMethodNames() + (a.nets.empty() ? "" : ", learned, direct") + ")");
+                                IkMethodNames() + (a.nets.empty() ? "" : ", learned, direct") +
+                                ")");
   if (!(a.lambda_mm >= 0) || !std::isfinite(a.lambda_mm))
-    throw std::invalid_argument("--lambda: expected a distance >= 0 mm, got " + std::to_string(a.lambda_mm));
+    throw std::invalid_argument("--lambda: expected a distance >= 0 mm, got " +
+                                std::to_string(a.lambda_mm));
   if (a.max_iterations < 1)
     throw std::invalid_argument("--max-iterations: expected an integer >= 1, got " +
                                 std::to_string(a.max_iterations));
@@ -173,13 +180,15 @@ IkOptions ParseIkOptions(const IkCommandArgs& a, const std::string& method) {
     throw std::invalid_argument("--max-evaluations: expected an integer >= 1, got " +
                                 std::to_string(a.max_evaluations));
   if (a.samples != 0 && (a.samples < 2 || a.samples > 50))
-    throw std::invalid_argument("--samples: expected 0 (start at rest) or an integer in [2, 50], got " +
-                                std::to_string(a.samples));
+    throw std::invalid_argument(
+        "--samples: expected 0 (start at rest) or an integer in [2, 50], got " +
+        std::to_string(a.samples));
   if (a.first_starts < 1 || a.first_starts > 1000)
     throw std::invalid_argument("--first-starts: expected an integer in [1, 1000], got " +
                                 std::to_string(a.first_starts));
   if (!(a.max_time_s > 0) || !std::isfinite(a.max_time_s))
-    throw std::invalid_argument("--max-time: expected a time > 0 s, got " + std::to_string(a.max_time_s));
+    throw std::invalid_argument("--max-time: expected a time > 0 s, got " +
+                                std::to_string(a.max_time_s));
   ik.max_time_s = a.max_time_s;
   ik.lambda = a.lambda_mm * a.lambda_mm;
   ik.max_iterations = a.max_iterations;
@@ -205,7 +214,8 @@ Eigen::MatrixX3d ReadTargets(const IkCommandArgs& a, std::string* source) {
 
 /// Checks which of the options the simulator IK needs are given.
 void CheckSimulatorArgs(const IkCommandArgs& a) {
-  if (a.interactive) throw std::invalid_argument("--interactive: needs --nets DIR (learned kinematics)");
+  if (a.interactive)
+    throw std::invalid_argument("--interactive: needs --nets DIR (learned kinematics)");
   if (a.s2r) throw std::invalid_argument("--s2r: needs --nets DIR (learned kinematics)");
   if (a.out.empty()) throw std::invalid_argument("--out: required (the output CSV)");
   if (a.robot.empty() == a.scene.empty())
@@ -216,7 +226,8 @@ void CheckSimulatorArgs(const IkCommandArgs& a) {
 }
 
 /// The simulator of `scene` tracking --point, with --gradient-tolerance applied.
-std::unique_ptr<SimulatorKinematics> MakeSimulatorKinematics(const IkCommandArgs& a, const Scene& scene,
+std::unique_ptr<SimulatorKinematics> MakeSimulatorKinematics(const IkCommandArgs& a,
+                                                             const Scene& scene,
                                                              SimulatorKinematicsOptions ko) {
   const std::string marker = a.point.substr(0, a.point.find('['));
   if (scene.marker_index(marker) < 0) {
@@ -248,8 +259,10 @@ TrajectoryOptions SimulatorTrajectoryOptions(const IkCommandArgs& a, const Simul
   to.first_waypoint_starts = a.first_starts;
   to.sampling.cache_file = a.cache;
   std::ostringstream key;
-  if (a.robot.empty()) key << "scene=" << fs::absolute(a.scene).string();
-  else key << "robot=" << a.robot << " res=" << a.res;
+  if (a.robot.empty())
+    key << "scene=" << fs::absolute(a.scene).string();
+  else
+    key << "robot=" << a.robot << " res=" << a.res;
   for (const auto& p : a.params) key << " " << p;
   key << " fk=" << kin.fk_options().solver;
   to.sampling.cache_key = key.str();
@@ -260,8 +273,8 @@ TrajectoryOptions SimulatorTrajectoryOptions(const IkCommandArgs& a, const Simul
 /// Opens --out for the rows: a new file with its header or, with --resume, after the complete rows
 /// of an interrupted run (the waypoints continue from there: sets to->first_waypoint and
 /// to->warm_start). Returns false when the file already holds every waypoint.
-bool OpenWaypointCsv(const IkCommandArgs& a, const Eigen::MatrixX3d& waypoints, const std::string& source,
-                     int n, TrajectoryOptions* to, std::ofstream* csv) {
+bool OpenWaypointCsv(const IkCommandArgs& a, const Eigen::MatrixX3d& waypoints,
+                     const std::string& source, int n, TrajectoryOptions* to, std::ofstream* csv) {
   std::ios::openmode mode = std::ios::out | std::ios::trunc;
   bool write_header = true;
   if (a.resume && fs::exists(a.out)) {
@@ -284,7 +297,8 @@ bool OpenWaypointCsv(const IkCommandArgs& a, const Eigen::MatrixX3d& waypoints, 
       std::cerr << "softkin ik: resuming " << a.out << " at waypoint " << r.next_index << " of "
                 << waypoints.rows() << "\n";
   } else if (a.resume && !a.quiet) {
-    std::cerr << "softkin ik: --resume: " << a.out << " does not exist yet; starting at waypoint 0\n";
+    std::cerr << "softkin ik: --resume: " << a.out
+              << " does not exist yet; starting at waypoint 0\n";
   }
   csv->open(a.out, mode);
   if (!*csv) throw std::runtime_error("cannot write " + a.out);
@@ -295,9 +309,9 @@ bool OpenWaypointCsv(const IkCommandArgs& a, const Eigen::MatrixX3d& waypoints, 
 void ReportSimulatorStart(const IkCommandArgs& a, const Scene& scene, int n,
                           const Eigen::MatrixX3d& waypoints, const TrajectoryOptions& to) {
   std::cerr << "softkin ik: " << (a.robot.empty() ? a.scene : a.robot) << " ("
-            << scene.mesh.num_vertices() << " vertices, " << n << " actuators), point "
-            << a.point << ", " << a.method << ", jacobian " << a.jacobian << ", lambda "
-            << a.lambda_mm << " mm, " << waypoints.rows() << " waypoint(s)\n";
+            << scene.mesh.num_vertices() << " vertices, " << n << " actuators), point " << a.point
+            << ", " << a.method << ", jacobian " << a.jacobian << ", lambda " << a.lambda_mm
+            << " mm, " << waypoints.rows() << " waypoint(s)\n";
   if (to.warm_start.size() == 0) {
     long long total = 1;
     for (int i = 0; i < n; ++i) total *= to.sampling.samples_per_axis;
@@ -313,8 +327,8 @@ void ReportSimulatorEnd(const IkCommandArgs& a, const TrajectoryResult& r) {
   std::cerr << "softkin ik: " << r.converged << " of " << r.waypoints.size()
             << " waypoint(s) within lambda; error mean " << r.mean_error_mm << " mm, max "
             << r.max_error_mm << " mm; largest actuation jump " << r.max_jump << " ("
-            << 100.0 * r.max_jump_fraction << " % of the range); " << r.total_time_s
-            << " s; wrote " << a.out << "\n";
+            << 100.0 * r.max_jump_fraction << " % of the range); " << r.total_time_s << " s; wrote "
+            << a.out << "\n";
 }
 
 /// `softkin ik` on the simulator (no --nets).
@@ -327,8 +341,8 @@ int RunSimulatorIk(const IkCommandArgs& a) {
     throw std::invalid_argument("--jacobian: unknown mode '" + a.jacobian + "' (expected one of " +
                                 JacobianModeNames() + ")");
   if (a.point.find("[*]") != std::string::npos)
-    throw std::invalid_argument("--point: expected one point (a marker or 'marker[i]'), got the group '" +
-                                a.point + "'");
+    throw std::invalid_argument(
+        "--point: expected one point (a marker or 'marker[i]'), got the group '" + a.point + "'");
   if (a.gradient_tolerance < 0 || !std::isfinite(a.gradient_tolerance))
     throw std::invalid_argument("--gradient-tolerance: expected a fraction > 0, got " +
                                 std::to_string(a.gradient_tolerance));
@@ -351,7 +365,8 @@ int RunSimulatorIk(const IkCommandArgs& a) {
     if (w.error_mm < 0) ++failed;
     if (!a.quiet) {
       char line[256];
-      std::snprintf(line, sizeof(line), "  [%d/%d] error %.3f mm, %s, %d iterations, %lld FK solves, %.2f s",
+      std::snprintf(line, sizeof(line),
+                    "  [%d/%d] error %.3f mm, %s, %d iterations, %lld FK solves, %.2f s",
                     w.index + 1, total, w.error_mm, IkTerminationToString(w.termination).c_str(),
                     w.iterations, w.fk_solves, w.time_s);
       std::cerr << line << (w.error_mm < 0 ? " (" + w.message + ")" : std::string()) << "\n";
@@ -392,14 +407,19 @@ WaypointResult DirectWaypoint(const LearnedNets& nets, NetKinematics& kin, int i
 /// Checks the learned IK's own options; returns --jacobian-source.
 JacobianSource CheckLearnedArgs(const IkCommandArgs& a) {
   if (a.nets.empty())
-    throw std::invalid_argument("--method " + a.method + ": needs --nets DIR (from `softkin train`)");
+    throw std::invalid_argument("--method " + a.method +
+                                ": needs --nets DIR (from `softkin train`)");
   if (!a.robot.empty() || !a.scene.empty())
     throw std::invalid_argument("--nets: the networks replace the simulator; drop --robot/--scene");
   const int given = !a.target.empty() + !a.trajectory.empty() + a.interactive;
   if (given != 1)
-    throw std::invalid_argument("ik --nets: give exactly one of --target x,y,z, --trajectory FILE or --interactive");
-  if (!a.interactive && a.out.empty()) throw std::invalid_argument("--out: required (the output CSV)");
-  if (a.resume) throw std::invalid_argument("--resume: not supported with --nets (learned IK takes milliseconds)");
+    throw std::invalid_argument(
+        "ik --nets: give exactly one of --target x,y,z, --trajectory FILE or --interactive");
+  if (!a.interactive && a.out.empty())
+    throw std::invalid_argument("--out: required (the output CSV)");
+  if (a.resume)
+    throw std::invalid_argument(
+        "--resume: not supported with --nets (learned IK takes milliseconds)");
   JacobianSource source;
   if (!JacobianSourceFromString(a.jacobian_source, &source))
     throw std::invalid_argument("--jacobian-source: unknown source '" + a.jacobian_source +
@@ -416,15 +436,18 @@ LearnedNets LoadCheckedNets(const IkCommandArgs& a, bool direct, JacobianSource 
     throw std::invalid_argument(std::string("--nets: ") + e.what());
   }
   if (direct && !nets.has_ik())
-    throw std::invalid_argument("--method direct: " + a.nets + " has no ik network (train it with --what fk,ik)");
+    throw std::invalid_argument("--method direct: " + a.nets +
+                                " has no ik network (train it with --what fk,ik)");
   if (!direct && source == JacobianSource::kNetwork && !nets.has_jac())
     throw std::invalid_argument("--jacobian-source network: " + a.nets +
                                 " has no jac network; train one (--what fk,jac) or use "
                                 "--jacobian-source fk-derivative");
   if (a.s2r && !nets.has_s2r())
-    throw std::invalid_argument("--s2r: " + a.nets + " has no s2r network (train it with `softkin train --s2r`)");
+    throw std::invalid_argument("--s2r: " + a.nets +
+                                " has no s2r network (train it with `softkin train --s2r`)");
   if (a.point != "tip" && a.point != nets.points.front())
-    throw std::invalid_argument("--point: the networks track '" + nets.points.front() + "' first; got '" + a.point + "'");
+    throw std::invalid_argument("--point: the networks track '" + nets.points.front() +
+                                "' first; got '" + a.point + "'");
   return nets;
 }
 
@@ -452,8 +475,8 @@ int RunInteractiveIk(const IkCommandArgs& a, const LearnedNets& nets, NetKinemat
     Eigen::Vector3d t;
     std::string extra;
     if (!(ss >> t.x() >> t.y() >> t.z()) || (ss >> extra) || !t.allFinite()) {
-      std::cerr << "softkin ik: stdin:" << lineno << ": expected a target 'x y z' (3 finite numbers, mm), got '"
-                << line << "'\n";
+      std::cerr << "softkin ik: stdin:" << lineno
+                << ": expected a target 'x y z' (3 finite numbers, mm), got '" << line << "'\n";
       continue;
     }
     WaypointResult w;
@@ -495,7 +518,8 @@ int RunLearnedWaypoints(const IkCommandArgs& a, const LearnedNets& nets, NetKine
   if (direct) {
     Eigen::VectorXd previous;
     for (int i = 0; i < waypoints.rows(); ++i) {
-      const WaypointResult w = DirectWaypoint(nets, kin, i, waypoints.row(i).transpose(), previous, range);
+      const WaypointResult w =
+          DirectWaypoint(nets, kin, i, waypoints.row(i).transpose(), previous, range);
       previous = w.c;
       csv << WaypointCsvRow(w) << "\n";
       sum += w.error_mm;
@@ -505,9 +529,8 @@ int RunLearnedWaypoints(const IkCommandArgs& a, const LearnedNets& nets, NetKine
       converged += w.error_mm * w.error_mm <= to.ik.lambda;
     }
   } else {
-    const TrajectoryResult r = FollowTrajectory(kin, waypoints, to, [&](const WaypointResult& w) {
-      csv << WaypointCsvRow(w) << "\n";
-    });
+    const TrajectoryResult r = FollowTrajectory(
+        kin, waypoints, to, [&](const WaypointResult& w) { csv << WaypointCsvRow(w) << "\n"; });
     for (const auto& w : r.waypoints) sum += std::max(0.0, w.error_mm);
     worst = r.max_error_mm;
     total_time = r.total_time_s;
@@ -520,8 +543,8 @@ int RunLearnedWaypoints(const IkCommandArgs& a, const LearnedNets& nets, NetKine
     const double N = static_cast<double>(waypoints.rows());
     std::cerr << "softkin ik: " << converged << " of " << waypoints.rows()
               << " waypoint(s) within lambda (predicted); error mean " << sum / N << " mm, max "
-              << worst << " mm; largest actuation jump " << max_jump << "; "
-              << 1e3 * total_time / N << " ms per waypoint; wrote " << a.out << "\n";
+              << worst << " mm; largest actuation jump " << max_jump << "; " << 1e3 * total_time / N
+              << " ms per waypoint; wrote " << a.out << "\n";
   }
   return 0;
 }

@@ -32,10 +32,10 @@ struct IkCommandArgs {
   bool quiet = false;
   bool trace_fk = false;
   // ---- learned kinematics (thesis Ch. 5; docs/learning.md) ----
-  std::string nets;                        ///< network directory from `softkin train`
-  std::string jacobian_source = "network"; ///< network (N_J) or fk-derivative (dN_fk/dc)
-  bool s2r = false;                        ///< drive the sim-to-real corrected kinematics
-  bool interactive = false;                ///< targets from stdin, rows to stdout (Fig. 5.13)
+  std::string nets;                         ///< network directory from `softkin train`
+  std::string jacobian_source = "network";  ///< network (N_J) or fk-derivative (dN_fk/dc)
+  bool s2r = false;                         ///< drive the sim-to-real corrected kinematics
+  bool interactive = false;                 ///< targets from stdin, rows to stdout (Fig. 5.13)
 };
 
 /// Adds the `ik` subcommand to `app`, bound to *args; returns it.

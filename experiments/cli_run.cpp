@@ -5,7 +5,8 @@ namespace softkin {
 CLI::App* AddRunCommand(CLI::App* app, RunCommandArgs* a) {
   auto* run = app->add_subcommand("run", "Run an experiment config (experiments/<name>.json)");
   run->add_option("config", a->config, "Experiment config JSON")->required();
-  run->add_flag("--quick", a->options.quick, "Quick mode: the config's small 'quick' settings (for CI)");
+  run->add_flag("--quick", a->options.quick,
+                "Quick mode: the config's small 'quick' settings (for CI)");
   run->add_flag("--no-plot", a->no_plot, "Do not run the paper_figs plot script");
   run->add_option("--results", a->options.results_root, "Results root folder (default: results)");
   return run;

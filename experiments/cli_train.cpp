@@ -28,22 +28,26 @@ CLI::App* AddTrainCommand(CLI::App* app, TrainCommandArgs* a) {
       "dataset, added to an existing network directory. Writes DIR/nets.json (points, bounds, "
       "errors, provenance) and one softkin-fnn file per network; `softkin ik --method learned "
       "--nets DIR` uses them. Exit 0 on success, 2 for bad input. See docs/learning.md");
-  auto* o_ds = t->add_option("--dataset", a->dataset, "Simulator dataset CSV (with its .json sidecar)");
+  auto* o_ds =
+      t->add_option("--dataset", a->dataset, "Simulator dataset CSV (with its .json sidecar)");
   auto* o_s2r = t->add_option("--s2r", a->s2r,
                               "Twin dataset CSV: train N_s2r and add it to the networks in --out");
   o_ds->excludes(o_s2r);
-  t->add_option("--out", a->out, "Network directory (created; --s2r: must hold N_fk already)")->required();
+  t->add_option("--out", a->out, "Network directory (created; --s2r: must hold N_fk already)")
+      ->required();
   t->add_option("--what", a->what,
                 "Networks to train: comma list of fk, jac, ik, or auto (fk and ik, and jac when "
                 "the dataset has Jacobians; default)");
-  t->add_option("--hidden", a->hidden, "Hidden layers of N_fk, neurons per layer (default 35,35: h = 2, b = 35)");
+  t->add_option("--hidden", a->hidden,
+                "Hidden layers of N_fk, neurons per layer (default 35,35: h = 2, b = 35)");
   t->add_option("--hidden-jac", a->hidden_jac, "Hidden layers of N_J (default 64,64)");
   t->add_option("--hidden-ik", a->hidden_ik, "Hidden layers of N_ik (default 35,35)");
   t->add_option("--eta", a->eta, "N_s2r neurons per training sample (default 0.25, Sec. 5.3.4)");
   t->add_option("--epochs", a->epochs, "Epoch cap per network (default 1000)");
   t->add_option("--max-time", a->max_time_s, "Wall-time cap per network, s (default: none)");
   t->add_option("--seed", a->seed, "Seed of the initialisation and of the splits (default 1)");
-  t->add_option("--threads", a->threads, "Trainer threads (default: OpenMP's; results do not depend on it)");
+  t->add_option("--threads", a->threads,
+                "Trainer threads (default: OpenMP's; results do not depend on it)");
   t->add_flag("--quiet", a->quiet, "No progress on stderr");
   return t;
 }
@@ -55,7 +59,8 @@ std::vector<int> ParseLayers(const std::string& s, const std::string& option) {
   std::vector<int> out;
   for (int i = 0; i < v.size(); ++i) {
     if (!(v[i] >= 1 && v[i] <= 10000 && v[i] == std::floor(v[i])))
-      throw std::invalid_argument(option + ": expected neuron counts (integers in [1, 10000]), got '" + s + "'");
+      throw std::invalid_argument(
+          option + ": expected neuron counts (integers in [1, 10000]), got '" + s + "'");
     out.push_back(static_cast<int>(v[i]));
   }
   if (out.empty()) throw std::invalid_argument(option + ": expected at least one hidden layer");
@@ -64,11 +69,11 @@ std::vector<int> ParseLayers(const std::string& s, const std::string& option) {
 
 void Report(const std::string& name, const nlohmann::json& j, double width) {
   std::cout << "softkin train: " << name << " " << j["layers"].dump() << ": test mean "
-            << j["test"]["mean_dist"].get<double>() << ", max " << j["test"]["max_dist"].get<double>()
-            << ", rmse " << j["test"]["rmse"].get<double>();
+            << j["test"]["mean_dist"].get<double>() << ", max "
+            << j["test"]["max_dist"].get<double>() << ", rmse " << j["test"]["rmse"].get<double>();
   if (name == "fk" && width > 0)
-    std::cout << " (mean " << 100.0 * j["test"]["mean_dist"].get<double>() / width
-              << " % of the " << width << " mm workspace)";
+    std::cout << " (mean " << 100.0 * j["test"]["mean_dist"].get<double>() / width << " % of the "
+              << width << " mm workspace)";
   std::cout << "; " << j["epochs"] << " epochs (" << j["termination"].get<std::string>() << "), "
             << j["time_s"].get<double>() << " s\n";
 }
@@ -98,7 +103,8 @@ LmOptions LmFromArgs(const TrainCommandArgs& a) {
   if (!(a.max_time_s >= 0) || !std::isfinite(a.max_time_s))
     throw std::invalid_argument("--max-time: expected a time >= 0 s");
   if (a.threads < 0) throw std::invalid_argument("--threads: expected an integer >= 0");
-  if (!(a.eta > 0) || !std::isfinite(a.eta)) throw std::invalid_argument("--eta: expected a number > 0");
+  if (!(a.eta > 0) || !std::isfinite(a.eta))
+    throw std::invalid_argument("--eta: expected a number > 0");
   LmOptions lm;
   lm.max_epochs = a.epochs;
   lm.max_time_s = a.max_time_s;
@@ -127,8 +133,9 @@ int TrainS2rCommand(const TrainCommandArgs& a, const LmOptions& lm) {
   nets.Save(a.out);
   const auto& j = nets.info["s2r"];
   std::cout << "softkin train: s2r " << j["layers"].dump() << ": test mean error "
-            << r.test.mean_dist << " mm (without s2r " << j["test_without_s2r"]["mean_dist"].get<double>()
-            << " mm, " << j["improvement"].get<double>() << "x better); wrote " << a.out << "\n";
+            << r.test.mean_dist << " mm (without s2r "
+            << j["test_without_s2r"]["mean_dist"].get<double>() << " mm, "
+            << j["improvement"].get<double>() << "x better); wrote " << a.out << "\n";
   return 0;
 }
 
@@ -143,13 +150,19 @@ NetsFromDatasetOptions NetsOptionsFromArgs(const TrainCommandArgs& a, const Data
     std::stringstream ss(a.what);
     std::string item;
     while (std::getline(ss, item, ',')) {
-      if (item == "fk") o.fk = true;
-      else if (item == "jac") o.jac = true;
-      else if (item == "ik") o.ik = true;
-      else throw std::invalid_argument("--what: unknown network '" + item + "' (expected fk, jac, ik or auto)");
+      if (item == "fk")
+        o.fk = true;
+      else if (item == "jac")
+        o.jac = true;
+      else if (item == "ik")
+        o.ik = true;
+      else
+        throw std::invalid_argument("--what: unknown network '" + item +
+                                    "' (expected fk, jac, ik or auto)");
     }
     if (!o.fk)
-      throw std::invalid_argument("--what: fk is required (N_J, N_ik and the learned IK all sit beside N_fk)");
+      throw std::invalid_argument(
+          "--what: fk is required (N_J, N_ik and the learned IK all sit beside N_fk)");
   }
   o.fk_options.hidden = ParseLayers(a.hidden, "--hidden");
   o.jac_options.hidden = ParseLayers(a.hidden_jac, "--hidden-jac");
@@ -172,8 +185,8 @@ int RunTrainCommand(const TrainCommandArgs& a) {
   if (!a.quiet)
     std::cerr << "softkin train: " << a.dataset << ": " << d.inputs.rows() << " samples, "
               << d.num_actuators << " actuators, " << d.point_names.size() << " point(s)"
-              << (d.jacobians.cols() ? ", Jacobians" : "") << "; training"
-              << (o.fk ? " fk" : "") << (o.jac ? " jac" : "") << (o.ik ? " ik" : "") << "\n";
+              << (d.jacobians.cols() ? ", Jacobians" : "") << "; training" << (o.fk ? " fk" : "")
+              << (o.jac ? " jac" : "") << (o.ik ? " ik" : "") << "\n";
   LearnedNets nets = TrainNetsFromDataset(d, a.dataset, o);
   nets.info["command"] = a.command_line;
   nets.info["git_commit"] = GitCommit();

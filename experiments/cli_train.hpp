@@ -12,10 +12,10 @@ namespace softkin {
 
 /// The values of `softkin train`'s options, filled in by CLI11.
 struct TrainCommandArgs {
-  std::string dataset;           ///< simulator dataset (N_fk, N_J, N_ik)
-  std::string s2r;               ///< twin dataset: add N_s2r to an existing --out directory
-  std::string out;               ///< network directory
-  std::string what = "auto";     ///< comma list of fk, jac, ik; auto = fk, ik and jac if J exists
+  std::string dataset;        ///< simulator dataset (N_fk, N_J, N_ik)
+  std::string s2r;            ///< twin dataset: add N_s2r to an existing --out directory
+  std::string out;            ///< network directory
+  std::string what = "auto";  ///< comma list of fk, jac, ik; auto = fk, ik and jac if J exists
   std::string hidden = "35,35";
   std::string hidden_jac = "64,64";
   std::string hidden_ik = "35,35";
@@ -25,7 +25,7 @@ struct TrainCommandArgs {
   std::uint64_t seed = 1;
   int threads = 0;
   bool quiet = false;
-  std::string command_line;      ///< the whole command line, for nets.json (set by RunCli)
+  std::string command_line;  ///< the whole command line, for nets.json (set by RunCli)
 };
 
 /// Adds the `train` subcommand to `app`, bound to *args; returns it.

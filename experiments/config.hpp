@@ -2,8 +2,8 @@
 /// \file config.hpp
 /// Experiment configs: JSON files in experiments/ with a name, an experiment type, a seed, the
 /// experiment's parameters and an optional "quick" object whose keys override the top-level ones
-/// in --quick mode (for CI). Every key is checked: unknown keys and wrong types are errors that name
-/// the config file and the key.
+/// in --quick mode (for CI). Every key is checked: unknown keys and wrong types are errors that
+/// name the config file and the key.
 #include "softkin/solver/fk/fk_options.hpp"
 
 #include <nlohmann/json.hpp>

@@ -22,8 +22,8 @@ struct Variant {
 /// The keys of an aa_ablation config.
 struct AaAblationParams {
   std::vector<std::string> robots;
-  std::vector<int> res;        ///< per robot (empty: the defaults)
-  std::vector<double> levels;  ///< fractions of the way from rest to the far end of each range
+  std::vector<int> res;           ///< per robot (empty: the defaults)
+  std::vector<double> levels;     ///< fractions of the way from rest to the far end of each range
   std::vector<Variant> variants;  ///< lg first, then every (window, safeguard) pair
 };
 
@@ -85,11 +85,12 @@ nlohmann::json RunCase(const AaAblationParams& p, const std::string& robot, cons
     const double it_ratio = lg_iters / std::max(1, r.iterations);
     const double t_ratio = lg_time / std::max(1e-12, r.time_s);
     csv->RowStrings({robot, std::to_string(level), v.label, std::to_string(r.iterations),
-                     std::to_string(r.time_s), std::to_string(r.energy),
-                     FkStatusToString(r.status), std::to_string(r.aa_accepted),
-                     std::to_string(r.aa_rejected), std::to_string(it_ratio),
-                     std::to_string(t_ratio)});
-    nlohmann::json rj{{"iterations", r.iterations}, {"time_s", r.time_s}, {"energy", r.energy},
+                     std::to_string(r.time_s), std::to_string(r.energy), FkStatusToString(r.status),
+                     std::to_string(r.aa_accepted), std::to_string(r.aa_rejected),
+                     std::to_string(it_ratio), std::to_string(t_ratio)});
+    nlohmann::json rj{{"iterations", r.iterations},
+                      {"time_s", r.time_s},
+                      {"energy", r.energy},
                       {"status", FkStatusToString(r.status)}};
     if (!plain) {
       rj["aa_accepted"] = r.aa_accepted;
@@ -105,8 +106,8 @@ nlohmann::json RunCase(const AaAblationParams& p, const std::string& robot, cons
     }
     row[v.label] = rj;
     if (verbose)
-      std::fprintf(stderr, "  %s level %.2f %s: %s\n", robot.c_str(), level,
-                   v.label.c_str(), r.BriefReport().c_str());
+      std::fprintf(stderr, "  %s level %.2f %s: %s\n", robot.c_str(), level, v.label.c_str(),
+                   r.BriefReport().c_str());
   }
   return row;
 }

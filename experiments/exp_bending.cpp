@@ -44,7 +44,8 @@ struct BendingParams {
 
 /// The swept actuators, checked to share their rest value and range.
 std::vector<int> SweptActuators(const Config& cfg, const Scene& scene, const std::string& robot,
-                                const std::string& act_name, const std::vector<std::string>& act_names) {
+                                const std::string& act_name,
+                                const std::vector<std::string>& act_names) {
   if (!act_name.empty() && !act_names.empty())
     cfg.Fail("actuators", "either 'actuator' or 'actuators', not both");
   std::vector<int> swept;
@@ -80,7 +81,8 @@ BendingParams ReadBendingParams(const Config& cfg) {
   p.milestones = cfg.NumberList("milestones_deg", {});
   const auto t_build0 = std::chrono::steady_clock::now();
   p.scene = ConfigRobot(cfg, p.robot, res);
-  p.robot_build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_build0).count();
+  p.robot_build_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_build0).count();
   p.opts = cfg.Solver(p.scene.solver);
   cfg.CheckNoUnknownKeys();
   if (p.steps < 1) cfg.Fail("steps", "an integer >= 1");
@@ -90,12 +92,14 @@ BendingParams ReadBendingParams(const Config& cfg) {
   const Actuator& act = p.scene.actuators[p.swept[0]];
   p.vmax = end_value_cfg > 0 ? end_value_cfg : act.FarEnd();
   if (p.vmax > act.max || p.vmax < act.min || p.vmax == act.rest)
-    cfg.Fail("end_value", "a value in [min, max] of actuator '" + act.name + "', not its rest value");
+    cfg.Fail("end_value",
+             "a value in [min, max] of actuator '" + act.name + "', not its rest value");
   // The bend angle needs the tip_top / tip_bottom markers; without them it is not reported.
   p.has_bend = p.scene.marker_index("tip_top") >= 0 && p.scene.marker_index("tip_bottom") >= 0;
   if (!p.has_bend && !p.milestones.empty())
-    cfg.Fail("milestones_deg", "no milestones: robot '" + p.robot +
-                                   "' has no tip_top / tip_bottom markers, so no bend angle is measured");
+    cfg.Fail("milestones_deg",
+             "no milestones: robot '" + p.robot +
+                 "' has no tip_top / tip_bottom markers, so no bend angle is measured");
   if (p.has_bend && p.milestones.empty()) p.milestones = {90, 180, 240};
   p.tip = p.scene.marker_index("tip");
   if (p.tip < 0) throw std::invalid_argument("robot '" + p.robot + "' has no 'tip' marker");
@@ -122,13 +126,13 @@ BendingSweep Sweep(const BendingParams& p, const std::shared_ptr<const Model>& m
   std::unique_ptr<BendAngle> bend;
   if (p.has_bend) bend = std::make_unique<BendAngle>(scene);
   CsvWriter csv(dir + "/trajectory.csv",
-                {"step", "actuation", "bend_deg", "tip_x", "tip_y", "tip_z", "iterations",
-                 "time_s", "cumulative_s", "energy", "volume_ratio", "residual_ratio", "converged"});
+                {"step", "actuation", "bend_deg", "tip_x", "tip_y", "tip_z", "iterations", "time_s",
+                 "cumulative_s", "energy", "volume_ratio", "residual_ratio", "converged"});
   std::vector<std::pair<double, std::string>> frames;
   if (p.vtu_every > 0) std::filesystem::create_directories(dir + "/frames");
   const Eigen::MatrixX3d rest_tip = scene.marker_positions(scene.mesh.vertices);
-  csv.Row({0, act.rest, 0.0, rest_tip(tip, 0), rest_tip(tip, 1), rest_tip(tip, 2), 0, 0, 0, 0,
-           1.0, 0, 1});
+  csv.Row({0, act.rest, 0.0, rest_tip(tip, 0), rest_tip(tip, 1), rest_tip(tip, 2), 0, 0, 0, 0, 1.0,
+           0, 1});
 
   Eigen::VectorXd c = scene.rest_actuation();
   Eigen::MatrixX3d X = scene.mesh.vertices, X_prev = X, guess;
@@ -186,7 +190,8 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
   const auto t_model0 = std::chrono::steady_clock::now();
   auto model = std::make_shared<const Model>(scene);
   const double build_s =
-      p.robot_build_s + std::chrono::duration<double>(std::chrono::steady_clock::now() - t_model0).count();
+      p.robot_build_s +
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_model0).count();
   const BendingSweep b = Sweep(p, model, dir, verbose);
 
   nlohmann::json j;
@@ -217,7 +222,8 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
   j["tips"] = b.tips;
   j["step_times_s"] = b.step_times;
   if (p.robot == "pneumatic_finger")
-    j["thesis_table_2_2"] = {{"t90_s", 8.5}, {"t180_s", 15.2}, {"t240_s", 23.2}, {"elements", 45802}};
+    j["thesis_table_2_2"] = {
+        {"t90_s", 8.5}, {"t180_s", 15.2}, {"t240_s", 23.2}, {"elements", 45802}};
   return j;
 }
 

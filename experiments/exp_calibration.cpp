@@ -16,9 +16,9 @@ namespace {
 
 /// The keys of a calibration config.
 struct CalibrationParams {
-  std::vector<double> rms;     ///< measured elasticity ratios R_m
-  std::vector<double> thesis;  ///< the thesis's ratio for each (or empty)
-  BarTestOptions opt;          ///< the headline resolution (its default resolved) and the tests
+  std::vector<double> rms;       ///< measured elasticity ratios R_m
+  std::vector<double> thesis;    ///< the thesis's ratio for each (or empty)
+  BarTestOptions opt;            ///< the headline resolution (its default resolved) and the tests
   std::vector<int> resolutions;  ///< of the sensitivity study
   std::vector<double> curve;     ///< R_omega^A / R_omega^B of the calibration curve
   double rel_tol = 1e-3;
@@ -70,8 +70,8 @@ nlohmann::json CalibrationCurve(const CalibrationParams& p, const std::string& d
   nlohmann::json curve_j = nlohmann::json::array();
   for (double q : p.curve) {
     const ElongationResult e = RunElongationTest(1.0, 1.0 / q, p.opt);
-    curve_csv.Row({double(p.opt.res), q, 1.0 / q, e.rm, e.dl1_mm,
-                   double(e.fk.iterations), e.fk.time_s});
+    curve_csv.Row(
+        {double(p.opt.res), q, 1.0 / q, e.rm, e.dl1_mm, double(e.fk.iterations), e.fk.time_s});
     curve_j.push_back({{"r_omega_ratio", q}, {"rm", e.rm}});
     if (verbose) std::fprintf(stderr, "  curve: R_omega ratio %.2f -> R_m %.4f\n", q, e.rm);
   }
@@ -80,26 +80,27 @@ nlohmann::json CalibrationCurve(const CalibrationParams& p, const std::string& d
 
 /// Sensitivity of the calibration of rm to the mesh resolution (rows of calibration.csv); the
 /// headline resolution's result c is reused rather than run again.
-nlohmann::json ResolutionSensitivity(const CalibrationParams& p, double rm, double th, const CalibrationResult& c,
-                                     CsvWriter* cal_csv, bool verbose) {
+nlohmann::json ResolutionSensitivity(const CalibrationParams& p, double rm, double th,
+                                     const CalibrationResult& c, CsvWriter* cal_csv, bool verbose) {
   nlohmann::json sens = nlohmann::json::array();
   for (int r : p.resolutions) {
     BarTestOptions o = p.opt;
     o.res = r;
     const CalibrationResult cr = r == p.opt.res ? c : CalibrateROmega(rm, o, p.rel_tol);
-    const int tets = r == p.opt.res ? p.bar.mesh.num_tets() : MakeRobot("bimaterial_bar", r).mesh.num_tets();
+    const int tets =
+        r == p.opt.res ? p.bar.mesh.num_tets() : MakeRobot("bimaterial_bar", r).mesh.num_tets();
     cal_csv->Row({rm, double(r), double(tets), cr.ratio, cr.r_omega_a, cr.r_omega_b, cr.achieved_rm,
                   double(cr.evaluations), th});
-    sens.push_back({{"res", r}, {"tets", tets}, {"r_omega_ratio", cr.ratio}, {"achieved_rm", cr.achieved_rm}});
-    if (verbose)
-      std::fprintf(stderr, "    res %d (%d tets): ratio %.3f\n", r, tets, cr.ratio);
+    sens.push_back(
+        {{"res", r}, {"tets", tets}, {"r_omega_ratio", cr.ratio}, {"achieved_rm", cr.achieved_rm}});
+    if (verbose) std::fprintf(stderr, "    res %d (%d tets): ratio %.3f\n", r, tets, cr.ratio);
   }
   return sens;
 }
 
 /// rms[i] calibrated, its twisting test and its sensitivity to the resolution; returns its row.
-nlohmann::json CalibrateRm(const Config& cfg, const CalibrationParams& p, size_t i, CsvWriter* cal_csv,
-                           CsvWriter* twist_csv, bool verbose) {
+nlohmann::json CalibrateRm(const Config& cfg, const CalibrationParams& p, size_t i,
+                           CsvWriter* cal_csv, CsvWriter* twist_csv, bool verbose) {
   const BarTestOptions& opt = p.opt;
   const double rm = p.rms[i];
   const double th = p.thesis.empty() ? NAN : p.thesis[i];
@@ -109,11 +110,13 @@ nlohmann::json CalibrateRm(const Config& cfg, const CalibrationParams& p, size_t
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(cfg.path() + ": rms[" + std::to_string(i) + "]: " + e.what());
   }
-  cal_csv->Row({rm, double(opt.res), double(p.bar.mesh.num_tets()), c.ratio, c.r_omega_a, c.r_omega_b,
-                c.achieved_rm, double(c.evaluations), th});
+  cal_csv->Row({rm, double(opt.res), double(p.bar.mesh.num_tets()), c.ratio, c.r_omega_a,
+                c.r_omega_b, c.achieved_rm, double(c.evaluations), th});
   if (verbose)
-    std::fprintf(stderr, "  R_m %.2f: R_omega^A/R_omega^B = %.3f (thesis %.2f), R_m reached %.4f in %d tests\n",
-                 rm, c.ratio, th, c.achieved_rm, c.evaluations);
+    std::fprintf(
+        stderr,
+        "  R_m %.2f: R_omega^A/R_omega^B = %.3f (thesis %.2f), R_m reached %.4f in %d tests\n", rm,
+        c.ratio, th, c.achieved_rm, c.evaluations);
   // The twisting test with the calibrated parameters: B's twist over A's against R_m.
   const TwistResult t = RunTwistTest(c.r_omega_a, c.r_omega_b, opt);
   const double twist_ratio = t.angle_b_deg / t.angle_a_deg;
@@ -122,8 +125,10 @@ nlohmann::json CalibrateRm(const Config& cfg, const CalibrationParams& p, size_t
   twist_csv->Row({rm, c.ratio, t.twist_deg, t.angle_a_deg, t.angle_b_deg, t.a_mid_deg, t.b_mid_deg,
                   twist_ratio, shear_ratio});
   if (verbose)
-    std::fprintf(stderr, "  twist %.0f deg: A turns %.2f deg, B %.2f deg (per unit length B/A %.3f, R_m %.2f)\n",
-                 t.twist_deg, t.angle_a_deg, t.angle_b_deg, shear_ratio, rm);
+    std::fprintf(
+        stderr,
+        "  twist %.0f deg: A turns %.2f deg, B %.2f deg (per unit length B/A %.3f, R_m %.2f)\n",
+        t.twist_deg, t.angle_a_deg, t.angle_b_deg, shear_ratio, rm);
   const nlohmann::json sens = ResolutionSensitivity(p, rm, th, c, cal_csv, verbose);
   return {{"rm", rm},
           {"r_omega_ratio", c.ratio},
@@ -132,9 +137,12 @@ nlohmann::json CalibrateRm(const Config& cfg, const CalibrationParams& p, size_t
           {"achieved_rm", c.achieved_rm},
           {"evaluations", c.evaluations},
           {"thesis_ratio", std::isfinite(th) ? nlohmann::json(th) : nlohmann::json(nullptr)},
-          {"twist", {{"twist_deg", t.twist_deg}, {"angle_a_deg", t.angle_a_deg},
-                     {"angle_b_deg", t.angle_b_deg}, {"ratio_b_over_a", twist_ratio},
-                     {"shear_ratio", shear_ratio}}},
+          {"twist",
+           {{"twist_deg", t.twist_deg},
+            {"angle_a_deg", t.angle_a_deg},
+            {"angle_b_deg", t.angle_b_deg},
+            {"ratio_b_over_a", twist_ratio},
+            {"shear_ratio", shear_ratio}}},
           {"resolution_sensitivity", sens}};
 }
 
@@ -146,11 +154,12 @@ nlohmann::json RunCalibration(const Config& cfg, const std::string& dir, bool ve
   CsvWriter cal_csv(dir + "/calibration.csv",
                     {"rm", "res", "tets", "r_omega_ratio", "r_omega_a", "r_omega_b", "achieved_rm",
                      "evaluations", "thesis_ratio"});
-  CsvWriter twist_csv(dir + "/twist.csv", {"rm", "r_omega_ratio", "twist_deg", "angle_a_deg",
-                                           "angle_b_deg", "a_mid_deg", "b_mid_deg", "twist_ratio_b_over_a",
-                                           "shear_ratio"});
+  CsvWriter twist_csv(dir + "/twist.csv",
+                      {"rm", "r_omega_ratio", "twist_deg", "angle_a_deg", "angle_b_deg",
+                       "a_mid_deg", "b_mid_deg", "twist_ratio_b_over_a", "shear_ratio"});
   nlohmann::json rows = nlohmann::json::array();
-  for (size_t i = 0; i < p.rms.size(); ++i) rows.push_back(CalibrateRm(cfg, p, i, &cal_csv, &twist_csv, verbose));
+  for (size_t i = 0; i < p.rms.size(); ++i)
+    rows.push_back(CalibrateRm(cfg, p, i, &cal_csv, &twist_csv, verbose));
   nlohmann::json j;
   j["rows"] = rows;
   j["curve"] = curve_j;

@@ -34,14 +34,16 @@ namespace softkin {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double Since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double Since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 Eigen::Vector3d JsonVec(const Config& cfg, const std::string& key, const nlohmann::json& v) {
-  if (!v.is_array() || v.size() != 3)
-    cfg.Fail(key, "an array of 3 numbers [x, y, z]");
+  if (!v.is_array() || v.size() != 3) cfg.Fail(key, "an array of 3 numbers [x, y, z]");
   Eigen::Vector3d out;
   for (int d = 0; d < 3; ++d) {
-    if (!v[d].is_number() || !std::isfinite(v[d].get<double>())) cfg.Fail(key, "an array of 3 finite numbers");
+    if (!v[d].is_number() || !std::isfinite(v[d].get<double>()))
+      cfg.Fail(key, "an array of 3 finite numbers");
     out[d] = v[d].get<double>();
   }
   return out;
@@ -61,28 +63,36 @@ std::vector<TriangleSurface> ConfigObstacles(const Config& cfg, const nlohmann::
       cfg.Fail(key, "an object with \"type\": box, cylinder or file");
     const std::string type = o["type"].get<std::string>();
     auto need = [&](const char* k) -> const nlohmann::json& {
-      if (!o.contains(k)) cfg.Fail(key + "." + k, std::string("a value (required for type ") + type + ")");
+      if (!o.contains(k))
+        cfg.Fail(key + "." + k, std::string("a value (required for type ") + type + ")");
       return o.at(k);
     };
     std::vector<std::string> allowed;
-    if (type == "box") allowed = {"type", "min", "max"};
-    else if (type == "cylinder") allowed = {"type", "base", "axis", "radius", "height", "segments"};
-    else if (type == "file") allowed = {"type", "path"};
-    else cfg.Fail(key + ".type", "one of box, cylinder, file");
+    if (type == "box")
+      allowed = {"type", "min", "max"};
+    else if (type == "cylinder")
+      allowed = {"type", "base", "axis", "radius", "height", "segments"};
+    else if (type == "file")
+      allowed = {"type", "path"};
+    else
+      cfg.Fail(key + ".type", "one of box, cylinder, file");
     for (auto it = o.begin(); it != o.end(); ++it)
       if (std::find(allowed.begin(), allowed.end(), it.key()) == allowed.end())
         cfg.Fail(key + "." + it.key(), "no such key for type " + type);
     try {
       if (type == "box") {
-        out.push_back(MakeBoxSurface(JsonVec(cfg, key + ".min", need("min")), JsonVec(cfg, key + ".max", need("max"))));
+        out.push_back(MakeBoxSurface(JsonVec(cfg, key + ".min", need("min")),
+                                     JsonVec(cfg, key + ".max", need("max"))));
       } else if (type == "cylinder") {
         const auto& r = need("radius");
         const auto& h = need("height");
         if (!r.is_number() || !h.is_number()) cfg.Fail(key, "numbers for radius and height (mm)");
-        const int seg = o.contains("segments") && o["segments"].is_number_integer() ? o["segments"].get<int>() : 48;
+        const int seg = o.contains("segments") && o["segments"].is_number_integer()
+                            ? o["segments"].get<int>()
+                            : 48;
         out.push_back(MakeCylinderSurface(JsonVec(cfg, key + ".base", need("base")),
-                                          JsonVec(cfg, key + ".axis", need("axis")), r.get<double>(),
-                                          h.get<double>(), seg));
+                                          JsonVec(cfg, key + ".axis", need("axis")),
+                                          r.get<double>(), h.get<double>(), seg));
       } else {
         const auto& p = need("path");
         if (!p.is_string()) cfg.Fail(key + ".path", "a file name (.obj or .stl)");
@@ -111,8 +121,10 @@ Eigen::VectorXd ConfigActuation(const Config& cfg, const std::string& key, const
       cfg.Fail(key + "." + it.key(), "an actuator of robot '" + scene.name + "' (" + known + ")");
     }
     const auto& act = scene.actuators[a];
-    if (!it.value().is_number() || it.value().get<double>() < act.min || it.value().get<double>() > act.max)
-      cfg.Fail(key + "." + it.key(), "a number in [" + std::to_string(act.min) + ", " + std::to_string(act.max) + "]");
+    if (!it.value().is_number() || it.value().get<double>() < act.min ||
+        it.value().get<double>() > act.max)
+      cfg.Fail(key + "." + it.key(),
+               "a number in [" + std::to_string(act.min) + ", " + std::to_string(act.max) + "]");
     c[a] = it.value().get<double>();
   }
   return c;
@@ -162,7 +174,8 @@ ContactPatch MeasureContact(const Obstacle& obs, const Mesh& mesh, const Eigen::
 
 /// Adds (or overrides) the numbers of the JSON object `j` (at config key `key`) in *p; anything but
 /// an object of numbers fails with the key.
-void MergeRobotParams(const Config& cfg, const std::string& key, const nlohmann::json& j, RobotParams* p) {
+void MergeRobotParams(const Config& cfg, const std::string& key, const nlohmann::json& j,
+                      RobotParams* p) {
   if (!j.is_object()) cfg.Fail(key, "an object of numbers");
   for (auto it = j.begin(); it != j.end(); ++it) {
     if (!it.value().is_number()) cfg.Fail(key + "." + it.key(), "a number");
@@ -174,41 +187,51 @@ void MergeRobotParams(const Config& cfg, const std::string& key, const nlohmann:
 /// {"alpha_max", "d_max", "method", "chamber_rest", "remesh_iterations", "max_remeshes_per_step"}
 /// (every key optional; the thesis's 4 / 4, auto, remeshed, 3, 2); the ladder is the robot's
 /// `steps` values.
-ProgressiveOptions CostsRemeshOptions(const Config& cfg, const std::string& key, const nlohmann::json& j,
-                                      const std::string& robot, int res, const RobotParams& params) {
+ProgressiveOptions CostsRemeshOptions(const Config& cfg, const std::string& key,
+                                      const nlohmann::json& j, const std::string& robot, int res,
+                                      const RobotParams& params) {
   if (!j.is_object())
-    cfg.Fail(key, "an object {\"alpha_max\", \"d_max\", \"method\", \"chamber_rest\", \"remesh_iterations\", "
-                  "\"max_remeshes_per_step\"}");
+    cfg.Fail(
+        key,
+        "an object {\"alpha_max\", \"d_max\", \"method\", \"chamber_rest\", \"remesh_iterations\", "
+        "\"max_remeshes_per_step\"}");
   auto number = [&](const char* k, double def) {
     if (!j.contains(k)) return def;
-    if (!j[k].is_number() || !std::isfinite(j[k].get<double>())) cfg.Fail(key + "." + k, "a finite number");
+    if (!j[k].is_number() || !std::isfinite(j[k].get<double>()))
+      cfg.Fail(key + "." + k, "a finite number");
     return j[k].get<double>();
   };
   auto integer = [&](const char* k, int def) {
     if (!j.contains(k)) return def;
-    if (!j[k].is_number_integer() || j[k].get<int>() < 1) cfg.Fail(key + "." + k, "an integer >= 1");
+    if (!j[k].is_number_integer() || j[k].get<int>() < 1)
+      cfg.Fail(key + "." + k, "an integer >= 1");
     return j[k].get<int>();
   };
   for (auto it = j.begin(); it != j.end(); ++it)
-    if (it.key() != "alpha_max" && it.key() != "d_max" && it.key() != "method" && it.key() != "chamber_rest" &&
-        it.key() != "remesh_iterations" && it.key() != "max_remeshes_per_step")
+    if (it.key() != "alpha_max" && it.key() != "d_max" && it.key() != "method" &&
+        it.key() != "chamber_rest" && it.key() != "remesh_iterations" &&
+        it.key() != "max_remeshes_per_step")
       cfg.Fail(key + "." + it.key(),
-               "one of alpha_max, d_max, method, chamber_rest, remesh_iterations, max_remeshes_per_step");
+               "one of alpha_max, d_max, method, chamber_rest, remesh_iterations, "
+               "max_remeshes_per_step");
   ProgressiveOptions popt;
   popt.criteria = {number("alpha_max", 4.0), number("d_max", 4.0)};
   popt.max_remeshes_per_step = integer("max_remeshes_per_step", 2);
-  const std::string method = j.contains("method") && j["method"].is_string() ? j["method"].get<std::string>() : "auto";
+  const std::string method =
+      j.contains("method") && j["method"].is_string() ? j["method"].get<std::string>() : "auto";
   if ((j.contains("method") && !j["method"].is_string()) ||
       !RemeshMethodFromString(method, &popt.remesh_options.method))
     cfg.Fail(key + ".method", "auto, chamber or whole");
-  const std::string rest =
-      j.contains("chamber_rest") && j["chamber_rest"].is_string() ? j["chamber_rest"].get<std::string>() : "remeshed";
+  const std::string rest = j.contains("chamber_rest") && j["chamber_rest"].is_string()
+                               ? j["chamber_rest"].get<std::string>()
+                               : "remeshed";
   if ((j.contains("chamber_rest") && !j["chamber_rest"].is_string()) ||
       !ChamberRestFromString(rest, &popt.remesh_options.rest))
     cfg.Fail(key + ".chamber_rest", "remeshed or original");
   popt.remesh_options.region.iterations = integer("remesh_iterations", 3);
   popt.remesh_options.region.seed = cfg.seed();
-  if (robot == "twisting_robot") popt.remesh_options.tessellation = TwistingRobotTessellation(res, params);
+  if (robot == "twisting_robot")
+    popt.remesh_options.tessellation = TwistingRobotTessellation(res, params);
   popt.remesh_options.tessellation.seed = cfg.seed();
   std::string why;
   if (!popt.IsValid(&why)) {
@@ -244,8 +267,9 @@ struct CollisionSweepParams {
 };
 
 /// variants[vi]: {"name", ["collision"], ["robot_params"]} on top of the base robot and options.
-SweepVariant ReadSweepVariant(const Config& cfg, size_t vi, const nlohmann::json& v, const Scene& base,
-                              const FkOptions& base_opts, const CollisionSweepParams& p, int res) {
+SweepVariant ReadSweepVariant(const Config& cfg, size_t vi, const nlohmann::json& v,
+                              const Scene& base, const FkOptions& base_opts,
+                              const CollisionSweepParams& p, int res) {
   const std::string key = "variants[" + std::to_string(vi) + "]";
   if (!v.is_object() || !v.contains("name") || !v["name"].is_string())
     cfg.Fail(key, "an object with a \"name\"");
@@ -302,7 +326,7 @@ CollisionSweepParams ReadCollisionSweepParams(const Config& cfg) {
 
 /// What one variant's sweep from rest to the end actuation accumulates.
 struct VariantSweep {
-  Eigen::MatrixX3d X;  ///< the final shape
+  Eigen::MatrixX3d X;               ///< the final shape
   std::unique_ptr<BendAngle> bend;  ///< if the robot has tip_top and tip_bottom markers
   double check_s = 0, resp_s = 0, solver_s = 0, total_s = 0;
   int iterations = 0, failed = 0;
@@ -337,7 +361,8 @@ VariantSweep SweepCollisionVariant(const Config& cfg, const CollisionSweepParams
     const double t = double(s) / steps;
     const Eigen::VectorXd c = rest + t * (p.c_end - rest);
     FkResult r = solver->Solve(c, s > 1 ? &v.X : nullptr);
-    if (r.status == FkStatus::InvalidInput) throw std::runtime_error(cfg.path() + ": " + key + ": " + r.message);
+    if (r.status == FkStatus::InvalidInput)
+      throw std::runtime_error(cfg.path() + ": " + key + ": " + r.message);
     v.X = r.positions;
     const CollisionCheck ck = probe.Check(v.X);
     const bool ok = r.status == FkStatus::Converged;
@@ -359,23 +384,36 @@ VariantSweep SweepCollisionVariant(const Config& cfg, const CollisionSweepParams
       touch += v.patches.back().vertices;
       touch_area += v.patches.back().area_mm2;
     }
-    csv->RowStrings({name, std::to_string(s), std::to_string(t), std::to_string(P(tip, 0)),
-                     std::to_string(P(tip, 1)), std::to_string(P(tip, 2)), std::to_string(ang),
-                     std::to_string(r.iterations), ok ? "1" : "0", std::to_string(r.springs),
-                     std::to_string(ck.self_contacts), std::to_string(ck.obstacle_contacts),
-                     std::to_string(ck.max_penetration), std::to_string(ck.self_penetration),
-                     std::to_string(ck.obstacle_penetration), std::to_string(ck.inverted_elements),
-                     std::to_string(ck.tangled_contacts), std::to_string(touch),
+    csv->RowStrings({name,
+                     std::to_string(s),
+                     std::to_string(t),
+                     std::to_string(P(tip, 0)),
+                     std::to_string(P(tip, 1)),
+                     std::to_string(P(tip, 2)),
+                     std::to_string(ang),
+                     std::to_string(r.iterations),
+                     ok ? "1" : "0",
+                     std::to_string(r.springs),
+                     std::to_string(ck.self_contacts),
+                     std::to_string(ck.obstacle_contacts),
+                     std::to_string(ck.max_penetration),
+                     std::to_string(ck.self_penetration),
+                     std::to_string(ck.obstacle_penetration),
+                     std::to_string(ck.inverted_elements),
+                     std::to_string(ck.tangled_contacts),
+                     std::to_string(touch),
                      std::to_string(touch_area),
                      std::to_string(r.collision_stats.check_s),
                      std::to_string(r.collision_stats.response_s),
-                     std::to_string(r.local_time_s + r.global_time_s), std::to_string(r.time_s)});
+                     std::to_string(r.local_time_s + r.global_time_s),
+                     std::to_string(r.time_s)});
     if (verbose)
-      std::fprintf(stderr,
-                   "  [%s %d/%d] %s; exact check: %d self (max depth %.3g mm; %d in tangles) + %d obstacle "
-                   "contacts (max depth %.3g mm); %d inverted elements\n",
-                   name.c_str(), s, steps, r.BriefReport().c_str(), ck.self_contacts, ck.self_penetration,
-                   ck.tangled_contacts, ck.obstacle_contacts, ck.obstacle_penetration, ck.inverted_elements);
+      std::fprintf(
+          stderr,
+          "  [%s %d/%d] %s; exact check: %d self (max depth %.3g mm; %d in tangles) + %d obstacle "
+          "contacts (max depth %.3g mm); %d inverted elements\n",
+          name.c_str(), s, steps, r.BriefReport().c_str(), ck.self_contacts, ck.self_penetration,
+          ck.tangled_contacts, ck.obstacle_contacts, ck.obstacle_penetration, ck.inverted_elements);
     v.last = r;
     v.last_check = ck;
   }
@@ -395,7 +433,8 @@ void WriteRegionSurface(const Config& cfg, const CollisionSweepParams& p, const 
 }
 
 /// A variant's entry in the summary.
-nlohmann::json VariantJson(const CollisionSweepParams& p, const SweepVariant& var, const VariantSweep& v) {
+nlohmann::json VariantJson(const CollisionSweepParams& p, const SweepVariant& var,
+                           const VariantSweep& v) {
   const Scene& scene = var.scene;
   const int tip = scene.marker_index("tip");
   nlohmann::json jv;
@@ -432,7 +471,8 @@ nlohmann::json VariantJson(const CollisionSweepParams& p, const SweepVariant& va
   if (!p.obstacles.empty()) {
     nlohmann::json contacts = nlohmann::json::array();
     for (const ContactPatch& cp : v.patches) {
-      contacts.push_back({{"vertices", cp.vertices}, {"extent_x_mm", cp.extent_mm}, {"area_mm2", cp.area_mm2}});
+      contacts.push_back(
+          {{"vertices", cp.vertices}, {"extent_x_mm", cp.extent_mm}, {"area_mm2", cp.area_mm2}});
     }
     jv["contact"] = contacts;
   }
@@ -443,7 +483,7 @@ nlohmann::json VariantJson(const CollisionSweepParams& p, const SweepVariant& va
 
 /// One robot of collision_costs, its keys checked before the first one runs.
 struct CostsRobot {
-  std::string key;  ///< "robots[i]"
+  std::string key;   ///< "robots[i]"
   nlohmann::json j;  ///< its object
   RobotParams params;
   std::optional<ProgressiveOptions> remesh;
@@ -463,20 +503,23 @@ CostsRobot ReadCostsRobot(const Config& cfg, size_t i, const nlohmann::json& rj)
   if (!rj.is_object() || !rj.contains("robot") || !rj["robot"].is_string())
     cfg.Fail(key, "an object with \"robot\"");
   for (auto it = rj.begin(); it != rj.end(); ++it)
-    if (it.key() != "robot" && it.key() != "res" && it.key() != "robot_params" && it.key() != "actuation" &&
-        it.key() != "steps" && it.key() != "obstacles" && it.key() != "thesis" && it.key() != "remesh" &&
-        it.key() != "collision" && it.key() != "label")
+    if (it.key() != "robot" && it.key() != "res" && it.key() != "robot_params" &&
+        it.key() != "actuation" && it.key() != "steps" && it.key() != "obstacles" &&
+        it.key() != "thesis" && it.key() != "remesh" && it.key() != "collision" &&
+        it.key() != "label")
       cfg.Fail(key + "." + it.key(),
-               "one of robot, label, res, robot_params, actuation, steps, obstacles, remesh, collision, thesis");
+               "one of robot, label, res, robot_params, actuation, steps, obstacles, remesh, "
+               "collision, thesis");
   if (rj.contains("label") && (!rj["label"].is_string() || rj["label"].get<std::string>().empty()))
     cfg.Fail(key + ".label", "a non-empty string naming the row (default: the robot)");
   if (rj.contains("res") && !rj["res"].is_number_integer()) cfg.Fail(key + ".res", "an integer");
   if (rj.contains("steps") && (!rj["steps"].is_number_integer() || rj["steps"].get<int>() < 1))
     cfg.Fail(key + ".steps", "an integer >= 1");
-  if (rj.contains("robot_params")) MergeRobotParams(cfg, key + ".robot_params", rj["robot_params"], &r.params);
+  if (rj.contains("robot_params"))
+    MergeRobotParams(cfg, key + ".robot_params", rj["robot_params"], &r.params);
   if (rj.contains("remesh"))
-    r.remesh = CostsRemeshOptions(cfg, key + ".remesh", rj["remesh"], rj["robot"].get<std::string>(),
-                                  rj.value("res", 0), r.params);
+    r.remesh = CostsRemeshOptions(cfg, key + ".remesh", rj["remesh"],
+                                  rj["robot"].get<std::string>(), rj.value("res", 0), r.params);
   if (rj.contains("collision")) {
     FkOptions probe;
     ApplySolverJson({{"collision", rj["collision"]}}, cfg.path() + ": " + key, &probe);
@@ -491,10 +534,13 @@ CollisionCostsParams ReadCollisionCostsParams(const Config& cfg) {
   (void)cfg.Solver(FkOptions());  // checks the solver object once
   cfg.CheckNoUnknownKeys();
   if (!robots_j.is_array() || robots_j.empty())
-    cfg.Fail("robots", "a non-empty array of {\"robot\", \"res\", [\"robot_params\"], \"actuation\", \"steps\", [\"obstacles\"], [\"thesis\"]}");
+    cfg.Fail("robots",
+             "a non-empty array of {\"robot\", \"res\", [\"robot_params\"], \"actuation\", "
+             "\"steps\", [\"obstacles\"], [\"thesis\"]}");
   // Every robot's keys are read and checked before the first one runs (a bad key in the last
   // robot fails at once, not after the others' minutes of solving).
-  for (size_t i = 0; i < robots_j.size(); ++i) p.robots.push_back(ReadCostsRobot(cfg, i, robots_j[i]));
+  for (size_t i = 0; i < robots_j.size(); ++i)
+    p.robots.push_back(ReadCostsRobot(cfg, i, robots_j[i]));
   return p;
 }
 
@@ -502,7 +548,8 @@ CollisionCostsParams ReadCollisionCostsParams(const Config& cfg) {
 /// of the collisions after them.
 struct StepCosts {
   double check = 0, resp = 0, solve = 0, total = 0, remesh_s = 0;
-  CollisionCheck left;  ///< the exact check after the last step (collision-free if the response was off)
+  CollisionCheck
+      left;  ///< the exact check after the last step (collision-free if the response was off)
   bool free = true;
   nlohmann::json remesh_j;  ///< the remeshing's summary (null without remeshing)
 };
@@ -510,7 +557,8 @@ struct StepCosts {
 /// Algorithm 2 with the collision handling on: the chamber's ratio is raised over the same
 /// `steps` values, and the chamber is re-tessellated when it has grown or distorted too far.
 StepCosts RemeshedStepCosts(const Config& cfg, const CostsRobot& cr, const Scene& scene,
-                            const Eigen::VectorXd& c_end, int steps, double mesh_gen_s, bool verbose) {
+                            const Eigen::VectorXd& c_end, int steps, double mesh_gen_s,
+                            bool verbose) {
   const std::string& key = cr.key;
   const std::string robot = cr.j["robot"].get<std::string>();
   const Eigen::VectorXd rest = scene.rest_actuation();
@@ -519,24 +567,32 @@ StepCosts RemeshedStepCosts(const Config& cfg, const CostsRobot& cr, const Scene
   try {
     chamber = ChamberActuator(scene);
   } catch (const std::invalid_argument& e) {
-    cfg.Fail(key + ".remesh", std::string("a robot with one pneumatic chamber actuator (") + e.what() + ")");
+    cfg.Fail(key + ".remesh",
+             std::string("a robot with one pneumatic chamber actuator (") + e.what() + ")");
   }
   const double alpha = c_end[chamber];
-  if (!(alpha > 1)) cfg.Fail(key + ".actuation", "a chamber volume ratio > 1 (remeshing raises it)");
-  for (int s = 1; s < steps; ++s) popt.ladder.push_back(rest[chamber] + (double(s) / steps) * (alpha - rest[chamber]));
-  popt.ladder.erase(std::remove_if(popt.ladder.begin(), popt.ladder.end(), [](double a) { return !(a > 1); }),
-                    popt.ladder.end());
+  if (!(alpha > 1))
+    cfg.Fail(key + ".actuation", "a chamber volume ratio > 1 (remeshing raises it)");
+  for (int s = 1; s < steps; ++s)
+    popt.ladder.push_back(rest[chamber] + (double(s) / steps) * (alpha - rest[chamber]));
+  popt.ladder.erase(
+      std::remove_if(popt.ladder.begin(), popt.ladder.end(), [](double a) { return !(a > 1); }),
+      popt.ladder.end());
   popt.on_step = [&](const ProgressiveStep& st, const Scene& s_now, const Eigen::MatrixX3d&) {
     if (verbose)
-      std::fprintf(stderr, "  [%s alpha %.3g] %s, %d iterations, %.2f s; %d remesh(es), %d failed, %.2f s, %d tets; "
-                   "exact check: %s, %d springs, %d inverted elements (%d body)\n",
-                   robot.c_str(), st.alpha, FkStatusToString(st.status), st.iterations, st.solver_seconds,
-                   st.remeshes, st.remesh_failures, st.mesh_seconds, s_now.mesh.num_tets(),
-                   st.collision_active ? (st.collision.collision_free() ? "collision-free" : "contacts left") : "off",
-                   st.springs, st.collision.inverted_elements, st.collision.inverted_body_elements);
+      std::fprintf(
+          stderr,
+          "  [%s alpha %.3g] %s, %d iterations, %.2f s; %d remesh(es), %d failed, %.2f s, %d tets; "
+          "exact check: %s, %d springs, %d inverted elements (%d body)\n",
+          robot.c_str(), st.alpha, FkStatusToString(st.status), st.iterations, st.solver_seconds,
+          st.remeshes, st.remesh_failures, st.mesh_seconds, s_now.mesh.num_tets(),
+          st.collision_active ? (st.collision.collision_free() ? "collision-free" : "contacts left")
+                              : "off",
+          st.springs, st.collision.inverted_elements, st.collision.inverted_body_elements);
   };
   const ProgressiveResult pr = SolveProgressive(scene, alpha, popt);
-  if (!pr.completed) throw std::runtime_error(cfg.path() + ": " + key + ": remeshing stopped: " + pr.message);
+  if (!pr.completed)
+    throw std::runtime_error(cfg.path() + ": " + key + ": remeshing stopped: " + pr.message);
   StepCosts sc;
   for (const ProgressiveStep& st : pr.steps) {
     sc.check += st.check_seconds;
@@ -547,11 +603,15 @@ StepCosts RemeshedStepCosts(const Config& cfg, const CostsRobot& cr, const Scene
     sc.free = sc.free && (!st.collision_active || st.collision.collision_free());
     if (st.collision_active) sc.left = st.collision;
   }
-  sc.remesh_j = {{"remeshes", pr.remeshes}, {"remesh_failures", pr.remesh_failures},
+  sc.remesh_j = {{"remeshes", pr.remeshes},
+                 {"remesh_failures", pr.remesh_failures},
                  {"first_remesh_failure", pr.first_remesh_failure},
-                 {"tets_final", pr.scene.mesh.num_tets()}, {"chamber_volume_ratio", pr.chamber_volume_ratio},
-                 {"status", FkStatusToString(pr.status)}, {"alpha_max", popt.criteria.alpha_max},
-                 {"d_max", popt.criteria.d_max}, {"chamber_rest", ChamberRestToString(popt.remesh_options.rest)},
+                 {"tets_final", pr.scene.mesh.num_tets()},
+                 {"chamber_volume_ratio", pr.chamber_volume_ratio},
+                 {"status", FkStatusToString(pr.status)},
+                 {"alpha_max", popt.criteria.alpha_max},
+                 {"d_max", popt.criteria.d_max},
+                 {"chamber_rest", ChamberRestToString(popt.remesh_options.rest)},
                  {"initial_mesh_s", mesh_gen_s}};
   return sc;
 }
@@ -568,7 +628,8 @@ StepCosts PlainStepCosts(const Config& cfg, const CostsRobot& cr, const Scene& s
   for (int s = 1; s <= steps; ++s) {
     const Eigen::VectorXd c = rest + (double(s) / steps) * (c_end - rest);
     FkResult r = solver->Solve(c, s > 1 ? &X : nullptr);
-    if (r.status == FkStatus::InvalidInput) throw std::runtime_error(cfg.path() + ": " + cr.key + ": " + r.message);
+    if (r.status == FkStatus::InvalidInput)
+      throw std::runtime_error(cfg.path() + ": " + cr.key + ": " + r.message);
     X = r.positions;
     sc.check += r.collision_stats.check_s;
     sc.resp += r.collision_stats.response_s;
@@ -576,7 +637,8 @@ StepCosts PlainStepCosts(const Config& cfg, const CostsRobot& cr, const Scene& s
     sc.total += r.time_s;
     sc.free = sc.free && (!r.collision_active || r.collision.collision_free());
     if (r.collision_active) sc.left = r.collision;
-    if (verbose) std::fprintf(stderr, "  [%s %d/%d] %s\n", robot.c_str(), s, steps, r.BriefReport().c_str());
+    if (verbose)
+      std::fprintf(stderr, "  [%s %d/%d] %s\n", robot.c_str(), s, steps, r.BriefReport().c_str());
   }
   return sc;
 }
@@ -598,15 +660,18 @@ nlohmann::json RunCostsRobot(const Config& cfg, const CollisionCostsParams& p, c
   }
   const double mesh_gen_s = Since(t0);
   if (rj.contains("obstacles")) scene.obstacles = ConfigObstacles(cfg, rj["obstacles"]);
-  if (!rj.contains("actuation")) cfg.Fail(key + ".actuation", "an object {\"actuator\": end value}");
+  if (!rj.contains("actuation"))
+    cfg.Fail(key + ".actuation", "an object {\"actuator\": end value}");
   const Eigen::VectorXd c_end = ConfigActuation(cfg, key + ".actuation", rj["actuation"], scene);
   FkOptions opts = scene.solver;  // the robot's defaults, then the config's solver object
   if (!p.solver_j.is_null()) ApplySolverJson(p.solver_j, cfg.path() + ": solver", &opts);
   // ... then the robot's own collision options (e.g. a spring stiffness for its contact set).
-  if (rj.contains("collision")) ApplySolverJson({{"collision", rj["collision"]}}, cfg.path() + ": " + key, &opts);
+  if (rj.contains("collision"))
+    ApplySolverJson({{"collision", rj["collision"]}}, cfg.path() + ": " + key, &opts);
   scene.solver = opts;
-  const StepCosts sc = cr.remesh ? RemeshedStepCosts(cfg, cr, scene, c_end, steps, mesh_gen_s, verbose)
-                                 : PlainStepCosts(cfg, cr, scene, c_end, steps, verbose);
+  const StepCosts sc = cr.remesh
+                           ? RemeshedStepCosts(cfg, cr, scene, c_end, steps, mesh_gen_s, verbose)
+                           : PlainStepCosts(cfg, cr, scene, c_end, steps, verbose);
   nlohmann::json row;
   row["robot"] = robot;
   row["label"] = rj.value("label", robot);
@@ -629,11 +694,13 @@ nlohmann::json RunCostsRobot(const Config& cfg, const CollisionCostsParams& p, c
     row["thesis"] = t;
     // Per-step speed ratios against the thesis (same robot type, its tet count in "tets").
     if (t.contains("solver_s") && t["solver_s"].is_number() && row["step_s"].get<double>() > 0) {
-      const double thesis_step = t.value("col_check_s", 0.0) + t.value("col_resp_s", 0.0) + t["solver_s"].get<double>();
+      const double thesis_step =
+          t.value("col_check_s", 0.0) + t.value("col_resp_s", 0.0) + t["solver_s"].get<double>();
       row["speedup_vs_thesis_step"] = thesis_step / (sc.total / steps);
     }
   }
-  csv->RowStrings({robot, row["label"].get<std::string>(), std::to_string(scene.mesh.num_tets()), std::to_string(row["mesh_gen_s"].get<double>()),
+  csv->RowStrings({robot, row["label"].get<std::string>(), std::to_string(scene.mesh.num_tets()),
+                   std::to_string(row["mesh_gen_s"].get<double>()),
                    std::to_string(sc.check / steps), std::to_string(sc.resp / steps),
                    std::to_string(sc.solve / steps), std::to_string(sc.total / steps),
                    std::to_string(steps), sc.free ? "1" : "0"});
@@ -645,11 +712,29 @@ nlohmann::json RunCostsRobot(const Config& cfg, const CollisionCostsParams& p, c
 nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool verbose) {
   const CollisionSweepParams p = ReadCollisionSweepParams(cfg);
   std::filesystem::create_directories(dir + "/frames");
-  CsvWriter csv(dir + "/steps.csv",
-                {"variant", "step", "actuation_scale", "tip_x", "tip_y", "tip_z", "bend_deg",
-                 "iterations", "converged", "springs", "self_contacts", "obstacle_contacts",
-                 "max_penetration_mm", "self_penetration_mm", "obstacle_penetration_mm",
-                 "inverted_elements", "tangled_contacts", "contact_vertices", "contact_area_mm2", "check_s", "response_s", "solver_s", "time_s"});
+  CsvWriter csv(dir + "/steps.csv", {"variant",
+                                     "step",
+                                     "actuation_scale",
+                                     "tip_x",
+                                     "tip_y",
+                                     "tip_z",
+                                     "bend_deg",
+                                     "iterations",
+                                     "converged",
+                                     "springs",
+                                     "self_contacts",
+                                     "obstacle_contacts",
+                                     "max_penetration_mm",
+                                     "self_penetration_mm",
+                                     "obstacle_penetration_mm",
+                                     "inverted_elements",
+                                     "tangled_contacts",
+                                     "contact_vertices",
+                                     "contact_area_mm2",
+                                     "check_s",
+                                     "response_s",
+                                     "solver_s",
+                                     "time_s"});
   nlohmann::json out_variants = nlohmann::json::array();
   std::vector<std::pair<double, std::string>> frames;
   for (size_t vi = 0; vi < p.variants.size(); ++vi) {
@@ -672,8 +757,9 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
 
 nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool verbose) {
   const CollisionCostsParams p = ReadCollisionCostsParams(cfg);
-  CsvWriter csv(dir + "/costs.csv", {"robot", "label", "tets", "mesh_gen_s", "col_check_s", "col_resp_s",
-                                     "solver_s", "step_s", "steps", "collision_free"});
+  CsvWriter csv(dir + "/costs.csv",
+                {"robot", "label", "tets", "mesh_gen_s", "col_check_s", "col_resp_s", "solver_s",
+                 "step_s", "steps", "collision_free"});
   nlohmann::json rows = nlohmann::json::array();
   for (const CostsRobot& cr : p.robots) rows.push_back(RunCostsRobot(cfg, p, cr, &csv, verbose));
   nlohmann::json j;

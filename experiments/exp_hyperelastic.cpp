@@ -1,8 +1,8 @@
 // Hyperelastic body elements (thesis Sec. 3.3.1, Eq. 3.6-3.7; our derivation in
-// solver/materials/hyperelastic.hpp): the fitted R_omega(strain) of each Mooney-Rivlin material, and its
-// uniaxial response three ways against the analytic Mooney-Rivlin curve: the homogeneous state
-// of the law, a simulated tension test of a bar with the law, and the same bar with the constant
-// R_omega of Ch. 2. Stresses are normalised by each response's small-strain modulus.
+// solver/materials/hyperelastic.hpp): the fitted R_omega(strain) of each Mooney-Rivlin material,
+// and its uniaxial response three ways against the analytic Mooney-Rivlin curve: the homogeneous
+// state of the law, a simulated tension test of a bar with the law, and the same bar with the
+// constant R_omega of Ch. 2. Stresses are normalised by each response's small-strain modulus.
 #include "softkin/experiments/results.hpp"
 #include "softkin/experiments/runner.hpp"
 #include "softkin/solver/materials/calibration.hpp"
@@ -21,7 +21,7 @@ struct HyperelasticParams {
   double rho0 = 1.0;               ///< zero-strain R_omega
   double lambda_max = 4.0;         ///< largest fitted stretch
   int knots = 61;
-  std::vector<double> stretches;   ///< end stretches of the tension tests
+  std::vector<double> stretches;  ///< end stretches of the tension tests
   int res = 3;
   FkOptions solver;
 };
@@ -32,7 +32,8 @@ HyperelasticParams ReadHyperelasticParams(const Config& cfg) {
   p.rho0 = cfg.Number("r_omega0", 1.0);
   p.lambda_max = cfg.Number("lambda_max", 4.0);
   p.knots = cfg.Int("knots", 61);
-  p.stretches = cfg.NumberList("stretches", {1.01, 1.1, 1.2, 1.3, 1.4, 1.5, 1.6, 1.7, 1.8, 1.9, 2.0});
+  p.stretches =
+      cfg.NumberList("stretches", {1.01, 1.1, 1.2, 1.3, 1.4, 1.5, 1.6, 1.7, 1.8, 1.9, 2.0});
   p.res = cfg.Int("res", 3);
   p.solver = cfg.Solver(FkOptions());
   cfg.CheckNoUnknownKeys();
@@ -41,7 +42,8 @@ HyperelasticParams ReadHyperelasticParams(const Config& cfg) {
   if (!(p.lambda_max > 1)) cfg.Fail("lambda_max", "a largest fitted stretch > 1");
   if (p.knots < 2) cfg.Fail("knots", "an integer >= 2");
   if (p.stretches.size() < 2 || p.stretches[0] > 1.05)
-    cfg.Fail("stretches", "increasing end stretches in (1, 2], the first <= 1.05 (it sets the modulus)");
+    cfg.Fail("stretches",
+             "increasing end stretches in (1, 2], the first <= 1.05 (it sets the modulus)");
   if (p.res < 1 || p.res > 12) cfg.Fail("res", "cells across the 10 mm bar, integer in [1, 12]");
   return p;
 }
@@ -77,8 +79,8 @@ nlohmann::json FitMaterial(const Config& cfg, const HyperelasticParams& p, const
     resp_csv->RowStrings({name, std::to_string(h[i].end_stretch), std::to_string(lam),
                           std::to_string(mrn), std::to_string(law), std::to_string(sh),
                           std::to_string(b[i].mid_stretch), std::to_string(sb),
-                          std::to_string(h[i].lateral_stretch), std::to_string(b[i].lateral_stretch),
-                          std::to_string(h[i].iterations)});
+                          std::to_string(h[i].lateral_stretch),
+                          std::to_string(b[i].lateral_stretch), std::to_string(h[i].iterations)});
     if (i == 0) continue;
     worst_h = std::max(worst_h, std::abs(sh / mrn - 1));
     worst_b = std::max(worst_b, std::abs(sb / mrb - 1));
@@ -87,10 +89,11 @@ nlohmann::json FitMaterial(const Config& cfg, const HyperelasticParams& p, const
   double rho2 = 0;
   CurveUniaxialStress(curve, 2.0, nullptr, &rho2);
   if (verbose)
-    std::fprintf(stderr,
-                 "  %s: R_omega(stretch 2) = %.3f; worst error vs Mooney-Rivlin up to stretch %.1f: "
-                 "law %.3f, simulated bar %.3f, constant R_omega %.3f\n",
-                 name.c_str(), rho2, p.stretches.back(), worst_law, worst_h, worst_b);
+    std::fprintf(
+        stderr,
+        "  %s: R_omega(stretch 2) = %.3f; worst error vs Mooney-Rivlin up to stretch %.1f: "
+        "law %.3f, simulated bar %.3f, constant R_omega %.3f\n",
+        name.c_str(), rho2, p.stretches.back(), worst_law, worst_h, worst_b);
   return {{"c1", mr.c1},
           {"c2", mr.c2},
           {"r_omega0", rho0},
@@ -111,10 +114,10 @@ nlohmann::json RunHyperelasticFit(const Config& cfg, const std::string& dir, boo
   CsvWriter resp_csv(dir + "/response.csv",
                      {"material", "end_stretch", "mid_stretch", "mooney_rivlin", "law_homogeneous",
                       "sim_hyperelastic", "mid_stretch_constant", "sim_constant_r_omega",
-                      "lateral_hyperelastic",
-                      "lateral_constant_r_omega", "iterations"});
+                      "lateral_hyperelastic", "lateral_constant_r_omega", "iterations"});
   nlohmann::json out = nlohmann::json::object();
-  for (const std::string& name : p.names) out[name] = FitMaterial(cfg, p, name, &curve_csv, &resp_csv, verbose);
+  for (const std::string& name : p.names)
+    out[name] = FitMaterial(cfg, p, name, &curve_csv, &resp_csv, verbose);
   nlohmann::json j;
   j["materials"] = out;
   j["res"] = p.res;

@@ -14,7 +14,9 @@ namespace softkin {
 
 namespace {
 
-nlohmann::json Vec(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+nlohmann::json Vec(const Eigen::VectorXd& v) {
+  return std::vector<double>(v.data(), v.data() + v.size());
+}
 nlohmann::json Vec3J(const Eigen::Vector3d& v) { return {v[0], v[1], v[2]}; }
 
 /// Writes the configuration-space samples (c0.., x, y, z) for the figures.
@@ -70,9 +72,12 @@ PathStats Stats(const std::vector<WaypointResult>& w, const Kinematics& kin, dou
     if (w[i].error_mm > lambda_mm * (1 + 1e-9)) ++s.outside;
     if (i > 0 && w[i - 1].error_mm >= 0) {
       const double jump = (w[i].c - w[i - 1].c).cwiseAbs().maxCoeff();
-      if (jump > s.max_jump) { s.max_jump = jump; s.max_jump_index = static_cast<int>(i); }
-      s.max_jump_fraction = std::max(s.max_jump_fraction,
-                                     (w[i].c - w[i - 1].c).cwiseAbs().cwiseQuotient(range).maxCoeff());
+      if (jump > s.max_jump) {
+        s.max_jump = jump;
+        s.max_jump_index = static_cast<int>(i);
+      }
+      s.max_jump_fraction = std::max(
+          s.max_jump_fraction, (w[i].c - w[i - 1].c).cwiseAbs().cwiseQuotient(range).maxCoeff());
       s.max_reached_step = std::max(s.max_reached_step, (w[i].reached - w[i - 1].reached).norm());
       s.max_target_step = std::max(s.max_target_step, (w[i].target - w[i - 1].target).norm());
     }
@@ -120,9 +125,10 @@ TrajectoryResult Follow(SimulatorKinematics& kin, const Eigen::MatrixX3d& waypoi
   auto cb = [&](const WaypointResult& w) {
     csv << WaypointCsvRow(w) << "\n" << std::flush;
     if (verbose)
-      std::fprintf(stderr, "  [%s %d/%d] error %.3f mm, %s, %d it, %lld FK, %.2f s%s%s\n", label.c_str(),
-                   w.index + 1, total, w.error_mm, IkTerminationToString(w.termination).c_str(),
-                   w.iterations, w.fk_solves, w.time_s, w.message.empty() ? "" : ": ", w.message.c_str());
+      std::fprintf(stderr, "  [%s %d/%d] error %.3f mm, %s, %d it, %lld FK, %.2f s%s%s\n",
+                   label.c_str(), w.index + 1, total, w.error_mm,
+                   IkTerminationToString(w.termination).c_str(), w.iterations, w.fk_solves,
+                   w.time_s, w.message.empty() ? "" : ": ", w.message.c_str());
   };
   return FollowTrajectory(kin, waypoints, to, cb);
 }
@@ -154,8 +160,8 @@ InitialGuessParams ReadInitialGuessParams(const Config& cfg) {
 }
 
 /// The target: the point that target_actuation reaches (checked against the kinematics).
-Eigen::Vector3d TargetPoint(const Config& cfg, const std::vector<double>& ta, SimulatorKinematics& kin,
-                            Eigen::VectorXd* c_target) {
+Eigen::Vector3d TargetPoint(const Config& cfg, const std::vector<double>& ta,
+                            SimulatorKinematics& kin, Eigen::VectorXd* c_target) {
   if (static_cast<int>(ta.size()) != kin.num_actuators())
     cfg.Fail("target_actuation", std::to_string(kin.num_actuators()) +
                                      " actuation values (the target is the point they reach)");
@@ -164,7 +170,8 @@ Eigen::Vector3d TargetPoint(const Config& cfg, const std::vector<double>& ta, Si
   if (!why.empty()) cfg.Fail("target_actuation", "values inside the box (" + why + ")");
   kin.Reset();
   const KinematicsEval te = kin.Evaluate(*c_target, false);
-  if (!te.ok) throw std::runtime_error("the forward solve at target_actuation failed: " + te.message);
+  if (!te.ok)
+    throw std::runtime_error("the forward solve at target_actuation failed: " + te.message);
   return te.p.row(0).transpose();
 }
 
@@ -181,7 +188,8 @@ TrajectoryParams ReadTrajectoryParams(const Config& cfg) {
   p.s = ReadIkSetup(cfg, "cable_finger");
   p.paths = cfg.Raw("paths");
   cfg.CheckNoUnknownKeys();
-  if (!p.paths.is_array() || p.paths.empty()) cfg.Fail("paths", "a non-empty array of path objects");
+  if (!p.paths.is_array() || p.paths.empty())
+    cfg.Fail("paths", "a non-empty array of path objects");
   return p;
 }
 
@@ -208,12 +216,14 @@ IkMethodsParams ReadIkMethodsParams(const Config& cfg) {
   cfg.CheckNoUnknownKeys();
   for (const auto& m : method_names) {
     IkMethod x;
-    if (!StringToIkMethod(m, &x)) cfg.Fail("methods", "names out of " + IkMethodNames() + " ('" + m + "' is not)");
+    if (!StringToIkMethod(m, &x))
+      cfg.Fail("methods", "names out of " + IkMethodNames() + " ('" + m + "' is not)");
     p.methods.push_back(x);
   }
   for (const auto& m : modes) {
     JacobianMode x;
-    if (!JacobianModeFromString(m, &x)) cfg.Fail("jacobians", "names out of " + JacobianModeNames() + " ('" + m + "' is not)");
+    if (!JacobianModeFromString(m, &x))
+      cfg.Fail("jacobians", "names out of " + JacobianModeNames() + " ('" + m + "' is not)");
     p.jmodes.push_back(x);
   }
   p.settings = cfg.json();
@@ -223,9 +233,10 @@ IkMethodsParams ReadIkMethodsParams(const Config& cfg) {
 }
 
 /// One method with one Jacobian mode on the path; returns its row of methods.csv.
-nlohmann::json MethodRow(const IkMethodsParams& p, const std::shared_ptr<const Model>& model, IkMethod m,
-                         JacobianMode jmode, const std::string& jname, const IkPath& path,
-                         const ConfigurationSamples& samples, const std::string& dir, bool verbose) {
+nlohmann::json MethodRow(const IkMethodsParams& p, const std::shared_ptr<const Model>& model,
+                         IkMethod m, JacobianMode jmode, const std::string& jname,
+                         const IkPath& path, const ConfigurationSamples& samples,
+                         const std::string& dir, bool verbose) {
   const IkExperimentSetup& s = p.s;
   SimulatorKinematicsOptions ko = s.KinematicsFor({s.point});
   ko.jacobian = jmode;
@@ -233,13 +244,14 @@ nlohmann::json MethodRow(const IkMethodsParams& p, const std::shared_ptr<const M
   IkOptions ik = s.ik;
   ik.method = m;
   const std::string label = IkMethodToString(m) + "/" + jname;
-  const TrajectoryResult r = Follow(kin, path.waypoints, samples, s, ik,
-                                    dir + "/path_" + IkMethodToString(m) + "_" + jname + ".csv",
-                                    label, verbose);
+  const TrajectoryResult r =
+      Follow(kin, path.waypoints, samples, s, ik,
+             dir + "/path_" + IkMethodToString(m) + "_" + jname + ".csv", label, verbose);
   const PathStats st = Stats(r.waypoints, kin, s.lambda_mm);
   const double ms = st.n ? 1e3 * st.time_s / st.n : 0.0;
   if (verbose)
-    std::fprintf(stderr, "  %s: %d/%d converged, %.1f ms/waypoint, mean %.3f mm, max %.3f mm, %lld FK\n",
+    std::fprintf(stderr,
+                 "  %s: %d/%d converged, %.1f ms/waypoint, mean %.3f mm, max %.3f mm, %lld FK\n",
                  label.c_str(), st.converged, st.n, ms, st.mean_err, st.max_err, st.fk);
   return {{"method", IkMethodToString(m)},
           {"jacobian", jname},
@@ -274,13 +286,14 @@ nlohmann::json RunIkInitialGuess(const Config& cfg, const std::string& dir, bool
   nlohmann::json runs = nlohmann::json::array();
   const PointTrackingObjective obj(kin.point_names(), kin.point_names().front(), target);
   for (const std::string start : {"rest", "sampled"}) {
-    const Eigen::VectorXd c0 = start == "rest" ? kin.rest()
-                                               : Eigen::VectorXd(samples.c.row(closest).transpose());
+    const Eigen::VectorXd c0 =
+        start == "rest" ? kin.rest() : Eigen::VectorXd(samples.c.row(closest).transpose());
     kin.Reset();
     const IkResult r = SolveIk(kin, obj, c0, s.ik);
     for (size_t i = 0; i < r.summary.history.size(); ++i)
       hist.RowStrings({start, std::to_string(i), std::to_string(r.summary.history[i])});
-    if (verbose) std::fprintf(stderr, "  [%s] %s\n", start.c_str(), r.summary.BriefReport().c_str());
+    if (verbose)
+      std::fprintf(stderr, "  [%s] %s\n", start.c_str(), r.summary.BriefReport().c_str());
     const double err = r.p.rows() ? (r.p.row(0).transpose() - target).norm() : -1.0;
     runs.push_back({{"start", start},
                     {"c0", Vec(c0)},
@@ -297,7 +310,8 @@ nlohmann::json RunIkInitialGuess(const Config& cfg, const std::string& dir, bool
   nlohmann::json j = s.Json();
   j["target_actuation"] = Vec(c_target);
   j["target"] = Vec3J(target);
-  j["closest_sample"] = {{"index", closest}, {"c", Vec(samples.c.row(closest).transpose())},
+  j["closest_sample"] = {{"index", closest},
+                         {"c", Vec(samples.c.row(closest).transpose())},
                          {"point", Vec3J(samples.p.row(closest).transpose())}};
   j["samples"] = SamplesJson(samples);
   j["runs"] = runs;
@@ -317,7 +331,8 @@ nlohmann::json RunIkTrajectory(const Config& cfg, const std::string& dir, bool v
   double total = 0;
   for (size_t i = 0; i < paths.size(); ++i) {
     kin.Reset();
-    const IkPath path = MakeIkPath(paths[i], cfg.path() + ": paths[" + std::to_string(i) + "]", kin, samples);
+    const IkPath path =
+        MakeIkPath(paths[i], cfg.path() + ": paths[" + std::to_string(i) + "]", kin, samples);
     const TrajectoryResult r = Follow(kin, path.waypoints, samples, s, s.ik,
                                       dir + "/path_" + path.name + ".csv", path.name, verbose);
     const PathStats st = Stats(r.waypoints, kin, s.lambda_mm);
@@ -355,10 +370,10 @@ nlohmann::json RunIkMethods(const Config& cfg, const std::string& dir, bool verb
   const Eigen::VectorXd closest =
       samples.c.row(ClosestSample(samples, path.waypoints.row(0).transpose())).transpose();
 
-  CsvWriter csv(dir + "/methods.csv", {"method", "jacobian", "waypoints", "converged", "ms_per_waypoint",
-                                       "mean_err_mm", "max_err_mm", "fk_calls", "fk_calls_per_waypoint",
-                                       "evaluations", "mean_iterations", "failures", "initial_sample",
-                                       "initial_starts_tried"});
+  CsvWriter csv(dir + "/methods.csv",
+                {"method", "jacobian", "waypoints", "converged", "ms_per_waypoint", "mean_err_mm",
+                 "max_err_mm", "fk_calls", "fk_calls_per_waypoint", "evaluations",
+                 "mean_iterations", "failures", "initial_sample", "initial_starts_tried"});
   nlohmann::json rows = nlohmann::json::array();
   // Resume: each finished method x Jacobian row is journaled with every setting that produced it
   // (the config but its method and Jacobian lists); a rerun reuses matching rows.
@@ -369,11 +384,14 @@ nlohmann::json RunIkMethods(const Config& cfg, const std::string& dir, bool verb
     for (size_t k = 0; k < p.jmodes.size(); ++k) {
       if (derivative_free && k > 0) break;
       const std::string jname = derivative_free ? "none" : JacobianModeToString(p.jmodes[k]);
-      const nlohmann::json key = {{"settings", p.settings}, {"method", IkMethodToString(m)}, {"jacobian", jname}};
+      const nlohmann::json key = {
+          {"settings", p.settings}, {"method", IkMethodToString(m)}, {"jacobian", jname}};
       if (const nlohmann::json* done = journal.Reuse(key)) {
         rows.push_back(*done);
         csv.RowJson(*done);
-        if (verbose) std::fprintf(stderr, "  %s/%s: resumed from methods.jsonl\n", IkMethodToString(m).c_str(), jname.c_str());
+        if (verbose)
+          std::fprintf(stderr, "  %s/%s: resumed from methods.jsonl\n", IkMethodToString(m).c_str(),
+                       jname.c_str());
         continue;
       }
       rows.push_back(MethodRow(p, model, m, p.jmodes[k], jname, path, samples, dir, verbose));

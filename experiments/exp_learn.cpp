@@ -32,7 +32,7 @@ double Seconds(std::chrono::steady_clock::time_point t0) {
 
 /// The keys of a learn_architecture config.
 struct ArchitectureParams {
-  nlohmann::json datasets;  ///< an array of dataset objects
+  nlohmann::json datasets;           ///< an array of dataset objects
   std::vector<int> layers, neurons;  ///< h and b of N_fk
   bool jac = true;                   ///< also N_J (on datasets with Jacobians)
   std::vector<int> jac_layers, jac_neurons;
@@ -51,7 +51,8 @@ ArchitectureParams ReadArchitectureParams(const Config& cfg) {
   p.lm = ReadLm(cfg);
   p.seed = cfg.seed();
   cfg.CheckNoUnknownKeys();
-  if (!p.datasets.is_array() || p.datasets.empty()) cfg.Fail("datasets", "a non-empty array of dataset objects");
+  if (!p.datasets.is_array() || p.datasets.empty())
+    cfg.Fail("datasets", "a non-empty array of dataset objects");
   for (int h : p.layers)
     if (h < 1 || h > 8) cfg.Fail("layers", "hidden-layer counts in [1, 8]");
   for (int b : p.neurons)
@@ -65,16 +66,21 @@ struct ArchitectureData {
   nlohmann::json spec_json;  ///< the config's dataset object (part of the journal's key)
   SampleSet pos, js;         ///< positions, and Jacobians (if trained)
   TrainTestSets split;
-  double width = 0;          ///< workspace width, mm
-  double range = 0;          ///< the largest actuation range
+  double width = 0;  ///< workspace width, mm
+  double range = 0;  ///< the largest actuation range
 };
 
 /// Trains one network (or reuses its journaled row) and returns its row.
-nlohmann::json ArchitectureRow(const ArchitectureParams& p, const ArchitectureData& d, const std::string& net,
-                               int h, int b, ResumeJournal* journal, bool verbose) {
+nlohmann::json ArchitectureRow(const ArchitectureParams& p, const ArchitectureData& d,
+                               const std::string& net, int h, int b, ResumeJournal* journal,
+                               bool verbose) {
   const SampleSet& s = net == "fk" ? d.pos : d.js;
-  const nlohmann::json key = {{"dataset", d.spec_json}, {"net", net}, {"h", h}, {"b", b},
-                              {"seed", p.seed}, {"epochs", p.lm.max_epochs},
+  const nlohmann::json key = {{"dataset", d.spec_json},
+                              {"net", net},
+                              {"h", h},
+                              {"b", b},
+                              {"seed", p.seed},
+                              {"epochs", p.lm.max_epochs},
                               {"max_train_time_s", p.lm.max_time_s}};
   // The Jacobian's error is quoted as the tip displacement error of a step of 1/10 of the
   // actuation range (the finite-difference step of Sec. 5.2.1), as % of the workspace width.
@@ -84,27 +90,35 @@ nlohmann::json ArchitectureRow(const ArchitectureParams& p, const ArchitectureDa
   if (done) {
     row = *done;
   } else {
-    const SampleSet train = SelectRows(s, d.split.train_rows), test = SelectRows(s, d.split.test_rows);
+    const SampleSet train = SelectRows(s, d.split.train_rows),
+                    test = SelectRows(s, d.split.test_rows);
     NetTrainOptions o;
     o.hidden.assign(h, b);
     o.lm = p.lm;
     o.split_seed = p.seed;
     const NetTrainResult t = TrainNet(train, test, o);
-    row = {{"robot", d.spec.robot}, {"net", net}, {"h", h}, {"b", b},
+    row = {{"robot", d.spec.robot},
+           {"net", net},
+           {"h", h},
+           {"b", b},
            {"parameters", t.net.num_parameters()},
-           {"test_mean", t.test.mean_dist}, {"test_max", t.test.max_dist},
+           {"test_mean", t.test.mean_dist},
+           {"test_max", t.test.max_dist},
            {"test_mean_pct", scale * t.test.mean_dist},
            {"test_max_pct", scale * t.test.max_dist},
-           {"relative", t.test.relative}, {"epochs", t.lm.epochs},
+           {"relative", t.test.relative},
+           {"epochs", t.lm.epochs},
            {"time_s", t.lm.total_time_s},
            {"termination", LmTerminationToString(t.lm.termination)}};
     journal->Append(key, row);
   }
   if (verbose)
-    std::fprintf(stderr, "  %s N_%s h=%d b=%d: test mean %.4f%% (max %.4f%%) of %.1f mm, %d epochs, %.1f s%s\n",
-                 d.spec.robot.c_str(), net.c_str(), h, b, row["test_mean_pct"].get<double>(),
-                 row["test_max_pct"].get<double>(), d.width, row["epochs"].get<int>(),
-                 row["time_s"].get<double>(), done ? " (resumed from architecture.jsonl)" : "");
+    std::fprintf(
+        stderr,
+        "  %s N_%s h=%d b=%d: test mean %.4f%% (max %.4f%%) of %.1f mm, %d epochs, %.1f s%s\n",
+        d.spec.robot.c_str(), net.c_str(), h, b, row["test_mean_pct"].get<double>(),
+        row["test_max_pct"].get<double>(), d.width, row["epochs"].get<int>(),
+        row["time_s"].get<double>(), done ? " (resumed from architecture.jsonl)" : "");
   return row;
 }
 
@@ -144,12 +158,18 @@ nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, b
         }
     }
   }
-  return {{"rows", rows}, {"datasets", datasets}, {"resumed_rows", journal.reused()},
+  return {{"rows", rows},
+          {"datasets", datasets},
+          {"resumed_rows", journal.reused()},
           {"jacobian_error_note",
-           "N_J errors are |dJ| x (range/10) (the tip error of a 1/10-range step), as % of the workspace width"},
-          {"thesis", {{"three_chamber", {{"fk", {{"h", 2}, {"b", 35}, {"test_mean_mm", 0.17}, {"test_mean_pct", 0.34}}}}},
-                      {"finger_manipulator", {{"fk", {{"h", 3}, {"b", 30}, {"test_mean_pct", 0.58}}},
-                                              {"jac", {{"h", 2}, {"b", 64}}}}}}}};
+           "N_J errors are |dJ| x (range/10) (the tip error of a 1/10-range step), as % of the "
+           "workspace width"},
+          {"thesis",
+           {{"three_chamber",
+             {{"fk", {{"h", 2}, {"b", 35}, {"test_mean_mm", 0.17}, {"test_mean_pct", 0.34}}}}},
+            {"finger_manipulator",
+             {{"fk", {{"h", 3}, {"b", 30}, {"test_mean_pct", 0.58}}},
+              {"jac", {{"h", 2}, {"b", 64}}}}}}}};
 }
 
 namespace {
@@ -161,9 +181,9 @@ struct IkMethodsParams {
   DatasetSpec spec;
   NetsFromDatasetOptions nets;
   int n_targets = 50;
-  int n_numerical = 5;          ///< targets of the (slow) simulator-in-the-loop method
-  double eps_pct = 0.1;         ///< lambda of the simulator, % of the workspace width
-  double net_eps_pct = 0.01;    ///< lambda of the (cheap) models
+  int n_numerical = 5;        ///< targets of the (slow) simulator-in-the-loop method
+  double eps_pct = 0.1;       ///< lambda of the simulator, % of the workspace width
+  double net_eps_pct = 0.01;  ///< lambda of the (cheap) models
   int max_iter = 30;
   std::vector<std::string> methods;
   unsigned seed = 0;
@@ -177,7 +197,8 @@ IkMethodsParams ReadIkMethodsParams(const Config& cfg) {
   no.jac_options.hidden = Layers(cfg, "jac_hidden", {64, 64});
   no.ik_options.hidden = Layers(cfg, "ik_hidden", {35, 35});
   no.fk_options.lm = no.jac_options.lm = no.ik_options.lm = ReadLm(cfg);
-  no.split_seed = no.fk_options.split_seed = no.jac_options.split_seed = no.ik_options.split_seed = cfg.seed();
+  no.split_seed = no.fk_options.split_seed = no.jac_options.split_seed = no.ik_options.split_seed =
+      cfg.seed();
   p.n_targets = cfg.Int("targets", 50);
   p.n_numerical = cfg.Int("numerical_targets", 5);
   p.eps_pct = cfg.Number("lambda_pct_width", 0.1);
@@ -186,7 +207,8 @@ IkMethodsParams ReadIkMethodsParams(const Config& cfg) {
   p.methods = cfg.StringList("methods", {"pcc", "numerical", "direct", "learned"});
   p.seed = cfg.seed();
   cfg.CheckNoUnknownKeys();
-  if (!p.spec.jacobian) cfg.Fail("dataset.jacobian", "true (N_J is trained on the recorded Jacobians)");
+  if (!p.spec.jacobian)
+    cfg.Fail("dataset.jacobian", "true (N_J is trained on the recorded Jacobians)");
   if (p.n_targets < 1) cfg.Fail("targets", "an integer >= 1");
   if (p.n_numerical < 0) cfg.Fail("numerical_targets", "an integer >= 0");
   if (!(p.eps_pct > 0)) cfg.Fail("lambda_pct_width", "a percentage > 0");
@@ -221,17 +243,23 @@ struct IkMethodsSetup {
   const LearnedNets& nets;
   Kinematics& truth;
   const Eigen::MatrixX3d& targets;
-  double width;     ///< workspace width, mm
-  IkOptions io;     ///< gauss-newton to the simulator's lambda
+  double width;  ///< workspace width, mm
+  IkOptions io;  ///< gauss-newton to the simulator's lambda
 };
 
 /// One method of Table 5.1 on the targets: rows of targets.csv and the method's summary row.
-nlohmann::json IkMethodRow(const IkMethodsSetup& s, const std::string& method, CsvWriter* csv, bool verbose) {
+nlohmann::json IkMethodRow(const IkMethodsSetup& s, const std::string& method, CsvWriter* csv,
+                           bool verbose) {
   static const std::map<std::string, std::pair<double, double>> kThesis = {
-      {"pcc", {12.6, 8.2}}, {"numerical", {138000.0, 4.7}}, {"direct", {3.2, 0.97}}, {"learned", {28.0, 0.78}}};
+      {"pcc", {12.6, 8.2}},
+      {"numerical", {138000.0, 4.7}},
+      {"direct", {3.2, 0.97}},
+      {"learned", {28.0, 0.78}}};
   static const std::map<std::string, std::string> kLabel = {
-      {"pcc", "PCC analytical"}, {"numerical", "simulation-in-the-loop (implicit J)"},
-      {"direct", "direct IK learning"}, {"learned", "learned Jacobian"}};
+      {"pcc", "PCC analytical"},
+      {"numerical", "simulation-in-the-loop (implicit J)"},
+      {"direct", "direct IK learning"},
+      {"learned", "learned Jacobian"}};
   const IkMethodsParams& p = s.p;
   std::unique_ptr<Kinematics> model;
   nlohmann::json extra = nlohmann::json::object();
@@ -266,7 +294,8 @@ nlohmann::json IkMethodRow(const IkMethodsSetup& s, const std::string& method, C
       const Eigen::VectorXd c0 = samples.c.row(ClosestSample(samples, t)).transpose();
       PointTrackingObjective obj(model->point_names(), model->point_names().front(), t);
       IkOptions mo = s.io;
-      if (method != "numerical") mo.lambda = std::pow(p.net_eps_pct / 100.0 * s.width, 2);  // models are cheap
+      if (method != "numerical")
+        mo.lambda = std::pow(p.net_eps_pct / 100.0 * s.width, 2);  // models are cheap
       const IkResult r = SolveIk(*model, obj, c0, mo);
       c = r.c;
       pred = std::sqrt(r.objective);
@@ -287,18 +316,24 @@ nlohmann::json IkMethodRow(const IkMethodsSetup& s, const std::string& method, C
     if (verbose && method == "numerical")
       std::fprintf(stderr, "  numerical target %d/%d: %.3f mm, %.2f s\n", i + 1, n, err, dt);
   }
-  nlohmann::json row = {{"method", method}, {"label", kLabel.at(method)}, {"targets", n},
+  nlohmann::json row = {{"method", method},
+                        {"label", kLabel.at(method)},
+                        {"targets", n},
                         {"evaluated", ok},
                         {"ms_per_waypoint", ok ? 1e3 * time / ok : 0.0},
-                        {"mean_err_mm", ok ? sum / ok : 0.0}, {"max_err_mm", worst},
+                        {"mean_err_mm", ok ? sum / ok : 0.0},
+                        {"max_err_mm", worst},
                         {"mean_err_pct_width", ok ? 100.0 * sum / ok / s.width : 0.0},
                         {"thesis_ms_per_waypoint", kThesis.at(method).first},
                         {"thesis_mean_err_mm", kThesis.at(method).second}};
   row.update(extra);
   if (verbose)
-    std::fprintf(stderr, "  %-10s %3d targets: %.3f ms per waypoint, error mean %.3f mm, max %.3f mm (thesis %.1f ms, %.2f mm)\n",
-                 method.c_str(), ok, row["ms_per_waypoint"].get<double>(), row["mean_err_mm"].get<double>(),
-                 worst, kThesis.at(method).first, kThesis.at(method).second);
+    std::fprintf(stderr,
+                 "  %-10s %3d targets: %.3f ms per waypoint, error mean %.3f mm, max %.3f mm "
+                 "(thesis %.1f ms, %.2f mm)\n",
+                 method.c_str(), ok, row["ms_per_waypoint"].get<double>(),
+                 row["mean_err_mm"].get<double>(), worst, kThesis.at(method).first,
+                 kThesis.at(method).second);
   return row;
 }
 
@@ -309,9 +344,12 @@ nlohmann::json RunLearnIkMethods(const Config& cfg, const std::string& dir, bool
   // Data and networks.
   nlohmann::json dinfo;
   const Dataset d = CachedDataset(p.spec, DatasetCacheDir(dir), verbose, &dinfo);
-  if (verbose) std::fprintf(stderr, "  training N_fk, N_J, N_ik on %lld samples\n", static_cast<long long>(d.inputs.rows()));
+  if (verbose)
+    std::fprintf(stderr, "  training N_fk, N_J, N_ik on %lld samples\n",
+                 static_cast<long long>(d.inputs.rows()));
   const auto t_train = std::chrono::steady_clock::now();
-  LearnedNets nets = CachedNets(d, dinfo["path"].get<std::string>(), p.spec.Tag(), p.nets, NetsCacheDir(dir), verbose);
+  LearnedNets nets = CachedNets(d, dinfo["path"].get<std::string>(), p.spec.Tag(), p.nets,
+                                NetsCacheDir(dir), verbose);
   const double train_s = Seconds(t_train);
   nets.Save(dir + "/nets");
   const double width = nets.info["dataset"]["workspace_width_mm"].get<double>();
@@ -326,29 +364,39 @@ nlohmann::json RunLearnIkMethods(const Config& cfg, const std::string& dir, bool
   io.max_iterations = p.max_iter;
   const IkMethodsSetup setup{p, d, nets, *truth, targets, width, io};
   CsvWriter csv(dir + "/targets.csv", {"method", "i", "target_x", "target_y", "target_z", "err_mm",
-                                        "predicted_err_mm", "time_ms", "iterations"});
+                                       "predicted_err_mm", "time_ms", "iterations"});
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& method : p.methods) rows.push_back(IkMethodRow(setup, method, &csv, verbose));
-  return {{"rows", rows}, {"dataset", dinfo}, {"networks", nets.info}, {"training_time_s", train_s},
-          {"workspace_width_mm", width}, {"lambda_mm", eps_mm},
+  return {{"rows", rows},
+          {"dataset", dinfo},
+          {"networks", nets.info},
+          {"training_time_s", train_s},
+          {"workspace_width_mm", width},
+          {"lambda_mm", eps_mm},
           {"model_lambda_mm", p.net_eps_pct / 100.0 * width},
-          {"errors_note", "every error is measured by the simulator at the method's actuation, on seeded random targets the simulator reaches (not on the training grid)"}};
+          {"errors_note",
+           "every error is measured by the simulator at the method's actuation, on seeded random "
+           "targets the simulator reaches (not on the training grid)"}};
 }
 
-// ---- Fig. 5.10 / 5.12: the redundant finger_manipulator on a path, learned Jacobian vs direct IK ----
+// ---- Fig. 5.10 / 5.12: the redundant finger_manipulator on a path, learned Jacobian vs direct IK
+// ----
 namespace {
 
 /// A figure '8' (lemniscate of Gerono) of n waypoints in the plane of axes (au, av) around
 /// centre: u = half_u sin t, v = half_v sin t cos t, t = 2 pi i / n.
 Eigen::MatrixX3d EightPath(const nlohmann::json& spec, const std::string& where) {
   auto num = [&](const char* k) {
-    if (!spec.contains(k) || !spec[k].is_number()) throw std::invalid_argument(where + "." + k + ": expected a number");
+    if (!spec.contains(k) || !spec[k].is_number())
+      throw std::invalid_argument(where + "." + k + ": expected a number");
     return spec[k].get<double>();
   };
   for (auto it = spec.begin(); it != spec.end(); ++it)
     if (it.key() != "name" && it.key() != "type" && it.key() != "center" && it.key() != "half_u" &&
         it.key() != "half_v" && it.key() != "axes" && it.key() != "n" && it.key() != "thesis")
-      throw std::invalid_argument(where + "." + it.key() + ": unknown key (expected name, type, center, half_u, half_v, axes, n, thesis)");
+      throw std::invalid_argument(
+          where + "." + it.key() +
+          ": unknown key (expected name, type, center, half_u, half_v, axes, n, thesis)");
   if (!spec.contains("center") || !spec["center"].is_array() || spec["center"].size() != 3)
     throw std::invalid_argument(where + ".center: expected [x, y, z] in mm");
   Eigen::Vector3d c;
@@ -358,7 +406,8 @@ Eigen::MatrixX3d EightPath(const nlohmann::json& spec, const std::string& where)
     au = spec["axes"][0].get<int>();
     av = spec["axes"][1].get<int>();
   }
-  if (au < 0 || au > 2 || av < 0 || av > 2 || au == av) throw std::invalid_argument(where + ".axes: expected two different axes out of 0, 1, 2");
+  if (au < 0 || au > 2 || av < 0 || av > 2 || au == av)
+    throw std::invalid_argument(where + ".axes: expected two different axes out of 0, 1, 2");
   if (!spec.contains("n") || !spec["n"].is_number_integer() || spec["n"].get<int>() < 4)
     throw std::invalid_argument(where + ".n: expected an integer >= 4");
   const int n = spec["n"].get<int>();
@@ -393,10 +442,12 @@ RedundantPathParams ReadRedundantPathParams(const Config& cfg) {
   no.jac_options.hidden = Layers(cfg, "jac_hidden", {30, 30});
   no.ik_options.hidden = Layers(cfg, "ik_hidden", {30, 30});
   no.fk_options.lm = no.jac_options.lm = no.ik_options.lm = ReadLm(cfg);
-  no.split_seed = no.fk_options.split_seed = no.jac_options.split_seed = no.ik_options.split_seed = cfg.seed();
+  no.split_seed = no.fk_options.split_seed = no.jac_options.split_seed = no.ik_options.split_seed =
+      cfg.seed();
   p.max_iter = cfg.Int("max_iterations", 30);
   cfg.CheckNoUnknownKeys();
-  if (!p.spec.jacobian) cfg.Fail("dataset.jacobian", "true (N_J is trained on the recorded Jacobians)");
+  if (!p.spec.jacobian)
+    cfg.Fail("dataset.jacobian", "true (N_J is trained on the recorded Jacobians)");
   if (!p.path_spec.is_object()) cfg.Fail("path", "a path object");
   return p;
 }
@@ -409,11 +460,13 @@ struct MethodPath {
 
 /// Measures a method's actuations with the truth (warm-started along the path): rows of
 /// path_<method>.csv and the method's summary row.
-nlohmann::json MeasurePath(const std::string& method, const MethodPath& mp, const Eigen::MatrixX3d& waypoints,
-                           Kinematics& truth, double width, const std::string& dir, bool verbose) {
+nlohmann::json MeasurePath(const std::string& method, const MethodPath& mp,
+                           const Eigen::MatrixX3d& waypoints, Kinematics& truth, double width,
+                           const std::string& dir, bool verbose) {
   const std::vector<Eigen::VectorXd>& cs = mp.cs;
   const Eigen::VectorXd range = truth.upper() - truth.lower();
-  std::vector<std::string> head = {"i", "target_x", "target_y", "target_z", "x", "y", "z", "err_mm", "time_ms", "jump"};
+  std::vector<std::string> head = {"i", "target_x", "target_y", "target_z", "x",
+                                   "y", "z",        "err_mm",   "time_ms",  "jump"};
   for (int a = 0; a < truth.num_actuators(); ++a) head.push_back("c" + std::to_string(a));
   CsvWriter csv(dir + "/path_" + method + ".csv", head);
   double sum = 0, worst = 0, time = 0, max_jump = 0, max_jump_frac = 0;
@@ -424,13 +477,15 @@ nlohmann::json MeasurePath(const std::string& method, const MethodPath& mp, cons
     if (i > 0) {
       jump = (cs[i] - cs[i - 1]).cwiseAbs().maxCoeff();
       max_jump = std::max(max_jump, jump);
-      max_jump_frac = std::max(max_jump_frac, (cs[i] - cs[i - 1]).cwiseAbs().cwiseQuotient(range).maxCoeff());
+      max_jump_frac =
+          std::max(max_jump_frac, (cs[i] - cs[i - 1]).cwiseAbs().cwiseQuotient(range).maxCoeff());
     }
     if (!e.ok) continue;
     const Eigen::Vector3d p = e.p.row(0).transpose(), t = waypoints.row(i).transpose();
     const double err = (p - t).norm();
-    std::vector<double> row = {static_cast<double>(i), t.x(), t.y(), t.z(), p.x(), p.y(), p.z(), err,
-                               1e3 * mp.times[i], jump};
+    std::vector<double> row = {
+        static_cast<double>(i), t.x(), t.y(), t.z(), p.x(), p.y(), p.z(), err,
+        1e3 * mp.times[i],      jump};
     for (int a = 0; a < cs[i].size(); ++a) row.push_back(cs[i][a]);
     csv.Row(row);
     ++ok;
@@ -438,21 +493,31 @@ nlohmann::json MeasurePath(const std::string& method, const MethodPath& mp, cons
     worst = std::max(worst, err);
     time += mp.times[i];
     if (verbose && (i + 1) % 20 == 0)
-      std::fprintf(stderr, "  %s: %zu/%zu waypoints measured by the simulator\n", method.c_str(), i + 1, cs.size());
+      std::fprintf(stderr, "  %s: %zu/%zu waypoints measured by the simulator\n", method.c_str(),
+                   i + 1, cs.size());
   }
   if (verbose)
-    std::fprintf(stderr, "  %s: error mean %.3f mm (%.3f %%), max %.3f mm (%.3f %%), largest jump %.3f (%.1f %% of the range), %.3f ms per waypoint\n",
-                 method.c_str(), ok ? sum / ok : 0.0, ok ? 100.0 * sum / ok / width : 0.0, worst, 100.0 * worst / width,
-                 max_jump, 100.0 * max_jump_frac, ok ? 1e3 * time / ok : 0.0);
-  return {{"method", method}, {"waypoints", cs.size()}, {"measured", ok},
-          {"mean_err_mm", ok ? sum / ok : 0.0}, {"max_err_mm", worst},
-          {"mean_err_pct", ok ? 100.0 * sum / ok / width : 0.0}, {"max_err_pct", 100.0 * worst / width},
-          {"ms_per_waypoint", ok ? 1e3 * time / ok : 0.0}, {"max_jump", max_jump},
+    std::fprintf(stderr,
+                 "  %s: error mean %.3f mm (%.3f %%), max %.3f mm (%.3f %%), largest jump %.3f "
+                 "(%.1f %% of the range), %.3f ms per waypoint\n",
+                 method.c_str(), ok ? sum / ok : 0.0, ok ? 100.0 * sum / ok / width : 0.0, worst,
+                 100.0 * worst / width, max_jump, 100.0 * max_jump_frac,
+                 ok ? 1e3 * time / ok : 0.0);
+  return {{"method", method},
+          {"waypoints", cs.size()},
+          {"measured", ok},
+          {"mean_err_mm", ok ? sum / ok : 0.0},
+          {"max_err_mm", worst},
+          {"mean_err_pct", ok ? 100.0 * sum / ok / width : 0.0},
+          {"max_err_pct", 100.0 * worst / width},
+          {"ms_per_waypoint", ok ? 1e3 * time / ok : 0.0},
+          {"max_jump", max_jump},
           {"max_jump_fraction", max_jump_frac}};
 }
 
 /// The learned Jacobian IK (Algorithm 4 on the networks) along the waypoints.
-MethodPath LearnedPath(NetKinematics& kin, const Eigen::MatrixX3d& waypoints, const TrajectoryOptions& to) {
+MethodPath LearnedPath(NetKinematics& kin, const Eigen::MatrixX3d& waypoints,
+                       const TrajectoryOptions& to) {
   MethodPath mp;
   const TrajectoryResult r = FollowTrajectory(kin, waypoints, to);
   for (const auto& w : r.waypoints) {
@@ -479,7 +544,8 @@ nlohmann::json RunLearnRedundantPath(const Config& cfg, const std::string& dir, 
   const RedundantPathParams p = ReadRedundantPathParams(cfg);
   nlohmann::json dinfo;
   const Dataset d = CachedDataset(p.spec, DatasetCacheDir(dir), verbose, &dinfo);
-  LearnedNets nets = CachedNets(d, dinfo["path"].get<std::string>(), p.spec.Tag(), p.nets, NetsCacheDir(dir), verbose);
+  LearnedNets nets = CachedNets(d, dinfo["path"].get<std::string>(), p.spec.Tag(), p.nets,
+                                NetsCacheDir(dir), verbose);
   const double width = nets.info["dataset"]["workspace_width_mm"].get<double>();
   NetKinematics kin(nets, JacobianSource::kNetwork, false);
   SamplingOptions so;
@@ -504,10 +570,14 @@ nlohmann::json RunLearnRedundantPath(const Config& cfg, const std::string& dir, 
   to.sampling = so;
   nlohmann::json rows = nlohmann::json::array();
   for (const std::string method : {"learned", "direct"}) {
-    const MethodPath mp = method == "learned" ? LearnedPath(kin, waypoints, to) : DirectPath(nets, waypoints);
+    const MethodPath mp =
+        method == "learned" ? LearnedPath(kin, waypoints, to) : DirectPath(nets, waypoints);
     rows.push_back(MeasurePath(method, mp, waypoints, *truth, width, dir, verbose));
   }
-  return {{"rows", rows}, {"path", pinfo}, {"dataset", dinfo}, {"networks", nets.info},
+  return {{"rows", rows},
+          {"path", pinfo},
+          {"dataset", dinfo},
+          {"networks", nets.info},
           {"workspace_width_mm", width},
           {"errors_note", "errors are measured by the simulator at each method's actuation"},
           {"thesis", p.path_spec.value("thesis", nlohmann::json::object())}};

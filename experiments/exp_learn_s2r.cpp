@@ -26,7 +26,7 @@ struct DataSourceParams {
   DatasetSpec sim_spec, twin_spec;
   std::vector<int> sizes;  ///< twin samples the s2r layer is trained on
   double eta = 0.25;
-  int test_n = 200;        ///< the twin's last samples, the test set
+  int test_n = 200;  ///< the twin's last samples, the test set
   std::vector<int> fk_hidden;
   LmOptions lm;
   unsigned seed = 0;
@@ -70,7 +70,8 @@ Dataset PccDataset(const Dataset& sim, const PccChamberKinematics& pcc) {
   ana.point_names = {"tip"};
   ana.positions.resize(ana.inputs.rows(), 3);
   for (int i = 0; i < ana.inputs.rows(); ++i)
-    ana.positions.row(i) = PccChamberKinematics::Tip(pcc.params(), ana.inputs.row(i).transpose()).transpose();
+    ana.positions.row(i) =
+        PccChamberKinematics::Tip(pcc.params(), ana.inputs.row(i).transpose()).transpose();
   return ana;
 }
 
@@ -95,7 +96,8 @@ nlohmann::json S2rRow(const DataSourceParams& p, const std::string& source, cons
   so.hidden = {S2rNeurons(p.eta, ts)};
   so.lm = p.lm;
   so.split_seed = p.seed;
-  const NetTrainResult r = TrainNet(S2rSamples(nets.fk, part.inputs, part.positions), SampleSet{}, so);
+  const NetTrainResult r =
+      TrainNet(S2rSamples(nets.fk, part.inputs, part.positions), SampleSet{}, so);
   const Eigen::MatrixXd pred = r.net.ForwardBatch(nets.fk.ForwardBatch(t.c_test));
   const Eigen::VectorXd e = (pred - t.p_test).rowwise().norm();
   const double width = t.width;
@@ -106,10 +108,14 @@ nlohmann::json S2rRow(const DataSourceParams& p, const std::string& source, cons
                      std::to_string(100.0 * e[i] / width)});
   }
   if (verbose)
-    std::fprintf(stderr, "  %s + s2r(TS#=%d): mean %.3f mm (%.2f %%), %.0f %% of test points within 1 %%\n",
+    std::fprintf(stderr,
+                 "  %s + s2r(TS#=%d): mean %.3f mm (%.2f %%), %.0f %% of test points within 1 %%\n",
                  source.c_str(), ts, e.mean(), 100.0 * e.mean() / width, 100.0 * within / e.size());
-  return {{"source", source}, {"ts", ts}, {"s2r_neurons", so.hidden[0]},
-          {"mean_err_mm", e.mean()}, {"max_err_mm", e.maxCoeff()},
+  return {{"source", source},
+          {"ts", ts},
+          {"s2r_neurons", so.hidden[0]},
+          {"mean_err_mm", e.mean()},
+          {"max_err_mm", e.maxCoeff()},
           {"mean_err_pct", 100.0 * e.mean() / width},
           {"within_1pct", static_cast<double>(within) / e.size()}};
 }
@@ -123,10 +129,12 @@ nlohmann::json RunLearnDataSource(const Config& cfg, const std::string& dir, boo
   const Dataset twin = CachedDataset(p.twin_spec, DatasetCacheDir(dir), verbose, &twin_info);
   const int max_train = *std::max_element(p.sizes.begin(), p.sizes.end());
   if (twin.inputs.rows() < max_train + p.test_n)
-    cfg.Fail("twin_dataset", "at least max(s2r_samples) + test_samples = " + std::to_string(max_train + p.test_n) +
-                                 " twin samples (it has " + std::to_string(twin.inputs.rows()) + ")");
+    cfg.Fail("twin_dataset",
+             "at least max(s2r_samples) + test_samples = " + std::to_string(max_train + p.test_n) +
+                 " twin samples (it has " + std::to_string(twin.inputs.rows()) + ")");
   // The twin's last test_n samples are the test set; the s2r training sets are nested prefixes.
-  const TwinData t{twin, twin.inputs.bottomRows(p.test_n), twin.positions.bottomRows(p.test_n).leftCols(3),
+  const TwinData t{twin, twin.inputs.bottomRows(p.test_n),
+                   twin.positions.bottomRows(p.test_n).leftCols(3),
                    WorkspaceWidth(twin.positions.leftCols(3))};
 
   // The analytical data: the PCC model calibrated on the simulator's data.
@@ -144,19 +152,28 @@ nlohmann::json RunLearnDataSource(const Config& cfg, const std::string& dir, boo
     o.fk_options.lm = p.lm;
     o.split_seed = o.fk_options.split_seed = p.seed;
     const LearnedNets base = CachedNets(source == "simulator" ? simd : ana, source,
-                                        (source == "simulator" ? "" : "pccfit-") + p.sim_spec.Tag(), o,
-                                        NetsCacheDir(dir), verbose);
+                                        (source == "simulator" ? "" : "pccfit-") + p.sim_spec.Tag(),
+                                        o, NetsCacheDir(dir), verbose);
     // Without s2r: N_fk against the twin.
     const Eigen::MatrixXd pred0 = base.fk.ForwardBatch(t.c_test);
     const double err0 = (pred0 - t.p_test).rowwise().norm().mean();
-    sources.push_back({{"source", source}, {"fk_test_pct_width", base.info["fk"]["test_mean_pct_width"]},
+    sources.push_back({{"source", source},
+                       {"fk_test_pct_width", base.info["fk"]["test_mean_pct_width"]},
                        {"twin_mean_err_without_s2r_mm", err0}});
-    if (verbose) std::fprintf(stderr, "  N_fk from %s: %.3f mm mean error on the twin without s2r\n", source.c_str(), err0);
+    if (verbose)
+      std::fprintf(stderr, "  N_fk from %s: %.3f mm mean error on the twin without s2r\n",
+                   source.c_str(), err0);
     for (int ts : p.sizes) rows.push_back(S2rRow(p, source, base, t, ts, &csv, verbose));
   }
-  return {{"rows", rows}, {"sources", sources}, {"pcc_fit", fit}, {"dataset", sim_info},
-          {"twin_dataset", twin_info}, {"twin_label", "twin data (simulated hardware, docs/twins.md)"},
-          {"workspace_width_mm", t.width}, {"test_samples", p.test_n}, {"eta", p.eta},
+  return {{"rows", rows},
+          {"sources", sources},
+          {"pcc_fit", fit},
+          {"dataset", sim_info},
+          {"twin_dataset", twin_info},
+          {"twin_label", "twin data (simulated hardware, docs/twins.md)"},
+          {"workspace_width_mm", t.width},
+          {"test_samples", p.test_n},
+          {"eta", p.eta},
           {"thesis", {{"within_1pct_at_ts", {{"simulator", 300}, {"pcc", 1000}}}}}};
 }
 
@@ -164,11 +181,13 @@ namespace {
 
 std::vector<DatasetSpec> TwinSpecs(const Config& cfg, const std::string& key) {
   const nlohmann::json j = cfg.Raw(key);
-  if (!j.is_array() || j.empty()) cfg.Fail(key, "a non-empty array of twin dataset objects {\"twin\", ...}");
+  if (!j.is_array() || j.empty())
+    cfg.Fail(key, "a non-empty array of twin dataset objects {\"twin\", ...}");
   std::vector<DatasetSpec> out;
   for (size_t i = 0; i < j.size(); ++i) {
     out.push_back(ParseDatasetSpec(j[i], cfg.path() + ": " + key + "[" + std::to_string(i) + "]"));
-    if (out.back().twin.empty()) cfg.Fail(key + "[" + std::to_string(i) + "]", "a dataset object with \"twin\"");
+    if (out.back().twin.empty())
+      cfg.Fail(key + "[" + std::to_string(i) + "]", "a dataset object with \"twin\"");
   }
   return out;
 }
@@ -219,8 +238,8 @@ S2rSweepParams ReadS2rSweepParams(const Config& cfg) {
 }
 
 /// Both sweeps on one twin: rows of s2r_sweep.csv and of the summary.
-void SweepTwin(const S2rSweepParams& p, const DatasetSpec& ts, const Dataset& twin, const LearnedNets& nets,
-               CsvWriter* csv, nlohmann::json* rows, bool verbose) {
+void SweepTwin(const S2rSweepParams& p, const DatasetSpec& ts, const Dataset& twin,
+               const LearnedNets& nets, CsvWriter* csv, nlohmann::json* rows, bool verbose) {
   const SampleSet all = S2rSamples(nets.fk, twin.inputs, twin.positions.leftCols(3));
   const int n = all.size();
   std::vector<int> test_rows;
@@ -235,16 +254,24 @@ void SweepTwin(const S2rSweepParams& p, const DatasetSpec& ts, const Dataset& tw
     so.lm = p.lm;
     so.split_seed = p.seed;
     const NetTrainResult r = TrainNet(SelectRows(all, rows_k), test, so);
-    rows->push_back({{"twin", ts.twin}, {"sweep", sweep}, {"eta", eta}, {"samples", samples},
-                     {"neurons", so.hidden[0]}, {"train_mm", r.train.mean_dist},
-                     {"test_mm", r.test.mean_dist}, {"test_max_mm", r.test.max_dist},
+    rows->push_back({{"twin", ts.twin},
+                     {"sweep", sweep},
+                     {"eta", eta},
+                     {"samples", samples},
+                     {"neurons", so.hidden[0]},
+                     {"train_mm", r.train.mean_dist},
+                     {"test_mm", r.test.mean_dist},
+                     {"test_max_mm", r.test.max_dist},
                      {"without_mm", without}});
     csv->RowStrings({ts.twin, sweep, std::to_string(eta), std::to_string(samples),
                      std::to_string(so.hidden[0]), std::to_string(r.train.mean_dist),
                      std::to_string(r.test.mean_dist), std::to_string(without)});
     if (verbose)
-      std::fprintf(stderr, "  %s eta %.4g, %d samples (%d neurons): train %.3f mm, test %.3f mm (without s2r %.3f mm)\n",
-                   ts.twin.c_str(), eta, samples, so.hidden[0], r.train.mean_dist, r.test.mean_dist, without);
+      std::fprintf(stderr,
+                   "  %s eta %.4g, %d samples (%d neurons): train %.3f mm, test %.3f mm (without "
+                   "s2r %.3f mm)\n",
+                   ts.twin.c_str(), eta, samples, so.hidden[0], r.train.mean_dist, r.test.mean_dist,
+                   without);
   };
   for (double eta : p.etas) run("eta", eta, p.eta_size);
   for (int size : p.sizes) run("samples", p.size_eta, size);
@@ -271,13 +298,17 @@ nlohmann::json RunLearnS2rSweep(const Config& cfg, const std::string& dir, bool 
     nlohmann::json info;
     const Dataset twin = CachedDataset(ts, DatasetCacheDir(dir), verbose, &info);
     if (twin.inputs.rows() < p.need + p.test_n)
-      cfg.Fail("twin_datasets", "at least " + std::to_string(p.need + p.test_n) + " samples per twin (" + ts.twin +
-                                    " has " + std::to_string(twin.inputs.rows()) + ")");
+      cfg.Fail("twin_datasets", "at least " + std::to_string(p.need + p.test_n) +
+                                    " samples per twin (" + ts.twin + " has " +
+                                    std::to_string(twin.inputs.rows()) + ")");
     tinfo.push_back(info);
     SweepTwin(p, ts, twin, nets, &csv, &rows, verbose);
   }
-  return {{"rows", rows}, {"dataset", sim_info}, {"twin_datasets", tinfo},
-          {"fk", nets.info["fk"]}, {"twin_label", "twin data (simulated hardware, docs/twins.md)"},
+  return {{"rows", rows},
+          {"dataset", sim_info},
+          {"twin_datasets", tinfo},
+          {"fk", nets.info["fk"]},
+          {"twin_label", "twin data (simulated hardware, docs/twins.md)"},
           {"thesis", {{"eta", 0.25}, {"twin_samples", {343, 620}}}}};
 }
 
@@ -313,7 +344,8 @@ S2rPathsParams ReadS2rPathsParams(const Config& cfg) {
   p.lm = no.fk_options.lm;
   p.seed = cfg.seed();
   cfg.CheckNoUnknownKeys();
-  if (!p.sim_spec.jacobian) cfg.Fail("dataset.jacobian", "true (N_J is trained on the recorded Jacobians)");
+  if (!p.sim_spec.jacobian)
+    cfg.Fail("dataset.jacobian", "true (N_J is trained on the recorded Jacobians)");
   if (!(p.eta > 0)) cfg.Fail("eta", "a number > 0");
   if (!(p.eps_pct > 0)) cfg.Fail("lambda_pct_width", "a percentage > 0");
   return p;
@@ -321,14 +353,14 @@ S2rPathsParams ReadS2rPathsParams(const Config& cfg) {
 
 /// Follows the path on `nets` (with or without s2r) and measures it on the twin: path_<tag>.csv
 /// and its row.
-nlohmann::json TwinPathRow(const DatasetSpec& ts, const LearnedNets& nets, bool with_s2r, const IkPath& path,
-                           const TrajectoryOptions& to, TwinKinematics& measure, const std::string& dir,
-                           bool verbose) {
+nlohmann::json TwinPathRow(const DatasetSpec& ts, const LearnedNets& nets, bool with_s2r,
+                           const IkPath& path, const TrajectoryOptions& to, TwinKinematics& measure,
+                           const std::string& dir, bool verbose) {
   NetKinematics kin(nets, JacobianSource::kNetwork, with_s2r);
   const TrajectoryResult r = FollowTrajectory(kin, path.waypoints, to);
   const std::string tag = ts.twin.substr(ts.twin.find('/') + 1) + (with_s2r ? "_s2r" : "_nominal");
-  CsvWriter csv(dir + "/path_" + tag + ".csv", {"i", "target_x", "target_y", "target_z", "x", "y", "z",
-                                                 "err_mm", "predicted_err_mm", "time_ms"});
+  CsvWriter csv(dir + "/path_" + tag + ".csv", {"i", "target_x", "target_y", "target_z", "x", "y",
+                                                "z", "err_mm", "predicted_err_mm", "time_ms"});
   double sum = 0, worst = 0, time = 0;
   int ok = 0;
   for (const WaypointResult& w : r.waypoints) {
@@ -336,20 +368,26 @@ nlohmann::json TwinPathRow(const DatasetSpec& ts, const LearnedNets& nets, bool 
     if (!e.ok) continue;
     const Eigen::Vector3d p = e.p.row(0).transpose();
     const double err = (p - w.target).norm();
-    csv.Row({static_cast<double>(w.index), w.target.x(), w.target.y(), w.target.z(), p.x(), p.y(), p.z(),
-             err, w.error_mm, 1e3 * w.time_s});
+    csv.Row({static_cast<double>(w.index), w.target.x(), w.target.y(), w.target.z(), p.x(), p.y(),
+             p.z(), err, w.error_mm, 1e3 * w.time_s});
     ++ok;
     sum += err;
     worst = std::max(worst, err);
     time += w.time_s;
   }
   if (verbose)
-    std::fprintf(stderr, "  %s %s: error on the twin mean %.3f mm, max %.3f mm, %.2f ms per waypoint\n",
+    std::fprintf(stderr,
+                 "  %s %s: error on the twin mean %.3f mm, max %.3f mm, %.2f ms per waypoint\n",
                  ts.twin.c_str(), with_s2r ? "with s2r" : "without s2r", ok ? sum / ok : 0.0, worst,
                  ok ? 1e3 * time / ok : 0.0);
-  return {{"twin", ts.twin}, {"s2r", with_s2r}, {"waypoints", path.waypoints.rows()},
-          {"measured", ok}, {"mean_err_mm", ok ? sum / ok : 0.0}, {"max_err_mm", worst},
-          {"ms_per_waypoint", ok ? 1e3 * time / ok : 0.0}, {"max_jump", r.max_jump},
+  return {{"twin", ts.twin},
+          {"s2r", with_s2r},
+          {"waypoints", path.waypoints.rows()},
+          {"measured", ok},
+          {"mean_err_mm", ok ? sum / ok : 0.0},
+          {"max_err_mm", worst},
+          {"ms_per_waypoint", ok ? 1e3 * time / ok : 0.0},
+          {"max_jump", r.max_jump},
           {"csv", "path_" + tag + ".csv"}};
 }
 
@@ -359,8 +397,8 @@ nlohmann::json RunLearnS2rPaths(const Config& cfg, const std::string& dir, bool 
   const S2rPathsParams p = ReadS2rPathsParams(cfg);
   nlohmann::json sim_info;
   const Dataset sim = CachedDataset(p.sim_spec, DatasetCacheDir(dir), verbose, &sim_info);
-  const LearnedNets nominal = CachedNets(sim, sim_info["path"].get<std::string>(), p.sim_spec.Tag(), p.nets,
-                                         NetsCacheDir(dir), verbose);
+  const LearnedNets nominal = CachedNets(sim, sim_info["path"].get<std::string>(), p.sim_spec.Tag(),
+                                         p.nets, NetsCacheDir(dir), verbose);
   const double width = nominal.info["dataset"]["workspace_width_mm"].get<double>();
   NetKinematics nominal_kin(nominal, JacobianSource::kNetwork, false);
   SamplingOptions so;
@@ -390,9 +428,16 @@ nlohmann::json RunLearnS2rPaths(const Config& cfg, const std::string& dir, bool 
     for (bool with_s2r : {false, true})
       rows.push_back(TwinPathRow(ts, nets, with_s2r, path, to, measure, dir, verbose));
   }
-  return {{"rows", rows}, {"path", path.info}, {"thesis", path.thesis}, {"dataset", sim_info},
-          {"twin_datasets", tinfo}, {"networks", nominal.info}, {"workspace_width_mm", width},
-          {"twin_label", "errors are measured on the twin (simulated hardware, docs/twins.md) without its measurement noise"}};
+  return {{"rows", rows},
+          {"path", path.info},
+          {"thesis", path.thesis},
+          {"dataset", sim_info},
+          {"twin_datasets", tinfo},
+          {"networks", nominal.info},
+          {"workspace_width_mm", width},
+          {"twin_label",
+           "errors are measured on the twin (simulated hardware, docs/twins.md) without its "
+           "measurement noise"}};
 }
 
 }  // namespace softkin

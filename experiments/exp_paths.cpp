@@ -46,7 +46,9 @@ ActuationPathsParams ReadActuationPathsParams(const Config& cfg) {
     std::string name;
     while (std::getline(ss, name, '+')) {
       const int a = p.scene.actuator_index(name);
-      if (a < 0) cfg.Fail("paths", "groups of actuator names of robot '" + p.robot + "', got '" + path + "'");
+      if (a < 0)
+        cfg.Fail("paths",
+                 "groups of actuator names of robot '" + p.robot + "', got '" + path + "'");
       g.push_back(a);
     }
     if (g.empty()) cfg.Fail("paths", "non-empty actuator groups");
@@ -68,9 +70,7 @@ nlohmann::json SweepPath(const ActuationPathsParams& p, size_t k, FkSolver& solv
   const std::string& path = p.paths[k];
   const int tip = p.tip, steps = p.steps;
   // Each actuator of the group goes from its rest value to end_value (default: its far end).
-  auto end_of = [&](int a) {
-    return p.end_value > 0 ? p.end_value : scene.actuators[a].FarEnd();
-  };
+  auto end_of = [&](int a) { return p.end_value > 0 ? p.end_value : scene.actuators[a].FarEnd(); };
   const Actuator& first = scene.actuators[group[0]];
   const double v_end = end_of(group[0]);
   const Eigen::MatrixX3d rest_tips = scene.marker_positions(scene.mesh.vertices);
@@ -106,8 +106,11 @@ nlohmann::json SweepPath(const ActuationPathsParams& p, size_t k, FkSolver& solv
       std::fprintf(stderr, "  [%s %d/%d] %s\n", path.c_str(), s, steps, r.BriefReport().c_str());
   }
   *total_s += path_s;
-  return {{"path", path}, {"end_value", v_end}, {"tips", tips},
-          {"solve_s", path_s}, {"iterations", path_iters}};
+  return {{"path", path},
+          {"end_value", v_end},
+          {"tips", tips},
+          {"solve_s", path_s},
+          {"iterations", path_iters}};
 }
 
 }  // namespace

@@ -28,7 +28,9 @@ namespace softkin {
 
 namespace {
 
-nlohmann::json V(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+nlohmann::json V(const Eigen::VectorXd& v) {
+  return std::vector<double>(v.data(), v.data() + v.size());
+}
 nlohmann::json V3(const Eigen::Vector3d& v) { return {v[0], v[1], v[2]}; }
 
 /// Vertex order index (within the marker) of the vertex that minimises score(rest position).
@@ -36,7 +38,8 @@ template <class F>
 int MarkerVertex(const Scene& scene, const Marker& m, F score) {
   int best = 0;
   for (size_t i = 1; i < m.vertices.size(); ++i)
-    if (score(scene.mesh.vertices.row(m.vertices[i])) < score(scene.mesh.vertices.row(m.vertices[best])))
+    if (score(scene.mesh.vertices.row(m.vertices[i])) <
+        score(scene.mesh.vertices.row(m.vertices[best])))
       best = static_cast<int>(i);
   return best;
 }
@@ -44,9 +47,9 @@ int MarkerVertex(const Scene& scene, const Marker& m, F score) {
 /// The keys of an ik_pick_and_place config.
 struct PickPlaceParams {
   IkExperimentSetup s;
-  double R = 20.0;      ///< object radius, mm
-  double d = 7.5;       ///< half the gripper's height, mm
-  double omega1 = 1.0;  ///< the pick objective's weight of the normal term
+  double R = 20.0;             ///< object radius, mm
+  double d = 7.5;              ///< half the gripper's height, mm
+  double omega1 = 1.0;         ///< the pick objective's weight of the normal term
   std::vector<double> design;  ///< pick_design_actuation [c1, c2]
   std::vector<double> offset;  ///< place_offset [dx, dy, dz], mm
   // Stop rule of the three stages on O itself (mm^2): the stages' objectives are not distances
@@ -78,7 +81,8 @@ PickPlaceParams ReadPickPlaceParams(const Config& cfg) {
   p.m0 = p.s.scene.marker_index("P0");
   p.mg = p.s.scene.marker_index("grip_layer");
   if (p.m0 < 0 || p.mg < 0 || p.s.scene.num_actuators() != 3)
-    cfg.Fail("robot", "a robot with markers P0 and grip_layer and three actuators (multi_segment_gripper)");
+    cfg.Fail("robot",
+             "a robot with markers P0 and grip_layer and three actuators (multi_segment_gripper)");
   if (p.design.size() != 2) cfg.Fail("pick_design_actuation", "[c1, c2]");
   return p;
 }
@@ -97,14 +101,15 @@ GripperPoints TrackedPoints(const PickPlaceParams& p) {
   // Three corners of P0's face: bottom (y min, z min), y max at the bottom, top (y min, z max).
   const Marker& pm = scene.markers[p.m0];
   const int va = MarkerVertex(scene, pm, [](const Eigen::RowVector3d& x) { return x.y() + x.z(); });
-  const int vb = MarkerVertex(scene, pm, [](const Eigen::RowVector3d& x) { return -x.y() + x.z(); });
+  const int vb =
+      MarkerVertex(scene, pm, [](const Eigen::RowVector3d& x) { return -x.y() + x.z(); });
   const int vc = MarkerVertex(scene, pm, [](const Eigen::RowVector3d& x) { return x.y() - x.z(); });
   g.pa = "P0[" + std::to_string(va) + "]";
   g.pb = "P0[" + std::to_string(vb) + "]";
   g.pc = "P0[" + std::to_string(vc) + "]";
-  // The grasp circle is fitted to the layer's inner surface (its vertices at the lowest rest z): the
-  // surface that closes on the object. Fitting both faces of the thin layer at once makes the fit
-  // degenerate as the gripper straightens (two parallel rows), and the diameter then peaks
+  // The grasp circle is fitted to the layer's inner surface (its vertices at the lowest rest z):
+  // the surface that closes on the object. Fitting both faces of the thin layer at once makes the
+  // fit degenerate as the gripper straightens (two parallel rows), and the diameter then peaks
   // (about 67 mm at c3 = 4.9 on res 6) instead of growing without bound.
   const Marker& gm = scene.markers[p.mg];
   double zmin = std::numeric_limits<double>::infinity();
@@ -124,7 +129,7 @@ constexpr int kP0 = 0, kA = 1, kB = 2, kC = 3;
 
 /// Where the object is: at R + d from P0 of the design pose, on the inner side of its end face.
 struct ObjectPlacement {
-  Eigen::Vector3d dp0, n;  ///< P0 and its face's normal at the design pose
+  Eigen::Vector3d dp0, n;   ///< P0 and its face's normal at the design pose
   Eigen::Vector3d p1, p1t;  ///< the object's centre, and where it is placed
 };
 
@@ -138,7 +143,8 @@ ObjectPlacement PlaceObject(const Config& cfg, const PickPlaceParams& p, Simulat
   }
   kin.Reset();
   const KinematicsEval de = kin.Evaluate(c_design, false);
-  if (!de.ok) throw std::runtime_error("the forward solve at pick_design_actuation failed: " + de.message);
+  if (!de.ok)
+    throw std::runtime_error("the forward solve at pick_design_actuation failed: " + de.message);
   ObjectPlacement o;
   o.dp0 = de.p.row(kP0).transpose();
   o.n = (de.p.row(kB) - de.p.row(kA)).cross(de.p.row(kC) - de.p.row(kA)).transpose();
@@ -155,11 +161,14 @@ ObjectPlacement PlaceObject(const Config& cfg, const PickPlaceParams& p, Simulat
 /// stage's shape (shapes.csv).
 class StageRunner {
  public:
-  StageRunner(SimulatorKinematics& kin, const IkOptions& ik, const Scene& scene, const std::string& dir,
-              bool verbose)
-      : kin_(kin), ik_(ik), verbose_(verbose),
-        stages_(dir + "/stages.csv", {"stage", "c1", "c2", "c3", "initial_objective", "final_objective",
-                                      "iterations", "evaluations", "fk_solves", "time_s", "termination"}),
+  StageRunner(SimulatorKinematics& kin, const IkOptions& ik, const Scene& scene,
+              const std::string& dir, bool verbose)
+      : kin_(kin),
+        ik_(ik),
+        verbose_(verbose),
+        stages_(dir + "/stages.csv",
+                {"stage", "c1", "c2", "c3", "initial_objective", "final_objective", "iterations",
+                 "evaluations", "fk_solves", "time_s", "termination"}),
         shapes_(dir + "/shapes.csv", {"stage", "x", "z"}) {
     for (int v = 0; v < scene.mesh.num_vertices(); ++v)
       if (std::abs(scene.mesh.vertices(v, 1)) < 1e-9) side_.push_back(v);
@@ -178,16 +187,19 @@ class StageRunner {
 
   /// Minimises obj over the `driven` actuators from c0 (the others as in `fixed`); returns the
   /// full actuation found and the stage's summary entry.
-  std::pair<Eigen::VectorXd, nlohmann::json> Run(const std::string& stage, const std::vector<int>& driven,
+  std::pair<Eigen::VectorXd, nlohmann::json> Run(const std::string& stage,
+                                                 const std::vector<int>& driven,
                                                  const Eigen::VectorXd& fixed, const Objective& obj,
                                                  const Eigen::VectorXd& c0) {
     SubsetKinematics sub(kin_, driven, fixed);
     kin_.Reset();
     const IkResult r = SolveIk(sub, obj, c0, ik_);
     const Eigen::VectorXd full = sub.Full(r.c);
-    if (verbose_) std::fprintf(stderr, "  [%s] %s\n", stage.c_str(), r.summary.BriefReport().c_str());
-    stages_.RowStrings({stage, std::to_string(full[0]), std::to_string(full[1]), std::to_string(full[2]),
-                        std::to_string(r.summary.initial_objective), std::to_string(r.summary.final_objective),
+    if (verbose_)
+      std::fprintf(stderr, "  [%s] %s\n", stage.c_str(), r.summary.BriefReport().c_str());
+    stages_.RowStrings({stage, std::to_string(full[0]), std::to_string(full[1]),
+                        std::to_string(full[2]), std::to_string(r.summary.initial_objective),
+                        std::to_string(r.summary.final_objective),
                         std::to_string(r.summary.iterations), std::to_string(r.summary.evaluations),
                         std::to_string(r.summary.fk_solves), std::to_string(r.summary.time_s),
                         IkTerminationToString(r.summary.termination)});
@@ -235,7 +247,8 @@ nlohmann::json PickStage(const PickPlaceParams& p, const GripperPoints& g, const
   const Eigen::Vector3d p0 = e.p.row(kP0).transpose();
   const Eigen::Vector3d nn = pick.Normal(e.p);
   j["distance_residual_mm"] = (o.p1 - p0).norm() - (p.R + p.d);
-  j["angle_n_p0p1_deg"] = std::acos(std::clamp(nn.dot((o.p1 - p0).normalized()), -1.0, 1.0)) * 180.0 / std::acos(-1.0);
+  j["angle_n_p0p1_deg"] =
+      std::acos(std::clamp(nn.dot((o.p1 - p0).normalized()), -1.0, 1.0)) * 180.0 / std::acos(-1.0);
   j["p0"] = V3(p0);
   *c_pick = c;
   return j;
@@ -243,8 +256,8 @@ nlohmann::json PickStage(const PickPlaceParams& p, const GripperPoints& g, const
 
 /// 2. grasp (Eq. 4.7): c3 alone from `grasp_start` until the fitted circle has diameter 2R.
 nlohmann::json GraspStage(const Config& cfg, const PickPlaceParams& p, SimulatorKinematics& kin,
-                          const Eigen::VectorXd& c_pick, StageRunner* stages, Eigen::VectorXd* c_grasp,
-                          double* c3_start_out) {
+                          const Eigen::VectorXd& c_pick, StageRunner* stages,
+                          Eigen::VectorXd* c_grasp, double* c3_start_out) {
   GraspParams gp;
   gp.group = "grip_layer";
   gp.object_diameter = 2 * p.R;
@@ -264,8 +277,9 @@ nlohmann::json GraspStage(const Config& cfg, const PickPlaceParams& p, Simulator
 }
 
 /// 3. place: c1, c2 (c3 held) bring P0 to R + d from the object's new centre p1t.
-nlohmann::json PlaceStage(const PickPlaceParams& p, const ObjectPlacement& o, SimulatorKinematics& kin,
-                          const Eigen::VectorXd& c_grasp, StageRunner* stages) {
+nlohmann::json PlaceStage(const PickPlaceParams& p, const ObjectPlacement& o,
+                          SimulatorKinematics& kin, const Eigen::VectorXd& c_grasp,
+                          StageRunner* stages) {
   PlaceParams lp;
   lp.p0 = "P0";
   lp.target_center = o.p1t;
@@ -303,8 +317,9 @@ nlohmann::json RunIkPickAndPlace(const Config& cfg, const std::string& dir, bool
   j.erase("point");
   j["stage_lambda"] = p.stage_lambda;
   j["grasp_start"] = c3_start;
-  j["object"] = {{"radius_mm", p.R}, {"half_width_mm", p.d}, {"omega1", p.omega1},
-                 {"pick_design_actuation", p.design}, {"center", V3(o.p1)}, {"place_center", V3(o.p1t)},
+  j["object"] = {{"radius_mm", p.R},       {"half_width_mm", p.d},
+                 {"omega1", p.omega1},     {"pick_design_actuation", p.design},
+                 {"center", V3(o.p1)},     {"place_center", V3(o.p1t)},
                  {"design_p0", V3(o.dp0)}, {"design_normal", V3(o.n)}};
   j["normal_points"] = {g.pa, g.pb, g.pc};
   j["grip_points"] = g.inner_count;

@@ -26,7 +26,8 @@ Mesh ChamberPart(const Mesh& mesh, const std::vector<int>& regions) {
   Mesh m;
   m.vertices = mesh.vertices;
   for (const auto& e : mesh.elements)
-    if (std::find(regions.begin(), regions.end(), e.region) != regions.end()) m.elements.push_back(e);
+    if (std::find(regions.begin(), regions.end(), e.region) != regions.end())
+      m.elements.push_back(e);
   return m;
 }
 
@@ -43,11 +44,11 @@ struct TwistingRemeshParams {
   std::vector<double> alphas;  ///< increasing chamber volume ratios; the last is the target
   double at_once = 28;         ///< the ratio applied at once, without remeshing
   double alpha_max = 4.0, d_max = 4.0;
-  int sections = 20;           ///< of the twist profile
+  int sections = 20;  ///< of the twist profile
   bool write_vtu = true;
   Scene scene;
-  double build_s = 0;          ///< the robot's generation, s
-  ProgressiveOptions popt;     ///< Algorithm 2's options (no on_step)
+  double build_s = 0;       ///< the robot's generation, s
+  ProgressiveOptions popt;  ///< Algorithm 2's options (no on_step)
   std::vector<int> chamber_regions;
 };
 
@@ -67,7 +68,8 @@ TwistingRemeshParams ReadTwistingRemeshParams(const Config& cfg) {
   p.sections = cfg.Int("sections", 20);
   p.write_vtu = cfg.Bool("vtu", true);
   if (p.robot != "twisting_robot")
-    cfg.Fail("robot", "twisting_robot (the twist is measured about its z axis over its 100 mm length)");
+    cfg.Fail("robot",
+             "twisting_robot (the twist is measured about its z axis over its 100 mm length)");
   const auto t_build0 = std::chrono::steady_clock::now();
   p.scene = ConfigRobot(cfg, p.robot, p.res);
   p.build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_build0).count();
@@ -79,8 +81,10 @@ TwistingRemeshParams ReadTwistingRemeshParams(const Config& cfg) {
     if (!(alphas[i] > 1) || (i > 0 && !(alphas[i] > alphas[i - 1])))
       cfg.Fail("alphas", "increasing chamber volume ratios > 1");
   const Actuator& act = p.scene.actuators.at(ChamberActuator(p.scene));
-  if (alphas.back() > act.max) cfg.Fail("alphas", "ratios up to the chamber's maximum " + std::to_string(act.max));
-  if (!(p.at_once > 1) || p.at_once > act.max) cfg.Fail("at_once_alpha", "a chamber volume ratio in (1, max]");
+  if (alphas.back() > act.max)
+    cfg.Fail("alphas", "ratios up to the chamber's maximum " + std::to_string(act.max));
+  if (!(p.at_once > 1) || p.at_once > act.max)
+    cfg.Fail("at_once_alpha", "a chamber volume ratio in (1, max]");
   if (p.sections < 2 || p.sections > 100) cfg.Fail("sections", "an integer in [2, 100]");
   if (remesh_iterations < 1) cfg.Fail("remesh_iterations", "an integer >= 1");
   if (max_remeshes < 1) cfg.Fail("max_remeshes_per_step", "an integer >= 1");
@@ -90,10 +94,12 @@ TwistingRemeshParams ReadTwistingRemeshParams(const Config& cfg) {
   popt.max_remeshes_per_step = max_remeshes;
   if (!RemeshMethodFromString(method_name, &popt.remesh_options.method))
     cfg.Fail("remesh_method", "auto, chamber or whole");
-  if (!ChamberRestFromString(rest_name, &popt.remesh_options.rest)) cfg.Fail("chamber_rest", "remeshed or original");
+  if (!ChamberRestFromString(rest_name, &popt.remesh_options.rest))
+    cfg.Fail("chamber_rest", "remeshed or original");
   popt.remesh_options.region.iterations = remesh_iterations;
   popt.remesh_options.region.seed = cfg.seed();
-  popt.remesh_options.tessellation = TwistingRobotTessellation(p.res, cfg.NumberMap("robot_params"));
+  popt.remesh_options.tessellation =
+      TwistingRobotTessellation(p.res, cfg.NumberMap("robot_params"));
   popt.remesh_options.tessellation.seed = cfg.seed();
   popt.snapshots.assign(alphas.begin(), alphas.end() - 1);
   std::string why;
@@ -113,28 +119,34 @@ std::string Fmt(double v) {
 class TwistingOutput {
  public:
   TwistingOutput(const TwistingRemeshParams& p, const std::string& dir, bool verbose)
-      : p_(p), dir_(dir), verbose_(verbose),
-        steps_csv_(dir + "/steps.csv",
-                   {"variant", "k", "alpha", "remeshes", "methods", "remesh_failures", "tets", "chamber_tets", "mesh_s",
-                    "solver_s", "iterations", "status", "chamber_volume_ratio", "max_volume_ratio",
-                    "max_distortion", "tip_twist_deg", "tip_x", "tip_y", "tip_z"}),
+      : p_(p),
+        dir_(dir),
+        verbose_(verbose),
+        steps_csv_(
+            dir + "/steps.csv",
+            {"variant", "k", "alpha", "remeshes", "methods", "remesh_failures", "tets",
+             "chamber_tets", "mesh_s", "solver_s", "iterations", "status", "chamber_volume_ratio",
+             "max_volume_ratio", "max_distortion", "tip_twist_deg", "tip_x", "tip_y", "tip_z"}),
         profile_csv_(dir + "/twist_profile.csv", {"variant", "alpha", "section", "z", "twist_deg"}),
         shapes_csv_(dir + "/shapes.csv",
-                    {"variant", "alpha", "tip_twist_deg", "chamber_volume_ratio", "remeshes", "tets",
-                     "inverted_tets", "mesh_s", "solver_s", "tip_x", "tip_y", "tip_z", "outer_obj",
-                     "chamber_obj", "vtu"}),
+                    {"variant", "alpha", "tip_twist_deg", "chamber_volume_ratio", "remeshes",
+                     "tets", "inverted_tets", "mesh_s", "solver_s", "tip_x", "tip_y", "tip_z",
+                     "outer_obj", "chamber_obj", "vtu"}),
         tip_(p.scene.marker_index("tip")) {}
 
   /// Writes one shape: surfaces (outer, chamber) as OBJ for the figure, the mesh as VTU, a row of
   /// shapes.csv and the twist profile; returns its summary entry.
-  nlohmann::json RecordShape(const std::string& variant, double alpha, const Scene& s, const Eigen::MatrixX3d& X,
-                             double volume_ratio, int remeshes, double mesh_s, double solver_s) {
+  nlohmann::json RecordShape(const std::string& variant, double alpha, const Scene& s,
+                             const Eigen::MatrixX3d& X, double volume_ratio, int remeshes,
+                             double mesh_s, double solver_s) {
     const int sections = p_.sections, tip = tip_;
     const std::string tag = Tag(variant, alpha);
     const std::vector<double> prof = Twist(s, X);
     for (int i = 0; i < sections; ++i)
-      profile_csv_.RowStrings({variant, Fmt(alpha), std::to_string(i), Fmt(kTwistLength * (i + 1) / sections), Fmt(prof[i])});
-    const std::string outer = "shapes/" + tag + "_outer.obj", chamber = "shapes/" + tag + "_chamber.obj";
+      profile_csv_.RowStrings({variant, Fmt(alpha), std::to_string(i),
+                               Fmt(kTwistLength * (i + 1) / sections), Fmt(prof[i])});
+    const std::string outer = "shapes/" + tag + "_outer.obj",
+                      chamber = "shapes/" + tag + "_chamber.obj";
     WriteSurfaceObj(dir_ + "/" + outer, s.mesh, X);
     WriteSurfaceObj(dir_ + "/" + chamber, ChamberPart(s.mesh, p_.chamber_regions), X);
     std::string vtu;
@@ -145,9 +157,10 @@ class TwistingOutput {
     }
     const Eigen::MatrixX3d P = s.marker_positions(X);
     const int inverted = CountInvertedElements(s.mesh, X);
-    shapes_csv_.RowStrings({variant, Fmt(alpha), Fmt(prof.back()), Fmt(volume_ratio), std::to_string(remeshes),
-                            std::to_string(s.mesh.num_tets()), std::to_string(inverted), Fmt(mesh_s), Fmt(solver_s),
-                            Fmt(P(tip, 0)), Fmt(P(tip, 1)), Fmt(P(tip, 2)), outer, chamber, vtu});
+    shapes_csv_.RowStrings({variant, Fmt(alpha), Fmt(prof.back()), Fmt(volume_ratio),
+                            std::to_string(remeshes), std::to_string(s.mesh.num_tets()),
+                            std::to_string(inverted), Fmt(mesh_s), Fmt(solver_s), Fmt(P(tip, 0)),
+                            Fmt(P(tip, 1)), Fmt(P(tip, 2)), outer, chamber, vtu});
     return nlohmann::json{{"alpha", alpha},
                           {"tip_twist_deg", prof.back()},
                           {"chamber_volume_ratio", volume_ratio},
@@ -160,20 +173,25 @@ class TwistingOutput {
   }
 
   /// A row of steps.csv (and a progress line) for one step of a variant.
-  void LogStep(const std::string& variant, const ProgressiveStep& st, const Scene& s, const Eigen::MatrixX3d& X) {
+  void LogStep(const std::string& variant, const ProgressiveStep& st, const Scene& s,
+               const Eigen::MatrixX3d& X) {
     const int tip = tip_;
     const std::vector<double> prof = Twist(s, X);
     const Eigen::MatrixX3d P = s.marker_positions(X);
-    steps_csv_.RowStrings({variant, std::to_string(st.k), Fmt(st.alpha), std::to_string(st.remeshes), st.methods,
-                           std::to_string(st.remesh_failures), std::to_string(st.tets), std::to_string(st.chamber_tets), Fmt(st.mesh_seconds),
-                           Fmt(st.solver_seconds), std::to_string(st.iterations), FkStatusToString(st.status),
-                           Fmt(st.chamber_volume_ratio), Fmt(st.max_volume_ratio), Fmt(st.max_distortion),
-                           Fmt(prof.back()), Fmt(P(tip, 0)), Fmt(P(tip, 1)), Fmt(P(tip, 2))});
+    steps_csv_.RowStrings(
+        {variant, std::to_string(st.k), Fmt(st.alpha), std::to_string(st.remeshes), st.methods,
+         std::to_string(st.remesh_failures), std::to_string(st.tets),
+         std::to_string(st.chamber_tets), Fmt(st.mesh_seconds), Fmt(st.solver_seconds),
+         std::to_string(st.iterations), FkStatusToString(st.status), Fmt(st.chamber_volume_ratio),
+         Fmt(st.max_volume_ratio), Fmt(st.max_distortion), Fmt(prof.back()), Fmt(P(tip, 0)),
+         Fmt(P(tip, 1)), Fmt(P(tip, 2))});
     if (verbose_)
-      std::fprintf(stderr, "  %s alpha %g: %s, %d iterations, %.1f s; %d remesh(es)%s%s, %d tets; chamber x%.2f, tip twist %.1f deg\n",
-                   variant.c_str(), st.alpha, FkStatusToString(st.status), st.iterations, st.solver_seconds,
-                   st.remeshes, st.methods.empty() ? "" : " ", st.methods.c_str(), st.tets,
-                   st.chamber_volume_ratio, prof.back());
+      std::fprintf(stderr,
+                   "  %s alpha %g: %s, %d iterations, %.1f s; %d remesh(es)%s%s, %d tets; chamber "
+                   "x%.2f, tip twist %.1f deg\n",
+                   variant.c_str(), st.alpha, FkStatusToString(st.status), st.iterations,
+                   st.solver_seconds, st.remeshes, st.methods.empty() ? "" : " ",
+                   st.methods.c_str(), st.tets, st.chamber_volume_ratio, prof.back());
   }
 
   /// progressive.pvd over the progressive shapes' VTU files, if any.
@@ -207,12 +225,15 @@ nlohmann::json ProgressiveShapes(const TwistingRemeshParams& p, const Progressiv
     return v;
   };
   auto add = [&](double alpha, const Scene& s, const Eigen::MatrixX3d& X, double ratio) {
-    shapes.push_back(out->RecordShape(
-        "progressive", alpha, s, X, ratio, static_cast<int>(upto(alpha, [](const ProgressiveStep& st) { return double(st.remeshes); })),
-        upto(alpha, [](const ProgressiveStep& st) { return st.mesh_seconds; }),
-        upto(alpha, [](const ProgressiveStep& st) { return st.solver_seconds; })));
+    shapes.push_back(
+        out->RecordShape("progressive", alpha, s, X, ratio,
+                         static_cast<int>(upto(
+                             alpha, [](const ProgressiveStep& st) { return double(st.remeshes); })),
+                         upto(alpha, [](const ProgressiveStep& st) { return st.mesh_seconds; }),
+                         upto(alpha, [](const ProgressiveStep& st) { return st.solver_seconds; })));
   };
-  for (const auto& snap : prog.snapshots) add(snap.alpha, snap.scene, snap.positions, snap.chamber_volume_ratio);
+  for (const auto& snap : prog.snapshots)
+    add(snap.alpha, snap.scene, snap.positions, snap.chamber_volume_ratio);
   if (prog.completed) add(p.alphas.back(), prog.scene, prog.positions, prog.chamber_volume_ratio);
   return shapes;
 }
@@ -229,7 +250,8 @@ nlohmann::json SolveAtOnce(const TwistingRemeshParams& p, TwistingOutput* out) {
   if (r.status == FkStatus::InvalidInput) throw std::runtime_error("at_once_alpha: " + r.message);
   const double ratio = RegionVolume(scene.mesh, r.positions, chamber_regions) /
                        RegionVolume(scene.mesh, scene.mesh.vertices, chamber_regions);
-  nlohmann::json once = out->RecordShape("at_once", p.at_once, scene, r.positions, ratio, 0, 0.0, r.time_s);
+  nlohmann::json once =
+      out->RecordShape("at_once", p.at_once, scene, r.positions, ratio, 0, 0.0, r.time_s);
   once["status"] = FkStatusToString(r.status);
   once["iterations"] = r.iterations;
   ProgressiveStep st;
@@ -240,11 +262,14 @@ nlohmann::json SolveAtOnce(const TwistingRemeshParams& p, TwistingOutput* out) {
   st.iterations = r.iterations;
   st.status = r.status;
   st.chamber_volume_ratio = ratio;
-  const RemeshCheck chk = CheckRemesh(scene.mesh, scene.mesh.vertices, r.positions, chamber_regions, p.popt.criteria);
+  const RemeshCheck chk =
+      CheckRemesh(scene.mesh, scene.mesh.vertices, r.positions, chamber_regions, p.popt.criteria);
   st.max_volume_ratio = chk.max_volume_ratio;
   st.max_distortion = chk.max_distortion;
   for (const auto& e : scene.mesh.elements)
-    if (std::find(chamber_regions.begin(), chamber_regions.end(), e.region) != chamber_regions.end()) ++st.chamber_tets;
+    if (std::find(chamber_regions.begin(), chamber_regions.end(), e.region) !=
+        chamber_regions.end())
+      ++st.chamber_tets;
   out->LogStep("at_once", st, scene, r.positions);
   return once;
 }
@@ -274,7 +299,8 @@ nlohmann::json ProgressiveJson(const ProgressiveResult& prog, const nlohmann::js
           {"mesh_seconds", prog.mesh_seconds},
           {"solver_seconds", prog.solver_seconds},
           {"mesh_seconds_per_remesh", prog.remeshes > 0 ? prog.mesh_seconds / prog.remeshes : 0.0},
-          {"solver_seconds_per_step", prog.steps.empty() ? 0.0 : prog.solver_seconds / prog.steps.size()},
+          {"solver_seconds_per_step",
+           prog.steps.empty() ? 0.0 : prog.solver_seconds / prog.steps.size()},
           {"shapes", shapes}};
 }
 
@@ -308,8 +334,11 @@ nlohmann::json RunTwistingRemesh(const Config& cfg, const std::string& dir, bool
   j["chamber_rest"] = ChamberRestToString(p.popt.remesh_options.rest);
   j["progressive"] = ProgressiveJson(prog, prog_shapes);
   j["at_once"] = once;
-  j["thesis_table_3_1_twisting"] = {{"tets", 28198}, {"mesh_gen_s", 2.81}, {"collision_check_s", 0.03},
-                                    {"collision_response_s", 1.71}, {"solver_s", 3.54}};
+  j["thesis_table_3_1_twisting"] = {{"tets", 28198},
+                                    {"mesh_gen_s", 2.81},
+                                    {"collision_check_s", 0.03},
+                                    {"collision_response_s", 1.71},
+                                    {"solver_s", 3.54}};
   return j;
 }
 

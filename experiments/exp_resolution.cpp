@@ -33,22 +33,24 @@ ResolutionParams ReadResolutionParams(const Config& cfg) {
 }
 
 /// One resolution: build, factor and solve; a row of resolution.csv and its entry.
-nlohmann::json SolveAtResolution(const Config& cfg, const ResolutionParams& p, int res, CsvWriter* csv,
-                                 bool verbose) {
+nlohmann::json SolveAtResolution(const Config& cfg, const ResolutionParams& p, int res,
+                                 CsvWriter* csv, bool verbose) {
   const auto t0 = std::chrono::steady_clock::now();
   Scene scene = ConfigRobot(cfg, p.robot, res);
   auto model = std::make_shared<const Model>(scene);
-  const double build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double build_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   Eigen::VectorXd c = scene.rest_actuation();
   if (!p.actuation.empty()) {
     if (static_cast<Eigen::Index>(p.actuation.size()) != c.size())
-      cfg.Fail("actuation", "one value per actuator of '" + p.robot + "' (" +
-                                std::to_string(c.size()) + ")");
+      cfg.Fail("actuation",
+               "one value per actuator of '" + p.robot + "' (" + std::to_string(c.size()) + ")");
     for (int i = 0; i < c.size(); ++i) c[i] = p.actuation[i];
   }
   auto solver = MakeFkSolver(model, p.opts);
   FkResult r = solver->Solve(c);
-  if (r.status == FkStatus::InvalidInput) throw std::invalid_argument(cfg.path() + ": " + r.message);
+  if (r.status == FkStatus::InvalidInput)
+    throw std::invalid_argument(cfg.path() + ": " + r.message);
   const Eigen::MatrixX3d P = scene.marker_positions(r.positions);
   const int tip = scene.marker_index("tip");
   const double ms_it = 1e3 * r.time_s / std::max(1, r.iterations);
@@ -59,10 +61,14 @@ nlohmann::json SolveAtResolution(const Config& cfg, const ResolutionParams& p, i
   if (verbose)
     std::fprintf(stderr, "  res %d: %d tets, %s\n", res, scene.mesh.num_tets(),
                  r.BriefReport().c_str());
-  return {{"res", res}, {"n_vertices", scene.mesh.num_vertices()},
-          {"n_tets", scene.mesh.num_tets()}, {"iterations", r.iterations},
-          {"ms_per_iteration", ms_it}, {"us_per_iteration_per_vertex", us_it_v},
-          {"solve_s", r.time_s}, {"status", FkStatusToString(r.status)},
+  return {{"res", res},
+          {"n_vertices", scene.mesh.num_vertices()},
+          {"n_tets", scene.mesh.num_tets()},
+          {"iterations", r.iterations},
+          {"ms_per_iteration", ms_it},
+          {"us_per_iteration_per_vertex", us_it_v},
+          {"solve_s", r.time_s},
+          {"status", FkStatusToString(r.status)},
           {"tip", {P(tip, 0), P(tip, 1), P(tip, 2)}}};
 }
 
@@ -70,10 +76,10 @@ nlohmann::json SolveAtResolution(const Config& cfg, const ResolutionParams& p, i
 
 nlohmann::json RunResolutionSweep(const Config& cfg, const std::string& dir, bool verbose) {
   const ResolutionParams p = ReadResolutionParams(cfg);
-  CsvWriter csv(dir + "/resolution.csv",
-                {"res", "n_vertices", "n_tets", "build_s", "factor_s", "iterations", "solve_s",
-                 "ms_per_iteration", "us_per_iteration_per_vertex", "tip_x", "tip_y", "tip_z",
-                 "converged"});
+  CsvWriter csv(
+      dir + "/resolution.csv",
+      {"res", "n_vertices", "n_tets", "build_s", "factor_s", "iterations", "solve_s",
+       "ms_per_iteration", "us_per_iteration_per_vertex", "tip_x", "tip_y", "tip_z", "converged"});
   nlohmann::json rows = nlohmann::json::array();
   for (int res : p.resolutions) rows.push_back(SolveAtResolution(cfg, p, res, &csv, verbose));
   nlohmann::json j;

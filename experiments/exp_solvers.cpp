@@ -42,9 +42,9 @@ struct SolverComparisonParams {
   // status time_limit and the milestones it reached.
   double budget = 600.0;
   Scene scene;
-  FkOptions base;     ///< the robot's solver options with the config's
-  double vmax = 0;    ///< the first actuator's end value
-  int tip = -1;       ///< the tip marker
+  FkOptions base;   ///< the robot's solver options with the config's
+  double vmax = 0;  ///< the first actuator's end value
+  int tip = -1;     ///< the tip marker
 };
 
 SolverComparisonParams ReadSolverComparisonParams(const Config& cfg) {
@@ -66,16 +66,19 @@ SolverComparisonParams ReadSolverComparisonParams(const Config& cfg) {
   const auto names = FkSolverNames();
   for (const auto& m : p.methods)
     if (std::find(names.begin(), names.end(), m) == names.end() && !kNotRun.count(m))
-      cfg.Fail("methods", "FK solver names (lg, lg-aa, ceres, ipopt-lbfgs, ipopt-newton, "
-                          "ipopt-hard, calculix-linear, calculix-nonlinear, sofa)");
+      cfg.Fail("methods",
+               "FK solver names (lg, lg-aa, ceres, ipopt-lbfgs, ipopt-newton, "
+               "ipopt-hard, calculix-linear, calculix-nonlinear, sofa)");
   const Actuator& act = p.scene.actuators.at(0);
   p.vmax = end_value_cfg > 0 ? end_value_cfg : act.FarEnd();
   if (p.vmax > act.max || p.vmax < act.min || p.vmax == act.rest)
-    cfg.Fail("end_value", "a value in [min, max] of actuator '" + act.name + "', not its rest value");
+    cfg.Fail("end_value",
+             "a value in [min, max] of actuator '" + act.name + "', not its rest value");
   for (const auto& m : p.methods)
     if (m.rfind("calculix", 0) == 0 && (act.type != ActuatorType::Pneumatic || act.is_signed()))
-      cfg.Fail("methods", "no calculix-* method unless the first actuator is an unsigned pneumatic "
-                          "chamber (the FEM increments are read back as its volume ratio)");
+      cfg.Fail("methods",
+               "no calculix-* method unless the first actuator is an unsigned pneumatic "
+               "chamber (the FEM increments are read back as its volume ratio)");
   p.tip = p.scene.marker_index("tip");
   if (p.tip < 0 || p.scene.marker_index("tip_top") < 0 || p.scene.marker_index("tip_bottom") < 0)
     cfg.Fail("robot", "a robot with tip, tip_top and tip_bottom markers (e.g. pneumatic_finger)");
@@ -97,8 +100,14 @@ struct Totals {
 struct MethodSweep {
   MethodSweep(const SolverComparisonParams& p, const std::string& name, CsvWriter* csv,
               std::vector<std::pair<double, double>>* bends, bool verbose)
-      : p(p), name(name), csv(csv), bends(bends), verbose(verbose), bend(p.scene),
-        reach(p.milestones.size(), -1.0), X(p.scene.mesh.vertices) {}
+      : p(p),
+        name(name),
+        csv(csv),
+        bends(bends),
+        verbose(verbose),
+        bend(p.scene),
+        reach(p.milestones.size(), -1.0),
+        X(p.scene.mesh.vertices) {}
 
   /// One row of the trajectory: the shape Xs after a step (or FEM increment) s at actuation
   /// `value`, `elapsed` seconds into the method's run.
@@ -112,10 +121,10 @@ struct MethodSweep {
     const Eigen::MatrixX3d P = p.scene.marker_positions(Xs);
     tips.push_back({P(tip, 0), P(tip, 1), P(tip, 2)});
     csv->RowStrings({name, std::to_string(s), std::to_string(value), std::to_string(ang),
-                     std::to_string(P(tip, 0)), std::to_string(P(tip, 1)), std::to_string(P(tip, 2)),
-                     std::to_string(rs.iterations), std::to_string(step_s), std::to_string(elapsed),
-                     std::to_string(rs.energy), std::to_string(rs.gradient_ratio),
-                     FkStatusToString(rs.status)});
+                     std::to_string(P(tip, 0)), std::to_string(P(tip, 1)),
+                     std::to_string(P(tip, 2)), std::to_string(rs.iterations),
+                     std::to_string(step_s), std::to_string(elapsed), std::to_string(rs.energy),
+                     std::to_string(rs.gradient_ratio), FkStatusToString(rs.status)});
     if (verbose)
       std::fprintf(stderr, "  %s [%d] %s = %.3f  bend %.1f deg  %.2f s\n", name.c_str(), s,
                    p.scene.actuators.at(0).name.c_str(), value, ang, elapsed);
@@ -148,7 +157,8 @@ void SweepCalculix(const std::shared_ptr<const Model>& model, FkOptions o, Metho
   Eigen::VectorXd c = p.scene.rest_actuation();
   c[0] = p.vmax;
   m->r = solver->Solve(c);
-  if (m->r.status == FkStatus::InvalidInput) throw std::runtime_error(m->name + ": " + m->r.message);
+  if (m->r.status == FkStatus::InvalidInput)
+    throw std::runtime_error(m->name + ": " + m->r.message);
   const auto& incs = dynamic_cast<const CalculixSolver&>(*solver).increments();
   double prev = 0;
   Eigen::VectorXd ck = c;
@@ -181,7 +191,8 @@ void SweepIterative(const std::shared_ptr<const Model>& model, FkOptions o, Meth
     c[0] = act.rest + (p.vmax - act.rest) * double(s) / p.steps;
     const Eigen::MatrixX3d guess = s > 1 ? Eigen::MatrixX3d(2 * m->X - X_prev) : m->X;
     o.time_limit_s = std::max(1e-3, p.budget - m->cumulative);
-    std::unique_ptr<FkSolver> solver = MakeFkSolver(model, o);  // cheap: the model (and its factor) is shared
+    std::unique_ptr<FkSolver> solver =
+        MakeFkSolver(model, o);  // cheap: the model (and its factor) is shared
     m->r = solver->Solve(c, &guess);
     const FkResult& r = m->r;
     if (r.status == FkStatus::InvalidInput) throw std::runtime_error(m->name + ": " + r.message);
@@ -205,15 +216,18 @@ void RunMethod(const SolverComparisonParams& p, const std::shared_ptr<const Mode
   const std::string key = Key(name);
   if (kNotRun.count(name)) {
     t->methods[key] = {{"status", "not_run"}, {"reason", kNotRun.at(name)}};
-    if (verbose) std::fprintf(stderr, "  %s: not run (%s)\n", name.c_str(), kNotRun.at(name).c_str());
+    if (verbose)
+      std::fprintf(stderr, "  %s: not run (%s)\n", name.c_str(), kNotRun.at(name).c_str());
     return;
   }
   FkOptions o = p.base;
   o.solver = name;
   o.continuation_steps = 1;
   MethodSweep m(p, name, csv, &t->bends[name], verbose);
-  if (name.rfind("calculix", 0) == 0) SweepCalculix(model, o, &m);
-  else SweepIterative(model, o, &m);
+  if (name.rfind("calculix", 0) == 0)
+    SweepCalculix(model, o, &m);
+  else
+    SweepIterative(model, o, &m);
   nlohmann::json mj;
   for (size_t q = 0; q < p.milestones.size(); ++q) {
     char k[32];
@@ -254,8 +268,9 @@ double AddEnergyGaps(const SolverComparisonParams& p, Totals* t) {
     }
     t->methods[key]["energy_gap"] = (t->final_energy[name] - lowest) / std::abs(lowest);
     t->methods[key]["max_distance_to_lg_aa_mm"] =
-        t->finals.count("lg-aa") ? (t->finals[name] - t->finals["lg-aa"]).rowwise().norm().maxCoeff()
-                                 : 0.0;
+        t->finals.count("lg-aa")
+            ? (t->finals[name] - t->finals["lg-aa"]).rowwise().norm().maxCoeff()
+            : 0.0;
   }
   return lowest;
 }
@@ -371,8 +386,10 @@ nlohmann::json RunSolverComparison(const Config& cfg, const std::string& dir, bo
   if (p.robot == "pneumatic_finger")
     j["thesis_table_2_2"] = {
         {"ours", {{"elements", 45802}, {"t90_s", 8.5}, {"t180_s", 15.2}, {"t240_s", 23.2}}},
-        {"fem1_abaqus_linear", {{"elements", 44774}, {"t90_s", 240}, {"t180_s", 529}, {"t240_s", 820}}},
-        {"fem2_abaqus_nonlinear", {{"elements", 44774}, {"t90_s", 288}, {"t180_s", 636}, {"t240_s", 1068}}},
+        {"fem1_abaqus_linear",
+         {{"elements", 44774}, {"t90_s", 240}, {"t180_s", 529}, {"t240_s", 820}}},
+        {"fem2_abaqus_nonlinear",
+         {{"elements", 44774}, {"t90_s", 288}, {"t180_s", 636}, {"t240_s", 1068}}},
         {"sofa", {{"elements", 44900}, {"t90_s", 3.8}}}};
   return j;
 }

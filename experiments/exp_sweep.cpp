@@ -26,7 +26,7 @@ struct Variant {
 struct MarkerSweepParams {
   std::string robot;
   int res = 0;
-  std::vector<std::string> act_names;     ///< the swept actuators
+  std::vector<std::string> act_names;  ///< the swept actuators
   int steps = 8;
   bool has_start = false, has_end = false;  ///< start_value / end_value given
   double start_value = 0, end_value = 0;
@@ -88,8 +88,8 @@ MarkerSweepParams ReadMarkerSweepParams(const Config& cfg) {
   try {
     p.opts = cfg.Solver(MakeRobot(p.robot, p.res, base_params).solver);
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(cfg.path() + ": robot '" + p.robot + "' (keys robot, res, robot_params): " +
-                                e.what());
+    throw std::invalid_argument(cfg.path() + ": robot '" + p.robot +
+                                "' (keys robot, res, robot_params): " + e.what());
   }
   cfg.CheckNoUnknownKeys();
   if (p.steps < 1) cfg.Fail("steps", "an integer >= 1");
@@ -118,7 +118,8 @@ VariantRobot MakeVariantRobot(const Config& cfg, const MarkerSweepParams& p, con
   const Scene& scene = v.scene;
   for (const auto& n : p.act_names) {
     const int a = scene.actuator_index(n);
-    if (a < 0) cfg.Fail("actuators", "names of actuators of robot '" + robot + "', got '" + n + "'");
+    if (a < 0)
+      cfg.Fail("actuators", "names of actuators of robot '" + robot + "', got '" + n + "'");
     v.acts.push_back(a);
   }
   if (p.marker_names.empty())
@@ -189,10 +190,9 @@ nlohmann::json SweepVariant(const MarkerSweepParams& p, const Variant& var, cons
     values.push_back(value);
     for (int m : v.marks) {
       traj[scene.markers[m].name].push_back({P(m, 0), P(m, 1), P(m, 2)});
-      csv->RowStrings({var.label, std::to_string(s), std::to_string(value),
-                       scene.markers[m].name, std::to_string(P(m, 0)), std::to_string(P(m, 1)),
-                       std::to_string(P(m, 2)), std::to_string(r.iterations),
-                       std::to_string(r.time_s), ok ? "1" : "0"});
+      csv->RowStrings({var.label, std::to_string(s), std::to_string(value), scene.markers[m].name,
+                       std::to_string(P(m, 0)), std::to_string(P(m, 1)), std::to_string(P(m, 2)),
+                       std::to_string(r.iterations), std::to_string(r.time_s), ok ? "1" : "0"});
     }
     nlohmann::json drow = nlohmann::json::array();
     for (const auto& [m0, m1] : v.dist_pairs) drow.push_back((P.row(m0) - P.row(m1)).norm());
@@ -213,10 +213,9 @@ nlohmann::json SweepVariant(const MarkerSweepParams& p, const Variant& var, cons
   nlohmann::json dnames = nlohmann::json::array();
   for (const auto& [m0, m1] : v.dist_pairs)
     dnames.push_back(scene.markers[m0].name + "-" + scene.markers[m1].name);
-  return {{"label", var.label}, {"robot_params", params}, {"values", values},
-          {"markers", traj}, {"distance_names", dnames}, {"distances", dists},
-          {"solve_s", var_s}, {"iterations", var_iters},
-          {"non_converged_steps", var_fail}};
+  return {{"label", var.label}, {"robot_params", params},   {"values", values},
+          {"markers", traj},    {"distance_names", dnames}, {"distances", dists},
+          {"solve_s", var_s},   {"iterations", var_iters},  {"non_converged_steps", var_fail}};
 }
 
 }  // namespace

@@ -44,7 +44,8 @@ int Int(const nlohmann::json& spec, const std::string& key, const std::string& w
   return spec[key].get<int>();
 }
 
-void OnlyKeys(const nlohmann::json& spec, const std::set<std::string>& keys, const std::string& where) {
+void OnlyKeys(const nlohmann::json& spec, const std::set<std::string>& keys,
+              const std::string& where) {
   for (auto it = spec.begin(); it != spec.end(); ++it)
     if (!keys.count(it.key())) {
       std::string list;
@@ -57,8 +58,8 @@ void OnlyKeys(const nlohmann::json& spec, const std::set<std::string>& keys, con
 /// flicker on its sides. Parameter t in [0, 2 pi): u = w sin t cos^2(t/2) (1 + 0.3 sin 3t),
 /// v = -h cos t / 2 (t = 0 is the bottom), turned by tilt_deg from the u axis towards the v axis.
 /// Returned densely as a closed polyline.
-std::vector<Eigen::Vector3d> FlameCurve(const Eigen::Vector3d& c, int au, int av, double w, double h,
-                                        double tilt_deg) {
+std::vector<Eigen::Vector3d> FlameCurve(const Eigen::Vector3d& c, int au, int av, double w,
+                                        double h, double tilt_deg) {
   const double pi = std::acos(-1.0);
   std::vector<Eigen::Vector3d> curve;
   const int m = 2000;
@@ -97,7 +98,8 @@ Eigen::MatrixX3d MapToWorkspace(const Eigen::MatrixX3d& W, const nlohmann::json&
   const int ax = m["axis"].get<int>(), au = (ax + 1) % 3, av = (ax + 2) % 3;
   if (!m.contains("anchor_actuation") || !m["anchor_actuation"].is_array() ||
       static_cast<int>(m["anchor_actuation"].size()) != kin.num_actuators())
-    Bad(where + ".anchor_actuation", "expected " + std::to_string(kin.num_actuators()) + " actuation values");
+    Bad(where + ".anchor_actuation",
+        "expected " + std::to_string(kin.num_actuators()) + " actuation values");
   Eigen::VectorXd ca(kin.num_actuators());
   for (int a = 0; a < ca.size(); ++a) {
     if (!m["anchor_actuation"][a].is_number()) Bad(where + ".anchor_actuation", "expected numbers");
@@ -122,7 +124,9 @@ Eigen::MatrixX3d MapToWorkspace(const Eigen::MatrixX3d& W, const nlohmann::json&
   for (int k = 0; k <= steps; ++k) {
     const Eigen::VectorXd c = c_rest + (ca - c_rest) * (double(k) / steps);
     const KinematicsEval e = kin.Evaluate(c, false);
-    if (!e.ok) throw std::runtime_error(where + ": the forward solve along the anchor ray failed: " + e.message);
+    if (!e.ok)
+      throw std::runtime_error(where +
+                               ": the forward solve along the anchor ray failed: " + e.message);
     const Eigen::Vector3d p = e.p.row(0).transpose();
     if (k == 0) t0 = p;
     if (k == steps) ta = p;
@@ -131,8 +135,9 @@ Eigen::MatrixX3d MapToWorkspace(const Eigen::MatrixX3d& W, const nlohmann::json&
   }
   for (size_t k = 1; k < prof_r.size(); ++k)
     if (!(prof_r[k] > prof_r[k - 1]))
-      Bad(where + ".anchor_actuation", "the point does not move steadily sideways along the ray (step " +
-                                           std::to_string(k) + ")");
+      Bad(where + ".anchor_actuation",
+          "the point does not move steadily sideways along the ray (step " + std::to_string(k) +
+              ")");
   auto height = [&](double r) {
     size_t k = 1;
     while (k + 1 < prof_r.size() && prof_r[k] < r) ++k;
@@ -144,14 +149,19 @@ Eigen::MatrixX3d MapToWorkspace(const Eigen::MatrixX3d& W, const nlohmann::json&
   double far_r = 0;
   for (int i = 0; i < W.rows(); ++i) {
     const double r = hdist(W.row(i).transpose(), p0);
-    if (r > far_r) { far_r = r; far = i; }
+    if (r > far_r) {
+      far_r = r;
+      far = i;
+    }
   }
-  if (far_r <= 0) Bad(where, "every waypoint has the first one's sideways position; nothing to scale");
+  if (far_r <= 0)
+    Bad(where, "every waypoint has the first one's sideways position; nothing to scale");
   const Eigen::Vector3d pf = W.row(far).transpose();
   const double anchor_r = prof_r.back();
   if (anchor_r <= 1e-9) Bad(where + ".anchor_actuation", "does not move the point sideways");
   const double s_h = anchor_r / far_r;
-  const double ang = std::atan2(ta[av] - t0[av], ta[au] - t0[au]) - std::atan2(pf[av] - p0[av], pf[au] - p0[au]);
+  const double ang =
+      std::atan2(ta[av] - t0[av], ta[au] - t0[au]) - std::atan2(pf[av] - p0[av], pf[au] - p0[au]);
   const double co = std::cos(ang), si = std::sin(ang);
   Eigen::MatrixX3d out(W.rows(), 3);
   for (int i = 0; i < W.rows(); ++i) {
@@ -167,7 +177,8 @@ Eigen::MatrixX3d MapToWorkspace(const Eigen::MatrixX3d& W, const nlohmann::json&
     sampled_reach = std::max(sampled_reach, hdist(samples.p.row(i).transpose(), t0));
   (*info)["mapping"] = {
       {"sideways", "h' = t0_h + s_h R (p_h - p0_h)"},
-      {"height", "our point's height along the anchor's actuation ray at the same sideways distance, + lift"},
+      {"height",
+       "our point's height along the anchor's actuation ray at the same sideways distance, + lift"},
       {"p0_file_first_waypoint", {p0[0], p0[1], p0[2]}},
       {"t0_rest_point", {t0[0], t0[1], t0[2]}},
       {"anchor_waypoint", far},
@@ -202,7 +213,8 @@ nlohmann::json IkExperimentSetup::Json() const {
           {"fk_solver", fk.solver}};
 }
 
-SimulatorKinematicsOptions IkExperimentSetup::KinematicsFor(const std::vector<std::string>& points) const {
+SimulatorKinematicsOptions IkExperimentSetup::KinematicsFor(
+    const std::vector<std::string>& points) const {
   SimulatorKinematicsOptions o = kin;
   o.points = points;
   return o;
@@ -216,7 +228,8 @@ IkExperimentSetup ReadIkSetup(const Config& cfg, const std::string& default_robo
   s.fk = cfg.Solver(s.scene.solver);
   s.point = cfg.String("point", "tip");
   const std::string jac = cfg.String("jacobian", "implicit");
-  if (!JacobianModeFromString(jac, &s.kin.jacobian)) cfg.Fail("jacobian", "one of " + JacobianModeNames());
+  if (!JacobianModeFromString(jac, &s.kin.jacobian))
+    cfg.Fail("jacobian", "one of " + JacobianModeNames());
   s.kin.fd_step = cfg.Number("fd_step", s.kin.fd_step);
   s.kin.trace = cfg.Bool("trace_fk", false);  // one stderr line per forward solve
   std::string why;
@@ -224,14 +237,16 @@ IkExperimentSetup ReadIkSetup(const Config& cfg, const std::string& default_robo
   const std::string method = cfg.String("method", "softls");
   if (!StringToIkMethod(method, &s.ik.method)) cfg.Fail("method", "one of " + IkMethodNames());
   s.lambda_mm = cfg.Number("lambda_mm", 0.2);
-  if (!(s.lambda_mm >= 0) || !std::isfinite(s.lambda_mm)) cfg.Fail("lambda_mm", "a distance >= 0 mm");
+  if (!(s.lambda_mm >= 0) || !std::isfinite(s.lambda_mm))
+    cfg.Fail("lambda_mm", "a distance >= 0 mm");
   s.ik.lambda = s.lambda_mm * s.lambda_mm;
   s.ik.max_iterations = cfg.Int("max_iterations", 30);
   s.ik.max_evaluations = cfg.Int("max_evaluations", 300);
   s.ik.max_time_s = cfg.Number("max_time_s", 600.0);
   if (!s.ik.IsValid(&why)) throw std::invalid_argument(cfg.path() + ": " + why);
   s.samples_per_axis = cfg.Int("samples_per_axis", 5);
-  if (s.samples_per_axis < 2 || s.samples_per_axis > 20) cfg.Fail("samples_per_axis", "an integer in [2, 20]");
+  if (s.samples_per_axis < 2 || s.samples_per_axis > 20)
+    cfg.Fail("samples_per_axis", "an integer in [2, 20]");
   s.first_waypoint_starts = cfg.Int("first_waypoint_starts", 3);
   if (s.first_waypoint_starts < 1 || s.first_waypoint_starts > 1000)
     cfg.Fail("first_waypoint_starts", "an integer in [1, 1000]");
@@ -265,7 +280,8 @@ IkPath MakeIkPath(const nlohmann::json& spec, const std::string& where, Kinemati
                   const ConfigurationSamples& samples) {
   if (!spec.is_object()) Bad(where, "expected a path object {\"name\", \"type\", ...}");
   IkPath path;
-  if (!spec.contains("name") || !spec["name"].is_string() || spec["name"].get<std::string>().empty())
+  if (!spec.contains("name") || !spec["name"].is_string() ||
+      spec["name"].get<std::string>().empty())
     Bad(where + ".name", "expected a non-empty string");
   path.name = spec["name"].get<std::string>();
   for (char ch : path.name)
@@ -299,19 +315,22 @@ IkPath MakeIkPath(const nlohmann::json& spec, const std::string& where, Kinemati
     int au = 0, av = 2;
     if (spec.contains("axes")) {
       const auto& a = spec["axes"];
-      if (!a.is_array() || a.size() != 2 || !a[0].is_number_integer() || !a[1].is_number_integer() ||
-          a[0].get<int>() < 0 || a[0].get<int>() > 2 || a[1].get<int>() < 0 || a[1].get<int>() > 2 ||
-          a[0] == a[1])
+      if (!a.is_array() || a.size() != 2 || !a[0].is_number_integer() ||
+          !a[1].is_number_integer() || a[0].get<int>() < 0 || a[0].get<int>() > 2 ||
+          a[1].get<int>() < 0 || a[1].get<int>() > 2 || a[0] == a[1])
         Bad(where + ".axes", "expected two different axes out of 0, 1, 2 (e.g. [0, 2]: x, z)");
       au = a[0].get<int>();
       av = a[1].get<int>();
     }
     const double w = Num(spec, "width", where, 0, true), h = Num(spec, "height", where, 0, true);
     if (!(w > 0) || !(h > 0)) Bad(where, "width and height must be > 0 mm");
-    path.waypoints = ResamplePolyline(FlameCurve(c, au, av, w, h, Num(spec, "tilt_deg", where, 0.0)), Int(spec, "n", where, 2), true);
+    path.waypoints =
+        ResamplePolyline(FlameCurve(c, au, av, w, h, Num(spec, "tilt_deg", where, 0.0)),
+                         Int(spec, "n", where, 2), true);
   } else if (type == "file") {
     OnlyKeys(spec, with({"file", "map", "stride"}), where);
-    if (!spec.contains("file") || !spec["file"].is_string()) Bad(where + ".file", "expected a file name");
+    if (!spec.contains("file") || !spec["file"].is_string())
+      Bad(where + ".file", "expected a file name");
     std::filesystem::path f = spec["file"].get<std::string>();
     if (f.is_relative()) f = std::filesystem::path(SOFTKIN_SOURCE_DIR) / f;
     Eigen::MatrixX3d w = ReadWaypoints(f.lexically_normal().string());
@@ -324,7 +343,8 @@ IkPath MakeIkPath(const nlohmann::json& spec, const std::string& where, Kinemati
       w = sub;
     }
     if (spec.contains("map")) {
-      if (!spec["map"].is_object()) Bad(where + ".map", "expected an object {axis, anchor_actuation}");
+      if (!spec["map"].is_object())
+        Bad(where + ".map", "expected an object {axis, anchor_actuation}");
       w = MapToWorkspace(w, spec["map"], where + ".map", kin, samples, &path.info);
     }
     path.waypoints = w;

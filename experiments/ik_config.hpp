@@ -15,12 +15,13 @@
 ///               polyline (both ends included), "closed" (false) to return to the first vertex;
 ///   "flame":    a closed teardrop with a flickering side (the thesis's flame, Fig. 4.2) in the
 ///               plane of two axes "axes" ([0, 2]: x and z), centred at "center" [x,y,z], "width"
-///               and "height" (mm), turned by "tilt_deg" (0) in that plane, "n" waypoints evenly by arc length, starting at its bottom;
+///               and "height" (mm), turned by "tilt_deg" (0) in that plane, "n" waypoints evenly by
+///               arc length, starting at its bottom;
 ///   "file":     a waypoint file "file" (ik/trajectory_io.hpp; relative paths are taken from the
 ///               source tree), every "stride"-th waypoint (1: all; the first is always kept, and
-///               the mapping uses the file's first waypoint), optionally mapped into the robot's workspace with "map"
-///               {axis, anchor_actuation, profile_steps, lift} (see MapToWorkspace in
-///               ik_config.cpp and docs/ik.md).
+///               the mapping uses the file's first waypoint), optionally mapped into the robot's
+///               workspace with "map" {axis, anchor_actuation, profile_steps, lift} (see
+///               MapToWorkspace in ik_config.cpp and docs/ik.md).
 /// Every path may carry "thesis": {...}, the thesis's numbers for it (e.g. {"total_time_s": 38}),
 /// copied into the summary beside ours.
 #include "softkin/experiments/config.hpp"

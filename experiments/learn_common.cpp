@@ -19,8 +19,10 @@ namespace fs = std::filesystem;
 std::string DatasetSpec::Tag() const {
   std::ostringstream s;
   s << (twin.empty() ? robot : "twin_" + twin) << "_r" << res << "_";
-  if (sampling.kind == DatasetSampling::Kind::kGrid) s << "g" << sampling.grid;
-  else s << "rnd" << sampling.random << "s" << sampling.seed;
+  if (sampling.kind == DatasetSampling::Kind::kGrid)
+    s << "g" << sampling.grid;
+  else
+    s << "rnd" << sampling.random << "s" << sampling.seed;
   s << "_b" << sampling.block << (jacobian ? "_J" : "") << "_gt" << gradient_tolerance;
   for (const auto& p : points) s << "_" << p;
   std::string t = s.str();
@@ -30,8 +32,12 @@ std::string DatasetSpec::Tag() const {
 }
 
 nlohmann::json DatasetSpec::Json() const {
-  return {{"robot", robot}, {"twin", twin}, {"res", res}, {"points", points},
-          {"sampling", sampling.ToJson()}, {"jacobian", jacobian},
+  return {{"robot", robot},
+          {"twin", twin},
+          {"res", res},
+          {"points", points},
+          {"sampling", sampling.ToJson()},
+          {"jacobian", jacobian},
           {"gradient_tolerance", gradient_tolerance}};
 }
 
@@ -39,11 +45,14 @@ DatasetSpec ParseDatasetSpec(const nlohmann::json& j, const std::string& where) 
   auto bad = [&where](const std::string& key, const std::string& what) {
     return std::invalid_argument(where + "." + key + ": expected " + what);
   };
-  if (!j.is_object()) throw std::invalid_argument(where + ": expected a dataset object {\"robot\", \"grid\", ...}");
-  const std::set<std::string> known = {"robot", "twin", "res", "points", "grid", "random", "seed",
-                                       "jacobian", "gradient_tolerance", "block"};
+  if (!j.is_object())
+    throw std::invalid_argument(where + ": expected a dataset object {\"robot\", \"grid\", ...}");
+  const std::set<std::string> known = {
+      "robot", "twin", "res", "points", "grid", "random", "seed", "jacobian", "gradient_tolerance",
+      "block"};
   for (auto it = j.begin(); it != j.end(); ++it)
-    if (!known.count(it.key())) throw std::invalid_argument(where + "." + it.key() + ": unknown key");
+    if (!known.count(it.key()))
+      throw std::invalid_argument(where + "." + it.key() + ": unknown key");
   DatasetSpec s;
   if (j.contains("twin")) {
     if (!j["twin"].is_string()) throw bad("twin", "a twin name");
@@ -55,7 +64,8 @@ DatasetSpec ParseDatasetSpec(const nlohmann::json& j, const std::string& where) 
     }
     if (j.contains("robot")) throw std::invalid_argument(where + ": give robot or twin, not both");
   } else {
-    if (!j.contains("robot") || !j["robot"].is_string()) throw bad("robot", "an embedded robot name");
+    if (!j.contains("robot") || !j["robot"].is_string())
+      throw bad("robot", "an embedded robot name");
     s.robot = j["robot"].get<std::string>();
   }
   if (j.contains("res")) {
@@ -63,7 +73,8 @@ DatasetSpec ParseDatasetSpec(const nlohmann::json& j, const std::string& where) 
     s.res = j["res"].get<int>();
   }
   if (j.contains("points")) {
-    if (!j["points"].is_array() || j["points"].empty()) throw bad("points", "a non-empty array of marker names");
+    if (!j["points"].is_array() || j["points"].empty())
+      throw bad("points", "a non-empty array of marker names");
     s.points.clear();
     for (const auto& p : j["points"]) {
       if (!p.is_string()) throw bad("points", "marker names");
@@ -71,14 +82,17 @@ DatasetSpec ParseDatasetSpec(const nlohmann::json& j, const std::string& where) 
     }
   }
   if (j.contains("random")) {
-    if (!j["random"].is_number_integer() || j["random"].get<long long>() < 1) throw bad("random", "a sample count >= 1");
-    if (!j.contains("seed") || !j["seed"].is_number_integer()) throw bad("seed", "an integer seed (required with random)");
+    if (!j["random"].is_number_integer() || j["random"].get<long long>() < 1)
+      throw bad("random", "a sample count >= 1");
+    if (!j.contains("seed") || !j["seed"].is_number_integer())
+      throw bad("seed", "an integer seed (required with random)");
     s.sampling.kind = DatasetSampling::Kind::kRandom;
     s.sampling.random = j["random"].get<long long>();
     s.sampling.seed = j["seed"].get<std::uint64_t>();
     if (j.contains("grid")) throw std::invalid_argument(where + ": give grid or random, not both");
   } else {
-    if (!j.contains("grid") || !j["grid"].is_number_integer()) throw bad("grid", "an integer N >= 2 (N^m samples)");
+    if (!j.contains("grid") || !j["grid"].is_number_integer())
+      throw bad("grid", "an integer N >= 2 (N^m samples)");
     s.sampling.grid = j["grid"].get<int>();
   }
   if (j.contains("block")) {
@@ -96,7 +110,8 @@ DatasetSpec ParseDatasetSpec(const nlohmann::json& j, const std::string& where) 
   }
   std::string why;
   if (!s.sampling.IsValid(&why)) throw std::invalid_argument(where + ": " + why);
-  if (!s.twin.empty() && s.jacobian) throw std::invalid_argument(where + ".jacobian: a twin has no Jacobian");
+  if (!s.twin.empty() && s.jacobian)
+    throw std::invalid_argument(where + ".jacobian: a twin has no Jacobian");
   return s;
 }
 
@@ -132,19 +147,26 @@ Dataset CachedDataset(const DatasetSpec& spec, const std::string& cache_dir, boo
   run.source = spec.Json();
   run.source["kind"] = spec.twin.empty() ? "robot" : "twin";
   if (!spec.twin.empty()) run.source["twin"] = "twin:" + spec.twin;
-  run.provenance = {{"git_commit", GitCommit()}, {"command", "softkin run (experiment dataset cache)"}};
+  run.provenance = {{"git_commit", GitCommit()},
+                    {"command", "softkin run (experiment dataset cache)"}};
   Kinematics* raw = kin.get();
   run.reset = [raw] {
-    if (auto* t = dynamic_cast<TwinKinematics*>(raw)) t->Reset();
-    else if (auto* s = dynamic_cast<SimulatorKinematics*>(raw)) s->Reset();
+    if (auto* t = dynamic_cast<TwinKinematics*>(raw))
+      t->Reset();
+    else if (auto* s = dynamic_cast<SimulatorKinematics*>(raw))
+      s->Reset();
   };
   run.progress = verbose;
   if (verbose) std::cerr << "  dataset " << path << " (" << kin->name() << ")\n";
   const DatasetRunSummary s = GenerateDataset(*kin, spec.sampling, run);
   Dataset d = LoadDataset(path);
   if (info) {
-    *info = {{"path", path}, {"spec", spec.Json()}, {"samples", d.inputs.rows()},
-             {"failed", d.failed}, {"generated_now", s.written}, {"already_cached", s.already},
+    *info = {{"path", path},
+             {"spec", spec.Json()},
+             {"samples", d.inputs.rows()},
+             {"failed", d.failed},
+             {"generated_now", s.written},
+             {"already_cached", s.already},
              {"time_s", s.time_s},
              {"ms_per_sample", s.written > 0 ? 1e3 * s.time_s / s.written : 0.0}};
   }
@@ -180,11 +202,12 @@ std::string NetTag(const char* name, bool on, const NetTrainOptions& o) {
 
 }  // namespace
 
-LearnedNets CachedNets(const Dataset& d, const std::string& dataset_path, const std::string& dataset_tag,
-                       const NetsFromDatasetOptions& opt, const std::string& cache_dir, bool verbose,
-                       bool* cached) {
+LearnedNets CachedNets(const Dataset& d, const std::string& dataset_path,
+                       const std::string& dataset_tag, const NetsFromDatasetOptions& opt,
+                       const std::string& cache_dir, bool verbose, bool* cached) {
   std::ostringstream key;
-  key << dataset_tag << "_n" << d.inputs.rows() << "_split" << opt.split_seed << "f" << opt.train_fraction;
+  key << dataset_tag << "_n" << d.inputs.rows() << "_split" << opt.split_seed << "f"
+      << opt.train_fraction;
   const fs::path dir = fs::path(cache_dir) / key.str();
   fs::create_directories(dir);
   // Bounds, points and the split's record, without training anything.
@@ -216,7 +239,9 @@ LearnedNets CachedNets(const Dataset& d, const std::string& dataset_path, const 
         continue;
       }
     } catch (const std::exception& e) {
-      if (verbose) std::cerr << "  ignoring the unreadable cached network " << base << ": " << e.what() << "\n";
+      if (verbose)
+        std::cerr << "  ignoring the unreadable cached network " << base << ": " << e.what()
+                  << "\n";
     }
     *it.miss = true;
     all_cached = false;
@@ -269,18 +294,21 @@ DatasetSpec SpecFromConfig(const Config& cfg, const std::string& key) {
 
 std::unique_ptr<PccChamberKinematics> FitPccBaseline(const Dataset& d, nlohmann::json* info) {
   if (d.num_actuators != 3)
-    throw std::invalid_argument("the PCC baseline models three_chamber (3 actuators), the dataset has " +
-                                std::to_string(d.num_actuators));
+    throw std::invalid_argument(
+        "the PCC baseline models three_chamber (3 actuators), the dataset has " +
+        std::to_string(d.num_actuators));
   PccChamberParams start;
-  if (d.meta.is_object() && d.meta.contains("config") && d.meta["config"].contains("actuator_bounds")) {
+  if (d.meta.is_object() && d.meta.contains("config") &&
+      d.meta["config"].contains("actuator_bounds")) {
     start.lower = d.meta["config"]["actuator_bounds"][0][0].get<double>();
     start.upper = d.meta["config"]["actuator_bounds"][0][1].get<double>();
     start.rest = start.lower;
   }
   const PccFitResult f = FitPccChamber(d.inputs, d.positions.leftCols(3), start);
   if (info)
-    *info = {{"gain", f.params.gain}, {"offset_mm", f.params.offset}, {"cap_mm", f.params.cap},
-             {"fit_rms_mm", f.rms_mm}, {"start_rms_mm", f.rms_start_mm}, {"fit_samples", d.inputs.rows()}};
+    *info = {{"gain", f.params.gain},          {"offset_mm", f.params.offset},
+             {"cap_mm", f.params.cap},         {"fit_rms_mm", f.rms_mm},
+             {"start_rms_mm", f.rms_start_mm}, {"fit_samples", d.inputs.rows()}};
   return std::make_unique<PccChamberKinematics>(f.params);
 }
 

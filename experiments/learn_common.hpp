@@ -22,13 +22,13 @@
 namespace softkin {
 
 struct DatasetSpec {
-  std::string robot;                       ///< embedded robot (always set; a twin's nominal robot)
-  std::string twin;                        ///< "" or a twin name (learn/twin.hpp)
-  int res = 0;                             ///< resolution (<= 0: the robot's default)
+  std::string robot;  ///< embedded robot (always set; a twin's nominal robot)
+  std::string twin;   ///< "" or a twin name (learn/twin.hpp)
+  int res = 0;        ///< resolution (<= 0: the robot's default)
   std::vector<std::string> points = {"tip"};
-  DatasetSampling sampling;                ///< grid N^m or seeded random
-  bool jacobian = false;                   ///< record J (implicit differentiation)
-  double gradient_tolerance = 1e-4;        ///< forward-solve stopping ratio
+  DatasetSampling sampling;          ///< grid N^m or seeded random
+  bool jacobian = false;             ///< record J (implicit differentiation)
+  double gradient_tolerance = 1e-4;  ///< forward-solve stopping ratio
   /// A file-name-safe key of everything above (the cache file's name).
   std::string Tag() const;
   nlohmann::json Json() const;
@@ -61,9 +61,9 @@ struct LearnedNets;
 /// <cache_dir>/<key> when a run with the same dataset, architectures, epochs, split and seed
 /// saved them there (training N_J on thousands of Jacobians takes minutes; several experiments
 /// share the same networks). *cached says which happened.
-LearnedNets CachedNets(const Dataset& d, const std::string& dataset_path, const std::string& dataset_tag,
-                       const NetsFromDatasetOptions& opt, const std::string& cache_dir, bool verbose,
-                       bool* cached = nullptr);
+LearnedNets CachedNets(const Dataset& d, const std::string& dataset_path,
+                       const std::string& dataset_tag, const NetsFromDatasetOptions& opt,
+                       const std::string& cache_dir, bool verbose, bool* cached = nullptr);
 
 /// The shared network cache directory of an experiment's result dir: <dir>/../_nets.
 std::string NetsCacheDir(const std::string& result_dir);

@@ -8,9 +8,10 @@
 namespace softkin {
 
 /// Tracks the bending angle (degrees) of the distal end face, unwrapped along a sweep so that it
-/// can exceed 180. It uses markers `tip_top` and `tip_bottom` (the end face's upper and lower parts):
-/// the angle is the rotation of the vector tip_bottom -> tip_top about the axis normal to the plane
-/// of the rest vector and the first bent one. Throws std::invalid_argument if the markers are missing.
+/// can exceed 180. It uses markers `tip_top` and `tip_bottom` (the end face's upper and lower
+/// parts): the angle is the rotation of the vector tip_bottom -> tip_top about the axis normal to
+/// the plane of the rest vector and the first bent one. Throws std::invalid_argument if the markers
+/// are missing.
 class BendAngle {
  public:
   explicit BendAngle(const Scene& scene);

@@ -20,13 +20,13 @@ std::string ResultDir(const std::string& root, const std::string& name) {
   fs::path p = fs::path(root) / name;
   std::error_code ec;
   fs::create_directories(p, ec);
-  if (ec) throw std::runtime_error("cannot create result folder " + p.string() + ": " + ec.message());
+  if (ec)
+    throw std::runtime_error("cannot create result folder " + p.string() + ": " + ec.message());
   return p.string();
 }
 
 std::string GitCommit() {
-  std::string cmd = std::string("git -C '") + SOFTKIN_SOURCE_DIR +
-                    "' rev-parse HEAD 2>/dev/null";
+  std::string cmd = std::string("git -C '") + SOFTKIN_SOURCE_DIR + "' rev-parse HEAD 2>/dev/null";
   FILE* f = popen(cmd.c_str(), "r");
   if (!f) return "unknown";
   char buf[128] = {0};
@@ -36,7 +36,9 @@ std::string GitCommit() {
   while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
   if (out.empty()) return "unknown";
   FILE* g = popen((std::string("git -C '") + SOFTKIN_SOURCE_DIR +
-                   "' status --porcelain --untracked-files=no 2>/dev/null").c_str(), "r");
+                   "' status --porcelain --untracked-files=no 2>/dev/null")
+                      .c_str(),
+                  "r");
   if (g) {
     if (fgets(buf, sizeof(buf), g)) out += "-dirty";
     pclose(g);
@@ -136,7 +138,9 @@ ResumeJournal::ResumeJournal(const std::string& path) : path_(path) {
         }
       } catch (const nlohmann::json::exception&) {
       }
-      std::fprintf(stderr, "  %s:%d: not a complete JSON record (an interrupted write?); that unit is computed again\n",
+      std::fprintf(stderr,
+                   "  %s:%d: not a complete JSON record (an interrupted write?); that unit is "
+                   "computed again\n",
                    path.c_str(), lineno);
     }
   }

@@ -41,11 +41,11 @@ class CsvWriter {
 };
 
 /// A journal of finished units of a long sweep, for resuming it: one JSON record per line,
-/// {"key": ..., "row": ...}, appended and flushed as each unit finishes. The key holds every setting
-/// that determines the row; a rerun reuses the rows whose key matches exactly and recomputes the
-/// rest. A line that does not parse (a write cut by a crash) is reported on stderr and skipped.
-/// The key does not identify the code: after changing the code, delete the journal to recompute
-/// (summaries report how many rows were reused, as "resumed_rows").
+/// {"key": ..., "row": ...}, appended and flushed as each unit finishes. The key holds every
+/// setting that determines the row; a rerun reuses the rows whose key matches exactly and
+/// recomputes the rest. A line that does not parse (a write cut by a crash) is reported on stderr
+/// and skipped. The key does not identify the code: after changing the code, delete the journal to
+/// recompute (summaries report how many rows were reused, as "resumed_rows").
 class ResumeJournal {
  public:
   explicit ResumeJournal(const std::string& path);

@@ -86,7 +86,8 @@ nlohmann::json RunExperiment(const std::string& config_path, const RunOptions& o
   run["machine"] = MachineInfo();
   run["seed"] = cfg.seed();
   const auto t0 = std::chrono::steady_clock::now();
-  if (opt.verbose) std::cerr << "softkin: running " << cfg.name() << (opt.quick ? " (quick)" : "") << "\n";
+  if (opt.verbose)
+    std::cerr << "softkin: running " << cfg.name() << (opt.quick ? " (quick)" : "") << "\n";
   nlohmann::json summary = fn(cfg, dir, opt.verbose);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   run["wall_time_s"] = wall;

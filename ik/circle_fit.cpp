@@ -120,8 +120,8 @@ CircleFit FitCircle(const Eigen::Ref<const Eigen::MatrixX3d>& points,
   const Eigen::VectorXd q = A * s;
   Eigen::MatrixX2d g(n_pts, 2);  // dr/du_i (unscaled u; see the note above)
   for (int i = 0; i < n_pts; ++i)
-    g.row(i) = res[i] * s.head<2>().transpose() -
-               q[i] * (theta.head<2>().transpose() + 2.0 * u.row(i));
+    g.row(i) =
+        res[i] * s.head<2>().transpose() - q[i] * (theta.head<2>().transpose() + 2.0 * u.row(i));
 
   // Into 3D: u_i = E^T (x_i - m).
   Eigen::MatrixX3d dr = g * E.transpose();

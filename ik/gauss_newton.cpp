@@ -115,8 +115,7 @@ IkResult SolveGaussNewton(Kinematics& kin, const Objective& objective,
     Eigen::VectorXd c_trial;
     Eigen::MatrixX3d p_trial;
     while (mu <= options.max_damping) {
-      const Eigen::VectorXd duf =
-          (Hf + mu * Eigen::MatrixXd::Identity(nf, nf)).ldlt().solve(-gf);
+      const Eigen::VectorXd duf = (Hf + mu * Eigen::MatrixXd::Identity(nf, nf)).ldlt().solve(-gf);
       Eigen::VectorXd dc = Eigen::VectorXd::Zero(n);
       for (int i = 0; i < nf; ++i) dc[free[i]] = range[free[i]] * duf[i];
       c_trial = P.Project(c + dc);
@@ -160,9 +159,9 @@ IkResult SolveGaussNewton(Kinematics& kin, const Objective& objective,
       S.message = "no decrease with damping up to max_damping";
       break;
     }
-    const double step = ((c_trial - c).cwiseAbs().cwiseQuotient(
-                             range.cwiseMax(std::numeric_limits<double>::min())))
-                            .maxCoeff();
+    const double step =
+        ((c_trial - c).cwiseAbs().cwiseQuotient(range.cwiseMax(std::numeric_limits<double>::min())))
+            .maxCoeff();
     const double o_prev = cur.value;
     const bool step_had_fresh_j = fresh;
     if (broyden) {

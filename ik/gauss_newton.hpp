@@ -5,7 +5,8 @@
 ///
 /// In coordinates scaled to [0, 1] per actuator (u = (c - c_min)/range, so the damping treats all
 /// actuators alike), with A = dr/du = dr/dp J diag(range) and g = A^T r, each iteration:
-///  1. the free set: actuators not at a bound that the steepest-descent direction -g pushes against;
+///  1. the free set: actuators not at a bound that the steepest-descent direction -g pushes
+///  against;
 ///  2. solve (A_F^T A_F + mu I) du_F = -g_F on the free set, c_trial = P(c + diag(range) du),
 ///     P the projection onto the box;
 ///  3. accept if O(c_trial) < O(c) (then mu /= 10), else mu *= 10 and retry; give up (no-progress)
@@ -27,8 +28,8 @@
 
 namespace softkin {
 
-/// The gauss-newton and broyden methods of SolveIk (which checks the inputs; call that instead). The objective
-/// must have num_residuals() > 0.
+/// The gauss-newton and broyden methods of SolveIk (which checks the inputs; call that instead).
+/// The objective must have num_residuals() > 0.
 IkResult SolveGaussNewton(Kinematics& kin, const Objective& objective,
                           const Eigen::Ref<const Eigen::VectorXd>& c0, const IkOptions& options);
 

@@ -62,7 +62,8 @@ IkPoint IkProblem::EvaluateOnce(const Eigen::Ref<const Eigen::VectorXd>& c, bool
     return pt;
   }
   if (e.p.rows() != objective_.num_points() || !e.p.allFinite() ||
-      (with_jacobian && (e.J.rows() != 3 * e.p.rows() || e.J.cols() != c.size() || !e.J.allFinite()))) {
+      (with_jacobian &&
+       (e.J.rows() != 3 * e.p.rows() || e.J.cols() != c.size() || !e.J.allFinite()))) {
     pt.failure = IkTermination::kKinematicsFailure;
     pt.message = kin_.name() + ": returned non-finite or wrongly sized points / Jacobian";
     return pt;
@@ -95,8 +96,8 @@ IkPoint IkProblem::EvaluateOnce(const Eigen::Ref<const Eigen::VectorXd>& c, bool
 
 IkPoint IkProblem::Evaluate(const Eigen::Ref<const Eigen::VectorXd>& c, bool with_gradient,
                             bool with_jacobian_too) {
-  const bool jac = with_jacobian_too ||
-                   (with_gradient && options_.gradient == IkGradient::kJacobian);
+  const bool jac =
+      with_jacobian_too || (with_gradient && options_.gradient == IkGradient::kJacobian);
   IkPoint pt = EvaluateOnce(c, jac, true);
   if (!pt.ok || !with_gradient || jac) return pt;
   // Eq. 4.2: central differences on O, one-sided where a probe would leave the box.
@@ -136,8 +137,10 @@ IkResult IkProblem::Finish(const Eigen::Ref<const Eigen::VectorXd>& c0, IkSummar
     res.p = best_p_;
     res.objective = best_value_;
     summary.final_objective = best_value_;
-    if (summary.history.empty()) summary.initial_objective = best_value_;
-    else summary.initial_objective = summary.history.front();
+    if (summary.history.empty())
+      summary.initial_objective = best_value_;
+    else
+      summary.initial_objective = summary.history.front();
   } else {
     res.c = c0;
   }

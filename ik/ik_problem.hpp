@@ -14,11 +14,11 @@ namespace softkin {
 struct IkPoint {
   bool ok = false;
   IkTermination failure = IkTermination::kKinematicsFailure;  ///< when !ok
-  std::string message;                                       ///< when !ok
-  double value = 0.0;       ///< O(c)
-  Eigen::VectorXd grad;     ///< dO/dc (#actuators), when requested
-  Eigen::MatrixX3d p;       ///< tracked points at c
-  Eigen::MatrixXd J;        ///< dp/dc, when requested with the Jacobian gradient
+  std::string message;                                        ///< when !ok
+  double value = 0.0;                                         ///< O(c)
+  Eigen::VectorXd grad;  ///< dO/dc (#actuators), when requested
+  Eigen::MatrixX3d p;    ///< tracked points at c
+  Eigen::MatrixXd J;     ///< dp/dc, when requested with the Jacobian gradient
 };
 
 class IkProblem {

@@ -15,10 +15,10 @@ namespace {
 
 const std::vector<std::pair<IkMethod, const char*>>& MethodNames() {
   static const std::vector<std::pair<IkMethod, const char*>> names = {
-      {IkMethod::kSoftLineSearch, "softls"},     {IkMethod::kNloptMma, "nlopt-mma"},
-      {IkMethod::kNloptLbfgs, "nlopt-lbfgs"},    {IkMethod::kNloptSlsqp, "nlopt-slsqp"},
-      {IkMethod::kNloptCcsaq, "nlopt-ccsaq"},    {IkMethod::kNloptBobyqa, "nlopt-bobyqa"},
-      {IkMethod::kGaussNewton, "gauss-newton"},  {IkMethod::kBroyden, "broyden"}};
+      {IkMethod::kSoftLineSearch, "softls"},    {IkMethod::kNloptMma, "nlopt-mma"},
+      {IkMethod::kNloptLbfgs, "nlopt-lbfgs"},   {IkMethod::kNloptSlsqp, "nlopt-slsqp"},
+      {IkMethod::kNloptCcsaq, "nlopt-ccsaq"},   {IkMethod::kNloptBobyqa, "nlopt-bobyqa"},
+      {IkMethod::kGaussNewton, "gauss-newton"}, {IkMethod::kBroyden, "broyden"}};
   return names;
 }
 
@@ -69,9 +69,12 @@ std::string IkGradientToString(IkGradient g) {
 }
 
 bool StringToIkGradient(const std::string& s, IkGradient* g) {
-  if (s == "jacobian") *g = IkGradient::kJacobian;
-  else if (s == "central-difference") *g = IkGradient::kCentralDifference;
-  else return false;
+  if (s == "jacobian")
+    *g = IkGradient::kJacobian;
+  else if (s == "central-difference")
+    *g = IkGradient::kCentralDifference;
+  else
+    return false;
   return true;
 }
 
@@ -93,25 +96,34 @@ bool StringToIkTermination(const std::string& s, IkTermination* t) {
 bool IkOptions::IsValid(std::string* why) const {
   std::ostringstream s;
   auto finite = [](double v) { return std::isfinite(v); };
-  if (IkMethodToString(method) == "unknown") s << "method: unknown value";
+  if (IkMethodToString(method) == "unknown")
+    s << "method: unknown value";
   else if (!(finite(fd_step) && fd_step > 0 && fd_step <= 0.5))
     s << "fd_step must be in (0, 0.5], got " << fd_step;
-  else if (!(finite(lambda) && lambda >= 0)) s << "lambda must be >= 0, got " << lambda;
-  else if (max_iterations < 1) s << "max_iterations must be >= 1, got " << max_iterations;
-  else if (max_evaluations < 1) s << "max_evaluations must be >= 1, got " << max_evaluations;
-  else if (!(finite(max_time_s) && max_time_s > 0)) s << "max_time_s must be > 0, got " << max_time_s;
+  else if (!(finite(lambda) && lambda >= 0))
+    s << "lambda must be >= 0, got " << lambda;
+  else if (max_iterations < 1)
+    s << "max_iterations must be >= 1, got " << max_iterations;
+  else if (max_evaluations < 1)
+    s << "max_evaluations must be >= 1, got " << max_evaluations;
+  else if (!(finite(max_time_s) && max_time_s > 0))
+    s << "max_time_s must be > 0, got " << max_time_s;
   else if (!(finite(function_tolerance) && function_tolerance >= 0))
     s << "function_tolerance must be >= 0, got " << function_tolerance;
   else if (!(finite(parameter_tolerance) && parameter_tolerance >= 0))
     s << "parameter_tolerance must be >= 0, got " << parameter_tolerance;
-  else if (!(finite(tau) && tau > 0 && tau < 1)) s << "tau must be in (0, 1), got " << tau;
-  else if (max_shrinks < 1) s << "max_shrinks must be >= 1, got " << max_shrinks;
-  else if (max_expansions < 0) s << "max_expansions must be >= 0, got " << max_expansions;
+  else if (!(finite(tau) && tau > 0 && tau < 1))
+    s << "tau must be in (0, 1), got " << tau;
+  else if (max_shrinks < 1)
+    s << "max_shrinks must be >= 1, got " << max_shrinks;
+  else if (max_expansions < 0)
+    s << "max_expansions must be >= 0, got " << max_expansions;
   else if (!(finite(initial_damping) && initial_damping > 0))
     s << "initial_damping must be > 0, got " << initial_damping;
   else if (!(finite(max_damping) && max_damping > initial_damping))
     s << "max_damping must be > initial_damping, got " << max_damping;
-  else if (!initial_jacobian.allFinite()) s << "initial_jacobian has a non-finite entry";
+  else if (!initial_jacobian.allFinite())
+    s << "initial_jacobian has a non-finite entry";
   if (why) *why = s.str();
   return s.str().empty();
 }
@@ -152,8 +164,9 @@ IkResult SolveIk(Kinematics& kin, const Objective& objective,
            options.initial_jacobian.cols() != kin.num_actuators()))
         throw std::invalid_argument(
             "IK: initial_jacobian is " + std::to_string(options.initial_jacobian.rows()) + " x " +
-            std::to_string(options.initial_jacobian.cols()) + ", expected 3 #points x #actuators = " +
-            std::to_string(3 * kin.num_points()) + " x " + std::to_string(kin.num_actuators()));
+            std::to_string(options.initial_jacobian.cols()) +
+            ", expected 3 #points x #actuators = " + std::to_string(3 * kin.num_points()) + " x " +
+            std::to_string(kin.num_actuators()));
       return SolveGaussNewton(kin, objective, c0, options);
     default:
       return SolveNlopt(kin, objective, c0, options);

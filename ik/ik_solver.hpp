@@ -72,9 +72,9 @@ struct IkOptions {
   double parameter_tolerance = 1e-10;
 
   // ---- softls (Algorithm 3) ----
-  double tau = 0.1;            ///< shrink ratio of the step, in (0, 1)
-  int max_shrinks = 30;        ///< shrinking steps before giving up on descent (>= 1)
-  int max_expansions = 50;     ///< expanding steps per line search (>= 0)
+  double tau = 0.1;         ///< shrink ratio of the step, in (0, 1)
+  int max_shrinks = 30;     ///< shrinking steps before giving up on descent (>= 1)
+  int max_expansions = 50;  ///< expanding steps per line search (>= 0)
   /// Search along -grad in coordinates scaled to [0, 1] per actuator (direction component a
   /// multiplied by range_a^2), so that Delta h = 1 means the same for actuators of any unit. false
   /// is the thesis's raw gradient.
@@ -112,8 +112,8 @@ struct IkSummary {
   IkMethod method = IkMethod::kSoftLineSearch;
   IkGradient gradient = IkGradient::kJacobian;
   IkTermination termination = IkTermination::kSolverFailure;
-  std::string message;           ///< why it stopped, in words
-  int iterations = 0;            ///< accepted steps (softls, gauss-newton); evaluations (NLopt)
+  std::string message;  ///< why it stopped, in words
+  int iterations = 0;   ///< accepted steps (softls, gauss-newton); evaluations (NLopt)
   /// O at the start and after each iteration (softls, gauss-newton), or the best O so far after
   /// each evaluation (NLopt); history.front() is O(c0) when c0 could be evaluated.
   std::vector<double> history;
@@ -130,8 +130,8 @@ struct IkSummary {
 };
 
 struct IkResult {
-  Eigen::VectorXd c;    ///< #actuators, the best actuation found (within the box)
-  Eigen::MatrixX3d p;   ///< #points x 3, the tracked points at c, mm
+  Eigen::VectorXd c;       ///< #actuators, the best actuation found (within the box)
+  Eigen::MatrixX3d p;      ///< #points x 3, the tracked points at c, mm
   double objective = 0.0;  ///< O(p(c))
   /// broyden only: its dp/dc at c (evaluated or secant-updated), to hand to the next solve as
   /// IkOptions::initial_jacobian; empty for the other methods or when c is not its last iterate.

@@ -16,14 +16,14 @@ namespace softkin {
 
 /// What one evaluation returns.
 struct KinematicsEval {
-  bool ok = false;            ///< false: p (and J) are not valid; `message` says why
+  bool ok = false;  ///< false: p (and J) are not valid; `message` says why
   std::string message;
-  Eigen::MatrixX3d p;         ///< #points x 3 tracked point positions, mm
+  Eigen::MatrixX3d p;  ///< #points x 3 tracked point positions, mm
   /// 3 #points x #actuators Jacobian dp/dc (row 3 i + d is coordinate d of point i), mm per unit
   /// of actuation; empty unless requested.
   Eigen::MatrixXd J;
-  int fk_solves = 0;          ///< forward solves this evaluation took (simulator), or 0
-  double time_s = 0.0;        ///< wall time of this evaluation
+  int fk_solves = 0;    ///< forward solves this evaluation took (simulator), or 0
+  double time_s = 0.0;  ///< wall time of this evaluation
 };
 
 class Kinematics {

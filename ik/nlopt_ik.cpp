@@ -13,12 +13,18 @@ namespace {
 
 nlopt::algorithm Algorithm(IkMethod m) {
   switch (m) {
-    case IkMethod::kNloptMma: return nlopt::LD_MMA;
-    case IkMethod::kNloptLbfgs: return nlopt::LD_LBFGS;
-    case IkMethod::kNloptSlsqp: return nlopt::LD_SLSQP;
-    case IkMethod::kNloptCcsaq: return nlopt::LD_CCSAQ;
-    case IkMethod::kNloptBobyqa: return nlopt::LN_BOBYQA;
-    default: break;
+    case IkMethod::kNloptMma:
+      return nlopt::LD_MMA;
+    case IkMethod::kNloptLbfgs:
+      return nlopt::LD_LBFGS;
+    case IkMethod::kNloptSlsqp:
+      return nlopt::LD_SLSQP;
+    case IkMethod::kNloptCcsaq:
+      return nlopt::LD_CCSAQ;
+    case IkMethod::kNloptBobyqa:
+      return nlopt::LN_BOBYQA;
+    default:
+      break;
   }
   assert(false && "not an NLopt method");
   return nlopt::LN_BOBYQA;

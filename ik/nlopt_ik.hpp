@@ -1,7 +1,7 @@
 #pragma once
 /// \file
-/// IK with NLopt (the "box-constrained actuation"): LD_MMA, LD_LBFGS, LD_SLSQP, LD_CCSAQ and
-/// the derivative-free LN_BOBYQA, each with c_min <= c <= c_max as NLopt bounds.
+/// IK with NLopt (the "box-constrained actuation"): LD_MMA, LD_LBFGS, LD_SLSQP, LD_CCSAQ
+/// and the derivative-free LN_BOBYQA, each with c_min <= c <= c_max as NLopt bounds.
 ///
 /// NLopt has no stopping rule by default; this sets all of them explicitly:
 ///  stopval = lambda, ftol_rel = function_tolerance, xtol_abs = parameter_tolerance * range,

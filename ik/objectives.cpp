@@ -28,8 +28,7 @@ double EvaluateFromResiduals(const Objective& o, const Eigen::Ref<const Eigen::M
 }
 
 void CheckFinite(const Eigen::Vector3d& v, const std::string& who, const std::string& what) {
-  if (!v.allFinite())
-    throw std::invalid_argument(who + ": " + what + " must be finite");
+  if (!v.allFinite()) throw std::invalid_argument(who + ": " + what + " must be finite");
 }
 
 void CheckNonNegative(double v, const std::string& who, const std::string& what) {
@@ -55,7 +54,8 @@ Eigen::Vector3d NormalFromPoints(const Eigen::Ref<const Eigen::MatrixX3d>& p,
 
 // d(g_n . n)/d(points), one 3-vector per normal point, for n = v/|v|.
 std::vector<Eigen::Vector3d> NormalPullback(const Eigen::Ref<const Eigen::MatrixX3d>& p,
-                                            const std::vector<int>& kn, const Eigen::Vector3d& g_n) {
+                                            const std::vector<int>& kn,
+                                            const Eigen::Vector3d& g_n) {
   const Eigen::Vector3d a = p.row(kn[0]).transpose(), b = p.row(kn[1]).transpose();
   if (kn.size() == 2) {
     const Eigen::Vector3d v = b - a;
@@ -112,7 +112,8 @@ std::vector<int> ResolvePointGroup(const std::vector<std::string>& point_names,
   const std::string prefix = group + "[";
   for (size_t i = 0; i < point_names.size(); ++i) {
     const std::string& n = point_names[i];
-    if (n.size() <= prefix.size() + 1 || n.compare(0, prefix.size(), prefix) != 0 || n.back() != ']')
+    if (n.size() <= prefix.size() + 1 || n.compare(0, prefix.size(), prefix) != 0 ||
+        n.back() != ']')
       continue;
     const std::string num = n.substr(prefix.size(), n.size() - prefix.size() - 1);
     if (num.empty() || !std::all_of(num.begin(), num.end(), ::isdigit)) continue;
@@ -219,7 +220,8 @@ PickObjective::PickObjective(const std::vector<std::string>& point_names, PickPa
   if (params_.normal.points.size() != 2 && params_.normal.points.size() != 3)
     throw std::invalid_argument(who + ": the plane normal needs 2 or 3 tracked point names, got " +
                                 std::to_string(params_.normal.points.size()));
-  for (const std::string& n : params_.normal.points) kn_.push_back(ResolvePoint(point_names, n, who));
+  for (const std::string& n : params_.normal.points)
+    kn_.push_back(ResolvePoint(point_names, n, who));
   CheckFinite(params_.center, who, "the object centre p1");
   CheckNonNegative(params_.object_radius, who, "the object radius R");
   CheckNonNegative(params_.half_width, who, "the half width d");
@@ -339,7 +341,8 @@ ShapeMatchingObjective::ShapeMatchingObjective(int num_points, std::vector<int> 
                                 " points but the target shape has " +
                                 std::to_string(target_.rows()) + " rows");
   if (idx_.empty()) throw std::invalid_argument("shape objective: empty region");
-  if (!target_.allFinite()) throw std::invalid_argument("shape objective: the target must be finite");
+  if (!target_.allFinite())
+    throw std::invalid_argument("shape objective: the target must be finite");
 }
 
 ShapeMatchingObjective::ShapeMatchingObjective(const std::vector<std::string>& point_names,
@@ -433,8 +436,8 @@ int WeightedSumObjective::num_residuals() const {
   return m;
 }
 
-bool WeightedSumObjective::Residuals(const Eigen::Ref<const Eigen::MatrixX3d>& p, Eigen::VectorXd* r,
-                                     Eigen::MatrixXd* dr_dp) const {
+bool WeightedSumObjective::Residuals(const Eigen::Ref<const Eigen::MatrixX3d>& p,
+                                     Eigen::VectorXd* r, Eigen::MatrixXd* dr_dp) const {
   CheckPoints(p);
   const int m = num_residuals();
   if (m == 0) return false;

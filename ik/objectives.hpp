@@ -80,7 +80,8 @@ class PointTrackingObjective : public Objective {
   PointTrackingObjective(const std::vector<std::string>& point_names, const std::string& point,
                          const Eigen::Vector3d& target);
   std::string name() const override { return "point(" + point_ + ")"; }
-  double Evaluate(const Eigen::Ref<const Eigen::MatrixX3d>& p, Eigen::MatrixX3d* grad) const override;
+  double Evaluate(const Eigen::Ref<const Eigen::MatrixX3d>& p,
+                  Eigen::MatrixX3d* grad) const override;
   int num_residuals() const override { return 3; }
   bool Residuals(const Eigen::Ref<const Eigen::MatrixX3d>& p, Eigen::VectorXd* r,
                  Eigen::MatrixXd* dr_dp) const override;
@@ -95,9 +96,9 @@ class PointTrackingObjective : public Objective {
 
 /// One term of MultiPointTrackingObjective.
 struct PointTarget {
-  std::string point;        ///< tracked point name
-  Eigen::Vector3d target;   ///< mm
-  double weight = 1.0;      ///< >= 0
+  std::string point;       ///< tracked point name
+  Eigen::Vector3d target;  ///< mm
+  double weight = 1.0;     ///< >= 0
 };
 
 /// O = sum_j w_j |p_{k_j} - t_j|^2 (several points of Eq. 4.4 at once).
@@ -108,7 +109,8 @@ class MultiPointTrackingObjective : public Objective {
   MultiPointTrackingObjective(const std::vector<std::string>& point_names,
                               std::vector<PointTarget> targets);
   std::string name() const override;
-  double Evaluate(const Eigen::Ref<const Eigen::MatrixX3d>& p, Eigen::MatrixX3d* grad) const override;
+  double Evaluate(const Eigen::Ref<const Eigen::MatrixX3d>& p,
+                  Eigen::MatrixX3d* grad) const override;
   int num_residuals() const override { return 3 * static_cast<int>(targets_.size()); }
   bool Residuals(const Eigen::Ref<const Eigen::MatrixX3d>& p, Eigen::VectorXd* r,
                  Eigen::MatrixXd* dr_dp) const override;
@@ -132,12 +134,12 @@ struct PlaneNormalSpec {
 /// (The thesis calls R a diameter in its text; geometrically |p1 - p0| = R + d needs the radius,
 /// which is what this takes. See docs/ik.md.)
 struct PickParams {
-  std::string p0 = "P0";          ///< tracked point that must reach the grasp position
-  PlaneNormalSpec normal;         ///< 2 or 3 tracked point names, see PlaneNormalSpec
+  std::string p0 = "P0";   ///< tracked point that must reach the grasp position
+  PlaneNormalSpec normal;  ///< 2 or 3 tracked point names, see PlaneNormalSpec
   Eigen::Vector3d center = Eigen::Vector3d::Zero();  ///< p1, the object's centre, mm
-  double object_radius = 0.0;     ///< R, mm, >= 0
-  double half_width = 0.0;        ///< d, mm, >= 0
-  double omega1 = 1.0;            ///< w1, weight of the orthogonality term, >= 0
+  double object_radius = 0.0;                        ///< R, mm, >= 0
+  double half_width = 0.0;                           ///< d, mm, >= 0
+  double omega1 = 1.0;                               ///< w1, weight of the orthogonality term, >= 0
 };
 
 class PickObjective : public Objective {
@@ -146,7 +148,8 @@ class PickObjective : public Objective {
   /// or negative / non-finite parameters.
   PickObjective(const std::vector<std::string>& point_names, PickParams params);
   std::string name() const override { return "pick(" + params_.p0 + ")"; }
-  double Evaluate(const Eigen::Ref<const Eigen::MatrixX3d>& p, Eigen::MatrixX3d* grad) const override;
+  double Evaluate(const Eigen::Ref<const Eigen::MatrixX3d>& p,
+                  Eigen::MatrixX3d* grad) const override;
   int num_residuals() const override { return 2; }
   /// r = (|p1 - p0| - (R + d), sqrt(w1) n . (p1 - p0)).
   bool Residuals(const Eigen::Ref<const Eigen::MatrixX3d>& p, Eigen::VectorXd* r,
@@ -165,15 +168,16 @@ class PickObjective : public Objective {
 struct PlaceParams {
   std::string p0 = "P0";
   Eigen::Vector3d target_center = Eigen::Vector3d::Zero();  ///< p1t, mm
-  double object_radius = 0.0;  ///< R, mm
-  double half_width = 0.0;     ///< d, mm
+  double object_radius = 0.0;                               ///< R, mm
+  double half_width = 0.0;                                  ///< d, mm
 };
 
 class PlaceObjective : public Objective {
  public:
   PlaceObjective(const std::vector<std::string>& point_names, PlaceParams params);
   std::string name() const override { return "place(" + params_.p0 + ")"; }
-  double Evaluate(const Eigen::Ref<const Eigen::MatrixX3d>& p, Eigen::MatrixX3d* grad) const override;
+  double Evaluate(const Eigen::Ref<const Eigen::MatrixX3d>& p,
+                  Eigen::MatrixX3d* grad) const override;
   int num_residuals() const override { return 1; }
   bool Residuals(const Eigen::Ref<const Eigen::MatrixX3d>& p, Eigen::VectorXd* r,
                  Eigen::MatrixXd* dr_dp) const override;
@@ -200,7 +204,8 @@ class GraspObjective : public Objective {
   /// Throws std::invalid_argument for an unknown group, fewer than 3 points or D <= 0.
   GraspObjective(const std::vector<std::string>& point_names, GraspParams params);
   std::string name() const override { return "grasp(" + params_.group + ")"; }
-  double Evaluate(const Eigen::Ref<const Eigen::MatrixX3d>& p, Eigen::MatrixX3d* grad) const override;
+  double Evaluate(const Eigen::Ref<const Eigen::MatrixX3d>& p,
+                  Eigen::MatrixX3d* grad) const override;
   int num_residuals() const override { return 1; }
   bool Residuals(const Eigen::Ref<const Eigen::MatrixX3d>& p, Eigen::VectorXd* r,
                  Eigen::MatrixXd* dr_dp) const override;
@@ -226,7 +231,8 @@ class ShapeMatchingObjective : public Objective {
                                          const std::string& group,
                                          const Eigen::Ref<const Eigen::MatrixX3d>& target);
   std::string name() const override { return "shape(" + std::to_string(idx_.size()) + " points)"; }
-  double Evaluate(const Eigen::Ref<const Eigen::MatrixX3d>& p, Eigen::MatrixX3d* grad) const override;
+  double Evaluate(const Eigen::Ref<const Eigen::MatrixX3d>& p,
+                  Eigen::MatrixX3d* grad) const override;
   int num_residuals() const override { return 3 * static_cast<int>(idx_.size()); }
   bool Residuals(const Eigen::Ref<const Eigen::MatrixX3d>& p, Eigen::VectorXd* r,
                  Eigen::MatrixXd* dr_dp) const override;
@@ -245,7 +251,8 @@ class WeightedSumObjective : public Objective {
   /// term or a term built for another number of points.
   WeightedSumObjective& Add(double weight, std::shared_ptr<const Objective> term);
   std::string name() const override;
-  double Evaluate(const Eigen::Ref<const Eigen::MatrixX3d>& p, Eigen::MatrixX3d* grad) const override;
+  double Evaluate(const Eigen::Ref<const Eigen::MatrixX3d>& p,
+                  Eigen::MatrixX3d* grad) const override;
   int num_residuals() const override;
   bool Residuals(const Eigen::Ref<const Eigen::MatrixX3d>& p, Eigen::VectorXd* r,
                  Eigen::MatrixXd* dr_dp) const override;

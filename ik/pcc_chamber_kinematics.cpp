@@ -18,12 +18,12 @@ constexpr double kPi = 3.14159265358979323846;
 // term < 1e-13), for doubles and Jets alike.
 template <typename T>
 void ArcGH(const T& t, T* g, T* h) {
-  using std::cos;
-  using std::sin;
-  using std::sqrt;
   using ceres::cos;
   using ceres::sin;
   using ceres::sqrt;
+  using std::cos;
+  using std::sin;
+  using std::sqrt;
   if (t < 0.1) {
     *g = 0.5 + t * (-1.0 / 24 + t * (1.0 / 720 + t * (-1.0 / 40320 + t * (1.0 / 3628800))));
     *h = 1.0 + t * (-1.0 / 6 + t * (1.0 / 120 + t * (-1.0 / 5040 + t * (1.0 / 362880))));
@@ -59,7 +59,7 @@ void TipT(const PccChamberParams& p, const T* c, T* out) {
   T g, h;
   ArcGH(t, &g, &h);
   const T ex = bx * l * l * g, ez = bz * l * l * g, ey = p.base + l * h;  // arc end
-  const T tx = bx * l * h, tz = bz * l * h, ty = 1.0 - t * g;               // unit end tangent
+  const T tx = bx * l * h, tz = bz * l * h, ty = 1.0 - t * g;             // unit end tangent
   out[0] = ex + p.cap * tx;
   out[1] = ey + p.cap * ty;
   out[2] = ez + p.cap * tz;
@@ -70,14 +70,22 @@ void TipT(const PccChamberParams& p, const T* c, T* out) {
 bool PccChamberParams::IsValid(std::string* why) const {
   std::ostringstream s;
   auto fin = [](double v) { return std::isfinite(v); };
-  if (!(fin(base) && base >= 0)) s << "base must be >= 0 mm";
-  else if (!(fin(chamber_length) && chamber_length > 0)) s << "chamber_length must be > 0 mm";
-  else if (!(fin(cap) && cap >= 0)) s << "cap must be >= 0 mm";
-  else if (!(fin(offset) && offset > 0)) s << "offset must be > 0 mm";
-  else if (!(fin(gain) && gain > 0)) s << "gain must be > 0";
-  else if (!(fin(lower) && fin(upper) && lower < upper)) s << "lower < upper expected";
-  else if (!(rest >= lower && rest <= upper)) s << "rest must lie in [lower, upper]";
-  else if (!(1.0 + gain * (lower - 1.0) > 0)) s << "gain and lower give a chamber of length <= 0";
+  if (!(fin(base) && base >= 0))
+    s << "base must be >= 0 mm";
+  else if (!(fin(chamber_length) && chamber_length > 0))
+    s << "chamber_length must be > 0 mm";
+  else if (!(fin(cap) && cap >= 0))
+    s << "cap must be >= 0 mm";
+  else if (!(fin(offset) && offset > 0))
+    s << "offset must be > 0 mm";
+  else if (!(fin(gain) && gain > 0))
+    s << "gain must be > 0";
+  else if (!(fin(lower) && fin(upper) && lower < upper))
+    s << "lower < upper expected";
+  else if (!(rest >= lower && rest <= upper))
+    s << "rest must lie in [lower, upper]";
+  else if (!(1.0 + gain * (lower - 1.0) > 0))
+    s << "gain and lower give a chamber of length <= 0";
   if (why) *why = s.str();
   return s.str().empty();
 }
@@ -89,7 +97,8 @@ PccChamberKinematics::PccChamberKinematics(const PccChamberParams& params) : par
   upper_ = Eigen::VectorXd::Constant(3, params_.upper);
 }
 
-Eigen::Vector3d PccChamberKinematics::Tip(const PccChamberParams& params, const Eigen::Vector3d& c) {
+Eigen::Vector3d PccChamberKinematics::Tip(const PccChamberParams& params,
+                                          const Eigen::Vector3d& c) {
   Eigen::Vector3d p;
   TipT<double>(params, c.data(), p.data());
   return p;
@@ -139,11 +148,13 @@ PccFitResult FitPccChamber(const Eigen::Ref<const Eigen::MatrixXd>& C,
                            const Eigen::Ref<const Eigen::MatrixXd>& P,
                            const PccChamberParams& start) {
   if (C.rows() != P.rows() || C.cols() != 3 || P.cols() != 3)
-    throw std::invalid_argument("FitPccChamber: expected n x 3 actuations and n x 3 tip positions, got " +
-                                std::to_string(C.rows()) + " x " + std::to_string(C.cols()) + " and " +
-                                std::to_string(P.rows()) + " x " + std::to_string(P.cols()));
+    throw std::invalid_argument(
+        "FitPccChamber: expected n x 3 actuations and n x 3 tip positions, got " +
+        std::to_string(C.rows()) + " x " + std::to_string(C.cols()) + " and " +
+        std::to_string(P.rows()) + " x " + std::to_string(P.cols()));
   if (C.rows() < 3) throw std::invalid_argument("FitPccChamber: at least 3 samples are needed");
-  if (!C.allFinite() || !P.allFinite()) throw std::invalid_argument("FitPccChamber: non-finite data");
+  if (!C.allFinite() || !P.allFinite())
+    throw std::invalid_argument("FitPccChamber: non-finite data");
   std::string why;
   if (!start.IsValid(&why)) throw std::invalid_argument("FitPccChamber: start: " + why);
   const int n = static_cast<int>(C.rows());
@@ -158,7 +169,8 @@ PccFitResult FitPccChamber(const Eigen::Ref<const Eigen::MatrixXd>& C,
     const PccChamberParams p = with(q);
     r->resize(3 * n);
     for (int i = 0; i < n; ++i)
-      r->segment<3>(3 * i) = PccChamberKinematics::Tip(p, C.row(i).transpose()) - P.row(i).transpose();
+      r->segment<3>(3 * i) =
+          PccChamberKinematics::Tip(p, C.row(i).transpose()) - P.row(i).transpose();
   };
   Eigen::Vector3d q(start.gain, start.offset, start.cap);
   Eigen::VectorXd r;
@@ -170,7 +182,8 @@ PccFitResult FitPccChamber(const Eigen::Ref<const Eigen::MatrixXd>& C,
   // gain and offset (the bending angle wraps): a coarse scan picks the basin first.
   for (int i = 0; i <= 40; ++i)
     for (double f : {0.6, 0.8, 1.0, 1.25, 1.6}) {
-      const Eigen::Vector3d qs(start.gain * std::pow(10.0, -1.0 + 1.5 * i / 40.0), start.offset * f, start.cap);
+      const Eigen::Vector3d qs(start.gain * std::pow(10.0, -1.0 + 1.5 * i / 40.0), start.offset * f,
+                               start.cap);
       if (!with(qs).IsValid(nullptr)) continue;
       Eigen::VectorXd rs;
       residuals(qs, &rs);

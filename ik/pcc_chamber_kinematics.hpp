@@ -4,9 +4,10 @@
 /// analytical" baseline, and the analytical data source of Fig. 5.14; refs. [129, 80] there):
 /// chamber extensions -> arc parameters (kappa, phi, l) -> tip position, in closed form.
 ///
-/// Frame as in solver/robots/three_chamber.cpp: y is the long axis (base face y = 0), the cross-section is the
-/// x-z plane, chamber k (actuator c_{k+1}, k = 0, 1, 2) sits at distance d from the axis in the
-/// direction u_k = (cos psi_k, sin psi_k) of the (x, z) plane, psi_k = 180 + 120 k degrees.
+/// Frame as in solver/robots/three_chamber.cpp: y is the long axis (base face y = 0), the
+/// cross-section is the x-z plane, chamber k (actuator c_{k+1}, k = 0, 1, 2) sits at distance d
+/// from the axis in the direction u_k = (cos psi_k, sin psi_k) of the (x, z) plane, psi_k = 180 +
+/// 120 k degrees.
 ///
 /// Model:
 ///  - chamber k lengthens with its volume ratio: l_k = L_c (1 + g (c_k - 1));
@@ -32,13 +33,13 @@
 namespace softkin {
 
 struct PccChamberParams {
-  double base = 8.0;            ///< straight base block, mm (>= 0)
-  double chamber_length = 120.0;///< L_c, chamber section at rest, mm (> 0)
-  double cap = 8.0;             ///< straight cap above the chambers, mm (>= 0)
-  double offset = 13.0;         ///< d, chamber axis distance from the centre line, mm (> 0)
-  double gain = 0.3;            ///< g, chamber elongation per unit of (c - 1) (> 0)
+  double base = 8.0;                ///< straight base block, mm (>= 0)
+  double chamber_length = 120.0;    ///< L_c, chamber section at rest, mm (> 0)
+  double cap = 8.0;                 ///< straight cap above the chambers, mm (>= 0)
+  double offset = 13.0;             ///< d, chamber axis distance from the centre line, mm (> 0)
+  double gain = 0.3;                ///< g, chamber elongation per unit of (c - 1) (> 0)
   double lower = 1.0, upper = 3.0;  ///< actuation box (volume ratios), lower < upper
-  double rest = 1.0;            ///< rest actuation, in [lower, upper]
+  double rest = 1.0;                ///< rest actuation, in [lower, upper]
   bool IsValid(std::string* why) const;
 };
 
@@ -75,9 +76,9 @@ class PccChamberKinematics : public Kinematics {
 };
 
 struct PccFitResult {
-  PccChamberParams params;   ///< start with gain, offset and cap fitted
-  double rms_mm = 0;         ///< RMS tip distance over the samples after the fit
-  double rms_start_mm = 0;   ///< ... with the start parameters
+  PccChamberParams params;  ///< start with gain, offset and cap fitted
+  double rms_mm = 0;        ///< RMS tip distance over the samples after the fit
+  double rms_start_mm = 0;  ///< ... with the start parameters
   int iterations = 0;
 };
 

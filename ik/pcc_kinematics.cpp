@@ -17,7 +17,8 @@ ArcFns Arc(double t) {
   ArcFns f;
   if (t < 0.1) {  // Taylor series; the first omitted term is below 1e-13
     f.g = 0.5 + t * (-1.0 / 24 + t * (1.0 / 720 + t * (-1.0 / 40320 + t * (1.0 / 3628800))));
-    f.dg = -1.0 / 24 + t * (2.0 / 720 + t * (-3.0 / 40320 + t * (4.0 / 3628800 - t * 5.0 / 479001600)));
+    f.dg = -1.0 / 24 +
+           t * (2.0 / 720 + t * (-3.0 / 40320 + t * (4.0 / 3628800 - t * 5.0 / 479001600)));
     f.h = 1.0 + t * (-1.0 / 6 + t * (1.0 / 120 + t * (-1.0 / 5040 + t * (1.0 / 362880))));
     f.dh = -1.0 / 6 + t * (2.0 / 120 + t * (-3.0 / 5040 + t * (4.0 / 362880 - t * 5.0 / 39916800)));
     return f;
@@ -34,11 +35,16 @@ ArcFns Arc(double t) {
 
 bool PccParams::IsValid(std::string* why) const {
   std::ostringstream s;
-  if (!(std::isfinite(length) && length > 0)) s << "length must be > 0";
-  else if (!(std::isfinite(cable_offset) && cable_offset > 0)) s << "cable_offset must be > 0";
-  else if (!(std::isfinite(max_pull) && max_pull > 0)) s << "max_pull must be > 0";
-  else if (axial && !(max_pull < length)) s << "max_pull must be < length (the backbone would vanish)";
-  else if (backbone_points < 1) s << "backbone_points must be >= 1";
+  if (!(std::isfinite(length) && length > 0))
+    s << "length must be > 0";
+  else if (!(std::isfinite(cable_offset) && cable_offset > 0))
+    s << "cable_offset must be > 0";
+  else if (!(std::isfinite(max_pull) && max_pull > 0))
+    s << "max_pull must be > 0";
+  else if (axial && !(max_pull < length))
+    s << "max_pull must be < length (the backbone would vanish)";
+  else if (backbone_points < 1)
+    s << "backbone_points must be >= 1";
   if (why) *why = s.str();
   return s.str().empty();
 }
@@ -95,7 +101,8 @@ KinematicsEval PccKinematics::Evaluate(const Eigen::Ref<const Eigen::VectorXd>& 
     if (!with_jacobian) continue;
     // Partial derivatives in (b, sigma), then the chain rule to c.
     const Eigen::Matrix2d dxy_db =
-        sig * sig * (f.g * Eigen::Matrix2d::Identity() + 2.0 * f.dg * sig * sig * b * b.transpose());
+        sig * sig *
+        (f.g * Eigen::Matrix2d::Identity() + 2.0 * f.dg * sig * sig * b * b.transpose());
     const Eigen::Vector2d dxy_dsig = b * sig * (2.0 * f.g + 2.0 * t * f.dg);
     const Eigen::RowVector2d dz_db = 2.0 * sig * sig * sig * f.dh * b.transpose();
     const double dz_dsig = f.h + 2.0 * t * f.dh;

@@ -16,7 +16,8 @@
 ///  - backbone length s = L - a (c_1 + c_2 + c_3)/3 (a = `axial` in {0, 1}: equal pulls compress
 ///    the backbone, which keeps the map from c to the tip locally invertible);
 ///  - the point at arc length sigma: with t = |b|^2 sigma^2,
-///      p_xy = b sigma^2 g(t),  p_z = sigma h(t),  g(t) = (1 - cos sqrt t)/t,  h(t) = sin(sqrt t)/sqrt t
+///      p_xy = b sigma^2 g(t),  p_z = sigma h(t),  g(t) = (1 - cos sqrt t)/t,  h(t) = sin(sqrt
+///      t)/sqrt t
 ///    (the arc (1 - cos theta)/kappa, sin(theta)/kappa written so it is smooth through kappa = 0;
 ///    g and h use their Taylor series for small t).
 /// Tracked points: "tip" (sigma = s) and "backbone[j]" at sigma = s (j + 1)/K, j = 0..K-1
@@ -28,11 +29,11 @@
 namespace softkin {
 
 struct PccParams {
-  double length = 100.0;        ///< L, rest backbone length, mm (> 0)
-  double cable_offset = 6.0;    ///< d, cable distance from the backbone, mm (> 0)
-  double max_pull = 20.0;       ///< c_max, mm (> 0)
-  int backbone_points = 8;      ///< K >= 1 tracked points along the backbone
-  bool axial = true;            ///< equal pulls compress the backbone (a = 1) or not (a = 0)
+  double length = 100.0;      ///< L, rest backbone length, mm (> 0)
+  double cable_offset = 6.0;  ///< d, cable distance from the backbone, mm (> 0)
+  double max_pull = 20.0;     ///< c_max, mm (> 0)
+  int backbone_points = 8;    ///< K >= 1 tracked points along the backbone
+  bool axial = true;          ///< equal pulls compress the backbone (a = 1) or not (a = 0)
   /// True if every field is in range; else false and *why (if given) names the field.
   bool IsValid(std::string* why) const;
 };

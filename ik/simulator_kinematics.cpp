@@ -15,9 +15,12 @@ namespace softkin {
 
 const char* JacobianModeToString(JacobianMode m) {
   switch (m) {
-    case JacobianMode::kFd: return "fd";
-    case JacobianMode::kFdWarm: return "fd-warm";
-    case JacobianMode::kImplicit: return "implicit";
+    case JacobianMode::kFd:
+      return "fd";
+    case JacobianMode::kFdWarm:
+      return "fd-warm";
+    case JacobianMode::kImplicit:
+      return "implicit";
   }
   return "unknown";
 }
@@ -34,7 +37,10 @@ bool JacobianModeFromString(const std::string& s, JacobianMode* m) {
 std::string JacobianModeNames() { return "fd, fd-warm, implicit"; }
 
 bool SimulatorKinematicsOptions::IsValid(std::string* why) const {
-  auto bad = [&](const std::string& m) { if (why) *why = m; return false; };
+  auto bad = [&](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
   if (!(fd_step > 0.0 && fd_step <= 0.25))
     return bad("fd_step: expected a fraction of the actuator range in (0, 0.25]");
   if (warm_max_iterations < 0)
@@ -52,7 +58,8 @@ double Seconds(Clock::time_point a, Clock::time_point b) {
 }
 }  // namespace
 
-SimulatorKinematics::SimulatorKinematics(const Scene& scene, const SimulatorKinematicsOptions& options,
+SimulatorKinematics::SimulatorKinematics(const Scene& scene,
+                                         const SimulatorKinematicsOptions& options,
                                          const FkOptions* fk)
     : model_(std::make_shared<const Model>(scene)) {
   Init(options, fk);
@@ -76,7 +83,8 @@ void SimulatorKinematics::Init(const SimulatorKinematicsOptions& options, const 
   if (options_.jacobian == JacobianMode::kImplicit && fk_.solver != "lg" && fk_.solver != "lg-aa")
     throw std::invalid_argument(
         "jacobian 'implicit' differentiates the local-global equilibrium; it needs solver lg or "
-        "lg-aa, got '" + fk_.solver + "' (use fd or fd-warm with other solvers)");
+        "lg-aa, got '" +
+        fk_.solver + "' (use fd or fd-warm with other solvers)");
   solver_ = MakeFkSolver(model_, fk_);
   warm_solver_.reset();
   if (options_.warm_max_iterations > 0 && options_.warm_max_iterations < fk_.max_iterations) {
@@ -130,8 +138,9 @@ void SimulatorKinematics::Init(const SimulatorKinematicsOptions& options, const 
     }
     if (used != inner.size() || inner.empty() || idx < 0 || idx >= static_cast<int>(verts.size()))
       throw std::invalid_argument("tracked point '" + s + "': expected an index in [0, " +
-                                  std::to_string(verts.size() - 1) + "] or '*' inside [] (marker '" +
-                                  base + "' has " + std::to_string(verts.size()) + " vertices)");
+                                  std::to_string(verts.size() - 1) +
+                                  "] or '*' inside [] (marker '" + base + "' has " +
+                                  std::to_string(verts.size()) + " vertices)");
     add(base + "[" + std::to_string(idx) + "]", {verts[idx]});
   }
 
@@ -286,17 +295,21 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
       double step = 0.0;
       const Eigen::VectorXd dc = ColumnStep(c, &step);
       const Eigen::VectorXd dx = jac_dXdc_ * dc;
-      predicted = last_X_ + Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(
-                                dx.data(), nv, 3);
-      if (!predicted.allFinite() || !PredictionIsSafe(last_X_, predicted, step)) predicted.resize(0, 3);
+      predicted =
+          last_X_ + Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(
+                        dx.data(), nv, 3);
+      if (!predicted.allFinite() || !PredictionIsSafe(last_X_, predicted, step))
+        predicted.resize(0, 3);
     }
     std::string err;
     bool from_rest = false;
     if (predicted.rows() > 0) {
       err = Solve(c, &predicted, &r, &note, "predicted", &ev.fk_solves, &from_rest);
       if (err.empty()) {
-        if (from_rest) centre_start.resize(0, 3);  // fd probes start where the centre did
-        else centre_start = predicted;
+        if (from_rest)
+          centre_start.resize(0, 3);  // fd probes start where the centre did
+        else
+          centre_start = predicted;
       }
     }
     // A failed prediction is retried from the plain warm start, unless a cold solve already failed.
@@ -317,7 +330,8 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
       const Eigen::VectorXd dc = ColumnStep(c, &step);
       Eigen::VectorXd w(dc.size());  // dc / range^2
       for (Eigen::Index j = 0; j < dc.size(); ++j)
-        w[j] = dc[j] / std::max(std::pow(upper_[jac_columns_[j]] - lower_[jac_columns_[j]], 2), 1e-300);
+        w[j] = dc[j] /
+               std::max(std::pow(upper_[jac_columns_[j]] - lower_[jac_columns_[j]], 2), 1e-300);
       bool others_fixed = true;  // actuators outside the columns (kinks) must not have moved
       for (int a = 0; a < num_actuators(); ++a)
         if (std::find(jac_columns_.begin(), jac_columns_.end(), a) == jac_columns_.end() &&
@@ -384,7 +398,8 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
     } else {
       // One-sided, second order, towards the inside of the box.
       const double s = (c[a] + h > upper_[a]) ? -1.0 : 1.0;
-      if (!(err = probe(s * h, &p1)).empty() || !(err = probe(2.0 * s * h, &p2)).empty()) return err;
+      if (!(err = probe(s * h, &p1)).empty() || !(err = probe(2.0 * s * h, &p2)).empty())
+        return err;
       const Eigen::VectorXd p0 = flatten(ev.p);
       ev.J.col(a) = (-3.0 * p0 + 4.0 * p1 - p2) / (2.0 * s * h);
     }
@@ -409,7 +424,8 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
   if (ContactHandlingActive(model_->scene(), fk_.collision)) {
     ev.message =
         "jacobian 'implicit' does not include collision springs, and collision response is "
-        "active for scene '" + model_->scene().name + "'; use fd or fd-warm";
+        "active for scene '" +
+        model_->scene().name + "'; use fd or fd-warm";
     return finish();
   }
   // A signed actuator at exactly 0 sits on a kink (both sides vented; p is not differentiable

@@ -26,9 +26,9 @@
 ///
 /// A solve from a stored or predicted state gets warm_max_iterations; if it does not converge, c
 /// is solved again from the rest shape (retry_from_rest). A forward solve that does not converge
-/// (status iteration_cap, diverged, time_limit) from there makes the evaluation fail (ok = false, message with the FK status and the actuation), unless
-/// accept_iteration_cap is set, in which case an iteration_cap result is used and `message` says
-/// so. p and J are never NaN when ok.
+/// (status iteration_cap, diverged, time_limit) from there makes the evaluation fail (ok = false,
+/// message with the FK status and the actuation), unless accept_iteration_cap is set, in which case
+/// an iteration_cap result is used and `message` says so. p and J are never NaN when ok.
 #include "softkin/ik/kinematics.hpp"
 #include "softkin/solver/sensitivity/equilibrium_jacobian.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
@@ -194,7 +194,8 @@ class SimulatorKinematics : public Kinematics {
   long long rest_retries_ = 0;
   EquilibriumJacobianResult last_implicit_;
   /// The implicit mode's preconditioner pattern, symbolic analysis and factor, kept along a path.
-  std::unique_ptr<EquilibriumJacobianWorkspace> workspace_ = std::make_unique<EquilibriumJacobianWorkspace>();
+  std::unique_ptr<EquilibriumJacobianWorkspace> workspace_ =
+      std::make_unique<EquilibriumJacobianWorkspace>();
 };
 
 }  // namespace softkin

@@ -8,7 +8,8 @@
 namespace softkin {
 
 IkResult SolveSoftLineSearch(Kinematics& kin, const Objective& objective,
-                             const Eigen::Ref<const Eigen::VectorXd>& c0, const IkOptions& options) {
+                             const Eigen::Ref<const Eigen::VectorXd>& c0,
+                             const IkOptions& options) {
   IkProblem P(kin, objective, options);
   IkSummary S;
   const int n = P.n();
@@ -22,8 +23,8 @@ IkResult SolveSoftLineSearch(Kinematics& kin, const Objective& objective,
   }
   S.history.push_back(cur.value);
   Eigen::VectorXd c = c0;
-  const Eigen::VectorXd scale =
-      options.normalize_by_range ? Eigen::VectorXd(P.range().cwiseAbs2()) : Eigen::VectorXd::Ones(n);
+  const Eigen::VectorXd scale = options.normalize_by_range ? Eigen::VectorXd(P.range().cwiseAbs2())
+                                                           : Eigen::VectorXd::Ones(n);
 
   std::string last_trial_failure;
   // O at a trial point, +inf if it cannot be evaluated; false when the budget is exhausted.
@@ -70,7 +71,8 @@ IkResult SolveSoftLineSearch(Kinematics& kin, const Objective& objective,
     // search as a stall if accepted; below that scale a simulator's O is its solver's noise, so
     // shrinking further only spends forward solves (cable_finger: 17 solves down to 1e-19).
     auto below_tolerance = [&](const Eigen::VectorXd& ct) {
-      return ((ct - c).cwiseAbs().cwiseQuotient(P.range().cwiseMax(std::numeric_limits<double>::min())))
+      return ((ct - c).cwiseAbs().cwiseQuotient(
+                  P.range().cwiseMax(std::numeric_limits<double>::min())))
                  .maxCoeff() <= options.parameter_tolerance;
     };
     bool tiny = false;

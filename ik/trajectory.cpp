@@ -93,17 +93,22 @@ std::string LoadCache(const std::string& path,
 
 bool SamplingOptions::IsValid(std::string* why) const {
   std::string s;
-  if (samples_per_axis < 2) s = "samples_per_axis must be >= 2, got " + std::to_string(samples_per_axis);
+  if (samples_per_axis < 2)
+    s = "samples_per_axis must be >= 2, got " + std::to_string(samples_per_axis);
   if (why) *why = s;
   return s.empty();
 }
 
 bool TrajectoryOptions::IsValid(std::string* why) const {
   std::string s;
-  if (point.empty()) s = "point must be named";
-  else if (!ik.IsValid(&s)) s = "ik." + s;
-  else if (!sampling.IsValid(&s)) s = "sampling." + s;
-  else if (first_waypoint < 0) s = "first_waypoint must be >= 0";
+  if (point.empty())
+    s = "point must be named";
+  else if (!ik.IsValid(&s))
+    s = "ik." + s;
+  else if (!sampling.IsValid(&s))
+    s = "sampling." + s;
+  else if (first_waypoint < 0)
+    s = "first_waypoint must be >= 0";
   else if (first_waypoint_starts < 1)
     s = "first_waypoint_starts must be >= 1, got " + std::to_string(first_waypoint_starts);
   if (why) *why = s;
@@ -140,8 +145,9 @@ ConfigurationSamples SampleConfigurationSpace(Kinematics& kin, const std::string
   for (int s = 0; s < count; ++s) {
     Eigen::VectorXd c(n);
     for (int a = 0; a < n; ++a)
-      c[a] = digit[a] == m - 1 ? kin.upper()[a]
-                               : kin.lower()[a] + (kin.upper()[a] - kin.lower()[a]) * digit[a] / (m - 1);
+      c[a] = digit[a] == m - 1
+                 ? kin.upper()[a]
+                 : kin.lower()[a] + (kin.upper()[a] - kin.lower()[a]) * digit[a] / (m - 1);
     const KinematicsEval e = kin.Evaluate(c, false);
     if (e.ok && e.p.rows() > k && e.p.row(k).allFinite()) {
       cs.push_back(c);
@@ -203,7 +209,8 @@ std::vector<int> ClosestSamples(const ConfigurationSamples& samples, const Eigen
   return out;
 }
 
-TrajectoryResult FollowTrajectory(Kinematics& kin, const Eigen::Ref<const Eigen::MatrixX3d>& waypoints,
+TrajectoryResult FollowTrajectory(Kinematics& kin,
+                                  const Eigen::Ref<const Eigen::MatrixX3d>& waypoints,
                                   const TrajectoryOptions& options,
                                   const WaypointCallback& on_waypoint) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -223,15 +230,18 @@ TrajectoryResult FollowTrajectory(Kinematics& kin, const Eigen::Ref<const Eigen:
   auto sample_set = [&]() { return options.samples ? options.samples : &res.samples; };
   std::vector<int> starts;  // samples to try for the first waypoint, closest first
   if (options.warm_start.size() == 0 && options.first_waypoint < waypoints.rows()) {
-    if (!options.samples) res.samples = SampleConfigurationSpace(kin, options.point, options.sampling);
+    if (!options.samples)
+      res.samples = SampleConfigurationSpace(kin, options.point, options.sampling);
     else if (options.samples->c.cols() != kin.num_actuators() ||
              options.samples->p.rows() != options.samples->c.rows())
       throw std::invalid_argument("trajectory samples: expected #samples x " +
-                                  std::to_string(kin.num_actuators()) + " actuations and as many points");
+                                  std::to_string(kin.num_actuators()) +
+                                  " actuations and as many points");
     starts = ClosestSamples(*sample_set(), waypoints.row(options.first_waypoint).transpose(),
                             options.first_waypoint_starts);
     res.initial_sample = starts.empty() ? -1 : starts.front();
-    c_prev = starts.empty() ? kin.rest() : Eigen::VectorXd(sample_set()->c.row(starts.front()).transpose());
+    c_prev = starts.empty() ? kin.rest()
+                            : Eigen::VectorXd(sample_set()->c.row(starts.front()).transpose());
   }
   res.initial_guess = c_prev;
   const Eigen::VectorXd range = (kin.upper() - kin.lower()).cwiseMax(1e-300);
@@ -245,7 +255,8 @@ TrajectoryResult FollowTrajectory(Kinematics& kin, const Eigen::Ref<const Eigen:
     const PointTrackingObjective objective(kin.point_names(), options.point, wr.target);
     // broyden: hand the last waypoint's J over (it was taken or updated at c_prev).
     IkOptions io = options.ik;
-    if (io.method == IkMethod::kBroyden && io.initial_jacobian.size() == 0) io.initial_jacobian = j_prev;
+    if (io.method == IkMethod::kBroyden && io.initial_jacobian.size() == 0)
+      io.initial_jacobian = j_prev;
     IkResult ik = SolveIk(kin, objective, c_prev, io);
     if (w == options.first_waypoint && starts.size() > 1) {
       // Further closest samples until one converges; keep the best, add up the cost.
@@ -261,7 +272,8 @@ TrajectoryResult FollowTrajectory(Kinematics& kin, const Eigen::Ref<const Eigen:
         total.jacobian_evaluations += again.summary.jacobian_evaluations;
         total.fk_solves += again.summary.fk_solves;
         total.time_s += again.summary.time_s;
-        const bool better = again.p.rows() > k && (ik.p.rows() <= k || again.objective < ik.objective);
+        const bool better =
+            again.p.rows() > k && (ik.p.rows() <= k || again.objective < ik.objective);
         if (better) {
           ik = again;
           res.initial_sample = starts[t];
@@ -270,8 +282,8 @@ TrajectoryResult FollowTrajectory(Kinematics& kin, const Eigen::Ref<const Eigen:
         }
       }
       const std::string tried = "; first waypoint solved from " +
-                                std::to_string(res.initial_starts_tried) + " sample(s), kept sample " +
-                                std::to_string(res.initial_sample);
+                                std::to_string(res.initial_starts_tried) +
+                                " sample(s), kept sample " + std::to_string(res.initial_sample);
       total.termination = ik.summary.termination;
       total.message = ik.summary.message + (res.initial_starts_tried > 1 ? tried : "");
       ik.summary = total;

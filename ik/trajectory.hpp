@@ -24,7 +24,7 @@
 namespace softkin {
 
 struct SamplingOptions {
-  int samples_per_axis = 5;   ///< grid points per actuator, >= 2 (the box corners included)
+  int samples_per_axis = 5;  ///< grid points per actuator, >= 2 (the box corners included)
   /// CSV cache file, or "" for none. If it exists and was built for the same kinematics name,
   /// point, key, bounds and grid, it is loaded; else the samples are computed and it is
   /// (over)written.
@@ -37,10 +37,10 @@ struct SamplingOptions {
 
 /// A sampled configuration space: one row per sample that could be evaluated.
 struct ConfigurationSamples {
-  Eigen::MatrixXd c;      ///< #samples x #actuators
-  Eigen::MatrixX3d p;     ///< #samples x 3, the tracked point, mm
-  int failed = 0;         ///< grid points whose evaluation failed (left out)
-  double time_s = 0.0;    ///< time to build or load
+  Eigen::MatrixXd c;    ///< #samples x #actuators
+  Eigen::MatrixX3d p;   ///< #samples x 3, the tracked point, mm
+  int failed = 0;       ///< grid points whose evaluation failed (left out)
+  double time_s = 0.0;  ///< time to build or load
   /// "built" (no cache file), "loaded", "written" (built, cache written) or
   /// "rebuilt: <reason the cache was rejected>".
   std::string cache_status;
@@ -88,8 +88,8 @@ struct WaypointResult {
   /// |reached - target|; -1 (and reached = 0) when not even the start actuation could be
   /// evaluated (the kinematics failed there; `message` says why).
   double error_mm = 0.0;
-  double objective = 0.0;     ///< error_mm^2 (-1 as error_mm)
-  bool converged = false;     ///< objective <= lambda
+  double objective = 0.0;  ///< error_mm^2 (-1 as error_mm)
+  bool converged = false;  ///< objective <= lambda
   IkTermination termination = IkTermination::kConverged;
   std::string message;
   int iterations = 0;
@@ -111,10 +111,11 @@ struct TrajectoryResult {
   double mean_error_mm = 0.0, max_error_mm = 0.0;  ///< over the waypoints with a reached point
   /// Sample the kept answer of the first waypoint started from (-1: warm start given).
   int initial_sample = -1;
-  int initial_starts_tried = 0;    ///< samples the first waypoint was solved from (0: warm start)
-  Eigen::VectorXd initial_guess;   ///< the actuation the kept first-waypoint answer started from
-  ConfigurationSamples samples;    ///< empty when a warm start or TrajectoryOptions::samples was given
-  double total_time_s = 0.0;       ///< including the sampling
+  int initial_starts_tried = 0;   ///< samples the first waypoint was solved from (0: warm start)
+  Eigen::VectorXd initial_guess;  ///< the actuation the kept first-waypoint answer started from
+  ConfigurationSamples
+      samples;                ///< empty when a warm start or TrajectoryOptions::samples was given
+  double total_time_s = 0.0;  ///< including the sampling
 };
 
 using WaypointCallback = std::function<void(const WaypointResult&)>;
@@ -124,7 +125,8 @@ using WaypointCallback = std::function<void(const WaypointResult&)>;
 /// options, an unknown point, non-finite waypoints or a warm start of the wrong size / outside
 /// the box; IK failures are reported per waypoint (a kinematics failure at a waypoint keeps the
 /// previous actuation for the next one).
-TrajectoryResult FollowTrajectory(Kinematics& kin, const Eigen::Ref<const Eigen::MatrixX3d>& waypoints,
+TrajectoryResult FollowTrajectory(Kinematics& kin,
+                                  const Eigen::Ref<const Eigen::MatrixX3d>& waypoints,
                                   const TrajectoryOptions& options,
                                   const WaypointCallback& on_waypoint = {});
 

@@ -45,7 +45,9 @@ std::string Lower(std::string s) {
   return s;
 }
 
-std::string Where(const std::string& path, int line) { return path + ":" + std::to_string(line) + ": "; }
+std::string Where(const std::string& path, int line) {
+  return path + ":" + std::to_string(line) + ": ";
+}
 
 // Parses a whole field as a finite number or throws with file, line and column.
 double ParseNumber(const std::string& tok, const std::string& path, int line, int column) {
@@ -53,11 +55,11 @@ double ParseNumber(const std::string& tok, const std::string& path, int line, in
   errno = 0;
   const double v = tok.empty() ? 0.0 : std::strtod(tok.c_str(), &end);
   if (tok.empty() || end != tok.c_str() + tok.size())
-    throw std::invalid_argument(Where(path, line) + "column " + std::to_string(column) + " '" + tok +
-                                "' is not a number");
+    throw std::invalid_argument(Where(path, line) + "column " + std::to_string(column) + " '" +
+                                tok + "' is not a number");
   if (!std::isfinite(v))
-    throw std::invalid_argument(Where(path, line) + "column " + std::to_string(column) + " '" + tok +
-                                "' is not finite (expected a finite coordinate in mm)");
+    throw std::invalid_argument(Where(path, line) + "column " + std::to_string(column) + " '" +
+                                tok + "' is not finite (expected a finite coordinate in mm)");
   return v;
 }
 
@@ -75,7 +77,8 @@ Eigen::MatrixX3d ReadWaypoints(const std::string& path) {
     if (hash != std::string::npos) line.resize(hash);
     const std::vector<std::string> f = SplitFields(line);
     if (f.empty()) continue;
-    if (pts.empty() && f.size() == 3 && Lower(f[0]) == "x" && Lower(f[1]) == "y" && Lower(f[2]) == "z")
+    if (pts.empty() && f.size() == 3 && Lower(f[0]) == "x" && Lower(f[1]) == "y" &&
+        Lower(f[2]) == "z")
       continue;  // header
     if (f.size() != 3)
       throw std::invalid_argument(Where(path, lineno) + "expected 3 values (x y z in mm), found " +
@@ -84,7 +87,8 @@ Eigen::MatrixX3d ReadWaypoints(const std::string& path) {
     for (int d = 0; d < 3; ++d) p[d] = ParseNumber(f[d], path, lineno, d + 1);
     pts.push_back(p);
   }
-  if (pts.empty()) throw std::invalid_argument(path + ": no waypoints (expected lines of x y z in mm)");
+  if (pts.empty())
+    throw std::invalid_argument(path + ": no waypoints (expected lines of x y z in mm)");
   Eigen::MatrixX3d out(pts.size(), 3);
   for (size_t i = 0; i < pts.size(); ++i) out.row(i) = pts[i].transpose();
   return out;
@@ -149,7 +153,8 @@ WaypointCsvResume ReadWaypointCsvForResume(const std::string& path, int num_actu
     out.next_index = static_cast<int>(idx) + 1;
     out.last_c = c;
   }
-  if (lineno == 0) throw std::invalid_argument(path + ": empty (expected the header '" + header + "')");
+  if (lineno == 0)
+    throw std::invalid_argument(path + ": empty (expected the header '" + header + "')");
   return out;
 }
 

@@ -14,10 +14,13 @@ namespace softkin {
 
 namespace {
 
-constexpr int kSubBlock = 16;  // samples per Jacobian kernel call (keeps Eigen's products serial-sized)
+constexpr int kSubBlock =
+    16;  // samples per Jacobian kernel call (keeps Eigen's products serial-sized)
 
 using Clock = std::chrono::steady_clock;
-double Seconds(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double Seconds(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 // Ceres calls this from its own threads; Eigen must not open OpenMP teams from inside them.
 class SerialEigenScope {
@@ -32,12 +35,14 @@ class SerialEigenScope {
 // Residuals z(w) - t of one block of samples (normalised scale), with the analytic Jacobian.
 class FnnBlockCost final : public ceres::CostFunction {
  public:
-  FnnBlockCost(const Fnn& net, Eigen::MatrixXd U, Eigen::MatrixXd T) : net_(net), U_(std::move(U)), T_(std::move(T)) {
+  FnnBlockCost(const Fnn& net, Eigen::MatrixXd U, Eigen::MatrixXd T)
+      : net_(net), U_(std::move(U)), T_(std::move(T)) {
     set_num_residuals(static_cast<int>(T_.size()));
     mutable_parameter_block_sizes()->push_back(net_.num_parameters());
   }
 
-  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
     SerialEigenScope serial;
     const int W = net_.num_parameters();
     const int nL = net_.num_outputs();
@@ -103,27 +108,33 @@ bool CeresFitOptions::IsValid(std::string* why) const {
   if (block_size < 0) return fail("block_size must be >= 0 (0: automatic)");
   if (num_threads < 1) return fail("num_threads must be >= 1");
   if (linear_solver != "dense_normal_cholesky" && linear_solver != "dense_qr")
-    return fail("linear_solver must be \"dense_normal_cholesky\" or \"dense_qr\", got \"" + linear_solver + "\"");
+    return fail("linear_solver must be \"dense_normal_cholesky\" or \"dense_qr\", got \"" +
+                linear_solver + "\"");
   return true;
 }
 
 std::string CeresFitSummary::BriefReport() const {
   char buf[256];
-  std::snprintf(buf, sizeof(buf), "Ceres: mse %.4g -> %.4g in %d iterations, %.3g s%s", initial_mse, final_mse,
-                iterations, total_time_s,
-                time_to_target_s >= 0.0 ? (" (target at " + std::to_string(time_to_target_s) + " s)").c_str() : "");
+  std::snprintf(buf, sizeof(buf), "Ceres: mse %.4g -> %.4g in %d iterations, %.3g s%s", initial_mse,
+                final_mse, iterations, total_time_s,
+                time_to_target_s >= 0.0
+                    ? (" (target at " + std::to_string(time_to_target_s) + " s)").c_str()
+                    : "");
   return buf;
 }
 
 CeresFitSummary FitFnnWithCeres(Fnn& net, const SampleSet& train, const CeresFitOptions& options) {
   std::string why;
-  if (!options.IsValid(&why)) throw std::invalid_argument("FitFnnWithCeres: invalid options: " + why);
+  if (!options.IsValid(&why))
+    throw std::invalid_argument("FitFnnWithCeres: invalid options: " + why);
   if (net.num_layers() == 0) throw std::invalid_argument("FitFnnWithCeres: the network is empty");
   if (train.empty()) throw std::invalid_argument("FitFnnWithCeres: the training set is empty");
-  if (train.X.rows() != train.Y.rows() || train.X.cols() != net.num_inputs() || train.Y.cols() != net.num_outputs())
-    throw std::invalid_argument("FitFnnWithCeres: data of " + std::to_string(train.X.rows()) + "x" +
-                                std::to_string(train.X.cols()) + " -> " + std::to_string(train.Y.rows()) + "x" +
-                                std::to_string(train.Y.cols()) + " does not fit the network " + net.Describe());
+  if (train.X.rows() != train.Y.rows() || train.X.cols() != net.num_inputs() ||
+      train.Y.cols() != net.num_outputs())
+    throw std::invalid_argument(
+        "FitFnnWithCeres: data of " + std::to_string(train.X.rows()) + "x" +
+        std::to_string(train.X.cols()) + " -> " + std::to_string(train.Y.rows()) + "x" +
+        std::to_string(train.Y.cols()) + " does not fit the network " + net.Describe());
   if (!train.X.allFinite() || !train.Y.allFinite())
     throw std::invalid_argument("FitFnnWithCeres: the training set has non-finite entries");
 
@@ -145,7 +156,8 @@ CeresFitSummary FitFnnWithCeres(Fnn& net, const SampleSet& train, const CeresFit
   problem.AddParameterBlock(w.data(), static_cast<int>(w.size()));
   for (int s0 = 0; s0 < N; s0 += bs) {
     const int n = std::min(bs, N - s0);
-    problem.AddResidualBlock(new FnnBlockCost(net, U.middleCols(s0, n), T.middleCols(s0, n)), nullptr, w.data());
+    problem.AddResidualBlock(new FnnBlockCost(net, U.middleCols(s0, n), T.middleCols(s0, n)),
+                             nullptr, w.data());
   }
 
   CeresFitSummary sum;
@@ -155,7 +167,8 @@ CeresFitSummary FitFnnWithCeres(Fnn& net, const SampleSet& train, const CeresFit
   sopt.minimizer_type = ceres::TRUST_REGION;
   sopt.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
   if (!ceres::StringToLinearSolverType(options.linear_solver, &sopt.linear_solver_type))
-    throw std::invalid_argument("FitFnnWithCeres: unknown linear_solver \"" + options.linear_solver + "\"");
+    throw std::invalid_argument("FitFnnWithCeres: unknown linear_solver \"" +
+                                options.linear_solver + "\"");
   sopt.max_num_iterations = options.max_iterations;
   if (options.max_time_s > 0.0) sopt.max_solver_time_in_seconds = options.max_time_s;
   sopt.num_threads = options.num_threads;

@@ -29,25 +29,25 @@ struct CeresFitOptions {
   double max_time_s = 0.0;    ///< wall-time cap in seconds, 0 = none
   /// Samples per residual block; 0 = automatic (max(1, 256 / n_L)).
   int block_size = 0;
-  int num_threads = 1;        ///< Ceres threads (>= 1)
+  int num_threads = 1;  ///< Ceres threads (>= 1)
   /// Ceres linear solver: "dense_normal_cholesky" (default) or "dense_qr".
   std::string linear_solver = "dense_normal_cholesky";
   /// true: fit the normalisation to the data and Nguyen-Widrow-initialise from `seed` first (as
   /// LmOptions::initialize); false: start from the network as given.
   bool initialize = true;
   std::uint64_t seed = 1;
-  bool verbose = false;       ///< Ceres progress on stdout
+  bool verbose = false;  ///< Ceres progress on stdout
   /// True if every field is in range; else false and *why names the field.
   bool IsValid(std::string* why) const;
 };
 
 struct CeresFitSummary {
-  bool reached_target = false;  ///< training mse <= target_mse (only with a target)
-  double initial_mse = 0.0;     ///< normalised training mse before the fit
-  double final_mse = 0.0;       ///< ... and after it
-  int iterations = 0;           ///< Ceres iterations (excluding iteration 0)
-  double total_time_s = 0.0;    ///< wall time of the whole call (set-up included)
-  double time_to_target_s = -1; ///< wall time when the target was first reached, or -1
+  bool reached_target = false;    ///< training mse <= target_mse (only with a target)
+  double initial_mse = 0.0;       ///< normalised training mse before the fit
+  double final_mse = 0.0;         ///< ... and after it
+  int iterations = 0;             ///< Ceres iterations (excluding iteration 0)
+  double total_time_s = 0.0;      ///< wall time of the whole call (set-up included)
+  double time_to_target_s = -1;   ///< wall time when the target was first reached, or -1
   std::vector<double> train_mse;  ///< per Ceres iteration (index 0 = start)
   std::vector<double> time_s;     ///< wall time since the call started, per entry of train_mse
   std::string ceres_report;       ///< ceres::Solver::Summary::BriefReport()

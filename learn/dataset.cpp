@@ -109,7 +109,8 @@ double ParseNumber(const std::string& s, const std::string& file, long long line
   const double v = std::strtod(b, &e);
   if (s.empty() || e != b + s.size())
     Bad(file, line, "column " + column + ": expected a number, got '" + s + "'");
-  if (!std::isfinite(v)) Bad(file, line, "column " + column + ": expected a finite number, got '" + s + "'");
+  if (!std::isfinite(v))
+    Bad(file, line, "column " + column + ": expected a finite number, got '" + s + "'");
   return v;
 }
 
@@ -148,7 +149,8 @@ nlohmann::json ReadSidecar(const std::string& csv) {
   }
   if (!j.is_object() || j.value("format", "") != "softkin-dataset" || !j.contains("config") ||
       !j.contains("shard"))
-    throw std::invalid_argument(path + ": expected a softkin-dataset sidecar with keys format, "
+    throw std::invalid_argument(path +
+                                ": expected a softkin-dataset sidecar with keys format, "
                                 "version, config, shard");
   if (j.value("version", 0) != kFormatVersion)
     throw std::invalid_argument(path + ": version " + j["version"].dump() + ", expected " +
@@ -173,8 +175,10 @@ void Differences(const nlohmann::json& a, const nlohmann::json& b, const std::st
   auto key = [&](const std::string& k) { return at.empty() ? k : at + "." + k; };
   if (a.is_object() && b.is_object()) {
     for (auto it = a.begin(); it != a.end(); ++it) {
-      if (!b.contains(it.key())) out->push_back(key(it.key()));
-      else Differences(it.value(), b[it.key()], key(it.key()), out);
+      if (!b.contains(it.key()))
+        out->push_back(key(it.key()));
+      else
+        Differences(it.value(), b[it.key()], key(it.key()), out);
     }
     for (auto it = b.begin(); it != b.end(); ++it)
       if (!a.contains(it.key())) out->push_back(key(it.key()));
@@ -182,7 +186,8 @@ void Differences(const nlohmann::json& a, const nlohmann::json& b, const std::st
     out->push_back(at.empty() ? "(root)" : at);
   }
 }
-std::string KeyDifferences(const nlohmann::json& a, const nlohmann::json& b, const std::string& at) {
+std::string KeyDifferences(const nlohmann::json& a, const nlohmann::json& b,
+                           const std::string& at) {
   std::vector<std::string> d;
   Differences(a, b, at, &d);
   std::string s;
@@ -212,14 +217,16 @@ RawLines ReadRawLines(const std::string& path, const std::string& header, long l
     ++lineno;
     if (lineno == 1) {
       if (line != header)
-        Bad(path, 1, "the header differs from the one this dataset's config gives:\n  found    " +
-                         line + "\n  expected " + header);
+        Bad(path, 1,
+            "the header differs from the one this dataset's config gives:\n  found    " + line +
+                "\n  expected " + header);
     } else {
       const size_t comma = line.find(',');
       const long long idx = ParseIndex(line.substr(0, comma), path, lineno);
       const long long want = first + static_cast<long long>(r.lines.size());
       if (idx != want)
-        Bad(path, lineno, "sample index " + std::to_string(idx) + ", expected " + std::to_string(want));
+        Bad(path, lineno,
+            "sample index " + std::to_string(idx) + ", expected " + std::to_string(want));
       r.lines.push_back(line);
     }
     pos = nl + 1;
@@ -269,7 +276,10 @@ class Progress {
 // ---- sampling ----
 
 bool DatasetSampling::IsValid(std::string* why) const {
-  auto bad = [&](const std::string& m) { if (why) *why = m; return false; };
+  auto bad = [&](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
   if (kind == Kind::kGrid && grid < 2) return bad("grid: expected N >= 2 values per actuator");
   if (kind == Kind::kRandom && random < 1) return bad("random: expected >= 1 samples");
   if (block < 1) return bad("block: expected >= 1 samples per warm-start block");
@@ -369,8 +379,8 @@ DatasetRunSummary GenerateDataset(Kinematics& kin, const DatasetSampling& sampli
                            {"sampling", sampling.ToJson()},
                            {"samples", total},
                            {"jacobian", opt.jacobian}};
-  nlohmann::json shard = {{"k", opt.shard}, {"n", opt.shards}, {"first", range.first},
-                          {"count", range.count}};
+  nlohmann::json shard = {
+      {"k", opt.shard}, {"n", opt.shards}, {"first", range.first}, {"count", range.count}};
   const std::string header = HeaderLine(m, points, opt.jacobian);
 
   DatasetRunSummary sum;
@@ -384,10 +394,11 @@ DatasetRunSummary GenerateDataset(Kinematics& kin, const DatasetSampling& sampli
     std::string d = KeyDifferences(config, side["config"], "config");
     if (d.empty()) d = KeyDifferences(shard, side["shard"], "shard");
     if (!d.empty())
-      throw std::invalid_argument(
-          opt.out + " exists and was made with another configuration (its sidecar " +
-          SidecarPath(opt.out) + " differs at '" + d + "'); refusing to overwrite it: remove it "
-          "or choose another output");
+      throw std::invalid_argument(opt.out +
+                                  " exists and was made with another configuration (its sidecar " +
+                                  SidecarPath(opt.out) + " differs at '" + d +
+                                  "'); refusing to overwrite it: remove it "
+                                  "or choose another output");
     const RawLines raw = ReadRawLines(opt.out, header, range.first);
     if (static_cast<long long>(raw.lines.size()) > range.count)
       Bad(opt.out, static_cast<long long>(range.count) + 2,
@@ -397,10 +408,12 @@ DatasetRunSummary GenerateDataset(Kinematics& kin, const DatasetSampling& sampli
     fresh = raw.complete_bytes == 0;
   }
   if (fresh) {
-    nlohmann::json side = {{"format", "softkin-dataset"}, {"version", kFormatVersion},
-                           {"config", config}, {"shard", shard},
-                           {"provenance", opt.provenance.is_null() ? nlohmann::json::object()
-                                                                    : opt.provenance}};
+    nlohmann::json side = {
+        {"format", "softkin-dataset"},
+        {"version", kFormatVersion},
+        {"config", config},
+        {"shard", shard},
+        {"provenance", opt.provenance.is_null() ? nlohmann::json::object() : opt.provenance}};
     WriteSidecar(opt.out, side);
   }
   std::ofstream csv(opt.out, std::ios::binary | (fresh ? std::ios::trunc : std::ios::app));
@@ -411,8 +424,7 @@ DatasetRunSummary GenerateDataset(Kinematics& kin, const DatasetSampling& sampli
   if (start >= end) return sum;
   // Recompute (not rewrite) the samples of start's block that are already in the file, so the
   // warm-start state at `start` is the one an uninterrupted run has.
-  const long long block_start =
-      std::max(range.first, (start / sampling.block) * sampling.block);
+  const long long block_start = std::max(range.first, (start / sampling.block) * sampling.block);
   const long long solves0 = kin.total_fk_solves();
   Progress bar(opt.progress, range.count, sum.already);
   for (long long i = block_start; i < end; ++i) {
@@ -422,7 +434,8 @@ DatasetRunSummary GenerateDataset(Kinematics& kin, const DatasetSampling& sampli
     KinematicsEval ev = kin.Evaluate(c, opt.jacobian);
     if (ev.ok) {
       // Never write NaN: a kinematics that claims ok with bad numbers is recorded as failed.
-      const bool shape = ev.p.rows() == np && (!opt.jacobian || (ev.J.rows() == 3 * np && ev.J.cols() == m));
+      const bool shape =
+          ev.p.rows() == np && (!opt.jacobian || (ev.J.rows() == 3 * np && ev.J.cols() == m));
       if (!shape || !ev.p.allFinite() || (opt.jacobian && !ev.J.allFinite())) {
         ev.ok = false;
         ev.message = shape ? "non-finite positions or Jacobian" : "wrong output shape";
@@ -461,14 +474,13 @@ long long MergeDatasets(const std::vector<std::string>& shards, const std::strin
         throw std::invalid_argument("merge: " + f + " has another configuration than " +
                                     shards.front() + " (sidecars differ at '" + d + "')");
       if (side["shard"].value("n", 0) != n)
-        throw std::invalid_argument("merge: " + f + " is a shard of " +
-                                    side["shard"]["n"].dump() + ", " + shards.front() +
-                                    " of " + std::to_string(n));
+        throw std::invalid_argument("merge: " + f + " is a shard of " + side["shard"]["n"].dump() +
+                                    ", " + shards.front() + " of " + std::to_string(n));
     }
     const int k = side["shard"].value("k", -1);
     if (by_k.count(k))
-      throw std::invalid_argument("merge: shard " + std::to_string(k) + " given twice (" +
-                                  by_k[k] + " and " + f + ")");
+      throw std::invalid_argument("merge: shard " + std::to_string(k) + " given twice (" + by_k[k] +
+                                  " and " + f + ")");
     by_k[k] = f;
   }
   for (int k = 0; k < n; ++k)
@@ -484,7 +496,8 @@ long long MergeDatasets(const std::vector<std::string>& shards, const std::strin
     if (!o) throw std::runtime_error("cannot write " + tmp);
     for (const auto& [k, f] : by_k) {
       const nlohmann::json side = ReadSidecar(f);
-      const long long first = side["shard"].value("first", 0LL), count = side["shard"].value("count", 0LL);
+      const long long first = side["shard"].value("first", 0LL),
+                      count = side["shard"].value("count", 0LL);
       const std::string text = ReadAll(f);
       const std::string h = text.substr(0, text.find('\n'));
       if (header.empty()) {
@@ -493,14 +506,15 @@ long long MergeDatasets(const std::vector<std::string>& shards, const std::strin
       }
       const RawLines raw = ReadRawLines(f, header, first);
       if (raw.truncated || static_cast<long long>(raw.lines.size()) != count)
-        throw std::invalid_argument("merge: shard " + f + " is incomplete: " +
-                                    std::to_string(raw.lines.size()) + " of " +
+        throw std::invalid_argument("merge: shard " + f +
+                                    " is incomplete: " + std::to_string(raw.lines.size()) + " of " +
                                     std::to_string(count) + " samples" +
                                     (raw.truncated ? " and a truncated last line" : "") +
                                     " (run its generation again to finish it)");
       if (first != written)
         throw std::invalid_argument("merge: shard " + f + " starts at sample " +
-                                    std::to_string(first) + ", expected " + std::to_string(written));
+                                    std::to_string(first) + ", expected " +
+                                    std::to_string(written));
       for (const auto& l : raw.lines) o << l << "\n";
       written += count;
     }
@@ -539,7 +553,9 @@ Dataset LoadDataset(const std::string& path) {
          head[col].compare(head[col].size() - 2, 2, "_x") == 0) {
     const std::string p = head[col].substr(0, head[col].size() - 2);
     if (head[col + 1] != p + "_y" || head[col + 2] != p + "_z")
-      Bad(path, 1, "column " + std::to_string(col + 1) + ": expected " + p + "_y and " + p + "_z after " + head[col]);
+      Bad(path, 1,
+          "column " + std::to_string(col + 1) + ": expected " + p + "_y and " + p + "_z after " +
+              head[col]);
     ds.point_names.push_back(p);
     col += 3;
   }
@@ -547,13 +563,17 @@ Dataset LoadDataset(const std::string& path) {
   if (P == 0) Bad(path, 1, "expected position columns <point>_x,<point>_y,<point>_z");
   const size_t nj = head.size() - 1 - col;
   if (nj != 0 && nj != static_cast<size_t>(3 * P * m))
-    Bad(path, 1, "expected 0 or " + std::to_string(3 * P * m) + " Jacobian columns, found " +
-                     std::to_string(nj));
+    Bad(path, 1,
+        "expected 0 or " + std::to_string(3 * P * m) + " Jacobian columns, found " +
+            std::to_string(nj));
   for (size_t j = 0; j < nj; ++j) {
     const int r = static_cast<int>(j) / m, a = static_cast<int>(j) % m;
-    const std::string want = "J_" + ds.point_names[r / 3] + "_" + kCoord[r % 3] + "_c" + std::to_string(a);
+    const std::string want =
+        "J_" + ds.point_names[r / 3] + "_" + kCoord[r % 3] + "_c" + std::to_string(a);
     if (head[col + j] != want)
-      Bad(path, 1, "column " + std::to_string(col + j + 1) + ": expected " + want + ", got " + head[col + j]);
+      Bad(path, 1,
+          "column " + std::to_string(col + j + 1) + ": expected " + want + ", got " +
+              head[col + j]);
   }
   const size_t nfields = head.size();
 
@@ -564,21 +584,25 @@ Dataset LoadDataset(const std::string& path) {
     const size_t nl = text.find('\n', pos);
     ++lineno;
     if (nl == std::string::npos)
-      Bad(path, lineno, "the last line has no line break (an interrupted run? run the generation "
-                        "again to resume it)");
+      Bad(path, lineno,
+          "the last line has no line break (an interrupted run? run the generation "
+          "again to resume it)");
     const std::string line = text.substr(pos, nl - pos);
     pos = nl + 1;
     const std::vector<std::string> f = SplitFields(line);
     if (f.size() != nfields)
-      Bad(path, lineno, "expected " + std::to_string(nfields) + " fields, found " + std::to_string(f.size()));
+      Bad(path, lineno,
+          "expected " + std::to_string(nfields) + " fields, found " + std::to_string(f.size()));
     const long long idx = ParseIndex(f[0], path, lineno);
     if (idx <= last_index)
-      Bad(path, lineno, "sample index " + std::to_string(idx) + " after " +
-                            std::to_string(last_index) + " (indices must increase)");
+      Bad(path, lineno,
+          "sample index " + std::to_string(idx) + " after " + std::to_string(last_index) +
+              " (indices must increase)");
     last_index = idx;
     if (f[1] == "failed") {
       for (size_t j = 2 + m; j + 1 < nfields; ++j)
-        if (!f[j].empty()) Bad(path, lineno, "a failed sample must have empty position and Jacobian fields");
+        if (!f[j].empty())
+          Bad(path, lineno, "a failed sample must have empty position and Jacobian fields");
       ++ds.failed;
       continue;
     }
@@ -586,7 +610,8 @@ Dataset LoadDataset(const std::string& path) {
     for (int a = 0; a < m; ++a) in.push_back(ParseNumber(f[2 + a], path, lineno, head[2 + a]));
     for (int j = 0; j < 3 * P; ++j)
       pos_v.push_back(ParseNumber(f[2 + m + j], path, lineno, head[2 + m + j]));
-    for (size_t j = 0; j < nj; ++j) jac.push_back(ParseNumber(f[col + j], path, lineno, head[col + j]));
+    for (size_t j = 0; j < nj; ++j)
+      jac.push_back(ParseNumber(f[col + j], path, lineno, head[col + j]));
     ds.index.push_back(idx);
   }
   const Eigen::Index n = static_cast<Eigen::Index>(ds.index.size());

@@ -49,10 +49,10 @@ namespace softkin {
 struct DatasetSampling {
   enum class Kind { kGrid, kRandom };
   Kind kind = Kind::kGrid;
-  int grid = 16;                ///< N, values per actuator (grid), >= 2
-  long long random = 0;         ///< number of samples (random), >= 1
-  std::uint64_t seed = 0;       ///< random sampling seed
-  int block = 64;               ///< warm-start block length (samples), >= 1
+  int grid = 16;           ///< N, values per actuator (grid), >= 2
+  long long random = 0;    ///< number of samples (random), >= 1
+  std::uint64_t seed = 0;  ///< random sampling seed
+  int block = 64;          ///< warm-start block length (samples), >= 1
   bool IsValid(std::string* why) const;
   /// {"kind": "grid", "grid": N, "block": B} or {"kind": "random", "samples": n, "seed": s, ...}.
   nlohmann::json ToJson() const;
@@ -77,28 +77,28 @@ ShardRange DatasetShard(long long total, int block, int k, int n);
 
 /// What a generation run is asked to do.
 struct DatasetRunOptions {
-  std::string out;              ///< CSV path; the sidecar is out + ".json"
-  bool jacobian = false;        ///< also record J (the kinematics must provide it)
-  int shard = 0, shards = 1;    ///< compute shard `shard` of `shards` (0-based)
+  std::string out;            ///< CSV path; the sidecar is out + ".json"
+  bool jacobian = false;      ///< also record J (the kinematics must provide it)
+  int shard = 0, shards = 1;  ///< compute shard `shard` of `shards` (0-based)
   /// Identifies the data source in the sidecar's config (robot, res, params, twin label, ...).
   nlohmann::json source;
   /// Recorded in the sidecar, not compared (git commit, command line).
   nlohmann::json provenance;
   /// Forgets the kinematics' warm-start state (nullptr: the kinematics has none).
   std::function<void()> reset;
-  bool progress = true;         ///< progress bar on stderr
+  bool progress = true;  ///< progress bar on stderr
   /// Stop after writing this many new samples (< 0: never); simulates an interruption in tests.
   long long stop_after = -1;
 };
 
 /// What a run did.
 struct DatasetRunSummary {
-  long long first = 0, count = 0;   ///< the shard's slice of the generation order
-  long long already = 0;            ///< samples found complete in the file (resume)
-  long long written = 0;            ///< samples written by this run
-  long long failed = 0;             ///< of them, failed evaluations
-  double time_s = 0;                ///< wall time of this run
-  long long fk_solves = 0;          ///< forward solves of this run
+  long long first = 0, count = 0;  ///< the shard's slice of the generation order
+  long long already = 0;           ///< samples found complete in the file (resume)
+  long long written = 0;           ///< samples written by this run
+  long long failed = 0;            ///< of them, failed evaluations
+  double time_s = 0;               ///< wall time of this run
+  long long fk_solves = 0;         ///< forward solves of this run
 };
 
 /// Evaluates `kin` on the dataset samples of the shard and appends them to opt.out, flushing each
@@ -118,14 +118,14 @@ long long MergeDatasets(const std::vector<std::string>& shards, const std::strin
 
 /// A dataset loaded for training: only the ok samples, in file order.
 struct Dataset {
-  std::vector<std::string> point_names;   ///< P tracked points
-  int num_actuators = 0;                  ///< m
-  Eigen::MatrixXd inputs;                 ///< n x m actuations
-  Eigen::MatrixXd positions;              ///< n x 3P, point-major (x, y, z per point), mm
-  Eigen::MatrixXd jacobians;              ///< n x 3Pm (row-major J, see the file comment), or n x 0
-  std::vector<long long> index;           ///< n generation-order indices
-  long long failed = 0;                   ///< failed samples skipped
-  nlohmann::json meta;                    ///< the sidecar (null if there is none)
+  std::vector<std::string> point_names;  ///< P tracked points
+  int num_actuators = 0;                 ///< m
+  Eigen::MatrixXd inputs;                ///< n x m actuations
+  Eigen::MatrixXd positions;             ///< n x 3P, point-major (x, y, z per point), mm
+  Eigen::MatrixXd jacobians;             ///< n x 3Pm (row-major J, see the file comment), or n x 0
+  std::vector<long long> index;          ///< n generation-order indices
+  long long failed = 0;                  ///< failed samples skipped
+  nlohmann::json meta;                   ///< the sidecar (null if there is none)
 };
 
 /// Reads a dataset CSV (and its sidecar if present). Throws std::invalid_argument with file:line

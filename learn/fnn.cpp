@@ -43,10 +43,11 @@ MinMaxMap::MinMaxMap(int size)
   if (size < 0) throw std::invalid_argument("MinMaxMap: size " + std::to_string(size) + " < 0");
 }
 
-MinMaxMap::MinMaxMap(const Eigen::Ref<const Eigen::VectorXd>& xmin, const Eigen::Ref<const Eigen::VectorXd>& xmax) {
+MinMaxMap::MinMaxMap(const Eigen::Ref<const Eigen::VectorXd>& xmin,
+                     const Eigen::Ref<const Eigen::VectorXd>& xmax) {
   if (xmin.size() != xmax.size())
-    throw std::invalid_argument("MinMaxMap: xmin has " + std::to_string(xmin.size()) + " rows, xmax " +
-                                std::to_string(xmax.size()));
+    throw std::invalid_argument("MinMaxMap: xmin has " + std::to_string(xmin.size()) +
+                                " rows, xmax " + std::to_string(xmax.size()));
   const Eigen::Index n = xmin.size();
   xmin_ = xmin;
   xmax_ = xmax;
@@ -54,7 +55,8 @@ MinMaxMap::MinMaxMap(const Eigen::Ref<const Eigen::VectorXd>& xmin, const Eigen:
   base_.resize(n);
   for (Eigen::Index r = 0; r < n; ++r) {
     if (!std::isfinite(xmin(r)) || !std::isfinite(xmax(r)))
-      throw std::invalid_argument("MinMaxMap: row " + std::to_string(r) + " has a non-finite range");
+      throw std::invalid_argument("MinMaxMap: row " + std::to_string(r) +
+                                  " has a non-finite range");
     if (xmin(r) > xmax(r))
       throw std::invalid_argument("MinMaxMap: row " + std::to_string(r) + " has xmin > xmax");
     const double range = xmax(r) - xmin(r);
@@ -70,18 +72,21 @@ MinMaxMap::MinMaxMap(const Eigen::Ref<const Eigen::VectorXd>& xmin, const Eigen:
 
 MinMaxMap MinMaxMap::Fit(const Eigen::Ref<const Eigen::MatrixXd>& X) {
   if (X.rows() < 1) throw std::invalid_argument("MinMaxMap::Fit: no samples");
-  if (!X.allFinite()) throw std::invalid_argument("MinMaxMap::Fit: the data has non-finite entries");
+  if (!X.allFinite())
+    throw std::invalid_argument("MinMaxMap::Fit: the data has non-finite entries");
   const Eigen::VectorXd lo = X.colwise().minCoeff().transpose();
   const Eigen::VectorXd hi = X.colwise().maxCoeff().transpose();
   return MinMaxMap(lo, hi);
 }
 
-void MinMaxMap::Apply(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::VectorXd> u) const {
+void MinMaxMap::Apply(const Eigen::Ref<const Eigen::VectorXd>& x,
+                      Eigen::Ref<Eigen::VectorXd> u) const {
   assert(x.size() == size() && u.size() == size());
   u.array() = gain_.array() * (x.array() - xmin_.array()) + base_.array();
 }
 
-void MinMaxMap::Reverse(const Eigen::Ref<const Eigen::VectorXd>& u, Eigen::Ref<Eigen::VectorXd> x) const {
+void MinMaxMap::Reverse(const Eigen::Ref<const Eigen::VectorXd>& u,
+                        Eigen::Ref<Eigen::VectorXd> x) const {
   assert(x.size() == size() && u.size() == size());
   x.array() = (u.array() - base_.array()) / gain_.array() + xmin_.array();
 }
@@ -107,8 +112,8 @@ Fnn::Fnn(const std::vector<int>& layer_sizes) : sizes_(layer_sizes) {
                                 std::to_string(sizes_.size()));
   for (std::size_t l = 0; l < sizes_.size(); ++l)
     if (sizes_[l] < 1)
-      throw std::invalid_argument("Fnn: layer size " + std::to_string(l) + " is " + std::to_string(sizes_[l]) +
-                                  ", expected >= 1");
+      throw std::invalid_argument("Fnn: layer size " + std::to_string(l) + " is " +
+                                  std::to_string(sizes_[l]) + ", expected >= 1");
   const int L = static_cast<int>(sizes_.size()) - 1;
   W_.resize(L);
   b_.resize(L);
@@ -142,28 +147,30 @@ std::string Fnn::Describe() const {
   return SizesString(sizes_) + (num_layers() > 1 ? " tansig/linear" : " linear");
 }
 
-void Fnn::FitNormalization(const Eigen::Ref<const Eigen::MatrixXd>& X, const Eigen::Ref<const Eigen::MatrixXd>& Y) {
+void Fnn::FitNormalization(const Eigen::Ref<const Eigen::MatrixXd>& X,
+                           const Eigen::Ref<const Eigen::MatrixXd>& Y) {
   if (X.rows() != Y.rows())
-    throw std::invalid_argument("Fnn::FitNormalization: X has " + std::to_string(X.rows()) + " samples, Y " +
-                                std::to_string(Y.rows()));
+    throw std::invalid_argument("Fnn::FitNormalization: X has " + std::to_string(X.rows()) +
+                                " samples, Y " + std::to_string(Y.rows()));
   if (X.cols() != num_inputs() || Y.cols() != num_outputs())
-    throw std::invalid_argument("Fnn::FitNormalization: data is " + std::to_string(X.cols()) + " -> " +
-                                std::to_string(Y.cols()) + " columns, network " + Describe());
+    throw std::invalid_argument("Fnn::FitNormalization: data is " + std::to_string(X.cols()) +
+                                " -> " + std::to_string(Y.cols()) + " columns, network " +
+                                Describe());
   in_map_ = MinMaxMap::Fit(X);
   out_map_ = MinMaxMap::Fit(Y);
 }
 
 void Fnn::set_input_map(const MinMaxMap& m) {
   if (m.size() != num_inputs())
-    throw std::invalid_argument("Fnn::set_input_map: map of size " + std::to_string(m.size()) + ", network has " +
-                                std::to_string(num_inputs()) + " inputs");
+    throw std::invalid_argument("Fnn::set_input_map: map of size " + std::to_string(m.size()) +
+                                ", network has " + std::to_string(num_inputs()) + " inputs");
   in_map_ = m;
 }
 
 void Fnn::set_output_map(const MinMaxMap& m) {
   if (m.size() != num_outputs())
-    throw std::invalid_argument("Fnn::set_output_map: map of size " + std::to_string(m.size()) + ", network has " +
-                                std::to_string(num_outputs()) + " outputs");
+    throw std::invalid_argument("Fnn::set_output_map: map of size " + std::to_string(m.size()) +
+                                ", network has " + std::to_string(num_outputs()) + " outputs");
   out_map_ = m;
 }
 
@@ -220,7 +227,8 @@ void Fnn::set_parameters(const Eigen::Ref<const Eigen::VectorXd>& w) {
 // ---------------------------------------------------------------------------------------------
 // Fnn: evaluation
 
-void Fnn::Forward(const Eigen::Ref<const Eigen::VectorXd>& x, FnnWorkspace& ws, Eigen::Ref<Eigen::VectorXd> y) const {
+void Fnn::Forward(const Eigen::Ref<const Eigen::VectorXd>& x, FnnWorkspace& ws,
+                  Eigen::Ref<Eigen::VectorXd> y) const {
   const int L = num_layers();
   assert(L >= 1 && x.size() == num_inputs() && y.size() == num_outputs());
   if (static_cast<int>(ws.a.size()) != L) ws.a.resize(L);
@@ -278,8 +286,8 @@ Eigen::MatrixXd Fnn::ForwardBatch(const Eigen::Ref<const Eigen::MatrixXd>& X) co
   return Z.transpose();
 }
 
-void Fnn::InputJacobian(const Eigen::Ref<const Eigen::VectorXd>& x, FnnWorkspace& ws, Eigen::Ref<Eigen::VectorXd> y,
-                        Eigen::Ref<Eigen::MatrixXd> J) const {
+void Fnn::InputJacobian(const Eigen::Ref<const Eigen::VectorXd>& x, FnnWorkspace& ws,
+                        Eigen::Ref<Eigen::VectorXd> y, Eigen::Ref<Eigen::MatrixXd> J) const {
   const int L = num_layers();
   const int n0 = num_inputs();
   assert(J.rows() == num_outputs() && J.cols() == n0);
@@ -327,8 +335,9 @@ Eigen::MatrixXd Fnn::InputJacobianBatch(const Eigen::Ref<const Eigen::MatrixXd>&
   return out;
 }
 
-void Fnn::ParameterJacobianNormalized(const Eigen::Ref<const Eigen::MatrixXd>& U, FnnBlockWorkspace& ws,
-                                      Eigen::Ref<Eigen::MatrixXd> Z, Eigen::Ref<Eigen::MatrixXd> Jt) const {
+void Fnn::ParameterJacobianNormalized(const Eigen::Ref<const Eigen::MatrixXd>& U,
+                                      FnnBlockWorkspace& ws, Eigen::Ref<Eigen::MatrixXd> Z,
+                                      Eigen::Ref<Eigen::MatrixXd> Jt) const {
   const int L = num_layers();
   const int nL = num_outputs();
   const Eigen::Index B = U.cols();
@@ -353,7 +362,8 @@ void Fnn::ParameterJacobianNormalized(const Eigen::Ref<const Eigen::MatrixXd>& U
         col(offL + nL * nprev + k) = 1.0;
       }
     }
-    // Hidden layers, backwards: d_{L-1} = diag(1 - a^2) W_L^T e_k; d_{l-1} = diag(1 - a^2) W_l^T d_l.
+    // Hidden layers, backwards: d_{L-1} = diag(1 - a^2) W_L^T e_k; d_{l-1} = diag(1 - a^2) W_l^T
+    // d_l.
     for (int l = L - 1; l >= 1; --l) {
       Eigen::MatrixXd& d = ws.d[l];
       d.resize(sizes_[l], B);

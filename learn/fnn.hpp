@@ -10,7 +10,8 @@
 /// #samples x n_0, Y is #samples x n_L (like Kinematics::p and a dataset table).
 ///
 /// Evaluation of one input x (original units):
-///   a_0 = N_in(x),  a_l = tansig(W_l a_{l-1} + b_l) (l < L),  z = W_L a_{L-1} + b_L,  y = N_out^-1(z)
+///   a_0 = N_in(x),  a_l = tansig(W_l a_{l-1} + b_l) (l < L),  z = W_L a_{L-1} + b_L,  y =
+///   N_out^-1(z)
 /// with W_l an n_l x n_{l-1} matrix and b_l an n_l vector.
 ///
 /// Flat parameter vector (#parameters = sum_l n_l (n_{l-1} + 1)): for l = 1..L in order, W_l in
@@ -69,7 +70,8 @@ class MinMaxMap {
   explicit MinMaxMap(int size);
   /// A map with the given per-row range. Throws std::invalid_argument if the sizes differ, an entry
   /// is not finite, or xmin > xmax (naming the row).
-  MinMaxMap(const Eigen::Ref<const Eigen::VectorXd>& xmin, const Eigen::Ref<const Eigen::VectorXd>& xmax);
+  MinMaxMap(const Eigen::Ref<const Eigen::VectorXd>& xmin,
+            const Eigen::Ref<const Eigen::VectorXd>& xmax);
   /// Range fitted from data: X is #samples x size (row per sample), #samples >= 1, all finite.
   /// Throws std::invalid_argument otherwise.
   static MinMaxMap Fit(const Eigen::Ref<const Eigen::MatrixXd>& X);
@@ -136,7 +138,8 @@ class Fnn {
   // ---- normalisation ----
   /// Fit both maps from data (X: #samples x n_0, Y: #samples x n_L, same #samples >= 1, finite).
   /// Throws std::invalid_argument on a shape mismatch or non-finite data.
-  void FitNormalization(const Eigen::Ref<const Eigen::MatrixXd>& X, const Eigen::Ref<const Eigen::MatrixXd>& Y);
+  void FitNormalization(const Eigen::Ref<const Eigen::MatrixXd>& X,
+                        const Eigen::Ref<const Eigen::MatrixXd>& Y);
   const MinMaxMap& input_map() const { return in_map_; }
   const MinMaxMap& output_map() const { return out_map_; }
   /// Throws std::invalid_argument if the size is not n_0 (resp. n_L).
@@ -158,15 +161,16 @@ class Fnn {
   /// y = f(x): x of length n_0, returns n_L values.
   Eigen::VectorXd Forward(const Eigen::Ref<const Eigen::VectorXd>& x) const;
   /// y = f(x) into y (length n_L) using ws; no heap allocation once ws has this network's shape.
-  void Forward(const Eigen::Ref<const Eigen::VectorXd>& x, FnnWorkspace& ws, Eigen::Ref<Eigen::VectorXd> y) const;
+  void Forward(const Eigen::Ref<const Eigen::VectorXd>& x, FnnWorkspace& ws,
+               Eigen::Ref<Eigen::VectorXd> y) const;
   /// Batch: X is #samples x n_0, returns #samples x n_L (row per sample).
   Eigen::MatrixXd ForwardBatch(const Eigen::Ref<const Eigen::MatrixXd>& X) const;
 
   /// Input Jacobian dy/dx (n_L x n_0) at x, through both normalisations.
   Eigen::MatrixXd InputJacobian(const Eigen::Ref<const Eigen::VectorXd>& x) const;
   /// As above, also returning y (length n_L); J must be n_L x n_0. No allocation once ws is shaped.
-  void InputJacobian(const Eigen::Ref<const Eigen::VectorXd>& x, FnnWorkspace& ws, Eigen::Ref<Eigen::VectorXd> y,
-                     Eigen::Ref<Eigen::MatrixXd> J) const;
+  void InputJacobian(const Eigen::Ref<const Eigen::VectorXd>& x, FnnWorkspace& ws,
+                     Eigen::Ref<Eigen::VectorXd> y, Eigen::Ref<Eigen::MatrixXd> J) const;
   /// Batch: X is #samples x n_0; returns (#samples n_L) x n_0, rows s n_L .. s n_L + n_L - 1
   /// holding dy/dx of sample s.
   Eigen::MatrixXd InputJacobianBatch(const Eigen::Ref<const Eigen::MatrixXd>& X) const;
@@ -182,11 +186,13 @@ class Fnn {
   /// Normalised outputs Z (n_L x B) and the TRANSPOSED parameter Jacobian Jt (#parameters x
   /// (B n_L)) of a block: column s n_L + k of Jt is d z_k / d w for sample s. (Column-major Jt is
   /// the row-major residual Jacobian Ceres expects.)
-  void ParameterJacobianNormalized(const Eigen::Ref<const Eigen::MatrixXd>& U, FnnBlockWorkspace& ws,
-                                   Eigen::Ref<Eigen::MatrixXd> Z, Eigen::Ref<Eigen::MatrixXd> Jt) const;
+  void ParameterJacobianNormalized(const Eigen::Ref<const Eigen::MatrixXd>& U,
+                                   FnnBlockWorkspace& ws, Eigen::Ref<Eigen::MatrixXd> Z,
+                                   Eigen::Ref<Eigen::MatrixXd> Jt) const;
 
   // ---- file I/O ("softkin-fnn v1", see the file comment) ----
-  /// Write to `path`. Throws std::runtime_error if the network is empty or the file cannot be written.
+  /// Write to `path`. Throws std::runtime_error if the network is empty or the file cannot be
+  /// written.
   void Save(const std::string& path) const;
   /// Write to a stream.
   void Write(std::ostream& out) const;

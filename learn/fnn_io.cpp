@@ -1,4 +1,5 @@
-// The "softkin-fnn v1" file format of Fnn (documented in learn/fnn.hpp): writer and checking reader.
+// The "softkin-fnn v1" file format of Fnn (documented in learn/fnn.hpp): writer and checking
+// reader.
 #include "softkin/learn/fnn.hpp"
 
 #include <cerrno>
@@ -33,7 +34,8 @@ class Reader {
   Reader(std::istream& in, std::string source) : in_(in), source_(std::move(source)) {}
 
   [[noreturn]] void Fail(const std::string& field, const std::string& what) const {
-    throw std::runtime_error(source_ + ":" + std::to_string(line_no_) + ": softkin-fnn field '" + field + "': " + what);
+    throw std::runtime_error(source_ + ":" + std::to_string(line_no_) + ": softkin-fnn field '" +
+                             field + "': " + what);
   }
 
   // Next non-empty, non-comment line split into tokens; fails with "unexpected end of file".
@@ -59,7 +61,8 @@ class Reader {
     if (t[0] != key) Fail(key, "expected a line starting with '" + key + "', found '" + t[0] + "'");
     t.erase(t.begin());
     if (count >= 0 && static_cast<int>(t.size()) != count)
-      Fail(key, "expected " + std::to_string(count) + " value(s), found " + std::to_string(t.size()));
+      Fail(key,
+           "expected " + std::to_string(count) + " value(s), found " + std::to_string(t.size()));
     return t;
   }
 
@@ -76,9 +79,11 @@ class Reader {
     errno = 0;
     char* end = nullptr;
     const long v = std::strtol(token.c_str(), &end, 10);
-    if (end == token.c_str() || *end != '\0' || errno == ERANGE) Fail(field, "'" + token + "' is not an integer");
+    if (end == token.c_str() || *end != '\0' || errno == ERANGE)
+      Fail(field, "'" + token + "' is not an integer");
     if (v < lo || v > hi)
-      Fail(field, token + " is out of range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+      Fail(field,
+           token + " is out of range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
     return static_cast<int>(v);
   }
 
@@ -145,14 +150,19 @@ Fnn Fnn::Read(std::istream& in, const std::string& source) {
   Reader r(in, source);
   {
     const std::vector<std::string> t = r.NextLine("magic");
-    if (t[0] != kMagic) r.Fail("magic", "expected '" + std::string(kMagic) + "', found '" + t[0] + "' (not a network file?)");
-    if (t.size() != 2) r.Fail("version", "expected '" + std::string(kMagic) + " v" + std::to_string(kVersion) + "'");
+    if (t[0] != kMagic)
+      r.Fail("magic",
+             "expected '" + std::string(kMagic) + "', found '" + t[0] + "' (not a network file?)");
+    if (t.size() != 2)
+      r.Fail("version", "expected '" + std::string(kMagic) + " v" + std::to_string(kVersion) + "'");
     if (t[1] != "v" + std::to_string(kVersion))
-      r.Fail("version", "unsupported version '" + t[1] + "', this reader knows v" + std::to_string(kVersion));
+      r.Fail("version",
+             "unsupported version '" + t[1] + "', this reader knows v" + std::to_string(kVersion));
   }
   {
     const std::vector<std::string> t = r.KeyLine("activation", 1);
-    if (t[0] != "tansig") r.Fail("activation", "unknown activation '" + t[0] + "', expected 'tansig'");
+    if (t[0] != "tansig")
+      r.Fail("activation", "unknown activation '" + t[0] + "', expected 'tansig'");
   }
   const int n_sizes = r.ParseInt("layers", r.KeyLine("layers", 1)[0], 2, 1000);
   std::vector<int> sizes(n_sizes);
@@ -162,26 +172,30 @@ Fnn Fnn::Read(std::istream& in, const std::string& source) {
       sizes[i] = r.ParseInt("sizes[" + std::to_string(i) + "]", t[i], 1, kMaxLayerSize);
   }
   long long expected = 0;
-  for (int l = 1; l < n_sizes; ++l) expected += static_cast<long long>(sizes[l]) * (sizes[l - 1] + 1);
-  if (expected > (1LL << 31) - 1) r.Fail("sizes", "the network would have " + std::to_string(expected) + " parameters");
+  for (int l = 1; l < n_sizes; ++l)
+    expected += static_cast<long long>(sizes[l]) * (sizes[l - 1] + 1);
+  if (expected > (1LL << 31) - 1)
+    r.Fail("sizes", "the network would have " + std::to_string(expected) + " parameters");
   Fnn net(sizes);
   net.in_map_ = ReadMap(r, "input", sizes.front());
   net.out_map_ = ReadMap(r, "output", sizes.back());
   const int count = r.ParseInt("parameters", r.KeyLine("parameters", 1)[0], 0, 1 << 30);
   if (count != net.num_parameters())
-    r.Fail("parameters", "count " + std::to_string(count) + " does not match the sizes (" + net.Describe() + " has " +
-                             std::to_string(net.num_parameters()) + ")");
+    r.Fail("parameters", "count " + std::to_string(count) + " does not match the sizes (" +
+                             net.Describe() + " has " + std::to_string(net.num_parameters()) + ")");
   Eigen::VectorXd w(count);
   for (int i = 0; i < count; ++i) {
     const std::string field = "parameters[" + std::to_string(i) + "]";
     const std::vector<std::string> t = r.NextLine(field);
-    if (t.size() != 1) r.Fail(field, "expected one number per line, found " + std::to_string(t.size()) + " tokens");
+    if (t.size() != 1)
+      r.Fail(field, "expected one number per line, found " + std::to_string(t.size()) + " tokens");
     w(i) = r.ParseDouble(field, t[0]);
   }
   net.set_parameters(w);
   {
     const std::vector<std::string> t = r.NextLine("end");
-    if (t.size() != 1 || t[0] != "end") r.Fail("end", "expected 'end' after the parameters, found '" + t[0] + "'");
+    if (t.size() != 1 || t[0] != "end")
+      r.Fail("end", "expected 'end' after the parameters, found '" + t[0] + "'");
   }
   return net;
 }

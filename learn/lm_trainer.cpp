@@ -16,14 +16,17 @@ namespace softkin {
 
 namespace {
 
-constexpr int kSubBlock = 16;     // samples per parallel Jacobian task (fixed: results do not depend on threads)
-constexpr int kTile = 64;         // columns of H per parallel product task
+constexpr int kSubBlock =
+    16;  // samples per parallel Jacobian task (fixed: results do not depend on threads)
+constexpr int kTile = 64;           // columns of H per parallel product task
 constexpr int kCholeskyTile = 128;  // tile of the damped normal matrix's factorisation
-constexpr double kMuMin = 1e-20;  // trainlm's floor on mu
+constexpr double kMuMin = 1e-20;    // trainlm's floor on mu
 
 using Clock = std::chrono::steady_clock;
 
-double Seconds(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double Seconds(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 // While alive, the calling thread's OpenMP default team size is 1, which threads spawned by our
 // own parallel regions inherit. Eigen then never parallelises a product or factorisation by
@@ -41,13 +44,15 @@ class SerialEigenGuard {
 void CheckSet(const Fnn& net, const SampleSet& s, const char* what) {
   if (s.X.rows() != s.Y.rows())
     throw std::invalid_argument(std::string("TrainLevenbergMarquardt: ") + what + " set has " +
-                                std::to_string(s.X.rows()) + " inputs but " + std::to_string(s.Y.rows()) + " targets");
+                                std::to_string(s.X.rows()) + " inputs but " +
+                                std::to_string(s.Y.rows()) + " targets");
   if (s.X.cols() != net.num_inputs() || s.Y.cols() != net.num_outputs())
     throw std::invalid_argument(std::string("TrainLevenbergMarquardt: ") + what + " set is " +
                                 std::to_string(s.X.cols()) + " -> " + std::to_string(s.Y.cols()) +
                                 " columns, the network is " + net.Describe());
   if (!s.X.allFinite() || !s.Y.allFinite())
-    throw std::invalid_argument(std::string("TrainLevenbergMarquardt: ") + what + " set has non-finite entries");
+    throw std::invalid_argument(std::string("TrainLevenbergMarquardt: ") + what +
+                                " set has non-finite entries");
 }
 
 // A sample set on the network's normalised scale, column per sample.
@@ -74,7 +79,8 @@ struct ThreadScratch {
 
 // Sum of squared normalised errors of `net` on `set`, over fixed blocks of `bs` samples (blocks in
 // parallel, partial sums added in block order: the same bits for any thread count).
-double SumSquaredError(const Fnn& net, const NormalizedSet& set, int bs, int nt, std::vector<ThreadScratch>& scratch) {
+double SumSquaredError(const Fnn& net, const NormalizedSet& set, int bs, int nt,
+                       std::vector<ThreadScratch>& scratch) {
   const int N = set.size();
   if (N == 0) return 0.0;
   const int nblocks = (N + bs - 1) / bs;
@@ -118,19 +124,26 @@ bool LmOptions::IsValid(std::string* why) const {
 
 const char* LmTerminationToString(LmTermination t) {
   switch (t) {
-    case LmTermination::kGoalReached: return "goal";
-    case LmTermination::kMinGradient: return "min_gradient";
-    case LmTermination::kMuMax: return "mu_max";
-    case LmTermination::kMaxEpochs: return "max_epochs";
-    case LmTermination::kMaxTime: return "max_time";
-    case LmTermination::kValidationStop: return "validation_stop";
+    case LmTermination::kGoalReached:
+      return "goal";
+    case LmTermination::kMinGradient:
+      return "min_gradient";
+    case LmTermination::kMuMax:
+      return "mu_max";
+    case LmTermination::kMaxEpochs:
+      return "max_epochs";
+    case LmTermination::kMaxTime:
+      return "max_time";
+    case LmTermination::kValidationStop:
+      return "validation_stop";
   }
   return "unknown";
 }
 
 bool LmTerminationFromString(const std::string& name, LmTermination* t) {
-  for (LmTermination c : {LmTermination::kGoalReached, LmTermination::kMinGradient, LmTermination::kMuMax,
-                          LmTermination::kMaxEpochs, LmTermination::kMaxTime, LmTermination::kValidationStop}) {
+  for (LmTermination c :
+       {LmTermination::kGoalReached, LmTermination::kMinGradient, LmTermination::kMuMax,
+        LmTermination::kMaxEpochs, LmTermination::kMaxTime, LmTermination::kValidationStop}) {
     if (name == LmTerminationToString(c)) {
       *t = c;
       return true;
@@ -147,12 +160,14 @@ double LmSummary::TimeToTrainMse(double target) const {
 
 std::string LmSummary::BriefReport() const {
   char buf[512];
-  std::snprintf(buf, sizeof(buf),
-                "LM: %s after %d epochs (%d accepted, %d rejected steps), train mse %.4g, best epoch %d%s, "
-                "%d parameters, %.3g s on %d thread(s)",
-                LmTerminationToString(termination), epochs, accepted_steps, rejected_steps, final_train_mse,
-                best_epoch, val_mse.empty() ? "" : (" (val mse " + std::to_string(best_val_mse) + ")").c_str(),
-                num_parameters, total_time_s, num_threads);
+  std::snprintf(
+      buf, sizeof(buf),
+      "LM: %s after %d epochs (%d accepted, %d rejected steps), train mse %.4g, best epoch %d%s, "
+      "%d parameters, %.3g s on %d thread(s)",
+      LmTerminationToString(termination), epochs, accepted_steps, rejected_steps, final_train_mse,
+      best_epoch,
+      val_mse.empty() ? "" : (" (val mse " + std::to_string(best_val_mse) + ")").c_str(),
+      num_parameters, total_time_s, num_threads);
   return buf;
 }
 
@@ -162,15 +177,19 @@ double NormalizedMse(const Fnn& net, const SampleSet& s) {
   SerialEigenGuard guard;
   const NormalizedSet n = Normalize(net, s);
   std::vector<ThreadScratch> scratch(1);
-  return SumSquaredError(net, n, 256, 1, scratch) / (static_cast<double>(n.size()) * net.num_outputs());
+  return SumSquaredError(net, n, 256, 1, scratch) /
+         (static_cast<double>(n.size()) * net.num_outputs());
 }
 
 LmSummary TrainLevenbergMarquardt(Fnn& net, const SampleSet& train, const SampleSet* validation,
                                   const LmOptions& options, const SampleSet* test) {
   std::string why;
-  if (!options.IsValid(&why)) throw std::invalid_argument("TrainLevenbergMarquardt: invalid options: " + why);
-  if (net.num_layers() == 0) throw std::invalid_argument("TrainLevenbergMarquardt: the network is empty");
-  if (train.empty()) throw std::invalid_argument("TrainLevenbergMarquardt: the training set is empty");
+  if (!options.IsValid(&why))
+    throw std::invalid_argument("TrainLevenbergMarquardt: invalid options: " + why);
+  if (net.num_layers() == 0)
+    throw std::invalid_argument("TrainLevenbergMarquardt: the network is empty");
+  if (train.empty())
+    throw std::invalid_argument("TrainLevenbergMarquardt: the training set is empty");
   CheckSet(net, train, "training");
   const bool has_val = validation && !validation->empty();
   const bool has_test = test && !test->empty();
@@ -198,7 +217,9 @@ LmSummary TrainLevenbergMarquardt(Fnn& net, const SampleSet& train, const Sample
   std::vector<ThreadScratch> scratch(nt);
   Fnn trial = net;
   auto mse_of = [&](const Fnn& f, const NormalizedSet& set) {
-    return set.size() == 0 ? 0.0 : SumSquaredError(f, set, bs, nt, scratch) / (static_cast<double>(set.size()) * nL);
+    return set.size() == 0
+               ? 0.0
+               : SumSquaredError(f, set, bs, nt, scratch) / (static_cast<double>(set.size()) * nL);
   };
 
   LmSummary sum;
@@ -229,7 +250,9 @@ LmSummary TrainLevenbergMarquardt(Fnn& net, const SampleSet& train, const Sample
   auto progress = [&](int epoch, bool force) {
     if (!options.verbose || (!force && epoch % options.progress_every != 0)) return;
     std::fprintf(stderr, "LM epoch %d/%d: mse %.4e", epoch, options.max_epochs, loss);
-    if (has_val) std::fprintf(stderr, "  val %.4e (best %.4e @%d, fail %d)", sum.val_mse.back(), best_val, best_epoch, val_fail);
+    if (has_val)
+      std::fprintf(stderr, "  val %.4e (best %.4e @%d, fail %d)", sum.val_mse.back(), best_val,
+                   best_epoch, val_fail);
     std::fprintf(stderr, "  mu %.1e", mu);
     if (!sum.gradient_norm.empty()) std::fprintf(stderr, "  |grad| %.2e", sum.gradient_norm.back());
     std::fprintf(stderr, "  %.1f s\n", Seconds(t0));
@@ -353,16 +376,24 @@ LmSummary TrainLevenbergMarquardt(Fnn& net, const SampleSet& train, const Sample
   sum.total_time_s = Seconds(t0);
   std::ostringstream msg;
   switch (sum.termination) {
-    case LmTermination::kGoalReached: msg << "training mse " << loss << " <= goal " << options.goal; break;
+    case LmTermination::kGoalReached:
+      msg << "training mse " << loss << " <= goal " << options.goal;
+      break;
     case LmTermination::kMinGradient:
       msg << "gradient norm " << sum.gradient_norm.back() << " < min_grad " << options.min_grad;
       break;
-    case LmTermination::kMuMax: msg << "mu " << mu << " > mu_max " << options.mu_max << ": no step lowers the loss"; break;
-    case LmTermination::kMaxEpochs: msg << "reached max_epochs " << options.max_epochs; break;
-    case LmTermination::kMaxTime: msg << "reached max_time_s " << options.max_time_s; break;
+    case LmTermination::kMuMax:
+      msg << "mu " << mu << " > mu_max " << options.mu_max << ": no step lowers the loss";
+      break;
+    case LmTermination::kMaxEpochs:
+      msg << "reached max_epochs " << options.max_epochs;
+      break;
+    case LmTermination::kMaxTime:
+      msg << "reached max_time_s " << options.max_time_s;
+      break;
     case LmTermination::kValidationStop:
-      msg << options.max_fail << " validation failures in a row; best validation mse " << best_val << " at epoch "
-          << best_epoch;
+      msg << options.max_fail << " validation failures in a row; best validation mse " << best_val
+          << " at epoch " << best_epoch;
       break;
   }
   sum.message = msg.str();

@@ -11,8 +11,8 @@
 /// One epoch (as trainlm): with J = dz/dw over all training samples (N n_L x W) and e = t - z,
 /// accumulate H = J^T J and g = J^T e; then repeat { solve (H + mu I) delta = g (tiled Cholesky,
 /// learn/tiled_cholesky.hpp);
-/// evaluate mse(w + delta); if it is lower, accept, mu *= mu_dec, end the epoch; else mu *= mu_inc }
-/// until mu > mu_max. The training loss therefore never increases: it is recorded per epoch in
+/// evaluate mse(w + delta); if it is lower, accept, mu *= mu_dec, end the epoch; else mu *= mu_inc
+/// } until mu > mu_max. The training loss therefore never increases: it is recorded per epoch in
 /// LmSummary::train_mse.
 ///
 /// Memory and threads. H and g are accumulated over blocks of block_size samples: the block's
@@ -38,18 +38,18 @@
 namespace softkin {
 
 struct LmOptions {
-  double mu = 1e-3;        ///< initial damping
-  double mu_dec = 0.1;     ///< mu factor after an accepted step (0 < mu_dec < 1)
-  double mu_inc = 10.0;    ///< mu factor after a rejected step (> 1)
-  double mu_max = 1e10;    ///< stop when mu exceeds this
-  double min_grad = 1e-7;  ///< stop when |d mse / dw| falls below this
-  int max_epochs = 1000;   ///< epoch cap (>= 0)
-  int max_fail = 6;        ///< validation failures in a row before early stopping (>= 1)
-  double goal = 0.0;       ///< stop when the training mse (normalised) <= goal (>= 0)
-  double max_time_s = 0.0; ///< wall-time cap in seconds; 0 = none
+  double mu = 1e-3;         ///< initial damping
+  double mu_dec = 0.1;      ///< mu factor after an accepted step (0 < mu_dec < 1)
+  double mu_inc = 10.0;     ///< mu factor after a rejected step (> 1)
+  double mu_max = 1e10;     ///< stop when mu exceeds this
+  double min_grad = 1e-7;   ///< stop when |d mse / dw| falls below this
+  int max_epochs = 1000;    ///< epoch cap (>= 0)
+  int max_fail = 6;         ///< validation failures in a row before early stopping (>= 1)
+  double goal = 0.0;        ///< stop when the training mse (normalised) <= goal (>= 0)
+  double max_time_s = 0.0;  ///< wall-time cap in seconds; 0 = none
   /// Samples per Jacobian block; 0 = automatic (max(1, 2048 / n_L), about 2048 Jacobian rows).
   int block_size = 0;
-  int num_threads = 0;     ///< OpenMP threads; 0 = omp_get_max_threads(). Results do not depend on it.
+  int num_threads = 0;  ///< OpenMP threads; 0 = omp_get_max_threads(). Results do not depend on it.
   /// true: fit the network's normalisation to the training set and Nguyen-Widrow-initialise it
   /// from `seed` before training; false: train from the network as given (its maps are kept).
   bool initialize = true;
@@ -84,14 +84,15 @@ struct LmSummary {
   std::vector<double> val_mse;    ///< normalised validation mse (empty without a validation set)
   std::vector<double> test_mse;   ///< normalised test mse (empty without a test set)
   std::vector<double> mu;         ///< mu at the end of each epoch
-  std::vector<double> gradient_norm;  ///< |d mse / dw| at the start of each epoch (one entry per gradient evaluated)
-  std::vector<double> time_s;     ///< wall time since the start at each entry of train_mse
-  int best_epoch = 0;             ///< epoch of the returned network
-  double best_val_mse = 0.0;      ///< its validation mse (0 without a validation set)
-  double final_train_mse = 0.0;   ///< training mse of the returned network
+  std::vector<double> gradient_norm;  ///< |d mse / dw| at the start of each epoch (one entry per
+                                      ///< gradient evaluated)
+  std::vector<double> time_s;         ///< wall time since the start at each entry of train_mse
+  int best_epoch = 0;                 ///< epoch of the returned network
+  double best_val_mse = 0.0;          ///< its validation mse (0 without a validation set)
+  double final_train_mse = 0.0;       ///< training mse of the returned network
   double total_time_s = 0.0;
   int num_parameters = 0;
-  int num_threads = 1;            ///< threads used
+  int num_threads = 1;  ///< threads used
   /// Wall time at which train_mse first reached <= target, or -1 if never.
   double TimeToTrainMse(double target) const;
   /// One line: termination, epochs, mse, best epoch, time.

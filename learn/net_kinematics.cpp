@@ -39,8 +39,7 @@ std::string LearnedNets::Check() const {
   std::ostringstream s;
   const int m = num_actuators(), P = num_points();
   if (m < 1) return "no actuators (empty lower bound)";
-  if (upper.size() != m || rest.size() != m)
-    return "lower, upper and rest have different sizes";
+  if (upper.size() != m || rest.size() != m) return "lower, upper and rest have different sizes";
   for (int a = 0; a < m; ++a) {
     if (!std::isfinite(lower[a]) || !std::isfinite(upper[a]) || !(lower[a] < upper[a]))
       return "actuator " + std::to_string(a) + ": expected finite bounds with lower < upper";
@@ -124,7 +123,8 @@ LearnedNets LearnedNets::Load(const std::string& dir) {
     if (!j.contains(key) || !j[key].is_array()) throw fail(key, "expected an array of numbers");
     Eigen::VectorXd v(j[key].size());
     for (size_t i = 0; i < j[key].size(); ++i) {
-      if (!j[key][i].is_number()) throw fail(key, "entry " + std::to_string(i) + " is not a number");
+      if (!j[key][i].is_number())
+        throw fail(key, "entry " + std::to_string(i) + " is not a number");
       v[static_cast<int>(i)] = j[key][i].get<double>();
     }
     return v;
@@ -145,7 +145,8 @@ LearnedNets LearnedNets::Load(const std::string& dir) {
     int which = -1;
     for (int i = 0; i < 4; ++i)
       if (it.key() == kNetNames[i]) which = i;
-    if (which < 0) throw fail("networks." + it.key(), "unknown network (expected fk, jac, s2r or ik)");
+    if (which < 0)
+      throw fail("networks." + it.key(), "unknown network (expected fk, jac, s2r or ik)");
     if (!it.value().is_string()) throw fail("networks." + it.key(), "expected a file name");
     const fs::path file = fs::path(dir) / it.value().get<std::string>();
     *NetByName(n, which) = Fnn::Load(file.string());  // throws naming the file and line
@@ -157,9 +158,12 @@ LearnedNets LearnedNets::Load(const std::string& dir) {
 }
 
 bool JacobianSourceFromString(const std::string& s, JacobianSource* out) {
-  if (s == "network") *out = JacobianSource::kNetwork;
-  else if (s == "fk-derivative") *out = JacobianSource::kFkDerivative;
-  else return false;
+  if (s == "network")
+    *out = JacobianSource::kNetwork;
+  else if (s == "fk-derivative")
+    *out = JacobianSource::kFkDerivative;
+  else
+    return false;
   return true;
 }
 

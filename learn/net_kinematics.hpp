@@ -30,9 +30,9 @@ namespace softkin {
 
 struct LearnedNets {
   Fnn fk, jac, s2r, ik;
-  std::vector<std::string> points;  ///< P tracked point names (N_fk's output order)
-  Eigen::VectorXd lower, upper;     ///< the actuation box (m each)
-  Eigen::VectorXd rest;             ///< rest actuation (m)
+  std::vector<std::string> points;                 ///< P tracked point names (N_fk's output order)
+  Eigen::VectorXd lower, upper;                    ///< the actuation box (m each)
+  Eigen::VectorXd rest;                            ///< rest actuation (m)
   nlohmann::json info = nlohmann::json::object();  ///< provenance and errors (free form)
 
   int num_actuators() const { return static_cast<int>(lower.size()); }

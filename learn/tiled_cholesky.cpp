@@ -35,14 +35,16 @@ bool TiledCholeskyInPlace(Eigen::Ref<Eigen::MatrixXd> A, int tile, int threads) 
       for (int j = 0; j < ntiles; ++j) {
         const Eigen::Index j0 = r0 + static_cast<Eigen::Index>(j) * tile;
         const Eigen::Index jw = std::min<Eigen::Index>(tile, n - j0);
-        A.block(j0, j0, n - j0, jw).noalias() -= A.block(j0, k0, n - j0, kw) * A.block(j0, k0, jw, kw).transpose();
+        A.block(j0, j0, n - j0, jw).noalias() -=
+            A.block(j0, k0, n - j0, kw) * A.block(j0, k0, jw, kw).transpose();
       }
     }
   }
   return true;
 }
 
-void TiledCholeskySolveInPlace(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::VectorXd> b) {
+void TiledCholeskySolveInPlace(const Eigen::Ref<const Eigen::MatrixXd>& A,
+                               Eigen::Ref<Eigen::VectorXd> b) {
   assert(A.rows() == A.cols() && b.size() == A.rows());
   A.triangularView<Eigen::Lower>().solveInPlace(b);
   A.triangularView<Eigen::Lower>().transpose().solveInPlace(b);

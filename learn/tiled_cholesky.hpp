@@ -18,6 +18,7 @@ namespace softkin {
 bool TiledCholeskyInPlace(Eigen::Ref<Eigen::MatrixXd> A, int tile, int threads);
 
 /// Solve L L^T x = b in place (b of length n), L the lower triangle of A from TiledCholeskyInPlace.
-void TiledCholeskySolveInPlace(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::VectorXd> b);
+void TiledCholeskySolveInPlace(const Eigen::Ref<const Eigen::MatrixXd>& A,
+                               Eigen::Ref<Eigen::VectorXd> b);
 
 }  // namespace softkin

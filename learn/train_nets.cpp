@@ -22,7 +22,10 @@ bool NetTrainOptions::IsValid(std::string* why) const {
 }
 
 nlohmann::json NetErrors::Json() const {
-  return {{"samples", samples}, {"rmse", rmse}, {"mean_dist", mean_dist}, {"max_dist", max_dist},
+  return {{"samples", samples},
+          {"rmse", rmse},
+          {"mean_dist", mean_dist},
+          {"max_dist", max_dist},
           {"relative", relative}};
 }
 
@@ -76,10 +79,12 @@ nlohmann::json NetTrainResult::Json() const {
 NetTrainResult TrainNet(const SampleSet& train, const SampleSet& test, const NetTrainOptions& opt) {
   std::string why;
   if (!opt.IsValid(&why)) throw std::invalid_argument("TrainNet: " + why);
-  if (train.size() < 2) throw std::invalid_argument("TrainNet: the training set needs >= 2 samples");
+  if (train.size() < 2)
+    throw std::invalid_argument("TrainNet: the training set needs >= 2 samples");
   SampleSet tr = train, val;
   if (opt.validation_fraction > 0 && train.size() >= 10) {
-    const SplitIndices idx = RandomSplit(train.size(), 1.0 - opt.validation_fraction, opt.split_seed);
+    const SplitIndices idx =
+        RandomSplit(train.size(), 1.0 - opt.validation_fraction, opt.split_seed);
     tr = SelectRows(train, idx.first);
     val = SelectRows(train, idx.second);
   }
@@ -152,14 +157,10 @@ LearnedNets TrainNetsFromDataset(const Dataset& d, const std::string& dataset_pa
   const SampleSet pos = PositionSamples(d);
   const TrainTestSets split = SplitTrainTest(pos, opt.split_seed, opt.train_fraction);
   const double width = WorkspaceWidth(pos.Y);
-  nets.info["dataset"] = {{"path", dataset_path},
-                          {"samples", d.inputs.rows()},
-                          {"failed", d.failed},
-                          {"train", split.train.size()},
-                          {"test", split.test.size()},
-                          {"split_seed", opt.split_seed},
-                          {"workspace_width_mm", width},
-                          {"sidecar", d.meta}};
+  nets.info["dataset"] = {{"path", dataset_path},        {"samples", d.inputs.rows()},
+                          {"failed", d.failed},          {"train", split.train.size()},
+                          {"test", split.test.size()},   {"split_seed", opt.split_seed},
+                          {"workspace_width_mm", width}, {"sidecar", d.meta}};
   auto pct = [width](double mm) { return width > 0 ? 100.0 * mm / width : 0.0; };
   if (opt.fk) {
     const NetTrainResult r = TrainNet(split.train, split.test, opt.fk_options);
@@ -171,15 +172,15 @@ LearnedNets TrainNetsFromDataset(const Dataset& d, const std::string& dataset_pa
   }
   if (opt.jac) {
     const SampleSet js = JacobianSamples(d);
-    const NetTrainResult r = TrainNet(SelectRows(js, split.train_rows), SelectRows(js, split.test_rows),
-                                      opt.jac_options);
+    const NetTrainResult r = TrainNet(SelectRows(js, split.train_rows),
+                                      SelectRows(js, split.test_rows), opt.jac_options);
     nets.jac = r.net;
     nets.info["jac"] = r.Json();
   }
   if (opt.ik) {
     SampleSet inv{pos.Y.leftCols(3), pos.X};
-    const NetTrainResult r = TrainNet(SelectRows(inv, split.train_rows), SelectRows(inv, split.test_rows),
-                                      opt.ik_options);
+    const NetTrainResult r = TrainNet(SelectRows(inv, split.train_rows),
+                                      SelectRows(inv, split.test_rows), opt.ik_options);
     nets.ik = r.net;
     nets.info["ik"] = r.Json();
   }
@@ -212,7 +213,8 @@ NetTrainResult TrainS2r(LearnedNets& nets, const Dataset& twin, const std::strin
   {
     const Eigen::MatrixXd D = split.test.X - split.test.Y;
     without.samples = split.test.size();
-    without.rmse = std::sqrt(D.squaredNorm() / std::max<double>(1.0, static_cast<double>(D.size())));
+    without.rmse =
+        std::sqrt(D.squaredNorm() / std::max<double>(1.0, static_cast<double>(D.size())));
     double sum = 0;
     const int groups = static_cast<int>(D.cols()) / 3;
     for (int i = 0; i < D.rows(); ++i)
@@ -230,7 +232,8 @@ NetTrainResult TrainS2r(LearnedNets& nets, const Dataset& twin, const std::strin
   j["twin_samples"] = twin.inputs.rows();
   j["test_without_s2r"] = without.Json();
   j["improvement"] = r.test.mean_dist > 0 ? without.mean_dist / r.test.mean_dist : 0.0;
-  if (twin.meta.is_object() && twin.meta.contains("config")) j["twin_source"] = twin.meta["config"].value("source", nlohmann::json());
+  if (twin.meta.is_object() && twin.meta.contains("config"))
+    j["twin_source"] = twin.meta["config"].value("source", nlohmann::json());
   nets.info["s2r"] = j;
   return r;
 }

@@ -28,11 +28,11 @@ struct NetTrainOptions {
 /// Errors of a network on a set, in the outputs' own units.
 struct NetErrors {
   int samples = 0;
-  double rmse = 0;       ///< sqrt(mean over every output entry of the squared error)
+  double rmse = 0;  ///< sqrt(mean over every output entry of the squared error)
   /// Outputs grouped in threes (x, y, z of a point; the flattened Jacobian's rows likewise):
   /// the mean and the largest Euclidean distance over samples and groups.
   double mean_dist = 0, max_dist = 0;
-  double relative = 0;   ///< ||Y_hat - Y||_F / ||Y||_F over the set
+  double relative = 0;  ///< ||Y_hat - Y||_F / ||Y||_F over the set
   nlohmann::json Json() const;
 };
 
@@ -65,13 +65,13 @@ int S2rNeurons(double eta, int samples);
 
 /// Which networks TrainNetsFromDataset trains, and how.
 struct NetsFromDatasetOptions {
-  bool fk = true;    ///< N_fk: c -> p (every tracked point)
-  bool jac = true;   ///< N_J: c -> vec(J) (only when the dataset has Jacobians)
-  bool ik = true;    ///< N_ik: p (first point) -> c, the direct-IK baseline
+  bool fk = true;   ///< N_fk: c -> p (every tracked point)
+  bool jac = true;  ///< N_J: c -> vec(J) (only when the dataset has Jacobians)
+  bool ik = true;   ///< N_ik: p (first point) -> c, the direct-IK baseline
   NetTrainOptions fk_options, jac_options, ik_options;  ///< jac defaults to h = 2, b = 64
   double train_fraction = 0.7;  ///< the seeded train / test split (Sec. 5.3.2)
   std::uint64_t split_seed = 1;
-  Eigen::VectorXd rest;         ///< rest actuation (empty: the lower bound)
+  Eigen::VectorXd rest;  ///< rest actuation (empty: the lower bound)
   NetsFromDatasetOptions() { jac_options.hidden = {64, 64}; }
 };
 

@@ -16,7 +16,9 @@ std::uint64_t Mix(std::uint64_t x) {  // SplitMix64
 }
 
 /// Uniform in (0, 1].
-double Unit(std::uint64_t h) { return (static_cast<double>(h >> 11) + 1.0) * (1.0 / 9007199254740992.0); }
+double Unit(std::uint64_t h) {
+  return (static_cast<double>(h >> 11) + 1.0) * (1.0 / 9007199254740992.0);
+}
 
 /// The built-in twins (docs/twins.md gives the measured tip differences).
 std::vector<TwinSpec> BuiltIn() {
@@ -33,8 +35,9 @@ std::vector<TwinSpec> BuiltIn() {
     s.actuator_weight_scale = 1.0;
     s.marker_offset = Eigen::Vector3d(0.6, 1.0, -0.4);
     s.noise_seed = 101;
-    s.doc = "body R_omega 0.85 (nominal 1), chamber radius 7.5 mm (nominal 7: outer wall 3.5 "
-            "instead of 4 mm), marker offset (0.6, 1.0, -0.4) mm, noise 0.05 mm";
+    s.doc =
+        "body R_omega 0.85 (nominal 1), chamber radius 7.5 mm (nominal 7: outer wall 3.5 "
+        "instead of 4 mm), marker offset (0.6, 1.0, -0.4) mm, noise 0.05 mm";
     t.push_back(s);
   }
   {
@@ -47,8 +50,9 @@ std::vector<TwinSpec> BuiltIn() {
     s.actuator_weight_scale = 0.8;
     s.marker_offset = Eigen::Vector3d(-0.5, 0.8, 0.7);
     s.noise_seed = 202;
-    s.doc = "actuator element weight x0.8 (chambers reach less of their volume), chamber radius "
-            "6.5 mm (outer wall 4.5 mm), marker offset (-0.5, 0.8, 0.7) mm, noise 0.05 mm";
+    s.doc =
+        "actuator element weight x0.8 (chambers reach less of their volume), chamber radius "
+        "6.5 mm (outer wall 4.5 mm), marker offset (-0.5, 0.8, 0.7) mm, noise 0.05 mm";
     t.push_back(s);
   }
   {
@@ -62,8 +66,9 @@ std::vector<TwinSpec> BuiltIn() {
     s.params = {{"gain", 3.6}, {"body_r_omega", 0.9}, {"chamber_weight", 17.0}};
     s.marker_offset = Eigen::Vector3d(0.7, -0.5, 0.3);
     s.noise_seed = 303;
-    s.doc = "gain 3.6 (nominal 4), body R_omega 0.9 (nominal 1), chamber weight 17 (nominal 20), "
-            "marker offset (0.7, -0.5, 0.3) mm, noise 0.05 mm";
+    s.doc =
+        "gain 3.6 (nominal 4), body R_omega 0.9 (nominal 1), chamber weight 17 (nominal 20), "
+        "marker offset (0.7, -0.5, 0.3) mm, noise 0.05 mm";
     t.push_back(s);
   }
   return t;
@@ -114,7 +119,8 @@ TwinKinematics::TwinKinematics(const TwinSpec& spec, const TwinOptions& options)
   FkOptions fk = scene.solver;
   if (options.gradient_tolerance > 0) fk.gradient_tolerance = options.gradient_tolerance;
   std::string why;
-  if (!fk.IsValid(&why)) throw std::invalid_argument("twin " + spec.name + ": gradient_tolerance: " + why);
+  if (!fk.IsValid(&why))
+    throw std::invalid_argument("twin " + spec.name + ": gradient_tolerance: " + why);
   sim_ = std::make_unique<SimulatorKinematics>(scene, ko, &fk);
 }
 
@@ -138,8 +144,9 @@ KinematicsEval TwinKinematics::Evaluate(const Eigen::Ref<const Eigen::VectorXd>&
                                         bool with_jacobian) {
   if (with_jacobian) {
     KinematicsEval ev;
-    ev.message = name() + " gives positions only, like the hardware it stands for: no Jacobian "
-                          "(use a simulator or a learned network for J)";
+    ev.message = name() +
+                 " gives positions only, like the hardware it stands for: no Jacobian "
+                 "(use a simulator or a learned network for J)";
     return ev;
   }
   KinematicsEval ev = sim_->Evaluate(c, false);

@@ -28,16 +28,16 @@ namespace softkin {
 
 /// How a twin differs from its nominal robot.
 struct TwinSpec {
-  std::string name;                 ///< e.g. "three_chamber/robot1"
-  std::string robot;                ///< the nominal robot (solver/robots/robots.hpp)
-  RobotParams params;               ///< geometry / design parameters given to MakeRobot
-  double body_r_omega = 1.0;        ///< R_omega of every body region (nominal: the robot's own)
-  bool set_body_r_omega = false;    ///< whether body_r_omega replaces the robot's values
+  std::string name;                    ///< e.g. "three_chamber/robot1"
+  std::string robot;                   ///< the nominal robot (solver/robots/robots.hpp)
+  RobotParams params;                  ///< geometry / design parameters given to MakeRobot
+  double body_r_omega = 1.0;           ///< R_omega of every body region (nominal: the robot's own)
+  bool set_body_r_omega = false;       ///< whether body_r_omega replaces the robot's values
   double actuator_weight_scale = 1.0;  ///< multiplies every actuator's element weight (> 0)
   Eigen::Vector3d marker_offset = Eigen::Vector3d::Zero();  ///< added to every point, mm
-  double noise_sigma_mm = 0.05;     ///< measurement noise per coordinate, mm (>= 0)
+  double noise_sigma_mm = 0.05;  ///< measurement noise per coordinate, mm (>= 0)
   std::uint64_t noise_seed = 0;
-  std::string doc;                  ///< one line: what differs
+  std::string doc;  ///< one line: what differs
 };
 
 /// Names of the built-in twins: "three_chamber/robot1", "three_chamber/robot2",
@@ -49,11 +49,11 @@ TwinSpec GetTwinSpec(const std::string& name);
 Scene MakeTwinScene(const TwinSpec& spec, int res);
 
 struct TwinOptions {
-  int res = 0;                      ///< robot resolution (<= 0: the robot's default)
+  int res = 0;  ///< robot resolution (<= 0: the robot's default)
   /// Tracked points (SimulatorKinematicsOptions::points; empty: every marker).
   std::vector<std::string> points;
-  bool noise = true;                ///< add the measurement noise (false: for calibration checks)
-  bool offset = true;               ///< add the marker offset
+  bool noise = true;   ///< add the measurement noise (false: for calibration checks)
+  bool offset = true;  ///< add the marker offset
   /// Forward-solve gradient tolerance (FkOptions::gradient_tolerance; 0: the robot's own).
   double gradient_tolerance = 0.0;
 };

@@ -52,11 +52,14 @@ void WriteCalculixInput(const Model& model, const Eigen::Ref<const Eigen::Vector
   const Mesh& mesh = s.mesh;
   CheckActuation(model, c);
   if (opt.law != "linear" && opt.law != "neo-hooke")
-    throw std::invalid_argument("calculix: law: expected linear or neo-hooke, got '" + opt.law + "'");
+    throw std::invalid_argument("calculix: law: expected linear or neo-hooke, got '" + opt.law +
+                                "'");
   if (!(opt.young > 0) || !(opt.poisson >= 0 && opt.poisson < 0.5) || opt.increments < 1)
-    throw std::invalid_argument("calculix: expected young > 0, 0 <= poisson < 0.5, increments >= 1");
+    throw std::invalid_argument(
+        "calculix: expected young > 0, 0 <= poisson < 0.5, increments >= 1");
   if (!s.region_rest.regions.empty())
-    throw std::invalid_argument("calculix: scene '" + s.name + "' has regions with their own rest shape (a remeshed "
+    throw std::invalid_argument("calculix: scene '" + s.name +
+                                "' has regions with their own rest shape (a remeshed "
                                 "chamber); the CalculiX export needs one rest mesh");
   for (int i = 0; i < mesh.num_elements(); ++i)
     if (mesh.elements[i].k() != 4)
@@ -70,7 +73,8 @@ void WriteCalculixInput(const Model& model, const Eigen::Ref<const Eigen::Vector
 
   std::ofstream o(path);
   if (!o) throw std::runtime_error("calculix: cannot write '" + path + "'");
-  o << "** SoftKin scene '" << s.name << "' exported for CalculiX (solver/baselines/calculix.hpp)\n";
+  o << "** SoftKin scene '" << s.name
+    << "' exported for CalculiX (solver/baselines/calculix.hpp)\n";
   o << "*NODE, NSET=NALL\n";
   for (int v = 0; v < mesh.num_vertices(); ++v)
     o << v + 1 << ", " << Num(mesh.vertices(v, 0)) << ", " << Num(mesh.vertices(v, 1)) << ", "
@@ -102,9 +106,11 @@ void WriteCalculixInput(const Model& model, const Eigen::Ref<const Eigen::Vector
   }
   for (int d = 0; d < 3; ++d) {
     if (s.fixed_axis[d].empty()) continue;
-    o << "*NSET, NSET=HELD" << "XYZ"[d] << "\n";
+    o << "*NSET, NSET=HELD"
+      << "XYZ"[d] << "\n";
     WriteIds(o, s.fixed_axis[d]);
-    o << "*BOUNDARY\nHELD" << "XYZ"[d] << ", " << d + 1 << ", " << d + 1 << ", 0.\n";
+    o << "*BOUNDARY\nHELD"
+      << "XYZ"[d] << ", " << d + 1 << ", " << d + 1 << ", 0.\n";
   }
   for (const auto& a : s.actuators)
     if (a.is_motion())
@@ -119,8 +125,8 @@ void WriteCalculixInput(const Model& model, const Eigen::Ref<const Eigen::Vector
       // A Mooney-Rivlin body region keeps its c1 : c2 ratio, scaled to the small-strain modulus E.
       const double sc = E / (6.0 * (mr->c1 + mr->c2));
       const double d1 = 6.0 * (1.0 - 2.0 * opt.poisson) / E;
-      o << "*HYPERELASTIC, MOONEY-RIVLIN\n" << Num(sc * mr->c1) << ", " << Num(sc * mr->c2) << ", "
-        << Num(d1) << "\n";
+      o << "*HYPERELASTIC, MOONEY-RIVLIN\n"
+        << Num(sc * mr->c1) << ", " << Num(sc * mr->c2) << ", " << Num(d1) << "\n";
     } else {
       const double c10 = E / (4.0 * (1.0 + opt.poisson));
       const double d1 = 6.0 * (1.0 - 2.0 * opt.poisson) / E;
@@ -196,7 +202,7 @@ std::vector<std::pair<double, Eigen::MatrixX3d>> ReadCalculixDisplacements(const
     double x, y, z;
     if (!(ss >> node)) {
       if (line.find_first_not_of(" \t\r") == std::string::npos) continue;  // blank line
-      finish();  // another kind of block
+      finish();                                                            // another kind of block
       continue;
     }
     if (!(ss >> x >> y >> z))
@@ -266,8 +272,8 @@ pid_t StartCcx(const std::string& ccx, const fs::path& work, const std::string& 
     ::close(fd);
   }
   ::setenv("OMP_NUM_THREADS", "2", 0);
-  char* const argv[] = {const_cast<char*>("ccx"), const_cast<char*>("-i"),
-                        const_cast<char*>("job"), nullptr};
+  char* const argv[] = {const_cast<char*>("ccx"), const_cast<char*>("-i"), const_cast<char*>("job"),
+                        nullptr};
   ::execv(ccx.c_str(), argv);
   ::_exit(127);
 }
@@ -277,13 +283,15 @@ std::string LastErrorLine(const std::string& log) {
   std::ifstream lg(log);
   std::string line, last;
   while (std::getline(lg, line))
-    if (line.find("ERROR") != std::string::npos || line.find("error") != std::string::npos) last = line;
+    if (line.find("ERROR") != std::string::npos || line.find("error") != std::string::npos)
+      last = line;
   return last;
 }
 
 }  // namespace
 
-FkResult CalculixSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c, const Eigen::MatrixX3d*) {
+FkResult CalculixSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
+                               const Eigen::MatrixX3d*) {
   const Model& m = *model_;
   const auto t0 = Clock::now();
   FkResult r;
@@ -308,7 +316,8 @@ FkResult CalculixSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c, const
                   "ccx (CalculiX) is not installed or not on PATH; install the Debian package "
                   "calculix-ccx (scripts/setup.sh does)");
   std::string tmpl = (fs::temp_directory_path() / "softkin_ccx_XXXXXX").string();
-  if (!::mkdtemp(tmpl.data())) return finish(FkStatus::InvalidInput, "cannot create a temporary folder");
+  if (!::mkdtemp(tmpl.data()))
+    return finish(FkStatus::InvalidInput, "cannot create a temporary folder");
   const fs::path work(tmpl);
   struct Cleanup {
     fs::path p;

@@ -47,8 +47,8 @@ void WriteCalculixInput(const Model& model, const Eigen::Ref<const Eigen::Vector
 /// Displacement blocks of a ccx .dat file ("displacements (vx,vy,vz) for set NALL and time T"):
 /// one (T, #V x 3 displacement) pair per increment, in file order. Node numbers are 1-based. Throws
 /// std::runtime_error naming the file and line on malformed content.
-std::vector<std::pair<double, Eigen::MatrixX3d>> ReadCalculixDisplacements(const std::string& dat_path,
-                                                                           int num_vertices);
+std::vector<std::pair<double, Eigen::MatrixX3d>> ReadCalculixDisplacements(
+    const std::string& dat_path, int num_vertices);
 
 /// Number of converged increments listed so far in a ccx .sta file (its lines "STEP INC ATT ITRS
 /// ..." whose attempt column has no 'U', the mark of an attempt that was cut back). 0 if the file

@@ -87,8 +87,8 @@ class RatioUpdateSolver : public FkSolver {
   virtual std::string Unsupported() const { return ""; }
   /// Minimises E with `ratios` frozen, from X (prescribed coordinates already set), until the
   /// 2-norm of the gradient over the free coordinates is below grad_tol or max_iterations.
-  virtual InnerResult Minimize(const std::vector<double>& ratios, double grad_tol, int max_iterations,
-                               Eigen::MatrixX3d* X) = 0;
+  virtual InnerResult Minimize(const std::vector<double>& ratios, double grad_tol,
+                               int max_iterations, Eigen::MatrixX3d* X) = 0;
 
   /// Gradient norm over the free coordinates of E with ratios frozen at their values at X.
   double FreeGradientNorm(const Eigen::VectorXd& c, const Eigen::MatrixX3d& X,
@@ -102,9 +102,7 @@ class RatioUpdateSolver : public FkSolver {
   }
 
   /// Seconds left before the time limit (a large number without one).
-  double SecondsLeft() const {
-    return has_deadline_ ? Seconds(Clock::now(), deadline_) : 1e30;
-  }
+  double SecondsLeft() const { return has_deadline_ ? Seconds(Clock::now(), deadline_) : 1e30; }
 
   FkOptions options_;
   double total_weight_ = 0;
@@ -130,7 +128,8 @@ class RatioUpdateSolver : public FkSolver {
       const double grad = FreeGradientNorm(c, X, &ratios, &E);
       if (!std::isfinite(grad) || !std::isfinite(E)) {
         r->status = FkStatus::Diverged;
-        r->message = "non-finite energy or gradient after " + std::to_string(updates) + " ratio updates";
+        r->message =
+            "non-finite energy or gradient after " + std::to_string(updates) + " ratio updates";
         return updates;
       }
       if (updates == 0) ref = std::max({ref, grad, 1e-8 * total_weight_ * m.size()});
@@ -150,13 +149,16 @@ class RatioUpdateSolver : public FkSolver {
         // further out the optimiser is stuck.
         if (r->gradient_ratio < 100.0 * options_.gradient_tolerance) {
           r->status = FkStatus::Converged;
-          r->message = "stopped at the precision floor: the optimiser no longer changes the positions "
-                       "(gradient ratio " + FormatNumber(r->gradient_ratio, 3) + ", target " +
-                       FormatNumber(options_.gradient_tolerance, 3) + ")";
+          r->message =
+              "stopped at the precision floor: the optimiser no longer changes the positions "
+              "(gradient ratio " +
+              FormatNumber(r->gradient_ratio, 3) + ", target " +
+              FormatNumber(options_.gradient_tolerance, 3) + ")";
         } else {
           r->status = FkStatus::Diverged;
           r->message = "stalled: the optimiser no longer changes the positions at gradient ratio " +
-                       FormatNumber(r->gradient_ratio, 3) + " (target " + FormatNumber(options_.gradient_tolerance, 3) + ")";
+                       FormatNumber(r->gradient_ratio, 3) + " (target " +
+                       FormatNumber(options_.gradient_tolerance, 3) + ")";
         }
         return updates;
       }
@@ -180,7 +182,8 @@ class RatioUpdateSolver : public FkSolver {
       if (!in.ok || !X.allFinite()) {
         if (!X.allFinite()) X = before;
         r->status = FkStatus::Diverged;
-        r->message = in.message.empty() ? "the optimiser returned non-finite positions" : in.message;
+        r->message =
+            in.message.empty() ? "the optimiser returned non-finite positions" : in.message;
         return updates;
       }
       move = (X - before).rowwise().norm().maxCoeff() / m.size();
@@ -325,7 +328,8 @@ class CeresFkSolver : public RatioUpdateSolver {
 
     InnerResult out;
     out.iterations = static_cast<int>(summary.iterations.size()) - 1;
-    if (summary.termination_type == ceres::FAILURE || summary.termination_type == ceres::USER_FAILURE) {
+    if (summary.termination_type == ceres::FAILURE ||
+        summary.termination_type == ceres::USER_FAILURE) {
       out.ok = false;
       out.message = "ceres: " + summary.message;
       return out;
@@ -348,7 +352,9 @@ class VertexTnlp : public Ipopt::TNLP {
  public:
   VertexTnlp(const Model& m, const std::vector<double>& ratios, Eigen::MatrixX3d* X,
              double seconds_left)
-      : m_(m), ratios_(ratios), X_(X),
+      : m_(m),
+        ratios_(ratios),
+        X_(X),
         deadline_(Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                      std::chrono::duration<double>(std::min(seconds_left, 1e9)))) {
     m.GatherFree(*X, &x0_);
@@ -386,10 +392,10 @@ class VertexTnlp : public Ipopt::TNLP {
     std::copy(g_.data(), g_.data() + n, g);
     return g_.allFinite();
   }
-  bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number,
+  bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number, Ipopt::Number,
                              Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number,
-                             Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Index,
-                             const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
+                             Ipopt::Number, Ipopt::Number, Ipopt::Index, const Ipopt::IpoptData*,
+                             Ipopt::IpoptCalculatedQuantities*) override {
     iterations = iter;
     timed_out = Clock::now() >= deadline_;
     return !timed_out;  // false stops Ipopt (USER_REQUESTED_STOP)
@@ -586,7 +592,8 @@ class HardTnlp : public VertexTnlp {
     style = C_STYLE;
     return true;
   }
-  bool eval_g(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Index mc, Ipopt::Number* g) override {
+  bool eval_g(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Index mc,
+              Ipopt::Number* g) override {
     Eval(n, x);
     for (Ipopt::Index q = 0; q < mc; ++q) g[q] = measure_[q] - targets_[q];
     return true;
@@ -628,7 +635,8 @@ class HardTnlp : public VertexTnlp {
   void OnFinal(Ipopt::Index mc, const Ipopt::Number* g) override {
     max_violation = 0;
     for (Ipopt::Index q = 0; q < mc; ++q)
-      max_violation = std::max(max_violation, std::abs(g[q]) / std::max(1e-300, std::abs(targets_[q])));
+      max_violation =
+          std::max(max_violation, std::abs(g[q]) / std::max(1e-300, std::abs(targets_[q])));
   }
 
  private:
@@ -703,7 +711,9 @@ class IpoptHardSolver : public FkSolver {
       app->OptimizeTNLP(nlp);
       r.iterations = nlp->iterations;
       switch (nlp->status) {
-        case Ipopt::SUCCESS: r.status = FkStatus::Converged; break;
+        case Ipopt::SUCCESS:
+          r.status = FkStatus::Converged;
+          break;
         case Ipopt::MAXITER_EXCEEDED:
           r.status = FkStatus::IterationCap;
           r.message = "iteration cap of " + std::to_string(options_.max_iterations) + " reached";
@@ -747,13 +757,15 @@ class IpoptHardSolver : public FkSolver {
 bool HasCeresSolver() { return true; }
 bool HasIpoptSolver() { return true; }
 
-std::unique_ptr<FkSolver> MakeNlpSolver(std::shared_ptr<const Model> model, const FkOptions& options) {
+std::unique_ptr<FkSolver> MakeNlpSolver(std::shared_ptr<const Model> model,
+                                        const FkOptions& options) {
   if (options.solver == "ceres") return std::make_unique<CeresFkSolver>(std::move(model), options);
   if (options.solver == "ipopt-lbfgs")
     return std::make_unique<IpoptFkSolver>(std::move(model), options, false);
   if (options.solver == "ipopt-newton")
     return std::make_unique<IpoptFkSolver>(std::move(model), options, true);
-  if (options.solver == "ipopt-hard") return std::make_unique<IpoptHardSolver>(std::move(model), options);
+  if (options.solver == "ipopt-hard")
+    return std::make_unique<IpoptHardSolver>(std::move(model), options);
   throw std::invalid_argument("MakeNlpSolver: unknown solver '" + options.solver + "'");
 }
 

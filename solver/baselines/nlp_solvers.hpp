@@ -52,8 +52,9 @@ namespace softkin {
 bool HasCeresSolver();
 bool HasIpoptSolver();
 
-/// Builds "ceres", "ipopt-lbfgs", "ipopt-newton" or "ipopt-hard" (options.solver). Throws std::invalid_argument
-/// for any other name.
-std::unique_ptr<FkSolver> MakeNlpSolver(std::shared_ptr<const Model> model, const FkOptions& options);
+/// Builds "ceres", "ipopt-lbfgs", "ipopt-newton" or "ipopt-hard" (options.solver). Throws
+/// std::invalid_argument for any other name.
+std::unique_ptr<FkSolver> MakeNlpSolver(std::shared_ptr<const Model> model,
+                                        const FkOptions& options);
 
 }  // namespace softkin

@@ -36,7 +36,9 @@ using FaceTree = CGAL::AABB_tree<CGAL::AABB_traits<K, FacePrimitive>>;
 using Inside = CGAL::Side_of_triangle_mesh<SurfaceMesh, K>;
 using Clock = std::chrono::steady_clock;
 
-double Seconds(Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); }
+double Seconds(Clock::time_point a) {
+  return std::chrono::duration<double>(Clock::now() - a).count();
+}
 
 [[noreturn]] void Fail(const std::string& where, const std::string& what) {
   throw std::invalid_argument(where + ": " + what);
@@ -48,7 +50,9 @@ Eigen::Vector3d FaceNormal(const TriangleSurface& s, int f) {
   return (b - a).cross(c - a).normalized();
 }
 
-CPoint P(const Eigen::Ref<const Eigen::MatrixX3d>& X, int v) { return CPoint(X(v, 0), X(v, 1), X(v, 2)); }
+CPoint P(const Eigen::Ref<const Eigen::MatrixX3d>& X, int v) {
+  return CPoint(X(v, 0), X(v, 1), X(v, 2));
+}
 
 }  // namespace
 
@@ -60,17 +64,20 @@ struct Obstacle::Impl {
   std::unique_ptr<Inside> inside;
 };
 
-Obstacle::Obstacle(TriangleSurface surface) : surface_(std::move(surface)), impl_(std::make_unique<Impl>()) {
+Obstacle::Obstacle(TriangleSurface surface)
+    : surface_(std::move(surface)), impl_(std::make_unique<Impl>()) {
   CheckClosedSurface(&surface_);
   box_min_ = surface_.vertices.colwise().minCoeff().transpose();
   box_max_ = surface_.vertices.colwise().maxCoeff().transpose();
   auto& m = impl_->mesh;
   std::vector<SurfaceMesh::Vertex_index> vi;
-  for (int i = 0; i < surface_.vertices.rows(); ++i) vi.push_back(m.add_vertex(P(surface_.vertices, i)));
+  for (int i = 0; i < surface_.vertices.rows(); ++i)
+    vi.push_back(m.add_vertex(P(surface_.vertices, i)));
   for (int f = 0; f < surface_.faces.rows(); ++f)
     if (m.add_face(vi[surface_.faces(f, 0)], vi[surface_.faces(f, 1)], vi[surface_.faces(f, 2)]) ==
         SurfaceMesh::null_face())
-      Fail(surface_.source, "triangle " + std::to_string(f) + " cannot be added to a manifold surface");
+      Fail(surface_.source,
+           "triangle " + std::to_string(f) + " cannot be added to a manifold surface");
   impl_->tree.rebuild(faces(m).first, faces(m).second, m);
   impl_->tree.accelerate_distance_queries();
   impl_->inside = std::make_unique<Inside>(impl_->tree);
@@ -167,7 +174,8 @@ inline int FilteredOrientation(const double* a, const double* b, const double* c
   const double dx = d[0] - a[0], dy = d[1] - a[1], dz = d[2] - a[2];
   const double m1 = cy * dz, m2 = cz * dy, m3 = cz * dx, m4 = cx * dz, m5 = cx * dy, m6 = cy * dx;
   const double det = bx * (m1 - m2) + by * (m3 - m4) + bz * (m5 - m6);
-  const double perm = std::abs(bx) * (std::abs(m1) + std::abs(m2)) + std::abs(by) * (std::abs(m3) + std::abs(m4)) +
+  const double perm = std::abs(bx) * (std::abs(m1) + std::abs(m2)) +
+                      std::abs(by) * (std::abs(m3) + std::abs(m4)) +
                       std::abs(bz) * (std::abs(m5) + std::abs(m6));
   const double margin = kRelMargin * perm + kAbsMargin;
   if (det > margin) return 1;
@@ -176,7 +184,8 @@ inline int FilteredOrientation(const double* a, const double* b, const double* c
 }
 
 /// The exact test with CGAL's filtered exact orientation predicate (Epick).
-bool ContainsExact(const double* a, const double* b, const double* c, const double* d, const double* p) {
+bool ContainsExact(const double* a, const double* b, const double* c, const double* d,
+                   const double* p) {
   const CPoint q[5] = {CPoint(a[0], a[1], a[2]), CPoint(b[0], b[1], b[2]), CPoint(c[0], c[1], c[2]),
                        CPoint(d[0], d[1], d[2]), CPoint(p[0], p[1], p[2])};
   const int o = static_cast<int>(CGAL::orientation(q[0], q[1], q[2], q[3]));
@@ -194,8 +203,8 @@ bool ContainsExact(const double* a, const double* b, const double* c, const doub
 /// p in the closed tet (a, b, c, d): the filter decides when every sign it needs is certain
 /// (one face certainly on the wrong side: outside; all certainly on the right side: inside),
 /// the exact test otherwise. *exact tells which.
-inline bool ContainsFiltered(const double* a, const double* b, const double* c, const double* d, const double* p,
-                             bool* exact) {
+inline bool ContainsFiltered(const double* a, const double* b, const double* c, const double* d,
+                             const double* p, bool* exact) {
   *exact = false;
   const int o = FilteredOrientation(a, b, c, d);
   if (o != 0) {
@@ -243,16 +252,19 @@ bool TetContainsPoint(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const 
 
 const char* SelfCollisionMethodToString(SelfCollisionDetector::Method m) {
   switch (m) {
-    case SelfCollisionDetector::Method::kBoxIntersection: return "box_intersection";
-    case SelfCollisionDetector::Method::kAabbTree: return "aabb_tree";
-    case SelfCollisionDetector::Method::kGrid: return "grid";
+    case SelfCollisionDetector::Method::kBoxIntersection:
+      return "box_intersection";
+    case SelfCollisionDetector::Method::kAabbTree:
+      return "aabb_tree";
+    case SelfCollisionDetector::Method::kGrid:
+      return "grid";
   }
   return "unknown";
 }
 
 SelfCollisionDetector::Method SelfCollisionMethodFromString(const std::string& name) {
-  for (auto m : {SelfCollisionDetector::Method::kBoxIntersection, SelfCollisionDetector::Method::kAabbTree,
-                 SelfCollisionDetector::Method::kGrid})
+  for (auto m : {SelfCollisionDetector::Method::kBoxIntersection,
+                 SelfCollisionDetector::Method::kAabbTree, SelfCollisionDetector::Method::kGrid})
     if (name == SelfCollisionMethodToString(m)) return m;
   throw std::invalid_argument("self-collision method '" + name +
                               "': expected one of box_intersection, aabb_tree, grid");
@@ -267,20 +279,23 @@ struct UniformTetGrid {
   std::array<double, 3> origin{{0, 0, 0}};
   double inv_h = 1;
   std::array<int, 3> n{{1, 1, 1}};
-  std::vector<double> box;       ///< 6 per tet: min x, y, z, max x, y, z (mm)
-  std::vector<int> start;        ///< #cells + 1
-  std::vector<int> cell_tets;    ///< tet ids, grouped by cell
-  std::vector<int> large;        ///< ascending ids of the tets spanning > kLargeTetCells cells
+  std::vector<double> box;     ///< 6 per tet: min x, y, z, max x, y, z (mm)
+  std::vector<int> start;      ///< #cells + 1
+  std::vector<int> cell_tets;  ///< tet ids, grouped by cell
+  std::vector<int> large;      ///< ascending ids of the tets spanning > kLargeTetCells cells
   /// Per tet: first cell of its box and the box's span in cells per axis (bytes 0, 1, 2); the
   /// first cell is -1 for a large tet.
   std::vector<std::array<int, 2>> range;
-  std::vector<int> cursor;       ///< #threads x #cells: counts, then write positions
+  std::vector<int> cursor;  ///< #threads x #cells: counts, then write positions
 
   int Coord(double x, int axis) const {
-    const double t = std::min(std::max((x - origin[axis]) * inv_h, 0.0), static_cast<double>(n[axis] - 1));
+    const double t =
+        std::min(std::max((x - origin[axis]) * inv_h, 0.0), static_cast<double>(n[axis] - 1));
     return static_cast<int>(t);
   }
-  int Cell(const double* p) const { return (Coord(p[2], 2) * n[1] + Coord(p[1], 1)) * n[0] + Coord(p[0], 0); }
+  int Cell(const double* p) const {
+    return (Coord(p[2], 2) * n[1] + Coord(p[1], 1)) * n[0] + Coord(p[0], 0);
+  }
 
   /// Rebuilds the grid over the tets at positions X (row-major #V x 3, mm).
   void Build(const RowX3& X, const std::vector<std::array<int, 4>>& tets);
@@ -361,7 +376,8 @@ void UniformTetGrid::Build(const RowX3& X, const std::vector<std::array<int, 4>>
     for (int t = begin; t < end; ++t) {
       const double* b = &box[6 * static_cast<size_t>(t)];
       const int i0 = Coord(b[0], 0), j0 = Coord(b[1], 1), k0 = Coord(b[2], 2);
-      const int si = Coord(b[3], 0) - i0 + 1, sj = Coord(b[4], 1) - j0 + 1, sk = Coord(b[5], 2) - k0 + 1;
+      const int si = Coord(b[3], 0) - i0 + 1, sj = Coord(b[4], 1) - j0 + 1,
+                sk = Coord(b[5], 2) - k0 + 1;
       if (static_cast<long long>(si) * sj * sk > kLargeTetCells) {
         range[t] = {-1, 0};
         continue;
@@ -449,8 +465,8 @@ void SelfCollisionDetector::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) 
   auto& I = *impl_;
   if (X.rows() != I.num_vertices)
     throw std::invalid_argument("SelfCollisionDetector::Update: expected positions for " +
-                                std::to_string(I.num_vertices) + " vertices, got " + std::to_string(X.rows()) +
-                                " rows");
+                                std::to_string(I.num_vertices) + " vertices, got " +
+                                std::to_string(X.rows()) + " rows");
   I.X = X;
   if (!I.X.allFinite()) {
     int v = 0;
@@ -498,12 +514,14 @@ void DetectInGrid(const UniformTetGrid& G, const TetList& tets, const RowX3& X,
     // Does tet t contain p (box, incidence, then the filtered exact test)?
     auto test = [&](int t) {
       const double* b = &G.box[6 * static_cast<size_t>(t)];
-      if (p[0] < b[0] || p[1] < b[1] || p[2] < b[2] || p[0] > b[3] || p[1] > b[4] || p[2] > b[5]) return false;
+      if (p[0] < b[0] || p[1] < b[1] || p[2] < b[2] || p[0] > b[3] || p[1] > b[4] || p[2] > b[5])
+        return false;
       const auto& tt = tets[t];
       if (tt[0] == v || tt[1] == v || tt[2] == v || tt[3] == v) return false;
       ++my_narrow;
       bool ex = false;
-      const bool in = ContainsFiltered(&X(tt[0], 0), &X(tt[1], 0), &X(tt[2], 0), &X(tt[3], 0), p, &ex);
+      const bool in =
+          ContainsFiltered(&X(tt[0], 0), &X(tt[1], 0), &X(tt[2], 0), &X(tt[3], 0), p, &ex);
       my_exact += ex;
       return in;
     };
@@ -570,8 +588,9 @@ void DetectByBoxIntersection(const std::vector<std::vector<int>>& incident, cons
   std::vector<int>& hit = *hit_out;
   long long narrow = 0;
   // Broad phase: boxes of the boundary vertices (points) against boxes of the tets.
-  using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, int,
-                                                         CGAL::Box_intersection_d::ID_FROM_BOX_ADDRESS>;
+  using Box =
+      CGAL::Box_intersection_d::Box_with_info_d<double, 3, int,
+                                                CGAL::Box_intersection_d::ID_FROM_BOX_ADDRESS>;
   std::vector<Box> vb, tb;
   vb.reserve(nb);
   for (int q = 0; q < nb; ++q) {
@@ -589,8 +608,9 @@ void DetectByBoxIntersection(const std::vector<std::vector<int>>& incident, cons
     tb.emplace_back(CGAL::Bbox_3(lo.x(), lo.y(), lo.z(), hi.x(), hi.y(), hi.z()), t);
   }
   std::vector<std::pair<int, int>> pairs;  // (boundary index, tet)
-  CGAL::box_intersection_d(vb.begin(), vb.end(), tb.begin(), tb.end(),
-                           [&](const Box& a, const Box& b) { pairs.emplace_back(a.info(), b.info()); });
+  CGAL::box_intersection_d(
+      vb.begin(), vb.end(), tb.begin(), tb.end(),
+      [&](const Box& a, const Box& b) { pairs.emplace_back(a.info(), b.info()); });
   std::sort(pairs.begin(), pairs.end());
   const int np = static_cast<int>(pairs.size());
   std::vector<signed char> ok(np, 0);
@@ -635,8 +655,8 @@ std::vector<ObstacleContact> DetectObstacleContacts(const std::vector<Obstacle>&
   const int n = vertices.empty() ? static_cast<int>(X.rows()) : static_cast<int>(vertices.size());
   for (int v : vertices)
     if (v < 0 || v >= X.rows())
-      throw std::invalid_argument("DetectObstacleContacts: vertex id " + std::to_string(v) + " is not in 0.." +
-                                  std::to_string(X.rows() - 1));
+      throw std::invalid_argument("DetectObstacleContacts: vertex id " + std::to_string(v) +
+                                  " is not in 0.." + std::to_string(X.rows() - 1));
   const int no = static_cast<int>(obstacles.size());
   if (no == 0 || n == 0) return {};
   // Serial pass: the vertices inside the union of the obstacles' boxes (a vertex outside it
@@ -649,8 +669,8 @@ std::vector<ObstacleContact> DetectObstacleContacts(const std::vector<Obstacle>&
   std::vector<int> near;
   for (int q = 0; q < n; ++q) {
     const int v = vertices.empty() ? q : vertices[q];
-    if (X(v, 0) >= lo.x() && X(v, 1) >= lo.y() && X(v, 2) >= lo.z() && X(v, 0) <= hi.x() && X(v, 1) <= hi.y() &&
-        X(v, 2) <= hi.z())
+    if (X(v, 0) >= lo.x() && X(v, 1) >= lo.y() && X(v, 2) >= lo.z() && X(v, 0) <= hi.x() &&
+        X(v, 1) <= hi.y() && X(v, 2) <= hi.z())
       near.push_back(v);
   }
   // The CGAL inside test (after each obstacle's own box) and, for contained vertices, the
@@ -677,7 +697,6 @@ std::vector<ObstacleContact> DetectObstacleContacts(const std::vector<Obstacle>&
   return out;
 }
 
-
 // ---- MovingSurface -----------------------------------------------------------------------------
 
 struct MovingSurface::Impl {
@@ -692,7 +711,8 @@ MovingSurface::MovingSurface(std::vector<std::array<int, 3>> faces)
   if (faces_.empty()) throw std::invalid_argument("MovingSurface: no triangles");
   for (const auto& f : faces_)
     for (int v : f)
-      if (v < 0) throw std::invalid_argument("MovingSurface: negative vertex index " + std::to_string(v));
+      if (v < 0)
+        throw std::invalid_argument("MovingSurface: negative vertex index " + std::to_string(v));
   impl_->ids.resize(faces_.size());
   for (size_t i = 0; i < faces_.size(); ++i) impl_->ids[i] = static_cast<int>(i);
 }
@@ -705,8 +725,9 @@ void MovingSurface::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) {
   for (const auto& f : faces_)
     for (int v : f)
       if (v >= X.rows())
-        throw std::invalid_argument("MovingSurface: a triangle refers to vertex " + std::to_string(v) +
-                                    " but the positions have " + std::to_string(X.rows()) + " rows");
+        throw std::invalid_argument("MovingSurface: a triangle refers to vertex " +
+                                    std::to_string(v) + " but the positions have " +
+                                    std::to_string(X.rows()) + " rows");
   impl_->X = X;
   impl_->tree.rebuild(impl_->ids.begin(), impl_->ids.end(), TriData{&impl_->X, &faces_});
   impl_->tree.accelerate_distance_queries();
@@ -725,7 +746,8 @@ bool MovingSurface::ClosestFacing(const Eigen::Vector3d& p, const Eigen::Vector3
   if (!impl_->built) throw std::logic_error("MovingSurface::ClosestFacing before Update");
   const auto& I = *impl_;
   const CGAL::Bbox_3 all = I.tree.bbox();
-  const double span = std::max({all.xmax() - all.xmin(), all.ymax() - all.ymin(), all.zmax() - all.zmin()});
+  const double span =
+      std::max({all.xmax() - all.xmin(), all.ymax() - all.ymin(), all.zmax() - all.zmin()});
   // Start from the unrestricted distance: no facing triangle is closer.
   double r = std::max((ClosestPoint(p) - p).norm(), 1e-9 * span);
   const CPoint cp(p.x(), p.y(), p.z());
@@ -753,8 +775,9 @@ bool MovingSurface::ClosestFacing(const Eigen::Vector3d& p, const Eigen::Vector3
     }
     // Every triangle within distance r meets the box, so an answer within r is final; so is
     // the best one once the box holds the whole surface.
-    const bool covers = box.xmin() <= all.xmin() && box.ymin() <= all.ymin() && box.zmin() <= all.zmin() &&
-                        box.xmax() >= all.xmax() && box.ymax() >= all.ymax() && box.zmax() >= all.zmax();
+    const bool covers = box.xmin() <= all.xmin() && box.ymin() <= all.ymin() &&
+                        box.zmin() <= all.zmin() && box.xmax() >= all.xmax() &&
+                        box.ymax() >= all.ymax() && box.zmax() >= all.zmax();
     if (best <= r || covers) {
       if (best_f < 0) return false;
       *closest = best_c;

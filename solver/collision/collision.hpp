@@ -170,7 +170,8 @@ SelfCollisionDetector::Method SelfCollisionMethodFromString(const std::string& n
 /// rigorous margin, CGAL's exact orientation predicate where the filter cannot tell. Points in
 /// mm (any unit). If `exact_used` is given, it is set to whether the exact predicate ran.
 bool TetContainsPoint(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
-                      const Eigen::Vector3d& d, const Eigen::Vector3d& p, bool* exact_used = nullptr);
+                      const Eigen::Vector3d& d, const Eigen::Vector3d& p,
+                      bool* exact_used = nullptr);
 
 /// Vertices of `vertices` (all robot vertices if empty; ids into the rows of X, #V x 3 in mm)
 /// strictly inside any of the obstacles (the first one, in obstacle order), in the order of

@@ -127,7 +127,8 @@ CollisionResponse::CollisionResponse(const Model& model, const CollisionOptions&
   d.reserve(check_vertices_.size());
   for (int v : check_vertices_)
     if (diag[v] > 0) d.push_back(diag[v]);
-  if (d.empty()) throw std::invalid_argument("collision response: the global matrix has no positive diagonal");
+  if (d.empty())
+    throw std::invalid_argument("collision response: the global matrix has no positive diagonal");
   std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
   k_ = k0_ = options_.stiffness * d[d.size() / 2];
 }
@@ -266,8 +267,8 @@ bool CollisionResponse::SelfTarget(const Eigen::Ref<const Eigen::MatrixX3d>& X, 
   std::vector<Eigen::Vector3d> dirs = {-VertexNormal(X, v), p - centroid};
   double best = std::numeric_limits<double>::infinity();
   for (size_t q = 0; q < dirs.size() + 6; ++q) {
-    Eigen::Vector3d dir = q < dirs.size() ? dirs[q]
-                                          : (q % 2 ? 1.0 : -1.0) * Eigen::Vector3d::Unit((q - 2) / 2);
+    Eigen::Vector3d dir =
+        q < dirs.size() ? dirs[q] : (q % 2 ? 1.0 : -1.0) * Eigen::Vector3d::Unit((q - 2) / 2);
     const double len = dir.norm();
     if (!(len > 0)) continue;
     dir /= len;
@@ -350,8 +351,9 @@ void CollisionResponse::RebuildPlanes(bool system_changed) {
       plane_solve_of_[s] = static_cast<int>(cache.size()) - 1;
       continue;
     }
-    auto it = std::lower_bound(plane_solve_.begin(), plane_solve_.end(), v,
-                               [](const std::pair<int, Eigen::VectorXd>& a, int b) { return a.first < b; });
+    auto it = std::lower_bound(
+        plane_solve_.begin(), plane_solve_.end(), v,
+        [](const std::pair<int, Eigen::VectorXd>& a, int b) { return a.first < b; });
     if (it != plane_solve_.end() && it->first == v) {
       cache.push_back(std::move(*it));
     } else {
@@ -373,7 +375,8 @@ void CollisionResponse::RebuildPlanes(bool system_changed) {
     for (int s = 0; s < m; ++s)
       for (int d = 0; d < 3; ++d) {
         const int fi = model_.free_index(d)[plane_[s].vertex];
-        if (fi >= 0) C(s, t) += plane_[s].normal[d] * plane_[t].normal[d] * g[model_.free_offset(d) + fi];
+        if (fi >= 0)
+          C(s, t) += plane_[s].normal[d] * plane_[t].normal[d] * g[model_.free_offset(d) + fi];
       }
   }
   plane_capacitance_.compute(0.5 * (C + C.transpose()));
@@ -465,9 +468,8 @@ void KeepPairWeights(const std::vector<CollisionSpring>& springs,
                      std::vector<CollisionSpring>* next) {
   for (auto& s : *next) {
     if (!s.pair()) continue;
-    const auto it = std::lower_bound(
-        springs.begin(), springs.end(), s.vertex,
-        [](const CollisionSpring& a, int v) { return a.vertex < v; });
+    const auto it = std::lower_bound(springs.begin(), springs.end(), s.vertex,
+                                     [](const CollisionSpring& a, int v) { return a.vertex < v; });
     if (it == springs.end() || it->vertex != s.vertex || it->face != s.face) continue;
     if ((it->weights - s.weights).cwiseAbs().maxCoeff() > 0.2) continue;
     s.weights = it->weights;
@@ -541,9 +543,8 @@ bool CollisionResponse::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) {
   std::vector<CollisionSpring> kept;
   int added = static_cast<int>(next.size());
   for (auto s : springs_) {
-    const auto it = std::lower_bound(
-        next.begin(), next.end(), s.vertex,
-        [](const CollisionSpring& a, int v) { return a.vertex < v; });
+    const auto it = std::lower_bound(next.begin(), next.end(), s.vertex,
+                                     [](const CollisionSpring& a, int v) { return a.vertex < v; });
     if (it != next.end() && it->vertex == s.vertex) {
       --added;  // still in collision: its spring stays (with a fresh target)
       continue;
@@ -578,8 +579,10 @@ bool CollisionResponse::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) {
   // a changed set of plane-spring vertices changes the matrix too.
   const std::vector<PlaneSpring> planes_before = std::move(plane_);
   RebuildPlanes(changed);
-  changed = changed || !std::equal(plane_.begin(), plane_.end(), planes_before.begin(), planes_before.end(),
-                                   [](const PlaneSpring& a, const PlaneSpring& b) { return a.vertex == b.vertex; });
+  changed =
+      changed ||
+      !std::equal(plane_.begin(), plane_.end(), planes_before.begin(), planes_before.end(),
+                  [](const PlaneSpring& a, const PlaneSpring& b) { return a.vertex == b.vertex; });
   stats_.max_springs = std::max(stats_.max_springs, static_cast<int>(springs_.size()));
   stats_.response_s += Since(t1);
   return changed;

@@ -84,7 +84,6 @@ class CollisionResponse : public ContactTerm {
   CollisionResponse(const Model& model, const CollisionOptions& options);
   ~CollisionResponse() override;
 
-
   /// Detection at positions X (#V x 3) and the spring rule: adds, refreshes and releases springs.
   /// Returns true if the set of spring vertices (hence the global matrix) changed.
   bool Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) override;
@@ -202,9 +201,10 @@ class CollisionResponse : public ContactTerm {
     double offset;
   };
   std::vector<PlaneSpring> plane_;
-  std::vector<std::pair<int, Eigen::VectorXd>> plane_solve_;  // (vertex, S^-1 sum_d e_(v,d)), sorted
-  std::vector<int> plane_solve_of_;                          // per plane spring, its entry there
-  Eigen::LDLT<Eigen::MatrixXd> plane_capacitance_;           // I / k + U^T W
+  std::vector<std::pair<int, Eigen::VectorXd>>
+      plane_solve_;                                 // (vertex, S^-1 sum_d e_(v,d)), sorted
+  std::vector<int> plane_solve_of_;                 // per plane spring, its entry there
+  Eigen::LDLT<Eigen::MatrixXd> plane_capacitance_;  // I / k + U^T W
   /// U^T x: per plane spring, n_s . (x's free coordinates of v_s).
   Eigen::VectorXd PlaneDot(const Eigen::VectorXd& x) const;
   CollisionStats stats_;

@@ -72,7 +72,8 @@ SpringStencil SpringStencil::Unit(int v) {
   return s;
 }
 
-SpringStencil SpringStencil::VertexFace(int v, const std::array<int, 3>& f, const Eigen::Vector3d& w) {
+SpringStencil SpringStencil::VertexFace(int v, const std::array<int, 3>& f,
+                                        const Eigen::Vector3d& w) {
   SpringStencil s = Unit(v);
   for (int i = 0; i < 3; ++i) {
     s.vertex[i + 1] = f[i];
@@ -244,7 +245,8 @@ bool SpringSystem::SetSprings(const std::vector<SpringStencil>& springs, double 
   springs_ = next;
   ++stats_.changes;
   if (method_ == Method::kRefactor ||
-      (refactor_after_ > 0 && since_refactor_ + long(added.size() + removed.size()) > refactor_after_)) {
+      (refactor_after_ > 0 &&
+       since_refactor_ + long(added.size() + removed.size()) > refactor_after_)) {
     Refactor();
     return true;
   }

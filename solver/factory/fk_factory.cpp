@@ -19,11 +19,12 @@ std::unique_ptr<ContactTerm> SpringResponse(const Model& model, const CollisionO
 }  // namespace
 
 std::vector<std::string> FkSolverNames() {
-  return {"lg",         "lg-aa",           "ceres",           "ipopt-lbfgs",
+  return {"lg",           "lg-aa",      "ceres",           "ipopt-lbfgs",
           "ipopt-newton", "ipopt-hard", "calculix-linear", "calculix-nonlinear"};
 }
 
-std::unique_ptr<FkSolver> MakeFkSolver(std::shared_ptr<const Model> model, const FkOptions& options) {
+std::unique_ptr<FkSolver> MakeFkSolver(std::shared_ptr<const Model> model,
+                                       const FkOptions& options) {
   std::string why;
   if (!options.IsValid(&why)) throw std::invalid_argument("solver options: " + why);
   if (options.solver == "lg" || options.solver == "lg-aa")

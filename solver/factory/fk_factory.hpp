@@ -20,7 +20,8 @@ namespace softkin {
 std::vector<std::string> FkSolverNames();
 /// Builds the solver named options.solver; throws std::invalid_argument for an unknown name or
 /// invalid options (message from FkOptions::IsValid).
-std::unique_ptr<FkSolver> MakeFkSolver(std::shared_ptr<const Model> model, const FkOptions& options);
+std::unique_ptr<FkSolver> MakeFkSolver(std::shared_ptr<const Model> model,
+                                       const FkOptions& options);
 
 /// One shot: builds the model and solves. Options default to the scene's.
 FkResult SolveFk(const Scene& scene, const Eigen::Ref<const Eigen::VectorXd>& c,

@@ -4,11 +4,11 @@
 /// measured per element, and the reshaping of an element's rest shape by its local ratio.
 ///
 ///   type       measure m_i(X)                              rest shape reshaped by S(r_i)
-///   pneumatic  volume Vol_i                                 cbrt(alpha_i) I                  (Eq. 2.8)
-///   cable      l_i |F_i d_i|: its share l_i of the cable    I - (1 - s_i) d d^T              (Eq. 2.6)
+///   pneumatic  volume Vol_i                                 cbrt(alpha_i) I (Eq. 2.8) cable l_i
+///   |F_i d_i|: its share l_i of the cable    I - (1 - s_i) d d^T              (Eq. 2.6)
 ///              length, stretched along the cable direction d
 ///              (F_i: the element's best-fit deformation gradient)
-///   dea        (area(bottom) + area(top)) / 2 of the prism  sqrt(lambda_i) (I - n n^T)     (Eq. 2.7)
+///   dea        (area(bottom) + area(top)) / 2 of the prism  sqrt(lambda_i) (I - n n^T) (Eq. 2.7)
 ///                                                             + n n^T / lambda_i
 ///
 /// S acts on the centred rest rows (rows P S^T); the reshaped shape is then rotated onto the

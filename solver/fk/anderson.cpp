@@ -5,8 +5,14 @@
 namespace softkin {
 
 Anderson::Anderson(int dim, int window)
-    : dim_(dim), m_(window), dG_(dim, window), dF_(dim, window), gram_(window, window),
-      g_prev_(dim), f_prev_(dim), x_(dim) {}
+    : dim_(dim),
+      m_(window),
+      dG_(dim, window),
+      dF_(dim, window),
+      gram_(window, window),
+      g_prev_(dim),
+      f_prev_(dim),
+      x_(dim) {}
 
 void Anderson::Reset() {
   cols_ = 0;
@@ -35,8 +41,8 @@ const Eigen::VectorXd& Anderson::Compute(const Eigen::Ref<const Eigen::VectorXd>
       gram_(c, j) = v;
       gram_(j, c) = v;
     }
-    const Eigen::MatrixXd M = gram_.topLeftCorner(cols_, cols_) +
-                              1e-10 * Eigen::MatrixXd::Identity(cols_, cols_);
+    const Eigen::MatrixXd M =
+        gram_.topLeftCorner(cols_, cols_) + 1e-10 * Eigen::MatrixXd::Identity(cols_, cols_);
     const Eigen::VectorXd rhs = dF_.leftCols(cols_).transpose() * f;
     const Eigen::VectorXd theta = M.ldlt().solve(rhs);
     if (theta.allFinite())

@@ -23,8 +23,8 @@ class Anderson {
  private:
   int dim_, m_;
   int cols_ = 0, next_ = 0, iter_ = 0;
-  Eigen::MatrixXd dG_, dF_;      // dim x m
-  Eigen::MatrixXd gram_;         // m x m, dF^T dF
+  Eigen::MatrixXd dG_, dF_;  // dim x m
+  Eigen::MatrixXd gram_;     // m x m, dF^T dF
   Eigen::VectorXd g_prev_, f_prev_, x_;
 };
 

@@ -20,10 +20,10 @@ struct Scene;
 
 /// Result of an exact collision check of a state.
 struct CollisionCheck {
-  int self_contacts = 0;      ///< boundary vertices inside a non-incident tet (exact predicates)
-  int obstacle_contacts = 0;  ///< vertices strictly inside an obstacle
-  double max_penetration = 0; ///< largest depth among them, mm (0 if collision-free)
-  double self_penetration = 0;      ///< largest depth among the self contacts, mm
+  int self_contacts = 0;        ///< boundary vertices inside a non-incident tet (exact predicates)
+  int obstacle_contacts = 0;    ///< vertices strictly inside an obstacle
+  double max_penetration = 0;   ///< largest depth among them, mm (0 if collision-free)
+  double self_penetration = 0;  ///< largest depth among the self contacts, mm
   double obstacle_penetration = 0;  ///< largest depth among the obstacle contacts, mm
   /// Elements with non-positive signed volume at the checked positions (CountInvertedElements):
   /// where the mesh has folded through itself, which no spring on a boundary vertex can undo.
@@ -41,10 +41,10 @@ struct CollisionStats {
   int checks = 0;
   int springs_added = 0, springs_released = 0;
   int max_springs = 0;
-  int unresolved = 0;      ///< self contacts for which no exit point was found (no spring)
-  int stiffenings = 0;     ///< times k was raised (CollisionResponse::Stiffen)
-  double check_s = 0;      ///< detection (self + obstacles)
-  double response_s = 0;   ///< targets, release rule and the factor update
+  int unresolved = 0;     ///< self contacts for which no exit point was found (no spring)
+  int stiffenings = 0;    ///< times k was raised (CollisionResponse::Stiffen)
+  double check_s = 0;     ///< detection (self + obstacles)
+  double response_s = 0;  ///< targets, release rule and the factor update
 };
 
 /// Contact handling inside the local-global iteration (Algorithm 1 with Eq. 3.9). Free-coordinate
@@ -69,7 +69,8 @@ class ContactTerm {
   virtual CollisionCheck Check(const Eigen::Ref<const Eigen::MatrixX3d>& X) const = 0;
   /// Whether `check` has contacts of a kind this term responds to.
   virtual bool HasHandledContacts(const CollisionCheck& check) const = 0;
-  /// Penalty continuation: raises k unless it was raised `max_raises` times; returns whether it did.
+  /// Penalty continuation: raises k unless it was raised `max_raises` times; returns whether it
+  /// did.
   virtual bool Stiffen(int max_raises = 3) = 0;
   /// Springs in the current set.
   virtual int num_springs() const = 0;
@@ -78,8 +79,8 @@ class ContactTerm {
 
 /// Builds the contact term of `model` (which must outlive it) for `options`; throws
 /// std::invalid_argument for a scene it cannot handle.
-using ContactTermFactory =
-    std::function<std::unique_ptr<ContactTerm>(const Model& model, const CollisionOptions& options)>;
+using ContactTermFactory = std::function<std::unique_ptr<ContactTerm>(
+    const Model& model, const CollisionOptions& options)>;
 
 /// Whether a scene with these options needs contact handling at all: self-collision is on, or
 /// obstacle response is on and the scene has obstacles.

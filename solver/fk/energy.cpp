@@ -54,7 +54,8 @@ namespace {
 /// E and its gradient for the given per-element ratios; `chain` adds the dependence of the ratios
 /// on the chamber measures (EnergyAndGradient), without it the ratios are constants.
 double EnergyAndGradientImpl(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
-                             const std::vector<double>& ratios, bool chain, Eigen::MatrixX3d* grad) {
+                             const std::vector<double>& ratios, bool chain,
+                             Eigen::MatrixX3d* grad) {
   const auto& els = model.elements();
   const int ne = static_cast<int>(els.size());
   grad->setZero(model.num_vertices(), 3);
@@ -128,8 +129,8 @@ double EnergyAndGradientImpl(const Model& model, const Eigen::Ref<const Eigen::M
       E += e.wv * r.squaredNorm();
       G = 2.0 * e.wv * r;
       ElemRows dT = ElemRows::Zero();
-      dT.topRows(k) = e.rest.topRows(k) * ActuationShapeDerivative(e, ratios[i]).transpose() *
-                      R.transpose();
+      dT.topRows(k) =
+          e.rest.topRows(k) * ActuationShapeDerivative(e, ratios[i]).transpose() * R.transpose();
       dE_dratio[i] = -2.0 * e.wv * (r.topRows(k).cwiseProduct(dT.topRows(k))).sum();
     }
     // D = N V: dE/dV = N^T dE/dD = dE/dD centred.

@@ -5,7 +5,10 @@
 namespace softkin {
 
 bool CollisionOptions::IsValid(std::string* why) const {
-  auto bad = [&](const std::string& m) { if (why) *why = m; return false; };
+  auto bad = [&](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
   if (!(epsilon >= 0.0) || !std::isfinite(epsilon))
     return bad("collision.epsilon: expected a number >= 0 (mm)");
   if (!(stiffness > 0.0) || !std::isfinite(stiffness))
@@ -18,20 +21,26 @@ bool CollisionOptions::IsValid(std::string* why) const {
   if (self_spring != "target" && self_spring != "pair")
     return bad("collision.self_spring: expected one of target, pair; got '" + self_spring + "'");
   if (obstacle_spring != "point" && obstacle_spring != "plane")
-    return bad("collision.obstacle_spring: expected one of point, plane; got '" + obstacle_spring + "'");
+    return bad("collision.obstacle_spring: expected one of point, plane; got '" + obstacle_spring +
+               "'");
   return true;
 }
 
 bool FkOptions::IsValid(std::string* why) const {
-  auto bad = [&](const std::string& m) { if (why) *why = m; return false; };
+  auto bad = [&](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
   if (solver != "lg" && solver != "lg-aa" && solver != "ceres" && solver != "ipopt-lbfgs" &&
       solver != "ipopt-newton" && solver != "ipopt-hard" && solver != "calculix-linear" &&
       solver != "calculix-nonlinear")
-    return bad("solver: expected one of lg, lg-aa, ceres, ipopt-lbfgs, ipopt-newton, ipopt-hard, "
-               "calculix-linear, calculix-nonlinear; got '" +
-               solver + "'");
+    return bad(
+        "solver: expected one of lg, lg-aa, ceres, ipopt-lbfgs, ipopt-newton, ipopt-hard, "
+        "calculix-linear, calculix-nonlinear; got '" +
+        solver + "'");
   if (max_iterations < 1) return bad("max_iterations: expected an integer >= 1");
-  if (!(tolerance > 0.0) || !std::isfinite(tolerance)) return bad("tolerance: expected a number > 0");
+  if (!(tolerance > 0.0) || !std::isfinite(tolerance))
+    return bad("tolerance: expected a number > 0");
   if (!(gradient_tolerance > 0.0) || !std::isfinite(gradient_tolerance))
     return bad("gradient_tolerance: expected a number > 0");
   if (anderson_window < 1 || anderson_window > 50)

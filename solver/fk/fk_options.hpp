@@ -10,8 +10,8 @@ namespace softkin {
 /// active in the local-global solvers when `self` is on or the scene has obstacles (and
 /// `obstacles` is on).
 struct CollisionOptions {
-  bool self = false;       ///< respond to self-collision (boundary vertices inside other tets)
-  bool obstacles = true;   ///< respond to the scene's obstacles (if it has any)
+  bool self = false;      ///< respond to self-collision (boundary vertices inside other tets)
+  bool obstacles = true;  ///< respond to the scene's obstacles (if it has any)
   /// Offset eps of the contact boundary (mm): springs pull a vertex eps beyond the surface, and
   /// release it once it is more than eps beyond its target (Eq. 3.8).
   double epsilon = 0.05;
@@ -80,7 +80,8 @@ struct FkOptions {
   /// Progress report, called after each continuation step of a Solve() (lg, lg-aa and the
   /// general-purpose optimisers) with the step (1-based), the number of steps, the step's status
   /// (FkStatusToString), the iterations and the seconds so far. Empty: no report.
-  std::function<void(int step, int steps, const std::string& status, int iterations, double seconds)>
+  std::function<void(int step, int steps, const std::string& status, int iterations,
+                     double seconds)>
       on_step;
 
   bool IsValid(std::string* why) const;

@@ -9,11 +9,16 @@ namespace softkin {
 
 const char* FkStatusToString(FkStatus s) {
   switch (s) {
-    case FkStatus::Converged: return "converged";
-    case FkStatus::IterationCap: return "iteration_cap";
-    case FkStatus::Diverged: return "diverged";
-    case FkStatus::InvalidInput: return "invalid_input";
-    case FkStatus::TimeLimit: return "time_limit";
+    case FkStatus::Converged:
+      return "converged";
+    case FkStatus::IterationCap:
+      return "iteration_cap";
+    case FkStatus::Diverged:
+      return "diverged";
+    case FkStatus::InvalidInput:
+      return "invalid_input";
+    case FkStatus::TimeLimit:
+      return "time_limit";
   }
   return "unknown";
 }

@@ -175,7 +175,8 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     if (move < tol && (r->gradient_ratio < gtol || roundoff)) {
       store_free(Gf);
       // With collisions, stop only if a check at this state leaves the spring set as it is.
-      if (resp && (resp->Update(X) || (resp->HasHandledContacts(resp->Check(X)) && resp->Stiffen()))) {
+      if (resp &&
+          (resp->Update(X) || (resp->HasHandledContacts(resp->Check(X)) && resp->Stiffen()))) {
         // Springs changed, or contacts are left (springs yield by force / k): raise k.
         aa.Reset();
         continue;
@@ -234,8 +235,8 @@ FkResult LocalGlobalSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
     response_->Reset();
   }
   for (int s = 1; s <= K; ++s) {
-    const Eigen::VectorXd cs = (K == 1) ? Eigen::VectorXd(c)
-                                        : Eigen::VectorXd(rest + (c - rest) * (double(s) / K));
+    const Eigen::VectorXd cs =
+        (K == 1) ? Eigen::VectorXd(c) : Eigen::VectorXd(rest + (c - rest) * (double(s) / K));
     SolveStage(cs, &r.positions, &r);
     if (options_.on_step)
       options_.on_step(s, K, FkStatusToString(r.status), r.iterations, Seconds(t0, Clock::now()));

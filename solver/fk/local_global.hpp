@@ -6,8 +6,8 @@
 ///    sides), fixed vertices eliminated as Dirichlet conditions;
 ///  - Anderson acceleration of the positions (x <- G(x) = global(local(x))) with a safeguard. An
 ///    accelerated iterate x_a, extrapolated from x_k, is checked after its own local and global
-///    steps; when it fails, the plain step G(x_k) is taken instead and the history is kept (it holds
-///    only checked iterates). FkOptions::anderson_safeguard picks the test:
+///    steps; when it fails, the plain step G(x_k) is taken instead and the history is kept (it
+///    holds only checked iterates). FkOptions::anderson_safeguard picks the test:
 ///      "energy": E(x_a) <= E(x_k), the classic rule for local-global solvers of a fixed energy;
 ///      "hybrid" (default): E(x_a) <= E(x_k) OR ||G(x_a) - x_a|| <= ||G(x_k) - x_k||;
 ///      "none": every finite step is kept.
@@ -50,12 +50,12 @@ class LocalGlobalSolver : public FkSolver {
   FkOptions options_;
   ContactTermFactory contacts_;
   std::unique_ptr<ContactTerm> response_;  // springs of Eq. 3.5-3.9, when active
-  std::vector<ElemRows> weighted_;  // per-element w Vol T, reused across iterations
+  std::vector<ElemRows> weighted_;         // per-element w Vol T, reused across iterations
   std::vector<double> ratios_;
   double total_weight_ = 0.0;  // sum of w_i Vol_i: the scale of the residual's round-off floor
   const std::chrono::steady_clock::time_point* deadline_ = nullptr;  // during Solve(), or none
-  Eigen::VectorXd ref_c_;    // actuation of the cached reference residual
-  double ref_value_ = 0.0;   // ||2 (A X_rest - B(X_rest; ref_c_))||
+  Eigen::VectorXd ref_c_;   // actuation of the cached reference residual
+  double ref_value_ = 0.0;  // ||2 (A X_rest - B(X_rest; ref_c_))||
 };
 
 }  // namespace softkin

@@ -15,7 +15,8 @@ Model::Model(const Scene& scene) : scene_(scene) {
   const int nv = m.num_vertices();
   const int ne = m.num_elements();
   size_ = m.size();
-  if (!(size_ > 0)) throw std::invalid_argument("scene '" + scene_.name + "': the mesh has zero size");
+  if (!(size_ > 0))
+    throw std::invalid_argument("scene '" + scene_.name + "': the mesh has zero size");
 
   // Region -> role lookup.
   std::map<int, std::pair<ElementRole, int>> role;  // region -> (role, actuator or -1)
@@ -267,7 +268,8 @@ void Model::ScatterFree(const Eigen::VectorXd& x, Eigen::MatrixX3d* X) const {
   }
 }
 
-void Model::ApplyConstraints(const Eigen::Ref<const Eigen::VectorXd>& c, Eigen::MatrixX3d* X) const {
+void Model::ApplyConstraints(const Eigen::Ref<const Eigen::VectorXd>& c,
+                             Eigen::MatrixX3d* X) const {
   const Eigen::MatrixX3d& R = rest_positions();
   for (int v : scene_.fixed) X->row(v) = R.row(v);
   for (int d = 0; d < 3; ++d)

@@ -33,13 +33,14 @@ struct ModelElement {
   std::array<int, 6> v{};
   int k = 4;
   ElementRole role = ElementRole::Body;
-  int group = -1;         ///< actuation group (Model::group_elements) of actuation elements, -1 for body elements
-  double rest_volume = 0; ///< Vol_i, mm^3 (> 0)
-  double wv = 0;          ///< w_i * Vol_i, the weight in Eq. 2.10
-  double r_omega = 1.0;   ///< shape-blending parameter R_omega (Eq. 2.5), body elements
+  int group =
+      -1;  ///< actuation group (Model::group_elements) of actuation elements, -1 for body elements
+  double rest_volume = 0;  ///< Vol_i, mm^3 (> 0)
+  double wv = 0;           ///< w_i * Vol_i, the weight in Eq. 2.10
+  double r_omega = 1.0;    ///< shape-blending parameter R_omega (Eq. 2.5), body elements
   /// Hyperelastic body elements (Eq. 3.6-3.7): R_omega(strain), owned by the Model; else null.
   const ROmegaCurve* curve = nullptr;
-  ElemRows rest;          ///< N * V_i: centred rest shape (first k rows), mm
+  ElemRows rest;  ///< N * V_i: centred rest shape (first k rows), mm
   /// Actuation elements (actuation.hpp): mu_i, the rest value of the constrained measure (volume,
   /// mm^3; mean triangle area, mm^2; the element's share l_i of the cable length, mm).
   double measure0 = 0;
@@ -129,7 +130,9 @@ class Model {
   /// Full #V x #V matrix A = sum_i w_i Vol_i S_i^T N_i S_i (the Hessian of Eq. 2.10 / 2 with
   /// frozen targets; the same for x, y and z), and its free-free block of axis d.
   const Eigen::SparseMatrix<double>& A() const { return A_; }
-  const Eigen::SparseMatrix<double>& A_ff(int d = 0) const { return *factors_[factor_of_axis_[d]].A_ff; }
+  const Eigen::SparseMatrix<double>& A_ff(int d = 0) const {
+    return *factors_[factor_of_axis_[d]].A_ff;
+  }
   /// Number of distinct factorisations (1 when every axis has the same free vertices).
   int num_factors() const { return static_cast<int>(factors_.size()); }
   /// Which factorisation axis d uses (in [0, num_factors())).

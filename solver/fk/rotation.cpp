@@ -46,8 +46,8 @@ Eigen::Matrix3d BestRotationEigen(const Eigen::Matrix3d& M) {
 namespace {
 
 // Newton's polar iteration on W matrices at once, lane l holding matrix l as x[3 r + c][l] (on
-// entry M, on exit its rotation where ok[l] = 1). Each loop over the lanes is branch-free (masks and
-// selects of values already computed), so for W = kRotationBatch the compiler vectorises it and
+// entry M, on exit its rotation where ok[l] = 1). Each loop over the lanes is branch-free (masks
+// and selects of values already computed), so for W = kRotationBatch the compiler vectorises it and
 // the square roots and divisions of independent matrices overlap; every lane still goes through
 // exactly the IEEE operations of the W = 1 instance, so a batch and a single call return the same
 // bits. ok[l] = 0: not handled (det <= 1e-9 |M|_F^3, which also catches NaN; a step that made
@@ -56,7 +56,7 @@ template <int W>
 void NewtonPolar(double x[9][W], double ok[W]) {
   double c[9][W], det[W], x2[W], cn2[W], active[W], scale[W], z[W], a[W], b[W], step2[W];
   auto cofactor = [&]() {
-    #pragma omp simd
+#pragma omp simd
     for (int l = 0; l < W; ++l) {
       c[0][l] = x[4][l] * x[8][l] - x[5][l] * x[7][l];
       c[1][l] = x[5][l] * x[6][l] - x[3][l] * x[8][l];
@@ -69,7 +69,7 @@ void NewtonPolar(double x[9][W], double ok[W]) {
       c[8][l] = x[0][l] * x[4][l] - x[1][l] * x[3][l];
       det[l] = x[0][l] * c[0][l] + x[1][l] * c[1][l] + x[2][l] * c[2][l];
     }
-    #pragma omp simd
+#pragma omp simd
     for (int l = 0; l < W; ++l) {
       double sx = x[0][l] * x[0][l], sc = c[0][l] * c[0][l];
       for (int k = 1; k < 9; ++k) {
@@ -81,9 +81,9 @@ void NewtonPolar(double x[9][W], double ok[W]) {
     }
   };
   cofactor();
-  #pragma omp simd
+#pragma omp simd
   for (int l = 0; l < W; ++l) z[l] = std::sqrt(x2[l]);
-  #pragma omp simd
+#pragma omp simd
   for (int l = 0; l < W; ++l) {
     // det <= 1e-9 |M|_F^3 catches det < 0, near-singular M and NaN (the comparison is false).
     active[l] = det[l] > 1e-9 * x2[l] * z[l] ? 1.0 : 0.0;
@@ -91,11 +91,11 @@ void NewtonPolar(double x[9][W], double ok[W]) {
     scale[l] = 1.0;
   }
   for (int it = 0; it < 16; ++it) {
-    // Higham's scaling z = (|X^-1|_F / |X|_F)^1/2, computed in every lane and used where scale is
-    // on; near the polar factor the unscaled iteration converges faster than the scaled one.
-    #pragma omp simd
+// Higham's scaling z = (|X^-1|_F / |X|_F)^1/2, computed in every lane and used where scale is
+// on; near the polar factor the unscaled iteration converges faster than the scaled one.
+#pragma omp simd
     for (int l = 0; l < W; ++l) z[l] = std::sqrt(std::sqrt(cn2[l] / x2[l]) / det[l]);
-    #pragma omp simd
+#pragma omp simd
     for (int l = 0; l < W; ++l) {
       const double zl = z[l];
       const double zz = scale[l] > 0.0 ? zl : 1.0;
@@ -104,7 +104,7 @@ void NewtonPolar(double x[9][W], double ok[W]) {
       step2[l] = 0.0;
     }
     for (int k = 0; k < 9; ++k)
-      #pragma omp simd
+#pragma omp simd
       for (int l = 0; l < W; ++l) {
         const double xo = x[k][l];
         const double xn = a[l] * xo + b[l] * c[k][l];
@@ -113,7 +113,7 @@ void NewtonPolar(double x[9][W], double ok[W]) {
       }
     cofactor();
     double any = 0.0;
-    #pragma omp simd reduction(+ : any)
+#pragma omp simd reduction(+ : any)
     for (int l = 0; l < W; ++l) {
       const double done = (active[l] > 0.0) & (step2[l] < 1e-18) ? 1.0 : 0.0;
       ok[l] = done > 0.0 ? 1.0 : ok[l];

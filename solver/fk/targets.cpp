@@ -83,7 +83,8 @@ double HyperelasticBlendWeight(const ElemRows& Rr, const ElemRows& D, int k, dou
   for (int it = 0; it < 100; ++it) {
     const double s = 3.0 * t;
     const double f = v0 + s * (d1 + (s - 1.0) / 2.0 * (d2 + (s - 2.0) / 3.0 * d3)) - floor;
-    const double df = 3.0 * (d1 + (2.0 * s - 1.0) / 2.0 * d2 + (3.0 * s * s - 6.0 * s + 2.0) / 6.0 * d3);
+    const double df =
+        3.0 * (d1 + (2.0 * s - 1.0) / 2.0 * d2 + (3.0 * s * s - 6.0 * s + 2.0) / 6.0 * d3);
     (f < 0.0 ? lo : hi) = t;
     double next = t - f / df;
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);

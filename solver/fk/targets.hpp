@@ -1,15 +1,16 @@
 #pragma once
 /// \file targets.hpp
 /// Target shapes V^t of Sec. 2.3 (the local step of Algorithm 1, lines 4-5).
-///  - Body elements: shape blending (Eq. 2.3-2.5), V^t = R_w N(R V) + (1 - R_w) N(S V^d), where R is
+///  - Body elements: shape blending (Eq. 2.3-2.5), V^t = R_w N(R V) + (1 - R_w) N(S V^d), where R
+///  is
 ///    the best rotation from the rest shape to the current one and S scales the current shape back
 ///    to the rest volume. Note: the thesis writes S = diag(r, r, r) with r = Vol(V)/Vol(V^d); a
 ///    uniform scale that restores the volume is the cube root of that ratio, which is what is used.
 ///  - Hyperelastic body elements (Eq. 3.6-3.7, hyperelastic.hpp): the current shape blended with
 ///    the rotated rest shape by R_omega(strain), rescaled to the rest volume.
 ///  - Actuation elements: the rest shape reshaped by the local ratio (actuation.hpp: pneumatic
-///    cbrt(alpha_i) I, Eq. 2.8; cable shrink s_i along the cable, Eq. 2.6; DEA in-plane sqrt(lambda_i)
-///    and thickness 1/lambda_i, Eq. 2.7), then rotated onto the current shape.
+///    cbrt(alpha_i) I, Eq. 2.8; cable shrink s_i along the cable, Eq. 2.6; DEA in-plane
+///    sqrt(lambda_i) and thickness 1/lambda_i, Eq. 2.7), then rotated onto the current shape.
 /// The blended target is already aligned with the current shape: D^T T is symmetric positive
 /// semi-definite, so the final rotation R_i of Eq. 2.10 is the identity and is not recomputed.
 #include "softkin/solver/fk/model.hpp"
@@ -71,7 +72,8 @@ void ElementTarget(const ModelElement& e, const ElemRows& D, double ratio, ElemR
 /// E = sum_i w_i Vol_i ||N V_i^d - T_i||_F^2 (Eq. 2.10). Runs in parallel, no heap allocation per
 /// element.
 double LocalStep(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
-                 const std::vector<double>& ratios, std::vector<ElemRows>* weighted, int threads = 0);
+                 const std::vector<double>& ratios, std::vector<ElemRows>* weighted,
+                 int threads = 0);
 
 /// Gathers sum_i w_i Vol_i S_i^T T_i into a #V x 3 matrix (the right-hand side of Eq. 2.11).
 void AssembleRhs(const Model& model, const std::vector<ElemRows>& weighted, Eigen::MatrixX3d* B,

@@ -24,8 +24,9 @@ void Require(bool ok, const std::string& field, const std::string& expected, dou
 }
 
 Scene Bar(double r_omega_a, double r_omega_b, const BarTestOptions& opt) {
-  return MakeRobot("bimaterial_bar", opt.res,
-                   {{"interface", opt.interface}, {"r_omega_a", r_omega_a}, {"r_omega_b", r_omega_b}});
+  return MakeRobot(
+      "bimaterial_bar", opt.res,
+      {{"interface", opt.interface}, {"r_omega_a", r_omega_a}, {"r_omega_b", r_omega_b}});
 }
 
 const Marker& FindMarker(const Scene& s, const std::string& name) {
@@ -79,9 +80,10 @@ void BarTestOptions::Validate() const {
   Require(res >= 0, "res", "0 (the default) or a resolution in bimaterial_bar's range", res);
   Require(interface > 0.05 - 1e-12 && interface < 0.95 + 1e-12, "interface",
           "a fraction of the length in [0.05, 0.95]", interface);
-  Require(stretch_mm > 0 && stretch_mm <= 40, "stretch_mm", "a displacement in (0, 40] mm", stretch_mm);
-  Require(twist_deg != 0 && std::abs(twist_deg) <= 180, "twist_deg", "an angle in [-180, 180], not 0",
-          twist_deg);
+  Require(stretch_mm > 0 && stretch_mm <= 40, "stretch_mm", "a displacement in (0, 40] mm",
+          stretch_mm);
+  Require(twist_deg != 0 && std::abs(twist_deg) <= 180, "twist_deg",
+          "an angle in [-180, 180], not 0", twist_deg);
   Require(twist_steps >= 1, "twist_steps", "an integer >= 1", twist_steps);
   std::string why;
   if (!solver.IsValid(&why)) throw std::invalid_argument("calibration: solver options: " + why);
@@ -134,7 +136,8 @@ TwistResult RunTwistTest(double r_omega_a, double r_omega_b, const BarTestOption
 
 CalibrationResult CalibrateROmega(double target_rm, const BarTestOptions& opt, double rel_tol,
                                   double r_min) {
-  Require(std::isfinite(target_rm) && target_rm > 0, "rm", "a finite elasticity ratio > 0", target_rm);
+  Require(std::isfinite(target_rm) && target_rm > 0, "rm", "a finite elasticity ratio > 0",
+          target_rm);
   Require(rel_tol > 0 && rel_tol < 0.5, "rel_tol", "a relative tolerance in (0, 0.5)", rel_tol);
   Require(r_min > 0 && r_min < 1, "r_min", "a lower bound of R_omega in (0, 1)", r_min);
   opt.Validate();
@@ -145,7 +148,8 @@ CalibrationResult CalibrateROmega(double target_rm, const BarTestOptions& opt, d
   CalibrationResult out;
   out.target_rm = target_rm;
   auto eval = [&](double r) {
-    const ElongationResult e = soft_b ? RunElongationTest(1.0, r, opt) : RunElongationTest(r, 1.0, opt);
+    const ElongationResult e =
+        soft_b ? RunElongationTest(1.0, r, opt) : RunElongationTest(r, 1.0, opt);
     ++out.evaluations;
     out.history.emplace_back(r, e.rm);
     return soft_b ? e.rm : 1.0 / e.rm;
@@ -165,8 +169,8 @@ CalibrationResult CalibrateROmega(double target_rm, const BarTestOptions& opt, d
   auto out_of_range = [&](double f_end) {
     std::ostringstream m;
     m << "calibration: R_m = " << target_rm << " is outside the range this specimen reaches with "
-      << "R_omega in [" << r_min << ", 1]: from " << (soft_b ? f_hi : 1.0 / f_hi) << " (equal R_omega) to "
-      << (soft_b ? f_end : 1.0 / f_end) << " or beyond";
+      << "R_omega in [" << r_min << ", 1]: from " << (soft_b ? f_hi : 1.0 / f_hi)
+      << " (equal R_omega) to " << (soft_b ? f_end : 1.0 / f_end) << " or beyond";
     return std::invalid_argument(m.str());
   };
   if (f_hi > goal) throw out_of_range(f_hi);
@@ -202,7 +206,8 @@ std::vector<UniaxialPoint> SimulateUniaxialTension(const Material& material,
   if (res < 1 || res > 12)
     throw std::invalid_argument("uniaxial test: res = " + std::to_string(res) + ", expected 1..12");
   for (size_t i = 0; i < stretches.size(); ++i)
-    if (!(stretches[i] > 1.0 && stretches[i] <= 2.0) || (i > 0 && !(stretches[i] > stretches[i - 1])))
+    if (!(stretches[i] > 1.0 && stretches[i] <= 2.0) ||
+        (i > 0 && !(stretches[i] > stretches[i - 1])))
       throw std::invalid_argument("uniaxial test: end stretches must increase within (1, 2]");
   const double h = kW / res;
   Scene s;

@@ -30,12 +30,12 @@ namespace softkin {
 /// The test specimen and its load. Defaults: bimaterial_bar's own resolution, interface at mid
 /// length, 10% elongation, a quarter turn.
 struct BarTestOptions {
-  int res = 0;                 ///< bimaterial_bar resolution (cells across 12 mm; 0 = default)
-  double interface = 0.5;      ///< interface position as a fraction of the length (snapped)
-  double stretch_mm = 8.0;     ///< dL: imposed end displacement, mm, in (0, 40]
-  double twist_deg = 90.0;     ///< imposed end rotation of the twisting test, degrees
-  int twist_steps = 3;         ///< continuation steps of the twisting test
-  FkOptions solver;            ///< FK options (lg-aa by default)
+  int res = 0;              ///< bimaterial_bar resolution (cells across 12 mm; 0 = default)
+  double interface = 0.5;   ///< interface position as a fraction of the length (snapped)
+  double stretch_mm = 8.0;  ///< dL: imposed end displacement, mm, in (0, 40]
+  double twist_deg = 90.0;  ///< imposed end rotation of the twisting test, degrees
+  int twist_steps = 3;      ///< continuation steps of the twisting test
+  FkOptions solver;         ///< FK options (lg-aa by default)
   /// Throws std::invalid_argument naming the field if a value is out of range.
   void Validate() const;
 };
@@ -44,12 +44,12 @@ struct BarTestOptions {
 double ElasticityRatio(double L, double L1, double dL, double dL1);
 
 struct ElongationResult {
-  double rm = 0;       ///< Eq. 2.9
-  double l_mm = 0;     ///< L: bar length
-  double l1_mm = 0;    ///< L1: interface position at rest (after snapping to the mesh)
-  double dl_mm = 0;    ///< dL: end displacement
-  double dl1_mm = 0;   ///< dL1: mean displacement of the interface cross-section along the bar
-  FkResult fk;         ///< the FK solve (status, iterations, time)
+  double rm = 0;      ///< Eq. 2.9
+  double l_mm = 0;    ///< L: bar length
+  double l1_mm = 0;   ///< L1: interface position at rest (after snapping to the mesh)
+  double dl_mm = 0;   ///< dL: end displacement
+  double dl1_mm = 0;  ///< dL1: mean displacement of the interface cross-section along the bar
+  FkResult fk;        ///< the FK solve (status, iterations, time)
 };
 
 /// One elongation test with the given R_omega of A and B. Throws std::runtime_error if the FK
@@ -57,12 +57,12 @@ struct ElongationResult {
 ElongationResult RunElongationTest(double r_omega_a, double r_omega_b, const BarTestOptions& opt);
 
 struct TwistResult {
-  double twist_deg = 0;     ///< imposed end rotation
+  double twist_deg = 0;        ///< imposed end rotation
   double l_mm = 0, l1_mm = 0;  ///< bar length and interface position at rest (as in elongation)
-  double angle_a_deg = 0;   ///< rotation of the interface section (material A's twist)
-  double angle_b_deg = 0;   ///< twist_deg - angle_a_deg (material B's twist)
-  double a_mid_deg = 0;     ///< rotation of the section midway through A
-  double b_mid_deg = 0;     ///< rotation of the section midway through B
+  double angle_a_deg = 0;      ///< rotation of the interface section (material A's twist)
+  double angle_b_deg = 0;      ///< twist_deg - angle_a_deg (material B's twist)
+  double a_mid_deg = 0;        ///< rotation of the section midway through A
+  double b_mid_deg = 0;        ///< rotation of the section midway through B
   FkResult fk;
 };
 
@@ -71,10 +71,10 @@ TwistResult RunTwistTest(double r_omega_a, double r_omega_b, const BarTestOption
 
 struct CalibrationResult {
   double target_rm = 0;
-  double achieved_rm = 0;     ///< R_m simulated with the returned parameters
+  double achieved_rm = 0;  ///< R_m simulated with the returned parameters
   double r_omega_a = 1, r_omega_b = 1;
-  double ratio = 1;           ///< r_omega_a / r_omega_b
-  int evaluations = 0;        ///< elongation tests run
+  double ratio = 1;     ///< r_omega_a / r_omega_b
+  int evaluations = 0;  ///< elongation tests run
   /// Every test run: (R_omega of the softer material, simulated R_m), in order.
   std::vector<std::pair<double, double>> history;
 };
@@ -82,9 +82,10 @@ struct CalibrationResult {
 /// Finds R_omega^A / R_omega^B such that the simulated R_m equals `target_rm` within
 /// `rel_tol` (relative), by bisection on log R_omega of the softer material in [r_min, 1].
 /// Throws std::invalid_argument if target_rm is not a finite number > 0, or if it lies outside the
-/// range the specimen can reach (the message gives that range), std::runtime_error if a solve fails.
-CalibrationResult CalibrateROmega(double target_rm, const BarTestOptions& opt, double rel_tol = 1e-3,
-                                  double r_min = 1e-3);
+/// range the specimen can reach (the message gives that range), std::runtime_error if a solve
+/// fails.
+CalibrationResult CalibrateROmega(double target_rm, const BarTestOptions& opt,
+                                  double rel_tol = 1e-3, double r_min = 1e-3);
 
 /// One point of a simulated uniaxial tension test.
 struct UniaxialPoint {
@@ -105,6 +106,7 @@ struct UniaxialPoint {
 /// if a solve fails.
 std::vector<UniaxialPoint> SimulateUniaxialTension(const Material& material,
                                                    const std::vector<double>& end_stretches,
-                                                   int res = 3, const FkOptions& solver = FkOptions());
+                                                   int res = 3,
+                                                   const FkOptions& solver = FkOptions());
 
 }  // namespace softkin

@@ -86,7 +86,8 @@ double ROmegaCurve::operator()(double eps) const {
   return (1.0 - t) * rho_[j - 1] + t * rho_[j];
 }
 
-double CurveUniaxialStress(const ROmegaCurve& curve, double lambda, double* lateral, double* rho_out) {
+double CurveUniaxialStress(const ROmegaCurve& curve, double lambda, double* lateral,
+                           double* rho_out) {
   double rho = curve(0.0), l = 1.0;
   for (int it = 0; it < 500; ++it) {
     BlendUniaxialStress(lambda, rho, &l);
@@ -104,8 +105,8 @@ ROmegaCurve FitMooneyRivlinROmega(const MooneyRivlin& m, double rho0, double lam
       !(lambda_max > 1) || n < 2) {
     std::ostringstream s;
     s << "Mooney-Rivlin R_omega fit: expected c1, c2 >= 0 with c1 + c2 > 0, R_omega(0) in (0, 1], "
-      << "lambda_max > 1, n >= 2; got c1 = " << m.c1 << ", c2 = " << m.c2 << ", R_omega(0) = " << rho0
-      << ", lambda_max = " << lambda_max << ", n = " << n;
+      << "lambda_max > 1, n >= 2; got c1 = " << m.c1 << ", c2 = " << m.c2
+      << ", R_omega(0) = " << rho0 << ", lambda_max = " << lambda_max << ", n = " << n;
     throw std::invalid_argument(s.str());
   }
   // Units: the geometric small-strain modulus at rho0, 6 rho0 / (2 + rho0) per unit weight

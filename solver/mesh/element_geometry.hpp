@@ -19,7 +19,8 @@ inline double RowsVolume(const ElemRows& P, int k) {
   if (k == 4) return TetVolume6(P.row(0), P.row(1), P.row(2), P.row(3)) / 6.0;
   return (TetVolume6(P.row(0), P.row(1), P.row(2), P.row(5)) +
           TetVolume6(P.row(0), P.row(1), P.row(5), P.row(4)) +
-          TetVolume6(P.row(0), P.row(4), P.row(5), P.row(3))) / 6.0;
+          TetVolume6(P.row(0), P.row(4), P.row(5), P.row(3))) /
+         6.0;
 }
 
 /// Subtracts the centroid of the first k rows (the operator N of Eq. 2.2) in place.

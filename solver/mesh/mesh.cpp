@@ -13,8 +13,10 @@ namespace softkin {
 
 const char* ElementTypeToString(ElementType t) {
   switch (t) {
-    case ElementType::Tet: return "tet";
-    case ElementType::Prism: return "prism";
+    case ElementType::Tet:
+      return "tet";
+    case ElementType::Prism:
+      return "prism";
   }
   return "unknown";
 }

@@ -67,7 +67,8 @@ void FlipElement(Element& e);
 /// Checks and repairs a freshly read mesh:
 ///  - throws std::runtime_error naming `source` and the element (its `lines[i]` when given, 1-based
 ///    file line of element i) for indices out of range, repeated vertices in one element, NaN/Inf
-///    coordinates (`vertex_lines[j]` for vertex j) and degenerate elements (|vol| <= 1e-12 * size^3);
+///    coordinates (`vertex_lines[j]` for vertex j) and degenerate elements (|vol| <= 1e-12 *
+///    size^3);
 ///  - flips negatively oriented elements consistently and records a note;
 ///  - warns about unused vertices and disconnected parts (element face/vertex connectivity).
 MeshReport ValidateAndOrient(Mesh& mesh, const std::string& source,

@@ -53,8 +53,7 @@ Mesh VoxelTetMesh(const Eigen::Vector3d& origin, double h, const Eigen::Vector3i
   for (std::int64_t k = 0; k < nz; ++k)
     for (std::int64_t j = 0; j < ny; ++j)
       for (std::int64_t i = 0; i < nx; ++i) {
-        const Eigen::Vector3d centre =
-            origin + h * Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5);
+        const Eigen::Vector3d centre = origin + h * Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5);
         const int t = classify(centre, Eigen::Vector3i(int(i), int(j), int(k)));
         tag[i + nx * (j + ny * k)] = t < 0 ? -1 : t;
         if (t < 0) continue;
@@ -75,8 +74,8 @@ Mesh VoxelTetMesh(const Eigen::Vector3d& origin, double h, const Eigen::Vector3i
       for (std::int64_t i = 0; i < vx; ++i) {
         const int id = newid[vid(i, j, k)];
         if (id >= 0)
-          mesh.vertices.row(id) = (origin + h * Eigen::Vector3d(double(i), double(j), double(k)))
-                                      .transpose();
+          mesh.vertices.row(id) =
+              (origin + h * Eigen::Vector3d(double(i), double(j), double(k))).transpose();
       }
 
   // 3. Kuhn split. Corner c of a cell has offset (c&1, c>>1&1, c>>2&1). For the axis order
@@ -191,9 +190,12 @@ ConcentricDisk MakeConcentricDisk(double radius, int rings) {
 
 std::array<int, 2> DiskPlaneAxes(int axis) {
   switch (axis) {
-    case 0: return {{1, 2}};
-    case 1: return {{0, 2}};
-    case 2: return {{0, 1}};
+    case 0:
+      return {{1, 2}};
+    case 1:
+      return {{0, 2}};
+    case 2:
+      return {{0, 1}};
   }
   throw std::invalid_argument("DiskPlaneAxes: axis must be 0, 1 or 2, got " + std::to_string(axis));
 }
@@ -245,9 +247,10 @@ Mesh ExtrudedDiskTetMesh(const DiskExtrusion& p, const DiskRegionFn& region) {
       const std::array<std::array<int, 4>, 3> tets = {{{{bot + a, bot + b, bot + c, top + c}},
                                                        {{bot + a, bot + b, top + b, top + c}},
                                                        {{bot + a, top + a, top + b, top + c}}}};
-      const std::array<std::array<int, 4>, 3> canon = {{{{bot + ca, bot + cb, bot + cc, top + cc}},
-                                                        {{bot + ca, bot + cb, top + cb, top + cc}},
-                                                        {{bot + ca, top + ca, top + cb, top + cc}}}};
+      const std::array<std::array<int, 4>, 3> canon = {
+          {{{bot + ca, bot + cb, bot + cc, top + cc}},
+           {{bot + ca, bot + cb, top + cb, top + cc}},
+           {{bot + ca, top + ca, top + cb, top + cc}}}};
       for (int t = 0; t < 3; ++t) {
         int tag = 0;
         if (region) {
@@ -269,11 +272,13 @@ Mesh ExtrudedDiskTetMesh(const DiskExtrusion& p, const DiskRegionFn& region) {
   return mesh;
 }
 
-Mesh PrismGridMesh(const Eigen::Vector3d& origin, double hx, double hy, const Eigen::Vector2i& cells,
-                   const std::vector<double>& z, const PrismClassifier& classify) {
+Mesh PrismGridMesh(const Eigen::Vector3d& origin, double hx, double hy,
+                   const Eigen::Vector2i& cells, const std::vector<double>& z,
+                   const PrismClassifier& classify) {
   if (!(hx > 0.0 && hy > 0.0) || !std::isfinite(hx) || !std::isfinite(hy))
     throw std::invalid_argument("PrismGridMesh: cell sizes must be > 0");
-  if (cells.minCoeff() < 1) throw std::invalid_argument("PrismGridMesh: every cell count must be >= 1");
+  if (cells.minCoeff() < 1)
+    throw std::invalid_argument("PrismGridMesh: every cell count must be >= 1");
   if (z.size() < 2) throw std::invalid_argument("PrismGridMesh: expected at least 2 z levels");
   for (size_t l = 1; l < z.size(); ++l)
     if (!(z[l] > z[l - 1])) throw std::invalid_argument("PrismGridMesh: z levels must increase");
@@ -288,8 +293,8 @@ Mesh PrismGridMesh(const Eigen::Vector3d& origin, double hx, double hy, const Ei
   for (std::int64_t l = 0; l < nl; ++l)
     for (std::int64_t j = 0; j < ny; ++j)
       for (std::int64_t i = 0; i < nx; ++i) {
-        const Eigen::Vector3d centre = origin + Eigen::Vector3d((i + 0.5) * hx, (j + 0.5) * hy,
-                                                                0.5 * (z[l] + z[l + 1]));
+        const Eigen::Vector3d centre =
+            origin + Eigen::Vector3d((i + 0.5) * hx, (j + 0.5) * hy, 0.5 * (z[l] + z[l + 1]));
         const int t = classify(centre, Eigen::Vector3i(int(i), int(j), int(l)));
         if (t < 0) continue;
         tag[i + nx * (j + ny * l)] = t;
@@ -319,14 +324,18 @@ Mesh PrismGridMesh(const Eigen::Vector3d& origin, double hx, double hy, const Ei
         if (((i + j) & 1) == 0) {
           const int t0[3][2] = {{0, 0}, {1, 0}, {1, 1}}, t1[3][2] = {{0, 0}, {1, 1}, {0, 1}};
           for (int q = 0; q < 3; ++q) {
-            tri[0][0][q] = t0[q][0]; tri[0][1][q] = t0[q][1];
-            tri[1][0][q] = t1[q][0]; tri[1][1][q] = t1[q][1];
+            tri[0][0][q] = t0[q][0];
+            tri[0][1][q] = t0[q][1];
+            tri[1][0][q] = t1[q][0];
+            tri[1][1][q] = t1[q][1];
           }
         } else {
           const int t0[3][2] = {{0, 0}, {1, 0}, {0, 1}}, t1[3][2] = {{1, 0}, {1, 1}, {0, 1}};
           for (int q = 0; q < 3; ++q) {
-            tri[0][0][q] = t0[q][0]; tri[0][1][q] = t0[q][1];
-            tri[1][0][q] = t1[q][0]; tri[1][1][q] = t1[q][1];
+            tri[0][0][q] = t0[q][0];
+            tri[0][1][q] = t0[q][1];
+            tri[1][0][q] = t1[q][0];
+            tri[1][1][q] = t1[q][1];
           }
         }
         for (int s = 0; s < 2; ++s) {

@@ -24,7 +24,8 @@ namespace softkin {
 /// Classifies one grid cell. Arguments: the cell centre (3-vector, mm) and its integer index
 /// (i, j, k), 0 <= i < cells[0] etc. Returns the region tag of the cell's six tets (>= 0), or any
 /// negative value to leave the cell empty.
-using VoxelClassifier = std::function<int(const Eigen::Vector3d& centre, const Eigen::Vector3i& cell)>;
+using VoxelClassifier =
+    std::function<int(const Eigen::Vector3d& centre, const Eigen::Vector3i& cell)>;
 
 /// Regular grid of cubic cells of edge `h` (mm) covering the box
 /// [origin, origin + h * cells] (cells = number of cells along x, y, z; each >= 1).
@@ -59,8 +60,9 @@ using PrismClassifier =
 /// so the triangulation is symmetric under reflection about any grid line. Unused grid vertices
 /// are removed; vertices are numbered in grid order (x fastest, then y, then level).
 /// Throws std::invalid_argument on bad sizes or non-increasing levels.
-Mesh PrismGridMesh(const Eigen::Vector3d& origin, double hx, double hy, const Eigen::Vector2i& cells,
-                   const std::vector<double>& z, const PrismClassifier& classify);
+Mesh PrismGridMesh(const Eigen::Vector3d& origin, double hx, double hy,
+                   const Eigen::Vector2i& cells, const std::vector<double>& z,
+                   const PrismClassifier& classify);
 
 // ------------------------------------------------------------------------------------------------
 // Concentric-ring disk and its extrusion
@@ -108,17 +110,17 @@ struct DiskExtrusion {
   /// Extrusion axis (0 = x, 1 = y, 2 = z). The disk lies in the other two coordinates taken in
   /// increasing order (axis 1: the x-z plane, angles measured from +x towards +z).
   int axis = 2;
-  double base = 0.0;    ///< axis coordinate of the bottom face, mm (top = base + length)
+  double base = 0.0;  ///< axis coordinate of the bottom face, mm (top = base + length)
 };
 
 /// What the region callback of ExtrudedDiskTetMesh sees for one tet.
 struct DiskElementInfo {
-  Eigen::Vector3d centroid;            ///< the tet's centroid, mm (world coordinates)
+  Eigen::Vector3d centroid;  ///< the tet's centroid, mm (world coordinates)
   /// Centroid of the canonical copy of this tet: the tet rotated by -sector * 120 degrees, computed
   /// from the canonical vertices' stored positions, hence bit-identical for the three rotated
   /// copies of a tet. Classify on it to get exactly 3-fold symmetric region tags.
   Eigen::Vector3d canonical_centroid;
-  int sector = 0;                      ///< this tet = canonical tet rotated by sector * 120 degrees
+  int sector = 0;  ///< this tet = canonical tet rotated by sector * 120 degrees
 };
 
 /// Region callback: returns the region tag (>= 0) of one tet.
@@ -128,13 +130,13 @@ using DiskRegionFn = std::function<int(const DiskElementInfo&)>;
 /// and splits each prism into 3 tets with a rule that is conforming and 3-fold symmetric: the
 /// triangle's vertices are ordered a < b < c by ConcentricDisk::key (invariant under the rotation),
 /// every vertical quad face gets the diagonal from the lower-key vertex's bottom copy to the
-/// higher-key vertex's top copy (a property of the edge alone, so both prisms sharing a face agree),
-/// and the tets are (a_b,b_b,c_b,c_t), (a_b,b_b,b_t,c_t), (a_b,a_t,b_t,c_t) (b = bottom, t = top),
-/// flipped where needed to be positively oriented.
-/// Output: #V = (layers+1) * #P vertices (mm; vertex id = layer * #P + disk point id) and
-/// 18 * rings^2 * layers tets with regions from `region` (a null function tags everything 0).
-/// Rotation by 120 degrees about the axis maps vertices and tets onto themselves.
-/// Throws std::invalid_argument on bad parameters or a negative region tag.
+/// higher-key vertex's top copy (a property of the edge alone, so both prisms sharing a face
+/// agree), and the tets are (a_b,b_b,c_b,c_t), (a_b,b_b,b_t,c_t), (a_b,a_t,b_t,c_t) (b = bottom, t
+/// = top), flipped where needed to be positively oriented. Output: #V = (layers+1) * #P vertices
+/// (mm; vertex id = layer * #P + disk point id) and 18 * rings^2 * layers tets with regions from
+/// `region` (a null function tags everything 0). Rotation by 120 degrees about the axis maps
+/// vertices and tets onto themselves. Throws std::invalid_argument on bad parameters or a negative
+/// region tag.
 Mesh ExtrudedDiskTetMesh(const DiskExtrusion& params, const DiskRegionFn& region = nullptr);
 
 /// In-plane axes (first, second) used for `axis` by ExtrudedDiskTetMesh: axis 0 -> (1, 2),

@@ -53,7 +53,8 @@ TriangleSurface ReadObj(const std::string& path) {
         char* end = nullptr;
         const long v = std::strtol(first.c_str(), &end, 10);
         if (first.empty() || *end != '\0' || v == 0)
-          Fail(at, "expected face vertex indices (1-based, or negative from the end), got '" + tok + "'");
+          Fail(at, "expected face vertex indices (1-based, or negative from the end), got '" + tok +
+                       "'");
         const long idx = v > 0 ? v - 1 : static_cast<long>(V.size()) + v;
         if (idx < 0 || idx >= static_cast<long>(V.size()))
           Fail(at, "face index " + std::to_string(v) + " refers to no vertex defined so far (" +
@@ -128,16 +129,19 @@ TriangleSurface ReadStl(const std::string& path) {
         if (corners != 0) Fail(at, "a facet starts before the previous one has 3 vertices");
       } else if (tag == "vertex") {
         Eigen::Vector3d p;
-        if (!(ls >> p.x() >> p.y() >> p.z())) Fail(at, "expected 'vertex x y z' with three numbers");
+        if (!(ls >> p.x() >> p.y() >> p.z()))
+          Fail(at, "expected 'vertex x y z' with three numbers");
         if (!p.allFinite()) Fail(at, "vertex coordinates must be finite");
         if (corners == 3) Fail(at, "a facet has more than 3 vertices; expected triangles");
         f[corners++] = pm.Add(p);
       } else if (tag == "endloop") {
-        if (corners != 3) Fail(at, "a facet has " + std::to_string(corners) + " vertices; expected 3");
+        if (corners != 3)
+          Fail(at, "a facet has " + std::to_string(corners) + " vertices; expected 3");
         F.push_back(f);
         corners = 0;
       } else if (tag != "solid" && tag != "endsolid" && tag != "outer" && tag != "endfacet") {
-        Fail(at, "unexpected '" + tag + "' in an ASCII STL file (binary STL: its size must be 84 + 50 n bytes)");
+        Fail(at, "unexpected '" + tag +
+                     "' in an ASCII STL file (binary STL: its size must be 84 + 50 n bytes)");
       }
     }
     if (corners != 0) Fail(path, "the file ends inside a facet");
@@ -163,8 +167,8 @@ void CheckClosedSurface(TriangleSurface* s) {
   for (int f = 0; f < nf; ++f) {
     for (int k = 0; k < 3; ++k)
       if (s->faces(f, k) < 0 || s->faces(f, k) >= nv)
-        Fail(src, "triangle " + std::to_string(f) + " has vertex index " + std::to_string(s->faces(f, k)) +
-                      ", expected 0.." + std::to_string(nv - 1));
+        Fail(src, "triangle " + std::to_string(f) + " has vertex index " +
+                      std::to_string(s->faces(f, k)) + ", expected 0.." + std::to_string(nv - 1));
     const Eigen::Vector3d a = s->vertices.row(s->faces(f, 0)), b = s->vertices.row(s->faces(f, 1)),
                           c = s->vertices.row(s->faces(f, 2));
     if (!((b - a).cross(c - a).norm() > 1e-12 * diag * diag))
@@ -172,7 +176,8 @@ void CheckClosedSurface(TriangleSurface* s) {
     for (int k = 0; k < 3; ++k) ++directed[{s->faces(f, k), s->faces(f, (k + 1) % 3)}];
   }
   for (const auto& [e, n] : directed) {
-    const std::string edge = "edge (" + std::to_string(e.first) + ", " + std::to_string(e.second) + ")";
+    const std::string edge =
+        "edge (" + std::to_string(e.first) + ", " + std::to_string(e.second) + ")";
     if (n > 1)
       Fail(src, edge + " is traversed in the same direction by " + std::to_string(n) +
                     " triangles; expected a closed, consistently oriented, manifold surface");
@@ -191,30 +196,35 @@ void CheckClosedSurface(TriangleSurface* s) {
 }
 
 TriangleSurface ReadSurfaceMesh(const std::string& path) {
-  const std::string ext = Lower(path.substr(path.find_last_of('.') == std::string::npos ? path.size()
-                                                                                         : path.find_last_of('.')));
+  const std::string ext = Lower(path.substr(
+      path.find_last_of('.') == std::string::npos ? path.size() : path.find_last_of('.')));
   TriangleSurface s;
-  if (ext == ".obj") s = ReadObj(path);
-  else if (ext == ".stl") s = ReadStl(path);
-  else Fail(path, "unknown surface format '" + ext + "'; expected .obj or .stl");
+  if (ext == ".obj")
+    s = ReadObj(path);
+  else if (ext == ".stl")
+    s = ReadStl(path);
+  else
+    Fail(path, "unknown surface format '" + ext + "'; expected .obj or .stl");
   CheckClosedSurface(&s);
   return s;
 }
 
 TriangleSurface MakeBoxSurface(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
-  if (!(lo.array() < hi.array()).all()) throw std::invalid_argument("box obstacle: expected min < max on every axis");
+  if (!(lo.array() < hi.array()).all())
+    throw std::invalid_argument("box obstacle: expected min < max on every axis");
   TriangleSurface s;
   s.source = "box";
   s.vertices.resize(8, 3);
   for (int i = 0; i < 8; ++i)
-    s.vertices.row(i) << (i & 1 ? hi.x() : lo.x()), (i & 2 ? hi.y() : lo.y()), (i & 4 ? hi.z() : lo.z());
+    s.vertices.row(i) << (i & 1 ? hi.x() : lo.x()), (i & 2 ? hi.y() : lo.y()),
+        (i & 4 ? hi.z() : lo.z());
   s.faces.resize(12, 3);
-  s.faces << 0, 2, 1, 1, 2, 3,   // z = lo
-      4, 5, 6, 5, 7, 6,          // z = hi
-      0, 1, 4, 1, 5, 4,          // y = lo
-      2, 6, 3, 3, 6, 7,          // y = hi
-      0, 4, 2, 2, 4, 6,          // x = lo
-      1, 3, 5, 3, 7, 5;          // x = hi
+  s.faces << 0, 2, 1, 1, 2, 3,  // z = lo
+      4, 5, 6, 5, 7, 6,         // z = hi
+      0, 1, 4, 1, 5, 4,         // y = lo
+      2, 6, 3, 3, 6, 7,         // y = hi
+      0, 4, 2, 2, 4, 6,         // x = lo
+      1, 3, 5, 3, 7, 5;         // x = hi
   CheckClosedSurface(&s);
   return s;
 }
@@ -222,7 +232,8 @@ TriangleSurface MakeBoxSurface(const Eigen::Vector3d& lo, const Eigen::Vector3d&
 TriangleSurface MakeCylinderSurface(const Eigen::Vector3d& base, const Eigen::Vector3d& axis_in,
                                     double radius, double height, int segments) {
   if (!(radius > 0) || !(height > 0) || segments < 3 || !(axis_in.norm() > 0))
-    throw std::invalid_argument("cylinder obstacle: expected radius > 0, height > 0, segments >= 3, a non-zero axis");
+    throw std::invalid_argument(
+        "cylinder obstacle: expected radius > 0, height > 0, segments >= 3, a non-zero axis");
   const Eigen::Vector3d a = axis_in.normalized();
   const Eigen::Vector3d u = a.unitOrthogonal(), w = a.cross(u);
   TriangleSurface s;
@@ -242,7 +253,7 @@ TriangleSurface MakeCylinderSurface(const Eigen::Vector3d& base, const Eigen::Ve
     const int j = (i + 1) % n;
     s.faces.row(4 * i) << i, j, n + j;
     s.faces.row(4 * i + 1) << i, n + j, n + i;
-    s.faces.row(4 * i + 2) << 2 * n, j, i;             // bottom, facing -a
+    s.faces.row(4 * i + 2) << 2 * n, j, i;              // bottom, facing -a
     s.faces.row(4 * i + 3) << 2 * n + 1, n + i, n + j;  // top, facing +a
   }
   CheckClosedSurface(&s);

@@ -30,7 +30,9 @@ constexpr double kRunawayExtent = 5.0;
 /// ... or whose chamber volume ratio exceeds this multiple of the ratio asked for.
 constexpr double kRunawayRatio = 2.0;
 
-double Seconds(Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); }
+double Seconds(Clock::time_point a) {
+  return std::chrono::duration<double>(Clock::now() - a).count();
+}
 
 bool InRegions(int tag, const std::vector<int>& regions) {
   return std::find(regions.begin(), regions.end(), tag) != regions.end();
@@ -41,15 +43,18 @@ bool InRegions(int tag, const std::vector<int>& regions) {
 void CheckProgressiveTargets(const Actuator& act, double alpha_target,
                              const ProgressiveOptions& opt) {
   if (!(alpha_target > 1) || alpha_target > act.max || alpha_target < act.min)
-    throw std::invalid_argument("SolveProgressive: alpha_target " + FormatNumber(alpha_target) + " is outside (1, " +
-                                FormatNumber(act.max) + "], the range of actuator '" + act.name + "'");
+    throw std::invalid_argument("SolveProgressive: alpha_target " + FormatNumber(alpha_target) +
+                                " is outside (1, " + FormatNumber(act.max) +
+                                "], the range of actuator '" + act.name + "'");
   for (double s : opt.snapshots)
     if (s > alpha_target)
-      throw std::invalid_argument("SolveProgressive: snapshot " + FormatNumber(s) + " is beyond alpha_target " +
-                                  FormatNumber(alpha_target) + "; expected snapshots in (1, alpha_target]");
+      throw std::invalid_argument("SolveProgressive: snapshot " + FormatNumber(s) +
+                                  " is beyond alpha_target " + FormatNumber(alpha_target) +
+                                  "; expected snapshots in (1, alpha_target]");
   if (!opt.ladder.empty() && opt.ladder.back() > alpha_target)
-    throw std::invalid_argument("SolveProgressive: ladder value " + FormatNumber(opt.ladder.back()) +
-                                " is beyond alpha_target " + FormatNumber(alpha_target) +
+    throw std::invalid_argument("SolveProgressive: ladder value " +
+                                FormatNumber(opt.ladder.back()) + " is beyond alpha_target " +
+                                FormatNumber(alpha_target) +
                                 "; expected ladder values in (1, alpha_target]");
 }
 
@@ -65,7 +70,8 @@ std::vector<double> Ladder(double alpha_target, const ProgressiveOptions& opt) {
     if (s < alpha_target) ladder.push_back(s);
   ladder.push_back(alpha_target);
   std::sort(ladder.begin(), ladder.end());
-  ladder.erase(std::unique(ladder.begin(), ladder.end(), [](double x, double y) { return std::abs(x - y) < 1e-12; }),
+  ladder.erase(std::unique(ladder.begin(), ladder.end(),
+                           [](double x, double y) { return std::abs(x - y) < 1e-12; }),
                ladder.end());
   return ladder;
 }
@@ -90,11 +96,13 @@ void AddSolve(const FkResult& r, ProgressiveStep* st) {
 void FlagRunaway(const Mesh& mesh, const std::vector<int>& regions, double V0, double rest_extent,
                  double alpha, FkResult* r) {
   if (r->status == FkStatus::Diverged || r->status == FkStatus::InvalidInput) return;
-  const double extent = (r->positions.colwise().maxCoeff() - r->positions.colwise().minCoeff()).norm();
+  const double extent =
+      (r->positions.colwise().maxCoeff() - r->positions.colwise().minCoeff()).norm();
   const double ratio = RegionVolume(mesh, r->positions, regions) / V0;
   if (!(extent <= kRunawayExtent * rest_extent) || !(ratio <= kRunawayRatio * alpha)) {
-    r->message = "runaway: the chamber reached " + FormatNumber(ratio) + " times its volume for alpha " +
-                 FormatNumber(alpha) + ", the bounding box " + FormatNumber(extent / rest_extent) + " times the rest one (" +
+    r->message = "runaway: the chamber reached " + FormatNumber(ratio) +
+                 " times its volume for alpha " + FormatNumber(alpha) + ", the bounding box " +
+                 FormatNumber(extent / rest_extent) + " times the rest one (" +
                  FkStatusToString(r->status) + "); treated as diverged";
     r->status = FkStatus::Diverged;
   }
@@ -108,30 +116,34 @@ bool ProgressiveOptions::IsValid(std::string* why) const {
     if (why) *why = m;
     return false;
   };
-  if (!(step >= 0) || !std::isfinite(step)) return fail("step: expected >= 0 (0: alpha_max), got " + FormatNumber(step));
+  if (!(step >= 0) || !std::isfinite(step))
+    return fail("step: expected >= 0 (0: alpha_max), got " + FormatNumber(step));
   if (max_remeshes_per_step < 1) return fail("max_remeshes_per_step: expected an integer >= 1");
   if (!remesh_options.IsValid(why)) return false;
   for (double s : snapshots)
-    if (!(s > 1) || !std::isfinite(s)) return fail("snapshots: expected volume ratios > 1, got " + FormatNumber(s));
+    if (!(s > 1) || !std::isfinite(s))
+      return fail("snapshots: expected volume ratios > 1, got " + FormatNumber(s));
   for (size_t i = 0; i < ladder.size(); ++i)
     if (!(ladder[i] > 1) || !std::isfinite(ladder[i]) || (i > 0 && !(ladder[i] > ladder[i - 1])))
-      return fail("ladder: expected increasing volume ratios > 1, got " + FormatNumber(ladder[i]) + " at position " +
-                  std::to_string(i));
+      return fail("ladder: expected increasing volume ratios > 1, got " + FormatNumber(ladder[i]) +
+                  " at position " + std::to_string(i));
   return true;
 }
 
 std::string ProgressiveResult::BriefReport() const {
   std::ostringstream os;
-  os << FkStatusToString(status) << ": " << steps.size() << " steps, " << remeshes << " remeshes, chamber volume ratio "
-     << chamber_volume_ratio << ", " << scene.mesh.num_tets() << " tets; mesh " << mesh_seconds << " s, solver "
-     << solver_seconds << " s";
-  if (remesh_failures > 0) os << "; " << remesh_failures << " remesh(es) failed, first at " << first_remesh_failure;
+  os << FkStatusToString(status) << ": " << steps.size() << " steps, " << remeshes
+     << " remeshes, chamber volume ratio " << chamber_volume_ratio << ", " << scene.mesh.num_tets()
+     << " tets; mesh " << mesh_seconds << " s, solver " << solver_seconds << " s";
+  if (remesh_failures > 0)
+    os << "; " << remesh_failures << " remesh(es) failed, first at " << first_remesh_failure;
   if (!completed) os << "; stopped early";
   if (!message.empty()) os << " (" << message << ")";
   return os.str();
 }
 
-ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target, const ProgressiveOptions& opt) {
+ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target,
+                                   const ProgressiveOptions& opt) {
   std::string why;
   if (!opt.IsValid(&why)) throw std::invalid_argument("progressive remeshing option " + why);
   scene.validate();
@@ -158,7 +170,8 @@ ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target, cons
   // rest volume a whole re-tessellation may change slightly.
   // After a remesh the actuator's range is widened by the same factor (before the model is built).
   auto value_for = [&](double alpha) {
-    return alpha * V0 / RegionVolume(res.scene.mesh, res.scene.rest_positions_of(regions[0]), regions);
+    return alpha * V0 /
+           RegionVolume(res.scene.mesh, res.scene.rest_positions_of(regions[0]), regions);
   };
   auto widen = [&]() {
     res.scene.actuators[a].max = std::max(act.max, value_for(act.max));
@@ -198,12 +211,13 @@ ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target, cons
       try {
         rm = RemeshChamber(res.scene, X, opt.remesh_options);
       } catch (const std::runtime_error& e) {
-        // Keep the state on the current mesh and go on up the ladder; the next check will try again.
-        // The failed attempt's time is mesh generation time too.
+        // Keep the state on the current mesh and go on up the ladder; the next check will try
+        // again. The failed attempt's time is mesh generation time too.
         st.mesh_seconds += Seconds(tr);
         ++st.remesh_failures;
         ++res.remesh_failures;
-        if (res.first_remesh_failure.empty()) res.first_remesh_failure = "alpha " + FormatNumber(st.alpha) + ": " + e.what();
+        if (res.first_remesh_failure.empty())
+          res.first_remesh_failure = "alpha " + FormatNumber(st.alpha) + ": " + e.what();
         break;
       }
       st.mesh_seconds += rm.seconds;
@@ -220,7 +234,8 @@ ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target, cons
     }
     if (st.status != FkStatus::Converged && res.status == FkStatus::Converged) {
       res.status = st.status;
-      if (res.message.empty()) res.message = "alpha " + FormatNumber(st.alpha) + ": " + FkStatusToString(st.status);
+      if (res.message.empty())
+        res.message = "alpha " + FormatNumber(st.alpha) + ": " + FkStatusToString(st.status);
     }
     st.tets = res.scene.mesh.num_tets();
     st.chamber_tets = 0;
@@ -232,7 +247,8 @@ ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target, cons
     res.steps.push_back(st);
     if (opt.on_step) opt.on_step(st, res.scene, X);
     for (double s : opt.snapshots)
-      if (std::abs(s - st.alpha) < 1e-12) res.snapshots.push_back({st.alpha, res.scene, X, st.chamber_volume_ratio});
+      if (std::abs(s - st.alpha) < 1e-12)
+        res.snapshots.push_back({st.alpha, res.scene, X, st.chamber_volume_ratio});
     if (stop) break;
   }
   res.positions = X;

@@ -31,7 +31,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using Rows4 = Eigen::Matrix<double, 4, 3>;
 
-double Seconds(Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); }
+double Seconds(Clock::time_point a) {
+  return std::chrono::duration<double>(Clock::now() - a).count();
+}
 
 Rows4 TetRows(const Element& e, const Eigen::Ref<const Eigen::MatrixX3d>& X) {
   Rows4 r;
@@ -64,10 +66,12 @@ class TetLocator {
       mean_extent += (r.colwise().maxCoeff() - r.colwise().minCoeff()).maxCoeff();
     }
     h_ = tets_.empty() ? 1.0 : std::max(1e-9, mean_extent / tets_.size());
-    for (int d = 0; d < 3; ++d) n_[d] = std::max(1, static_cast<int>(std::ceil((hi[d] - lo_[d]) / h_)) + 1);
+    for (int d = 0; d < 3; ++d)
+      n_[d] = std::max(1, static_cast<int>(std::ceil((hi[d] - lo_[d]) / h_)) + 1);
     for (int t : tets_) {
       const Rows4 r = TetRows(mesh_.elements[t], X_);
-      const Eigen::Vector3i a = Cell(r.colwise().minCoeff().transpose()), b = Cell(r.colwise().maxCoeff().transpose());
+      const Eigen::Vector3i a = Cell(r.colwise().minCoeff().transpose()),
+                            b = Cell(r.colwise().maxCoeff().transpose());
       for (int i = a[0]; i <= b[0]; ++i)
         for (int j = a[1]; j <= b[1]; ++j)
           for (int k = a[2]; k <= b[2]; ++k) grid_[Key(i, j, k)].push_back(t);
@@ -105,7 +109,9 @@ class TetLocator {
       c[d] = std::clamp(static_cast<int>(std::floor((p[d] - lo_[d]) / h_)), 0, n_[d] - 1);
     return c;
   }
-  long long Key(int i, int j, int k) const { return (static_cast<long long>(k) * n_[1] + j) * n_[0] + i; }
+  long long Key(int i, int j, int k) const {
+    return (static_cast<long long>(k) * n_[1] + j) * n_[0] + i;
+  }
   const Mesh& mesh_;
   Eigen::Ref<const Eigen::MatrixX3d> X_;
   std::vector<int> tets_;
@@ -115,13 +121,15 @@ class TetLocator {
   std::unordered_map<long long, std::vector<int>> grid_;
 };
 
-std::vector<int> Remap(const std::vector<int>& ids, const std::vector<int>& new_of_old, const std::string& what) {
+std::vector<int> Remap(const std::vector<int>& ids, const std::vector<int>& new_of_old,
+                       const std::string& what) {
   std::vector<int> out;
   out.reserve(ids.size());
   for (int v : ids) {
     if (new_of_old[v] < 0)
-      throw std::runtime_error("RemeshChamber: " + what + " uses vertex " + std::to_string(v) +
-                               ", which the chamber remesh removed; expected it outside the chamber's interior");
+      throw std::runtime_error(
+          "RemeshChamber: " + what + " uses vertex " + std::to_string(v) +
+          ", which the chamber remesh removed; expected it outside the chamber's interior");
     out.push_back(new_of_old[v]);
   }
   return out;
@@ -129,7 +137,8 @@ std::vector<int> Remap(const std::vector<int>& ids, const std::vector<int>& new_
 
 }  // namespace
 
-// ---- checks --------------------------------------------------------------------------------------
+// ---- checks
+// --------------------------------------------------------------------------------------
 
 bool RemeshCriteria::IsValid(std::string* why) const {
   if (!(alpha_max > 1) || !std::isfinite(alpha_max)) {
@@ -155,11 +164,11 @@ TetChangeInfo TetChange(const Rows4& reference, const Rows4& current) {
 }
 
 RemeshCheck CheckRemesh(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& reference,
-                        const Eigen::Ref<const Eigen::MatrixX3d>& current, const std::vector<int>& regions,
-                        const RemeshCriteria& criteria) {
+                        const Eigen::Ref<const Eigen::MatrixX3d>& current,
+                        const std::vector<int>& regions, const RemeshCriteria& criteria) {
   if (reference.rows() != mesh.num_vertices() || current.rows() != mesh.num_vertices())
-    throw std::invalid_argument("CheckRemesh: positions have " + std::to_string(reference.rows()) + " and " +
-                                std::to_string(current.rows()) + " rows; expected " +
+    throw std::invalid_argument("CheckRemesh: positions have " + std::to_string(reference.rows()) +
+                                " and " + std::to_string(current.rows()) + " rows; expected " +
                                 std::to_string(mesh.num_vertices()) + " (one per vertex)");
   std::string why;
   if (!criteria.IsValid(&why)) throw std::invalid_argument("remesh criteria " + why);
@@ -192,7 +201,8 @@ bool NeedsRemesh(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& ref
   return CheckRemesh(mesh, reference, current, regions, criteria).needed;
 }
 
-double RegionVolume(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X, const std::vector<int>& regions) {
+double RegionVolume(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                    const std::vector<int>& regions) {
   double v = 0;
   for (const auto& e : mesh.elements)
     if (InRegions(e.region, regions)) v += SignedVolume(e, X);
@@ -203,27 +213,35 @@ int ChamberActuator(const Scene& scene) {
   int found = -1;
   for (int a = 0; a < scene.num_actuators(); ++a) {
     const Actuator& act = scene.actuators[a];
-    if (act.type != ActuatorType::Pneumatic || act.is_signed() || act.regions.size() != 1 || found >= 0)
+    if (act.type != ActuatorType::Pneumatic || act.is_signed() || act.regions.size() != 1 ||
+        found >= 0)
       throw std::invalid_argument(
-          "scene '" + scene.name + "': progressive remeshing needs exactly one actuator, an unsigned "
-          "pneumatic chamber on one region; actuator '" + act.name + "' (" + ActuatorTypeToString(act.type) +
-          (act.is_signed() ? ", signed" : "") + ", " + std::to_string(act.regions.size()) + " region(s)) is " +
+          "scene '" + scene.name +
+          "': progressive remeshing needs exactly one actuator, an unsigned "
+          "pneumatic chamber on one region; actuator '" +
+          act.name + "' (" + ActuatorTypeToString(act.type) + (act.is_signed() ? ", signed" : "") +
+          ", " + std::to_string(act.regions.size()) + " region(s)) is " +
           (found >= 0 ? "a second actuator" : "not one"));
     found = a;
   }
   if (found < 0)
-    throw std::invalid_argument("scene '" + scene.name + "': progressive remeshing needs one pneumatic chamber "
+    throw std::invalid_argument("scene '" + scene.name +
+                                "': progressive remeshing needs one pneumatic chamber "
                                 "actuator; the scene has none");
   return found;
 }
 
-// ---- RemeshChamber -------------------------------------------------------------------------------
+// ---- RemeshChamber
+// -------------------------------------------------------------------------------
 
 const char* RemeshMethodToString(RemeshMethod m) {
   switch (m) {
-    case RemeshMethod::Auto: return "auto";
-    case RemeshMethod::ChamberOnly: return "chamber";
-    case RemeshMethod::Whole: return "whole";
+    case RemeshMethod::Auto:
+      return "auto";
+    case RemeshMethod::ChamberOnly:
+      return "chamber";
+    case RemeshMethod::Whole:
+      return "whole";
   }
   return "?";
 }
@@ -270,8 +288,8 @@ constexpr int kOutFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 /// the chamber region used once within it), oriented outwards by the tets' vertex order, with
 /// compact vertex numbering; *_old maps a surface vertex to its mesh vertex.
 void DeformedSurfaces(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X, int region,
-                      TriangleSurface* chamber, std::vector<int>* chamber_old, TriangleSurface* outer,
-                      std::vector<int>* outer_old) {
+                      TriangleSurface* chamber, std::vector<int>* chamber_old,
+                      TriangleSurface* outer, std::vector<int>* outer_old) {
   struct Use {
     int count = 0, chamber_count = 0;
     std::array<int, 3> outer_face{}, chamber_face{};
@@ -292,14 +310,16 @@ void DeformedSurfaces(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>
       }
     }
   }
-  auto build = [&](bool want_chamber, TriangleSurface* s, std::vector<int>* old, const std::string& name) {
+  auto build = [&](bool want_chamber, TriangleSurface* s, std::vector<int>* old,
+                   const std::string& name) {
     std::map<int, int> index;
     std::vector<Eigen::Vector3i> F;
     for (const auto& [key, u] : faces) {
       const bool take = want_chamber ? u.chamber_count == 1 : u.count == 1;
       if (!take) continue;
       if (!want_chamber && u.chamber_count == 1)
-        throw std::invalid_argument("RemeshChamber: the chamber reaches the outer surface; expected it inside the body");
+        throw std::invalid_argument(
+            "RemeshChamber: the chamber reaches the outer surface; expected it inside the body");
       const std::array<int, 3>& f = want_chamber ? u.chamber_face : u.outer_face;
       Eigen::Vector3i t;
       for (int k = 0; k < 3; ++k) {
@@ -327,7 +347,8 @@ void DeformedSurfaces(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>
 /// CGAL AABB tree over `to`'s triangles (MovingSurface).
 double OneSidedDeviation(const TriangleSurface& from, const TriangleSurface& to) {
   std::vector<std::array<int, 3>> faces(static_cast<size_t>(to.faces.rows()));
-  for (int f = 0; f < to.faces.rows(); ++f) faces[f] = {to.faces(f, 0), to.faces(f, 1), to.faces(f, 2)};
+  for (int f = 0; f < to.faces.rows(); ++f)
+    faces[f] = {to.faces(f, 0), to.faces(f, 1), to.faces(f, 2)};
   MovingSurface tree(std::move(faces));
   tree.Update(to.vertices);
   double worst = 0;
@@ -411,7 +432,8 @@ int UntangleTets(Mesh& m, const std::vector<char>& held) {
         const Eigen::Vector3d n = (b - a).cross(c - a);  // points away from v_j when positive
         const double nn = n.norm();
         if (!(nn > 0)) continue;
-        const double need = kUntangleHeight * std::sqrt(0.5 * nn);  // wanted height of v above the face
+        const double need =
+            kUntangleHeight * std::sqrt(0.5 * nn);  // wanted height of v above the face
         const double height = -n.dot(p - a) / nn;
         if (height < need) {
           shift -= (need - height) * n / nn;
@@ -429,7 +451,8 @@ int UntangleTets(Mesh& m, const std::vector<char>& held) {
       for (const auto& [t, j] : star[v]) touched.push_back(t);
     sort_unique(touched);
     for (int t : touched) inverted[t] = SignedVolume(m.elements[t], m.vertices) > 0 ? 0 : 1;
-    // bad <- every inverted tet: the listed ones still inverted, and the newly inverted touched ones.
+    // bad <- every inverted tet: the listed ones still inverted, and the newly inverted touched
+    // ones.
     for (int t : bad) listed[t] = 1;
     next.clear();
     for (int t : bad)
@@ -453,7 +476,8 @@ TessellationOptions WholeTessellationOptions(const TriangleSurface& sb,
     double sum = 0;
     int n = 0;
     for (int f = 0; f < sb.faces.rows(); ++f)
-      for (int k = 0; k < 3; ++k, ++n) sum += (sb.vertices.row(sb.faces(f, k)) - sb.vertices.row(sb.faces(f, (k + 1) % 3))).norm();
+      for (int k = 0; k < 3; ++k, ++n)
+        sum += (sb.vertices.row(sb.faces(f, k)) - sb.vertices.row(sb.faces(f, (k + 1) % 3))).norm();
     topt.facet_size = sum / std::max(1, n);
     topt.cell_size = 2.0 * topt.facet_size;
     topt.facet_distance = 0.05 * topt.cell_size;
@@ -490,11 +514,13 @@ PulledBack PullBack(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX3d>
   // harmonically (ExtendHarmonically).
   std::vector<int> old_chamber_ok;
   for (int i = 0; i < mesh.num_elements(); ++i)
-    if (mesh.elements[i].region == region && SignedVolume(mesh.elements[i], X) > 0) old_chamber_ok.push_back(i);
+    if (mesh.elements[i].region == region && SignedVolume(mesh.elements[i], X) > 0)
+      old_chamber_ok.push_back(i);
   TetLocator locate_chamber(mesh, X, old_chamber_ok);
   std::vector<char> fixed_old(mesh.num_vertices(), 0);
   for (int v : scene.fixed) fixed_old[v] = 1;
-  std::vector<std::vector<char>> marker_old(scene.markers.size(), std::vector<char>(mesh.num_vertices(), 0));
+  std::vector<std::vector<char>> marker_old(scene.markers.size(),
+                                            std::vector<char>(mesh.num_vertices(), 0));
   for (size_t m = 0; m < scene.markers.size(); ++m)
     for (int v : scene.markers[m].vertices) marker_old[m][v] = 1;
 
@@ -563,14 +589,17 @@ void ExtendHarmonically(const Mesh& fresh, const std::vector<char>& known, Eigen
       const int iu = unknown_index[u];
       if (iu < 0) continue;
       trip.emplace_back(iu, iu, 1.0);
-      if (unknown_index[w] >= 0) trip.emplace_back(iu, unknown_index[w], -1.0);
-      else rhs.row(iu) += rest->row(w);
+      if (unknown_index[w] >= 0)
+        trip.emplace_back(iu, unknown_index[w], -1.0);
+      else
+        rhs.row(iu) += rest->row(w);
     }
   Eigen::SparseMatrix<double> L(nu, nu);
   L.setFromTriplets(trip.begin(), trip.end());
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(L);
   if (ldlt.info() != Eigen::Success)
-    throw std::runtime_error("RemeshChamber (whole): a part of the new chamber has no vertex on its boundary");
+    throw std::runtime_error(
+        "RemeshChamber (whole): a part of the new chamber has no vertex on its boundary");
   const Eigen::MatrixX3d r = ldlt.solve(rhs);
   for (int v = 0; v < nv; ++v)
     if (unknown_index[v] >= 0) rest->row(v) = r.row(unknown_index[v]);
@@ -606,8 +635,9 @@ int UntangleRestShapes(const std::vector<int>& fixed, int region, bool chamber_t
     const double v = SignedVolume(fresh->elements[i], rest);
     if (!(v > 0))
       throw std::runtime_error("RemeshChamber (whole): new tet " + std::to_string(i) + " (region " +
-                               std::to_string(fresh->elements[i].region) + ") has interpolated rest volume " +
-                               FormatNumber(v) + " mm^3; expected positive");
+                               std::to_string(fresh->elements[i].region) +
+                               ") has interpolated rest volume " + FormatNumber(v) +
+                               " mm^3; expected positive");
   }
   return untangled;
 }
@@ -617,8 +647,10 @@ void RemeshWhole(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX3d>& X
                  const ChamberRemeshOptions& opt, ChamberRemesh* out) {
   const Mesh& mesh = scene.mesh;
   if (!scene.fixed_axis[0].empty() || !scene.fixed_axis[1].empty() || !scene.fixed_axis[2].empty())
-    throw std::invalid_argument("RemeshChamber: the whole re-tessellation does not support fixed_axis "
-                                "constraints (scene '" + scene.name + "')");
+    throw std::invalid_argument(
+        "RemeshChamber: the whole re-tessellation does not support fixed_axis "
+        "constraints (scene '" +
+        scene.name + "')");
   TriangleSurface sc, sb;
   std::vector<int> sc_old, sb_old;
   DeformedSurfaces(mesh, X, region, &sc, &sc_old, &sb, &sb_old);
@@ -627,7 +659,8 @@ void RemeshWhole(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX3d>& X
   try {
     fresh = Tessellate(sc, sb, topt);
   } catch (const std::invalid_argument& e) {
-    throw std::runtime_error(std::string("RemeshChamber (whole): the deformed surfaces cannot be meshed: ") + e.what());
+    throw std::runtime_error(
+        std::string("RemeshChamber (whole): the deformed surfaces cannot be meshed: ") + e.what());
   }
   const int nv = fresh.num_vertices();
   out->positions = fresh.vertices;
@@ -661,10 +694,13 @@ void RemeshWhole(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX3d>& X
       // No new vertex on the old marker's faces (e.g. a single-vertex marker): the new vertex
       // nearest to where the marker was.
       Eigen::RowVector3d p = Eigen::RowVector3d::Zero();
-      for (int v : scene.markers[m].vertices) p += X.row(v) / static_cast<double>(scene.markers[m].vertices.size());
+      for (int v : scene.markers[m].vertices)
+        p += X.row(v) / static_cast<double>(scene.markers[m].vertices.size());
       int best = 0;
       for (int v = 1; v < nv; ++v)
-        if ((out->positions.row(v) - p).squaredNorm() < (out->positions.row(best) - p).squaredNorm()) best = v;
+        if ((out->positions.row(v) - p).squaredNorm() <
+            (out->positions.row(best) - p).squaredNorm())
+          best = v;
       markers[m] = {best};
     }
     out->scene.markers[m].vertices = markers[m];
@@ -691,7 +727,8 @@ int UntangleChamberInterior(const Mesh& mesh, const Eigen::Ref<const Eigen::Matr
   ch.vertices = X;
   std::vector<char> held(mesh.num_vertices(), 0);
   for (const auto& e : mesh.elements) {
-    if (e.region == region) ch.elements.push_back(e);
+    if (e.region == region)
+      ch.elements.push_back(e);
     else
       for (int j = 0; j < e.k(); ++j) held[e.v[j]] = 1;
   }
@@ -721,7 +758,9 @@ void PullBackChamberVertices(const Mesh& mesh, const Eigen::MatrixX3d& Xc, int r
     }
     Eigen::Vector4d b;
     const int t = locate.Locate(positions.row(v).transpose(), &b);
-    if (t < 0) throw std::runtime_error("RemeshChamber: the old chamber has no tets to locate a new vertex in");
+    if (t < 0)
+      throw std::runtime_error(
+          "RemeshChamber: the old chamber has no tets to locate a new vertex in");
     worst_outside = std::min(worst_outside, b.minCoeff());
     const Element& e = mesh.elements[t];
     Eigen::RowVector3d r = Eigen::RowVector3d::Zero();
@@ -729,8 +768,9 @@ void PullBackChamberVertices(const Mesh& mesh, const Eigen::MatrixX3d& Xc, int r
     fresh->vertices.row(v) = r;
   }
   if (worst_outside < -1e-6)
-    throw std::runtime_error("RemeshChamber: a created vertex lies outside the old chamber (barycentric " +
-                             FormatNumber(worst_outside) + "); expected every created vertex inside it");
+    throw std::runtime_error(
+        "RemeshChamber: a created vertex lies outside the old chamber (barycentric " +
+        FormatNumber(worst_outside) + "); expected every created vertex inside it");
 }
 
 /// The chamber-only re-tessellation (RemeshRegionInterior of the chamber at Xc) and the state on
@@ -766,9 +806,11 @@ void RemeshChamberOnly(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX
       if (e.region != region) continue;
       const double v = SignedVolume(e, fresh.vertices);
       if (!(v > 0))
-        throw std::runtime_error("RemeshChamber: the pulled-back rest shape of new chamber tet " + std::to_string(i) +
-                                 " has volume " + FormatNumber(v) + " mm^3; expected positive (the previous deformation "
-                                 "varies too much across it; remesh earlier, i.e. lower alpha_max / d_max)");
+        throw std::runtime_error(
+            "RemeshChamber: the pulled-back rest shape of new chamber tet " + std::to_string(i) +
+            " has volume " + FormatNumber(v) +
+            " mm^3; expected positive (the previous deformation "
+            "varies too much across it; remesh earlier, i.e. lower alpha_max / d_max)");
     }
   }
   std::vector<int> new_of_old(mesh.num_vertices(), -1);
@@ -777,11 +819,15 @@ void RemeshChamberOnly(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX
   out->scene = scene;
   out->scene.mesh = std::move(fresh);
   out->scene.fixed = Remap(scene.fixed, new_of_old, "the fixed set");
-  for (int d = 0; d < 3; ++d) out->scene.fixed_axis[d] = Remap(scene.fixed_axis[d], new_of_old, "fixed_axis");
-  for (auto& m : out->scene.markers) m.vertices = Remap(m.vertices, new_of_old, "marker '" + m.name + "'");
+  for (int d = 0; d < 3; ++d)
+    out->scene.fixed_axis[d] = Remap(scene.fixed_axis[d], new_of_old, "fixed_axis");
+  for (auto& m : out->scene.markers)
+    m.vertices = Remap(m.vertices, new_of_old, "marker '" + m.name + "'");
   for (auto& act : out->scene.actuators)
-    if (act.is_motion()) act.vertices = Remap(act.vertices, new_of_old, "actuator '" + act.name + "'");
-  for (auto* ids : {&out->scene.fixed, &out->scene.fixed_axis[0], &out->scene.fixed_axis[1], &out->scene.fixed_axis[2]})
+    if (act.is_motion())
+      act.vertices = Remap(act.vertices, new_of_old, "actuator '" + act.name + "'");
+  for (auto* ids : {&out->scene.fixed, &out->scene.fixed_axis[0], &out->scene.fixed_axis[1],
+                    &out->scene.fixed_axis[2]})
     std::sort(ids->begin(), ids->end());
   TriangleSurface sc, sb;
   std::vector<int> u, w;
@@ -801,7 +847,8 @@ ChamberRemesh RemeshChamber(const Scene& scene, const Eigen::Ref<const Eigen::Ma
   const Mesh& mesh = scene.mesh;
   if (X.rows() != mesh.num_vertices() || !X.allFinite())
     throw std::invalid_argument("RemeshChamber: expected finite positions, one row per vertex (" +
-                                std::to_string(mesh.num_vertices()) + "), got " + std::to_string(X.rows()) + " rows");
+                                std::to_string(mesh.num_vertices()) + "), got " +
+                                std::to_string(X.rows()) + " rows");
   const std::vector<int> regions = {region};
   ChamberRemesh out;
   for (const auto& e : mesh.elements)
@@ -821,8 +868,9 @@ ChamberRemesh RemeshChamber(const Scene& scene, const Eigen::Ref<const Eigen::Ma
   if (method == RemeshMethod::Auto) {
     method = still_inverted > 0 ? RemeshMethod::Whole : RemeshMethod::ChamberOnly;
     if (method == RemeshMethod::Whole)
-      out.reason = std::to_string(out.inverted_chamber_tets) + " of " + std::to_string(out.chamber_tets_before) +
-                   " chamber tets are inverted, " + std::to_string(still_inverted) +
+      out.reason = std::to_string(out.inverted_chamber_tets) + " of " +
+                   std::to_string(out.chamber_tets_before) + " chamber tets are inverted, " +
+                   std::to_string(still_inverted) +
                    " of them cannot be untangled by moving the chamber's interior vertices";
   }
   out.method = method;
@@ -851,7 +899,8 @@ ChamberRemesh RemeshChamber(const Scene& scene, const Eigen::Ref<const Eigen::Ma
   out.chamber_tets_after = 0;
   for (const auto& e : out.scene.mesh.elements)
     if (e.region == region) ++out.chamber_tets_after;
-  out.chamber_rest_volume_after = RegionVolume(out.scene.mesh, out.scene.rest_positions_of(region), regions);
+  out.chamber_rest_volume_after =
+      RegionVolume(out.scene.mesh, out.scene.rest_positions_of(region), regions);
   out.chamber_volume_after = RegionVolume(out.scene.mesh, out.positions, regions);
   out.seconds = Seconds(t0);
   return out;

@@ -86,7 +86,8 @@ struct TetChangeInfo {
 };
 
 /// TetChange of tet rows (4 x 3 vertex positions, mm) `reference` -> `current`.
-TetChangeInfo TetChange(const Eigen::Matrix<double, 4, 3>& reference, const Eigen::Matrix<double, 4, 3>& current);
+TetChangeInfo TetChange(const Eigen::Matrix<double, 4, 3>& reference,
+                        const Eigen::Matrix<double, 4, 3>& current);
 
 /// What CheckRemesh found over the chamber elements.
 struct RemeshCheck {
@@ -103,8 +104,8 @@ struct RemeshCheck {
 /// `current` against `reference` (both #V x 3, mm). Throws std::invalid_argument for mismatched
 /// sizes or a chamber element that is not a tet.
 RemeshCheck CheckRemesh(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& reference,
-                        const Eigen::Ref<const Eigen::MatrixX3d>& current, const std::vector<int>& regions,
-                        const RemeshCriteria& criteria = {});
+                        const Eigen::Ref<const Eigen::MatrixX3d>& current,
+                        const std::vector<int>& regions, const RemeshCriteria& criteria = {});
 /// CheckRemesh(...).needed.
 bool NeedsRemesh(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& reference,
                  const Eigen::Ref<const Eigen::MatrixX3d>& current, const std::vector<int>& regions,
@@ -153,7 +154,7 @@ struct ChamberRemeshOptions {
 /// Result of RemeshChamber.
 struct ChamberRemesh {
   RemeshMethod method = RemeshMethod::ChamberOnly;  ///< the method used
-  std::string reason;           ///< why auto chose the whole re-tessellation ("" otherwise)
+  std::string reason;             ///< why auto chose the whole re-tessellation ("" otherwise)
   int inverted_chamber_tets = 0;  ///< at the input positions
   /// Chamber-only: vertex moves made to untangle the chamber at X before re-tessellating it (only
   /// vertices strictly inside the chamber move; see RemeshChamber).
@@ -161,9 +162,9 @@ struct ChamberRemesh {
   /// Rest positions of created vertices moved to untangle interpolated rest shapes that came out
   /// inverted (the vertex is moved above the planes of its tets' opposite faces, repeatedly).
   int untangled_vertices = 0;
-  Scene scene;                  ///< the scene on the new mesh (rest positions as described above)
-  Eigen::MatrixX3d positions;   ///< #V' x 3 deformed positions on the new mesh, mm
-  std::vector<int> old_index;   ///< per new vertex: its vertex in the input scene, or -1 if created
+  Scene scene;                 ///< the scene on the new mesh (rest positions as described above)
+  Eigen::MatrixX3d positions;  ///< #V' x 3 deformed positions on the new mesh, mm
+  std::vector<int> old_index;  ///< per new vertex: its vertex in the input scene, or -1 if created
   int chamber_tets_before = 0, chamber_tets_after = 0;
   int new_vertices = 0, removed_vertices = 0;
   double chamber_rest_volume_before = 0, chamber_rest_volume_after = 0;  ///< mm^3
@@ -173,8 +174,8 @@ struct ChamberRemesh {
   /// Symmetric Hausdorff distance between the old and new outer surfaces, measured from each
   /// one's vertices to the other surface, mm (0 for chamber-only).
   double outer_deviation = 0;
-  double target_edge = 0;       ///< chamber-only: the target edge length, mm
-  double seconds = 0;           ///< wall time, s
+  double target_edge = 0;  ///< chamber-only: the target edge length, mm
+  double seconds = 0;      ///< wall time, s
 };
 
 /// Re-tessellates the chamber of `scene` (ChamberActuator) in its deformed shape X (#V x 3, mm)
@@ -189,15 +190,15 @@ ChamberRemesh RemeshChamber(const Scene& scene, const Eigen::Ref<const Eigen::Ma
 
 /// One ladder value of SolveProgressive.
 struct ProgressiveStep {
-  int k = 0;                    ///< 1-based ladder index
-  double alpha = 1.0;           ///< chamber volume ratio asked for (of the original chamber)
-  int remeshes = 0;             ///< remeshes done at this value
-  std::string methods;          ///< the methods used by them, joined by '+' ("" if none)
-  int remesh_failures = 0;      ///< remeshes that threw std::runtime_error (the step went on without)
-  int tets = 0, chamber_tets = 0;       ///< after the step
-  double mesh_seconds = 0;      ///< time in RemeshChamber at this step (failed attempts too), s
-  double solver_seconds = 0;    ///< time in FkSolver::Solve (and Model builds) at this step, s
-  int iterations = 0;           ///< solver iterations summed over the step's solves
+  int k = 0;                ///< 1-based ladder index
+  double alpha = 1.0;       ///< chamber volume ratio asked for (of the original chamber)
+  int remeshes = 0;         ///< remeshes done at this value
+  std::string methods;      ///< the methods used by them, joined by '+' ("" if none)
+  int remesh_failures = 0;  ///< remeshes that threw std::runtime_error (the step went on without)
+  int tets = 0, chamber_tets = 0;  ///< after the step
+  double mesh_seconds = 0;         ///< time in RemeshChamber at this step (failed attempts too), s
+  double solver_seconds = 0;       ///< time in FkSolver::Solve (and Model builds) at this step, s
+  int iterations = 0;              ///< solver iterations summed over the step's solves
   FkStatus status = FkStatus::Converged;  ///< of the step's last solve
   double chamber_volume_ratio = 1.0;      ///< chamber volume / original chamber volume, reached
   double max_volume_ratio = 1.0, max_distortion = 1.0;  ///< CheckRemesh after the first solve
@@ -247,13 +248,13 @@ struct ProgressiveResult {
   FkStatus status = FkStatus::Converged;
   /// False if the ladder stopped before alpha_target (a diverged or invalid solve).
   bool completed = true;
-  std::string message;          ///< why a solve did not converge or the ladder stopped, "" if none
+  std::string message;  ///< why a solve did not converge or the ladder stopped, "" if none
   /// Remeshes that failed (RemeshChamber threw std::runtime_error, e.g. a self-intersecting
   /// deformed chamber surface); the ladder then goes on without remeshing at that step.
   int remesh_failures = 0;
   std::string first_remesh_failure;
-  Scene scene;                   ///< the final scene (remeshed)
-  Eigen::MatrixX3d positions;    ///< final positions on it, #V x 3 mm
+  Scene scene;                 ///< the final scene (remeshed)
+  Eigen::MatrixX3d positions;  ///< final positions on it, #V x 3 mm
   std::vector<ProgressiveStep> steps;
   std::vector<ProgressiveSnapshot> snapshots;
   int remeshes = 0;

@@ -50,12 +50,15 @@ using Domain = CGAL::Polyhedral_complex_mesh_domain_3<K, Polyhedron>;
 using MeshGt = CGAL::details::Mesh_geom_traits_generator<K>::type;
 using MeshTr = CGAL::Mesh_triangulation_3<Domain, K, CGAL::Sequential_tag, CGAL::Default,
                                           CGAL::Mesh_cell_base_3<MeshGt, Domain>>::type;
-using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<MeshTr, Domain::Corner_index, Domain::Curve_index>;
+using C3t3 =
+    CGAL::Mesh_complex_3_in_triangulation_3<MeshTr, Domain::Corner_index, Domain::Curve_index>;
 using Criteria = CGAL::Mesh_criteria_3<MeshTr>;
 using RemeshTr = CGAL::Tetrahedral_remeshing::Remeshing_triangulation_3<K>;
 using Clock = std::chrono::steady_clock;
 
-double Seconds(Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); }
+double Seconds(Clock::time_point a) {
+  return std::chrono::duration<double>(Clock::now() - a).count();
+}
 
 std::string SourceOf(const TriangleSurface& s, const char* role) {
   return s.source.empty() ? std::string(role) : s.source;
@@ -112,20 +115,30 @@ bool TessellationOptions::IsValid(std::string* why) const {
     if (why) *why = m;
     return false;
   };
-  if (!(cell_size > 0) || !std::isfinite(cell_size)) return fail("cell_size: expected a finite size > 0 mm, got " + FormatNumber(cell_size));
+  if (!(cell_size > 0) || !std::isfinite(cell_size))
+    return fail("cell_size: expected a finite size > 0 mm, got " + FormatNumber(cell_size));
   if (!(chamber_cell_size >= 0) || !std::isfinite(chamber_cell_size))
-    return fail("chamber_cell_size: expected >= 0 mm (0: cell_size), got " + FormatNumber(chamber_cell_size));
-  if (!(facet_size >= 0) || !std::isfinite(facet_size)) return fail("facet_size: expected >= 0 mm (0: cell_size), got " + FormatNumber(facet_size));
+    return fail("chamber_cell_size: expected >= 0 mm (0: cell_size), got " +
+                FormatNumber(chamber_cell_size));
+  if (!(facet_size >= 0) || !std::isfinite(facet_size))
+    return fail("facet_size: expected >= 0 mm (0: cell_size), got " + FormatNumber(facet_size));
   if (!(facet_distance >= 0) || !std::isfinite(facet_distance))
-    return fail("facet_distance: expected >= 0 mm (0: cell_size / 10), got " + FormatNumber(facet_distance));
+    return fail("facet_distance: expected >= 0 mm (0: cell_size / 10), got " +
+                FormatNumber(facet_distance));
   if (!(facet_angle > 0 && facet_angle <= 30))
-    return fail("facet_angle: expected an angle in (0, 30] degrees (Mesh_3 terminates only up to 30), got " + FormatNumber(facet_angle));
+    return fail(
+        "facet_angle: expected an angle in (0, 30] degrees (Mesh_3 terminates only up to 30), "
+        "got " +
+        FormatNumber(facet_angle));
   if (!(radius_edge_ratio >= 2) || !std::isfinite(radius_edge_ratio))
-    return fail("radius_edge_ratio: expected a finite ratio >= 2, got " + FormatNumber(radius_edge_ratio));
+    return fail("radius_edge_ratio: expected a finite ratio >= 2, got " +
+                FormatNumber(radius_edge_ratio));
   if (!(feature_angle >= 0 && feature_angle < 180))
-    return fail("feature_angle: expected an angle in [0, 180) degrees (0: no protection), got " + FormatNumber(feature_angle));
+    return fail("feature_angle: expected an angle in [0, 180) degrees (0: no protection), got " +
+                FormatNumber(feature_angle));
   if (body_region == chamber_region)
-    return fail("body_region and chamber_region: expected two different tags, both are " + std::to_string(body_region));
+    return fail("body_region and chamber_region: expected two different tags, both are " +
+                std::to_string(body_region));
   return true;
 }
 
@@ -135,12 +148,15 @@ bool RegionRemeshOptions::IsValid(std::string* why) const {
     return false;
   };
   if (!(target_edge >= 0) || !std::isfinite(target_edge))
-    return fail("target_edge: expected >= 0 mm (0: the region boundary's mean edge), got " + FormatNumber(target_edge));
-  if (iterations < 1) return fail("iterations: expected an integer >= 1, got " + std::to_string(iterations));
+    return fail("target_edge: expected >= 0 mm (0: the region boundary's mean edge), got " +
+                FormatNumber(target_edge));
+  if (iterations < 1)
+    return fail("iterations: expected an integer >= 1, got " + std::to_string(iterations));
   return true;
 }
 
-// ---- surfaces -------------------------------------------------------------------------------------
+// ---- surfaces
+// -------------------------------------------------------------------------------------
 
 double EnclosedVolume(const TriangleSurface& s) {
   double v = 0;
@@ -154,7 +170,8 @@ double EnclosedVolume(const TriangleSurface& s) {
 }
 
 void CheckChamberInBody(TriangleSurface* chamber, TriangleSurface* body) {
-  const std::string sc = SourceOf(*chamber, "chamber surface"), sb = SourceOf(*body, "body surface");
+  const std::string sc = SourceOf(*chamber, "chamber surface"),
+                    sb = SourceOf(*body, "body surface");
   if (chamber->source.empty()) chamber->source = sc;
   if (body->source.empty()) body->source = sb;
   CheckClosedSurface(chamber);
@@ -164,9 +181,13 @@ void CheckChamberInBody(TriangleSurface* chamber, TriangleSurface* body) {
   ToPolygonMesh(*body, &mb);
   namespace PMP = CGAL::Polygon_mesh_processing;
   if (PMP::does_self_intersect(mc))
-    throw std::invalid_argument(sc + ": the chamber surface intersects itself; expected a closed surface without self-intersections");
+    throw std::invalid_argument(sc +
+                                ": the chamber surface intersects itself; expected a closed "
+                                "surface without self-intersections");
   if (PMP::does_self_intersect(mb))
-    throw std::invalid_argument(sb + ": the body surface intersects itself; expected a closed surface without self-intersections");
+    throw std::invalid_argument(sb +
+                                ": the body surface intersects itself; expected a closed surface "
+                                "without self-intersections");
   if (PMP::do_intersect(mc, mb))
     throw std::invalid_argument(sc + ": the chamber surface intersects the body surface " + sb +
                                 "; expected the chamber strictly inside the body");
@@ -182,7 +203,8 @@ void CheckChamberInBody(TriangleSurface* chamber, TriangleSurface* body) {
   }
 }
 
-// ---- T(S_c, S_b) ------------------------------------------------------------------------------------
+// ---- T(S_c, S_b)
+// ------------------------------------------------------------------------------------
 
 Mesh Tessellate(const TriangleSurface& chamber_in, const TriangleSurface& body_in,
                 const TessellationOptions& opt, TessellationReport* report) {
@@ -207,7 +229,8 @@ Mesh Tessellate(const TriangleSurface& chamber_in, const TriangleSurface& body_i
   const double facet_size = opt.facet_size > 0 ? opt.facet_size : opt.cell_size;
   const double facet_distance = opt.facet_distance > 0 ? opt.facet_distance : 0.1 * opt.cell_size;
   namespace P = CGAL::parameters;
-  const CellSize cell_size{opt.cell_size, opt.chamber_cell_size > 0 ? opt.chamber_cell_size : opt.cell_size};
+  const CellSize cell_size{opt.cell_size,
+                           opt.chamber_cell_size > 0 ? opt.chamber_cell_size : opt.cell_size};
   Criteria criteria(P::edge_size = facet_size, P::facet_angle = opt.facet_angle,
                     P::facet_size = facet_size, P::facet_distance = facet_distance,
                     P::cell_radius_edge_ratio = opt.radius_edge_ratio, P::cell_size = cell_size);
@@ -243,9 +266,10 @@ Mesh Tessellate(const TriangleSurface& chamber_in, const TriangleSurface& body_i
   mesh.vertices.resize(static_cast<int>(verts.size()), 3);
   for (size_t i = 0; i < verts.size(); ++i) mesh.vertices.row(i) = verts[i].transpose();
   if (body_tets == 0 || chamber_tets == 0)
-    throw std::runtime_error("T(S_c, S_b): Mesh_3 produced " + std::to_string(body_tets) + " body and " +
-                             std::to_string(chamber_tets) + " chamber tets for " + body.source + " and " +
-                             chamber.source + " at cell_size " + FormatNumber(opt.cell_size) +
+    throw std::runtime_error("T(S_c, S_b): Mesh_3 produced " + std::to_string(body_tets) +
+                             " body and " + std::to_string(chamber_tets) + " chamber tets for " +
+                             body.source + " and " + chamber.source + " at cell_size " +
+                             FormatNumber(opt.cell_size) +
                              " mm; expected both regions meshed (use smaller sizes)");
   // CGAL's cells are positively oriented; orient explicitly anyway (a no-op then) and reject
   // degenerate tets with the mesh module's checks.
@@ -267,7 +291,8 @@ Mesh Tessellate(const TriangleSurface& chamber_in, const TriangleSurface& body_i
   return mesh;
 }
 
-// ---- re-tessellation of one region's interior -------------------------------------------------------
+// ---- re-tessellation of one region's interior
+// -------------------------------------------------------
 
 std::vector<std::array<int, 3>> RegionBoundaryFaces(const Mesh& mesh, int region) {
   static const int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
@@ -331,7 +356,8 @@ void CheckRegionRemeshInput(const Mesh& mesh, const Eigen::Ref<const Eigen::Matr
   const std::vector<int> tags = mesh.regions();
   const auto tag_it = std::find(tags.begin(), tags.end(), region);
   if (tag_it == tags.end())
-    throw std::invalid_argument("RemeshRegionInterior: no element has region tag " + std::to_string(region));
+    throw std::invalid_argument("RemeshRegionInterior: no element has region tag " +
+                                std::to_string(region));
 }
 
 /// The points of X for CGAL's triangulation, and *by_coord: each position's vertex (throws
@@ -346,8 +372,9 @@ std::vector<RemeshTr::Point> TriangulationPoints(const Eigen::Ref<const Eigen::M
     pts.emplace_back(X(i, 0), X(i, 1), X(i, 2));
     const CoordKey key = KeyOf(X(i, 0), X(i, 1), X(i, 2));
     if (!by_coord->emplace(key, i).second)
-      throw std::invalid_argument("RemeshRegionInterior: vertices " + std::to_string((*by_coord)[key]) +
-                                  " and " + std::to_string(i) + " are at the same position; expected distinct positions");
+      throw std::invalid_argument("RemeshRegionInterior: vertices " +
+                                  std::to_string((*by_coord)[key]) + " and " + std::to_string(i) +
+                                  " are at the same position; expected distinct positions");
   }
   return pts;
 }
@@ -364,13 +391,15 @@ std::vector<std::array<int, 5>> TriangulationCells(const Mesh& mesh,
   for (int i = 0; i < mesh.num_elements(); ++i) {
     const Element& e = mesh.elements[i];
     if (e.type != ElementType::Tet)
-      throw std::invalid_argument("RemeshRegionInterior: element " + std::to_string(i) + " is not a tet");
+      throw std::invalid_argument("RemeshRegionInterior: element " + std::to_string(i) +
+                                  " is not a tet");
     const double vol = TetVolume(X.row(e.v[0]).transpose(), X.row(e.v[1]).transpose(),
                                  X.row(e.v[2]).transpose(), X.row(e.v[3]).transpose());
     if (e.region == region && !(vol > 0))
-      throw std::invalid_argument("RemeshRegionInterior: tet " + std::to_string(i) + " (region " +
-                                  std::to_string(e.region) + ") has volume " + FormatNumber(vol) +
-                                  " mm^3 at the given positions; expected the region's tets positively oriented");
+      throw std::invalid_argument(
+          "RemeshRegionInterior: tet " + std::to_string(i) + " (region " +
+          std::to_string(e.region) + ") has volume " + FormatNumber(vol) +
+          " mm^3 at the given positions; expected the region's tets positively oriented");
     cells.push_back({e.v[0], e.v[1], e.v[2], e.v[3], e.region == region ? 1 : 0});
     if (e.region == region) ++*region_tets;
   }
@@ -379,9 +408,9 @@ std::vector<std::array<int, 5>> TriangulationCells(const Mesh& mesh,
 
 /// The remeshed region's cells read back from CGAL's triangulation.
 struct RemeshedCells {
-  std::vector<Eigen::Vector3d> fresh;        ///< positions of created vertices
-  std::vector<std::array<int, 4>> tets;      ///< old vertex index >= 0, or -(1 + fresh id)
-  std::map<int, int> other_count;            ///< cells per subdomain index outside the region
+  std::vector<Eigen::Vector3d> fresh;    ///< positions of created vertices
+  std::vector<std::array<int, 4>> tets;  ///< old vertex index >= 0, or -(1 + fresh id)
+  std::map<int, int> other_count;        ///< cells per subdomain index outside the region
 };
 
 /// Reads the cells of subdomain `selected` back from `tr`: vertices at a position of the input
@@ -456,8 +485,9 @@ void AssembleRemeshedMesh(const Mesh& mesh, const Eigen::Ref<const Eigen::Matrix
     const double vol = TetVolume(V.row(m.v[0]).transpose(), V.row(m.v[1]).transpose(),
                                  V.row(m.v[2]).transpose(), V.row(m.v[3]).transpose());
     if (!(vol > 0))
-      throw std::runtime_error("RemeshRegionInterior: CGAL's remesher produced a tet of volume " + FormatNumber(vol) +
-                               " mm^3 in region " + std::to_string(region) + "; expected positive volumes");
+      throw std::runtime_error("RemeshRegionInterior: CGAL's remesher produced a tet of volume " +
+                               FormatNumber(vol) + " mm^3 in region " + std::to_string(region) +
+                               "; expected positive volumes");
     out->mesh.elements.push_back(m);
   }
   out->region_tets_after = static_cast<int>(cells.tets.size());
@@ -465,8 +495,9 @@ void AssembleRemeshedMesh(const Mesh& mesh, const Eigen::Ref<const Eigen::Matrix
 
 }  // namespace
 
-RegionRemeshResult RemeshRegionInterior(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X,
-                                        int region, const RegionRemeshOptions& opt) {
+RegionRemeshResult RemeshRegionInterior(const Mesh& mesh,
+                                        const Eigen::Ref<const Eigen::MatrixX3d>& X, int region,
+                                        const RegionRemeshOptions& opt) {
   const auto t0 = Clock::now();
   CheckRegionRemeshInput(mesh, X, region, opt);
   // Subdomain indices of the CGAL triangulation: 1 for the region, 0 ("outside the domain", like
@@ -497,9 +528,11 @@ RegionRemeshResult RemeshRegionInterior(const Mesh& mesh, const Eigen::Ref<const
   RemeshTr tr;
   std::vector<RemeshTr::Vertex_handle> handles;
   const std::map<std::array<int, 3>, RemeshTr::Cell::Surface_patch_index> no_patches;
-  if (!CGAL::build_triangulation<RemeshTr, false>(tr, pts, cells, no_patches, handles, false, false))
-    throw std::runtime_error("RemeshRegionInterior: CGAL could not build a triangulation from the tets "
-                             "(is the mesh conforming and its boundary a manifold surface?)");
+  if (!CGAL::build_triangulation<RemeshTr, false>(tr, pts, cells, no_patches, handles, false,
+                                                  false))
+    throw std::runtime_error(
+        "RemeshRegionInterior: CGAL could not build a triangulation from the tets "
+        "(is the mesh conforming and its boundary a manifold surface?)");
   {
     SilenceCout quiet;
     namespace P = CGAL::parameters;
@@ -538,9 +571,10 @@ RegionRemeshResult RemeshRegionInterior(const Mesh& mesh, const Eigen::Ref<const
   }
   std::sort(after.begin(), after.end());
   if (after != boundary_before)
-    throw std::runtime_error("RemeshRegionInterior: the re-tessellated region " + std::to_string(region) +
-                             " has " + std::to_string(after.size()) + " boundary triangles, not the " +
-                             std::to_string(boundary_before.size()) + " it had; expected its boundary kept");
+    throw std::runtime_error(
+        "RemeshRegionInterior: the re-tessellated region " + std::to_string(region) + " has " +
+        std::to_string(after.size()) + " boundary triangles, not the " +
+        std::to_string(boundary_before.size()) + " it had; expected its boundary kept");
   out.seconds = Seconds(t0);
   return out;
 }

@@ -5,16 +5,16 @@
 /// (remesh.hpp) with CGAL's tetrahedral remeshing.
 ///
 /// T(S_c, S_b): two closed, outward-oriented triangle surfaces, the chamber S_c strictly inside
-/// the body S_b, become one labelled tet mesh. The domain is a CGAL Polyhedral_complex_mesh_domain_3
-/// with two surface patches: S_b between the outside (subdomain 0) and the body (1), S_c between
-/// the body (1) and the chamber (2). Mesh_3 meshes every patch once and both incident subdomains
-/// use the same restricted-Delaunay facets, so the chamber-body interface is conforming: every
-/// interface triangle is a face of exactly one body tet and one chamber tet. Edges of the input
-/// surfaces whose dihedral angle exceeds `feature_angle` (a cylinder's rims, a box's edges) are
-/// protected, so sharp edges and flat faces are reproduced. Mesh_3 is randomised; the seed sets
-/// both the domain's random generator and CGAL's default one, and the sliver perturbation and
-/// exudation run without a time limit, so the same input and options give the same mesh.
-/// Units: millimetres throughout.
+/// the body S_b, become one labelled tet mesh. The domain is a CGAL
+/// Polyhedral_complex_mesh_domain_3 with two surface patches: S_b between the outside (subdomain 0)
+/// and the body (1), S_c between the body (1) and the chamber (2). Mesh_3 meshes every patch once
+/// and both incident subdomains use the same restricted-Delaunay facets, so the chamber-body
+/// interface is conforming: every interface triangle is a face of exactly one body tet and one
+/// chamber tet. Edges of the input surfaces whose dihedral angle exceeds `feature_angle` (a
+/// cylinder's rims, a box's edges) are protected, so sharp edges and flat faces are reproduced.
+/// Mesh_3 is randomised; the seed sets both the domain's random generator and CGAL's default one,
+/// and the sliver perturbation and exudation run without a time limit, so the same input and
+/// options give the same mesh. Units: millimetres throughout.
 #include "softkin/solver/mesh/surface.hpp"
 #include "softkin/solver/mesh/mesh.hpp"
 
@@ -65,9 +65,10 @@ struct TessellationOptions {
 /// What T(S_c, S_b) produced and how long it took.
 struct TessellationReport {
   int vertices = 0, tets = 0, body_tets = 0, chamber_tets = 0;
-  double body_volume = 0, chamber_volume = 0;          ///< sums of the tets' volumes, mm^3
-  double body_enclosed = 0, chamber_enclosed = 0;      ///< volumes enclosed by the inputs: |S_b| - |S_c| and |S_c|, mm^3
-  double seconds = 0;                                  ///< wall time of the whole call, s
+  double body_volume = 0, chamber_volume = 0;  ///< sums of the tets' volumes, mm^3
+  double body_enclosed = 0,
+         chamber_enclosed = 0;  ///< volumes enclosed by the inputs: |S_b| - |S_c| and |S_c|, mm^3
+  double seconds = 0;           ///< wall time of the whole call, s
 };
 
 /// Volume enclosed by a closed triangle surface (divergence theorem; positive when the faces are
@@ -127,8 +128,9 @@ struct RegionRemeshResult {
 /// std::invalid_argument for prisms, an unknown region, mismatched sizes, non-finite X or an
 /// inverted tet of the region at X, and std::runtime_error if CGAL cannot build the
 /// triangulation or the result is not conforming.
-RegionRemeshResult RemeshRegionInterior(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X,
-                                        int region, const RegionRemeshOptions& options = {});
+RegionRemeshResult RemeshRegionInterior(const Mesh& mesh,
+                                        const Eigen::Ref<const Eigen::MatrixX3d>& X, int region,
+                                        const RegionRemeshOptions& options = {});
 
 /// Boundary triangles of the tets with region tag `region` (faces not shared by two of them), each
 /// with sorted vertex ids. For checks of conformity.

@@ -81,8 +81,10 @@ RobotEntry BimaterialBarEntry() {
       "x = 0 fixed; the x = 80 face is driven by the motion actuators 'twist' (degrees about the "
       "bar's axis, [-180, 180]) and 'stretch' (mm along +x, [0, 40]). Markers: tip, interface, "
       "a_mid, b_mid.",
-      kBarDefaultRes, "cells across the 12 mm side (cell size 12/res mm), integer in [2, 24]",
-      {{"interface", 0.5, 0.05, 0.95, "interface position as a fraction of the length (snapped to a cell face)"},
+      kBarDefaultRes,
+      "cells across the 12 mm side (cell size 12/res mm), integer in [2, 24]",
+      {{"interface", 0.5, 0.05, 0.95,
+        "interface position as a fraction of the length (snapped to a cell face)"},
        {"r_omega_a", 1.0, 0.0, 1.0, "R_omega of material A"},
        {"r_omega_b", 1.0, 0.0, 1.0, "R_omega of material B"},
        {"weight_a", 1.0, 1e-3, 1e3, "element weight of material A"},

@@ -78,7 +78,8 @@ Scene MakeCableFinger(int res, const RobotParams&) {
     a.rest = 1.0;
     a.min = kCableMinShortening;
     a.max = 1.0;
-    a.path = {Eigen::Vector3d(x0, 0.5 * kCableWidth, zmid), Eigen::Vector3d(x1, 0.5 * kCableWidth, zmid)};
+    a.path = {Eigen::Vector3d(x0, 0.5 * kCableWidth, zmid),
+              Eigen::Vector3d(x1, 0.5 * kCableWidth, zmid)};
     s.actuators.push_back(a);
   }
   const double eps = 1e-6 * h, xmax = nx * h;
@@ -99,7 +100,9 @@ RobotEntry CableFingerEntry() {
       "elements of its own tendon t1, t2, t3 (cable, shortening ratio in [0.5, 1]; regions 1-3; "
       "each tendon's path runs along x through its bridge). Markers: tip (face x = 120), tip_top / "
       "tip_bottom (top / bottom quarter of that face).",
-      kCableDefaultRes, "cells across the 25 mm width (cell size 25/res mm), integer in [5, 30]", {}};
+      kCableDefaultRes,
+      "cells across the 25 mm width (cell size 25/res mm), integer in [5, 30]",
+      {}};
   return {info, kCableMinRes, kCableMaxRes, &MakeCableFinger};
 }
 

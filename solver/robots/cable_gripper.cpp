@@ -34,7 +34,8 @@ constexpr double kCgLength = 100.0, kCgWidth = 20.0, kCgHeight = 20.0, kCgChanne
 
 Scene MakeCableGripper(int res, const RobotParams& P) {
   const double h = kCgWidth / res;
-  const int nx = static_cast<int>(std::lround(kCgLength / h)), nz = static_cast<int>(std::lround(kCgHeight / h));
+  const int nx = static_cast<int>(std::lround(kCgLength / h)),
+            nz = static_cast<int>(std::lround(kCgHeight / h));
   auto cell = [&](const Eigen::Vector3d& c, const Eigen::Vector3i&) {
     if (c.z() > kCgChannel && c.x() > kCgStart) return 1;
     const double u = std::fmod(c.x(), kCgLink + kCgJoint);
@@ -59,8 +60,8 @@ Scene MakeCableGripper(int res, const RobotParams& P) {
   s.actuators.push_back(a);
   const double eps = 1e-6 * h;
   s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
-  s.markers.push_back({"tip", VerticesOnPlane(s.mesh, Eigen::Vector3d(xmax, 0, 0),
-                                              Eigen::Vector3d::UnitX(), eps)});
+  s.markers.push_back(
+      {"tip", VerticesOnPlane(s.mesh, Eigen::Vector3d(xmax, 0, 0), Eigen::Vector3d::UnitX(), eps)});
   for (int q = 0; q < 3; ++q) {
     const double xm = std::min(xmax, 40.0 + 30.0 * q);
     s.markers.push_back({"m" + std::to_string(q + 1),
@@ -79,7 +80,8 @@ RobotEntry CableGripperEntry() {
       "axis (x = 0 fixed), planar motion in x-z; a cable channel along the top (z >= 16, cable "
       "'cable', shortening ratio in [0.5, 1]) over a body of alternating 10 mm links (region 0) "
       "and 5 mm joints (region 2). Markers: tip, m1, m2, m3 (bottom face at x = 40, 70, 100).",
-      kCgDefaultRes, "cells across the 20 mm width (cell size 20/res mm), integer in [4, 24]",
+      kCgDefaultRes,
+      "cells across the 20 mm width (cell size 20/res mm), integer in [4, 24]",
       {{"link_weight", 1.0, 1e-3, 1e3, "element weight of the links"},
        {"joint_weight", 1.0, 1e-3, 1e3, "element weight of the joints"},
        {"link_r_omega", 1.0, 0.0, 1.0, "R_omega of the links"},

@@ -15,8 +15,8 @@ namespace robots_detail {
 namespace {
 
 // ================================================================================================
-// dea_crawler (thesis Fig. 2.10, after [83]): a thin strip of prism elements, a DEA membrane under a
-// bendable frame, with a leg under each end.
+// dea_crawler (thesis Fig. 2.10, after [83]): a thin strip of prism elements, a DEA membrane under
+// a bendable frame, with a leg under each end.
 //
 // Axes: x = long axis [0, 60], y = width [0, 20], z = up. Prism layers (mm): legs z in [0, 5] under
 // x in [0, 5] and [55, 60] (region 3, weight 20: rigid); the membrane layer z in [5, 5.5], whose
@@ -69,12 +69,13 @@ Scene MakeDeaCrawler(int res, const RobotParams& P) {
   const double eps = 1e-6 * h, xmax = nx * h;
   const std::vector<int> rear = VerticesInBox(s.mesh, Eigen::Vector3d(-kInf, -kInf, -eps),
                                               Eigen::Vector3d(kCrawlLeg + eps, kInf, eps));
-  const std::vector<int> front = VerticesInBox(s.mesh, Eigen::Vector3d(xmax - kCrawlLeg - eps, -kInf, -eps),
-                                               Eigen::Vector3d(kInf, kInf, eps));
+  const std::vector<int> front =
+      VerticesInBox(s.mesh, Eigen::Vector3d(xmax - kCrawlLeg - eps, -kInf, -eps),
+                    Eigen::Vector3d(kInf, kInf, eps));
   s.fixed = rear;
   s.fixed_axis[2] = front;
-  s.markers.push_back({"tip", VerticesOnPlane(s.mesh, Eigen::Vector3d(xmax, 0, 0),
-                                              Eigen::Vector3d::UnitX(), eps)});
+  s.markers.push_back(
+      {"tip", VerticesOnPlane(s.mesh, Eigen::Vector3d(xmax, 0, 0), Eigen::Vector3d::UnitX(), eps)});
   s.markers.push_back({"rear_foot", rear});
   s.markers.push_back({"front_foot", front});
   const double ztop = z.back();
@@ -96,7 +97,8 @@ RobotEntry DeaCrawlerEntry() {
       "lambda_init) under a bendable frame, with a 5 mm leg under each end. The mesh is the flat "
       "pre-stretched state. The rear foot is pinned, the front foot slides on the x-y plane (z "
       "held). Markers: tip, rear_foot, front_foot, apex (top of the frame at mid-length).",
-      kCrawlDefaultRes, "prisms across the 20 mm width (in-plane cell 20/res mm), integer in [4, 40]",
+      kCrawlDefaultRes,
+      "prisms across the 20 mm width (in-plane cell 20/res mm), integer in [4, 40]",
       {{"frame_thickness", kCrawlFrame, 0.2, 5.0, "thickness of the frame layer, mm"},
        {"frame_weight", 1.0, 0.01, 100.0, "element weight of the frame (membrane: 1, DEA: 5)"}}};
   return {info, kCrawlMinRes, kCrawlMaxRes, &MakeDeaCrawler};

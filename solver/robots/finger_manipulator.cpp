@@ -37,27 +37,28 @@ namespace {
 // thinner walls let the chambers grow more (at res 8 they reach volume ratio 9.8 of the 13
 // asked: the actuation elements are soft constraints, Eq. 2.10, held back by the rigid walls,
 // floor and roof). With the thesis's weight 5 and gain 2 it is 38 degrees at res 8. A
-// PneuNet-style variant with gaps between the chamber boxes did not bend more (50). The mesh is mirror-symmetric about y = 10 (res is even), so v and -v give
-// mirror images. Markers: tip (distal face x = L), j1, j2 (the connectors' distal faces: the
-// ends of sections 1 and 2).
+// PneuNet-style variant with gaps between the chamber boxes did not bend more (50). The mesh is
+// mirror-symmetric about y = 10 (res is even), so v and -v give mirror images. Markers: tip (distal
+// face x = L), j1, j2 (the connectors' distal faces: the ends of sections 1 and 2).
 // ================================================================================================
 
 constexpr int kManipMinRes = 6, kManipMaxRes = 24, kManipDefaultRes = 8;
 constexpr double kManipWidth = 20.0, kManipThick = 12.0, kManipBase = 6.0, kManipSection = 40.0,
                  kManipJoint = 6.0, kManipCap = 3.0, kManipWall = 1.5, kManipCavity = 4.0,
-                 kManipSpine = 3.0, kManipGain = 4.0, kManipRange = 3.0,
-                 kManipChamberWeight = 20.0;
+                 kManipSpine = 3.0, kManipGain = 4.0, kManipRange = 3.0, kManipChamberWeight = 20.0;
 
 Scene MakeFingerManipulator(int res, const RobotParams& P) {
   if (res % 2 != 0)
-    throw std::invalid_argument("finger_manipulator: --res must be even (mirror symmetry about "
-                                "the mid-plane y = 10), got " + std::to_string(res));
+    throw std::invalid_argument(
+        "finger_manipulator: --res must be even (mirror symmetry about "
+        "the mid-plane y = 10), got " +
+        std::to_string(res));
   const double h = kManipWidth / res;
   const int ny = res, nz = static_cast<int>(std::lround(kManipThick / h));
   const int wall = Cells(kManipWall, h), cav = Cells(kManipCavity, h);
   const int side_cav = std::max(1, (ny - 2 * wall - Cells(kManipSpine, h)) / 2);
-  const int base = Cells(kManipBase, h), sec = Cells(kManipSection, h), joint = Cells(kManipJoint, h),
-            cap = Cells(kManipCap, h);
+  const int base = Cells(kManipBase, h), sec = Cells(kManipSection, h),
+            joint = Cells(kManipJoint, h), cap = Cells(kManipCap, h);
   const int nx = base + 3 * sec + 2 * joint + cap;
   if (nz < 2 * wall + 1 || ny < 2 * wall + 2 * side_cav + 1)
     throw std::invalid_argument("finger_manipulator: res " + std::to_string(res) + " too coarse");
@@ -81,7 +82,7 @@ Scene MakeFingerManipulator(int res, const RobotParams& P) {
       if (i < r.x0 || i >= r.x1) continue;
       const bool zin = k >= wall && k < nz - wall;
       if (InCavity(r, i) && zin) {
-        if (j >= wall && j < wall + side_cav) return 2 + 2 * q;           // -y side
+        if (j >= wall && j < wall + side_cav) return 2 + 2 * q;            // -y side
         if (j >= ny - wall - side_cav && j < ny - wall) return 1 + 2 * q;  // +y side
       }
       if (j >= wall + side_cav && j < ny - wall - side_cav && i >= r.first) return 7;  // spine
@@ -111,8 +112,8 @@ Scene MakeFingerManipulator(int res, const RobotParams& P) {
   }
   const double eps = 1e-6 * h, xmax = nx * h;
   s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
-  s.markers.push_back({"tip", VerticesOnPlane(s.mesh, Eigen::Vector3d(xmax, 0, 0),
-                                              Eigen::Vector3d::UnitX(), eps)});
+  s.markers.push_back(
+      {"tip", VerticesOnPlane(s.mesh, Eigen::Vector3d(xmax, 0, 0), Eigen::Vector3d::UnitX(), eps)});
   for (int q = 0; q < 2; ++q)
     s.markers.push_back({"j" + std::to_string(q + 1),
                          VerticesOnPlane(s.mesh, Eigen::Vector3d(joints[q].second * h, 0, 0),

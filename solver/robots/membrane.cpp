@@ -28,9 +28,10 @@ namespace {
 // chambers' swelling side walls press on each other) and one cell in from the rim, standing on
 // the fixed plane z = 0, with a 2 mm air gap between their roofs and the membrane (the mesh is
 // cut there, CutSlit). Chamber k sits under quadrant k: c1 (x < 125, y < 125), c2 (x > 125,
-// y < 125), c3 (x < 125, y > 125), c4 (x > 125, y > 125). Material: Mooney-Rivlin Dragon Skin 20 (Eq. 3.6-3.7) for membrane and walls.
-// Markers: tip (the membrane's top centre) and q1..q4 (membrane top above each chamber's
-// centre). Self-collision response is on in the scene's solver options.
+// y < 125), c3 (x < 125, y > 125), c4 (x > 125, y > 125). Material: Mooney-Rivlin Dragon Skin 20
+// (Eq. 3.6-3.7) for membrane and walls. Markers: tip (the membrane's top centre) and q1..q4
+// (membrane top above each chamber's centre). Self-collision response is on in the scene's solver
+// options.
 // ================================================================================================
 
 constexpr int kMemMinRes = 10, kMemMaxRes = 60, kMemDefaultRes = 20;
@@ -46,11 +47,12 @@ Scene MakeMembrane(int res, const RobotParams& P) {
   // Chamber width in cells: 1 margin + nc + gap + nc + (the rest) margin.
   const int nc = (n - 2 - gap) / 2;
   if (nc < 3)
-    throw std::invalid_argument("membrane: chamber_gap = " + std::to_string(gap) + " leaves chambers " +
-                                std::to_string(nc) + " cells wide at res " + std::to_string(res) +
+    throw std::invalid_argument("membrane: chamber_gap = " + std::to_string(gap) +
+                                " leaves chambers " + std::to_string(nc) + " cells wide at res " +
+                                std::to_string(res) +
                                 "; expected at least 3 (raise res or lower chamber_gap)");
   const int hc = std::max(3, static_cast<int>(std::lround(kMemChamberHeight / h)));
-  const int zm = hc;           // membrane cell layer, on the roofs (then lifted by the slit)
+  const int zm = hc;  // membrane cell layer, on the roofs (then lifted by the slit)
   const int x0[2] = {1, 1 + nc + gap};
   auto cell = [&](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
     const int i = c[0], j = c[1], k = c[2];
@@ -59,7 +61,8 @@ Scene MakeMembrane(int res, const RobotParams& P) {
     for (int q = 0; q < 4; ++q) {
       const int ox = x0[q % 2], oy = x0[q / 2];
       if (i < ox || i >= ox + nc || j < oy || j >= oy + nc) continue;
-      const bool interior = i > ox && i < ox + nc - 1 && j > oy && j < oy + nc - 1 && k > 0 && k < hc - 1;
+      const bool interior =
+          i > ox && i < ox + nc - 1 && j > oy && j < oy + nc - 1 && k > 0 && k < hc - 1;
       return interior ? 2 + q : 1;
     }
     return -1;
@@ -69,8 +72,9 @@ Scene MakeMembrane(int res, const RobotParams& P) {
   s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(n, n, zm + 1), cell);
   // The membrane is a separate body: lift it off the roofs by kMemGap.
   const double z_roof = zm * h;
-  CutSlit(&s.mesh, [&](const Eigen::Vector3d& p) { return std::abs(p.z() - z_roof) < 1e-6 * h; },
-          [&](const Eigen::Vector3d& c) { return c.z() > z_roof; }, Eigen::Vector3d(0, 0, kMemGap));
+  CutSlit(
+      &s.mesh, [&](const Eigen::Vector3d& p) { return std::abs(p.z() - z_roof) < 1e-6 * h; },
+      [&](const Eigen::Vector3d& c) { return c.z() > z_roof; }, Eigen::Vector3d(0, 0, kMemGap));
   s.body[0] = MooneyRivlinMaterial("membrane", "dragon-skin-20", 1.0);
   s.body[1] = MooneyRivlinMaterial("chamber_wall", "dragon-skin-20", 1.0);
   for (int q = 0; q < 4; ++q) {
@@ -83,7 +87,8 @@ Scene MakeMembrane(int res, const RobotParams& P) {
     s.actuators.push_back(a);
   }
   const double eps = 1e-6 * h, side = n * h, zlo = zm * h + kMemGap;
-  std::vector<int> fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), eps);
+  std::vector<int> fixed =
+      VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), eps);
   for (int v = 0; v < s.mesh.num_vertices(); ++v) {
     const Eigen::Vector3d p = s.mesh.vertices.row(v);
     const bool rim = p.x() < eps || p.y() < eps || p.x() > side - eps || p.y() > side - eps;
@@ -93,10 +98,12 @@ Scene MakeMembrane(int res, const RobotParams& P) {
   fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
   s.fixed = fixed;
   const double ztop = zlo + h;
-  s.markers.push_back({"tip", {NearestVertex(s.mesh, Eigen::Vector3d(0.5 * side, 0.5 * side, ztop))}});
+  s.markers.push_back(
+      {"tip", {NearestVertex(s.mesh, Eigen::Vector3d(0.5 * side, 0.5 * side, ztop))}});
   for (int q = 0; q < 4; ++q) {
     const double cx = (x0[q % 2] + 0.5 * nc) * h, cy = (x0[q / 2] + 0.5 * nc) * h;
-    s.markers.push_back({"q" + std::to_string(q + 1), {NearestVertex(s.mesh, Eigen::Vector3d(cx, cy, ztop))}});
+    s.markers.push_back(
+        {"q" + std::to_string(q + 1), {NearestVertex(s.mesh, Eigen::Vector3d(cx, cy, ztop))}});
   }
   s.solver.collision.self = true;
   s.validate();
@@ -113,10 +120,12 @@ RobotEntry MembraneEntry() {
       "[1, 4]) under quadrants (x<125,y<125), (x>125,y<125), (x<125,y>125), (x>125,y>125). "
       "Self-collision response on. Markers: tip (membrane top centre), q1..q4 (membrane top above "
       "each chamber).",
-      kMemDefaultRes, "cells across the 250 mm side (cell size 250/res mm), integer in [10, 60]",
+      kMemDefaultRes,
+      "cells across the 250 mm side (cell size 250/res mm), integer in [10, 60]",
       {{"chamber_gap", 2.0, 1.0, 10.0,
         "cells between neighbouring chambers (integer). With 1 the swelling chambers' side walls "
-        "press on each other and the contact response breaks down at res 24 (docs/collision_response.md)"}}};
+        "press on each other and the contact response breaks down at res 24 "
+        "(docs/collision_response.md)"}}};
   return {info, kMemMinRes, kMemMaxRes, &MakeMembrane};
 }
 

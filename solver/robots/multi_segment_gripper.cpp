@@ -58,7 +58,8 @@ Scene MakeMultiSegmentGripper(int res, const RobotParams&) {
   const int base = Cells(kGripBase, h), seg = Cells(kGripSegment, h), joint = Cells(kGripJoint, h);
   const int nx = base + 3 * seg + 2 * joint;
   if (nz < layer + 2 * wall + 1)
-    throw std::invalid_argument("multi_segment_gripper: res " + std::to_string(res) + " too coarse");
+    throw std::invalid_argument("multi_segment_gripper: res " + std::to_string(res) +
+                                " too coarse");
   std::vector<ChamberRow> rows;
   std::vector<std::pair<int, int>> joints;
   int x = base;
@@ -114,7 +115,9 @@ RobotEntry MultiSegmentGripperEntry() {
       "motion in x-z. Pneumatic actuators c1, c2, c3 (volume ratio in [1, 8]). Markers: tip, "
       "tip_top, tip_bottom, P0 (end of the second segment), grip_layer (the third segment's "
       "inextensible layer).",
-      kGripDefaultRes, "cells across the 20 mm width (cell size 20/res mm), integer in [6, 24]", {}};
+      kGripDefaultRes,
+      "cells across the 20 mm width (cell size 20/res mm), integer in [6, 24]",
+      {}};
   return {info, kGripMinRes, kGripMaxRes, &MakeMultiSegmentGripper};
 }
 

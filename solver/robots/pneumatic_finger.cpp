@@ -47,14 +47,14 @@ constexpr double kFingerMaxAlpha = 10.0;
 
 /// The finger's layout in cells.
 struct FingerLayout {
-  double h = 1.0;        // cell size, mm
+  double h = 1.0;  // cell size, mm
   int nx = 0, ny = 0, nz = 0;
-  int base = 0;          // base layer thickness (cells)
-  int floor = 0;         // solid floor between the base layer and the cavities
-  int wall = 0;          // walls: between cavities (x), sides (y), roof (z)
-  int cavity = 0;        // cavity length (x)
-  int chambers = 0;      // number of cavities
-  int proximal = 0;      // proximal solid block length
+  int base = 0;      // base layer thickness (cells)
+  int floor = 0;     // solid floor between the base layer and the cavities
+  int wall = 0;      // walls: between cavities (x), sides (y), roof (z)
+  int cavity = 0;    // cavity length (x)
+  int chambers = 0;  // number of cavities
+  int proximal = 0;  // proximal solid block length
 };
 
 FingerLayout MakeFingerLayout(int res) {
@@ -124,7 +124,8 @@ RobotEntry PneumaticFingerEntry() {
       "distal face).",
       kFingerDefaultRes,
       "cells across the 20 mm width (cell size 20/res mm), integer in [5, 40]; 27 res^3 tets; "
-      "features snap to whole cells (16 chambers at res 12)", {}};
+      "features snap to whole cells (16 chambers at res 12)",
+      {}};
   return {info, kFingerMinRes, kFingerMaxRes, &MakePneumaticFinger};
 }
 

@@ -29,9 +29,11 @@ double Param(const RobotParams& p, const std::string& name, double def) {
 
 TriangleSurface MakeHelicalTubeSurface(double rh, double turns, double z0, double z1, double rt,
                                        int around, int along, int cap_rings) {
-  if (!(rh > 0) || !(rt > 0) || !(turns > 0) || !(z1 > z0) || around < 3 || along < 1 || cap_rings < 1)
+  if (!(rh > 0) || !(rt > 0) || !(turns > 0) || !(z1 > z0) || around < 3 || along < 1 ||
+      cap_rings < 1)
     throw std::invalid_argument(
-        "helical tube: expected helix_radius > 0, tube_radius > 0, turns > 0, z1 > z0, around >= 3, "
+        "helical tube: expected helix_radius > 0, tube_radius > 0, turns > 0, z1 > z0, around >= "
+        "3, "
         "along >= 1, cap_rings >= 1");
   if (!(rt < rh))
     throw std::invalid_argument("helical tube: tube_radius " + std::to_string(rt) +
@@ -43,7 +45,8 @@ TriangleSurface MakeHelicalTubeSurface(double rh, double turns, double z0, doubl
                                 " mm must exceed the tube diameter " + std::to_string(2 * rt) +
                                 " mm (neighbouring turns would overlap)");
   const double dphi = 2.0 * kPi * turns, dz = z1 - z0;
-  auto frame = [&](double t, Eigen::Vector3d* c, Eigen::Vector3d* T, Eigen::Vector3d* N, Eigen::Vector3d* B) {
+  auto frame = [&](double t, Eigen::Vector3d* c, Eigen::Vector3d* T, Eigen::Vector3d* N,
+                   Eigen::Vector3d* B) {
     const double phi = dphi * t;
     *c = Eigen::Vector3d(rh * std::cos(phi), rh * std::sin(phi), z0 + dz * t);
     *T = Eigen::Vector3d(-rh * dphi * std::sin(phi), rh * dphi * std::cos(phi), dz).normalized();
@@ -54,7 +57,8 @@ TriangleSurface MakeHelicalTubeSurface(double rh, double turns, double z0, doubl
   // their local (N, B) frames, so consecutive rings join by quads.
   std::vector<Eigen::Vector3d> pts;
   std::vector<int> ring_start;
-  auto add_ring = [&](const Eigen::Vector3d& centre, const Eigen::Vector3d& N, const Eigen::Vector3d& B, double radius) {
+  auto add_ring = [&](const Eigen::Vector3d& centre, const Eigen::Vector3d& N,
+                      const Eigen::Vector3d& B, double radius) {
     ring_start.push_back(static_cast<int>(pts.size()));
     for (int j = 0; j < around; ++j) {
       const double psi = 2.0 * kPi * j / around;
@@ -67,7 +71,8 @@ TriangleSurface MakeHelicalTubeSurface(double rh, double turns, double z0, doubl
   const int pole0 = 0;
   pts.push_back(c0 - rt * T0);
   for (int k = 1; k < cap_rings; ++k) {
-    const double beta = 0.5 * kPi * (cap_rings - k) / cap_rings;  // from near the pole to the equator
+    const double beta =
+        0.5 * kPi * (cap_rings - k) / cap_rings;  // from near the pole to the equator
     add_ring(c0 - rt * std::sin(beta) * T0, N0, B0, rt * std::cos(beta));
   }
   for (int i = 0; i <= along; ++i) {
@@ -92,7 +97,8 @@ TriangleSurface MakeHelicalTubeSurface(double rh, double turns, double z0, doubl
   for (int r = 0; r + 1 < rings; ++r)
     for (int j = 0; j < around; ++j) {
       const int jn = (j + 1) % around;
-      const int a = ring_start[r] + j, b = ring_start[r] + jn, c = ring_start[r + 1] + jn, d = ring_start[r + 1] + j;
+      const int a = ring_start[r] + j, b = ring_start[r] + jn, c = ring_start[r + 1] + jn,
+                d = ring_start[r + 1] + j;
       F.emplace_back(a, b, c);
       F.emplace_back(a, c, d);
     }
@@ -110,8 +116,9 @@ void TwistingRobotSurfaces(const RobotParams& P, TriangleSurface* chamber, Trian
   const double rh = Param(P, "helix_radius", 5.0), rt = Param(P, "tube_radius", 2.5),
                turns = Param(P, "turns", kTwistDefaultTurns);
   if (!(rh + rt <= kTwistBodyRadius - 1.0))
-    throw std::invalid_argument("twisting_robot: helix_radius + tube_radius = " + std::to_string(rh + rt) +
-                                " mm leaves less than a 1 mm wall to the 10 mm body radius; expected <= 9");
+    throw std::invalid_argument(
+        "twisting_robot: helix_radius + tube_radius = " + std::to_string(rh + rt) +
+        " mm leaves less than a 1 mm wall to the 10 mm body radius; expected <= 9");
   const int along = std::max(48, static_cast<int>(std::ceil(64 * turns)));
   *chamber = MakeHelicalTubeSurface(rh, turns, kTwistHelixZ0, kTwistHelixZ1, rt, 24, along, 6);
   chamber->source = "twisting_robot chamber (helical tube)";
@@ -133,14 +140,16 @@ TessellationOptions TwistingRobotTessellation(int res, double tube_radius) {
 }
 
 TessellationOptions TwistingRobotTessellation(int res, const RobotParams& params) {
-  return TwistingRobotTessellation(res <= 0 ? kTwistDefaultRes : res, Param(params, "tube_radius", 2.5));
+  return TwistingRobotTessellation(res <= 0 ? kTwistDefaultRes : res,
+                                   Param(params, "tube_radius", 2.5));
 }
 
 Scene MakeTwistingRobot(int res, const RobotParams& P) {
   if (res <= 0) res = kTwistDefaultRes;
   if (res < kTwistMinRes || res > kTwistMaxRes)
-    throw std::invalid_argument("twisting_robot: --res must be an integer in [" + std::to_string(kTwistMinRes) +
-                                ", " + std::to_string(kTwistMaxRes) + "], got " + std::to_string(res));
+    throw std::invalid_argument("twisting_robot: --res must be an integer in [" +
+                                std::to_string(kTwistMinRes) + ", " + std::to_string(kTwistMaxRes) +
+                                "], got " + std::to_string(res));
   TriangleSurface chamber, body;
   TwistingRobotSurfaces(P, &chamber, &body);
   const TessellationOptions topt = TwistingRobotTessellation(res, P);
@@ -172,8 +181,9 @@ Scene MakeTwistingRobot(int res, const RobotParams& P) {
       }
     }
     if (n == 0)
-      throw std::invalid_argument("twisting_robot: strip = " + std::to_string(strip) +
-                                  " mm holds no body tet at this resolution; expected a thicker strip");
+      throw std::invalid_argument(
+          "twisting_robot: strip = " + std::to_string(strip) +
+          " mm holds no body tet at this resolution; expected a thicker strip");
     Material m = s.body[0];
     m.name += "+strip";
     m.weight *= Param(P, "strip_weight", 20.0);
@@ -189,7 +199,8 @@ Scene MakeTwistingRobot(int res, const RobotParams& P) {
   s.actuators.push_back(a);
   const double eps = 1e-6 * kTwistLength;
   s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), eps);
-  std::vector<int> tip = VerticesOnPlane(s.mesh, Eigen::Vector3d(0, 0, kTwistLength), Eigen::Vector3d::UnitZ(), eps);
+  std::vector<int> tip =
+      VerticesOnPlane(s.mesh, Eigen::Vector3d(0, 0, kTwistLength), Eigen::Vector3d::UnitZ(), eps);
   int rim = tip.empty() ? -1 : tip[0];
   for (int v : tip)
     if ((s.mesh.vertices.row(v) - Eigen::RowVector3d(kTwistBodyRadius, 0, kTwistLength)).norm() <
@@ -211,18 +222,22 @@ RobotEntry TwistingRobotEntry() {
       "c1 = 0.0418, c2 = 0.0106 MPa; region 0) with a spiral tube chamber (region 1, pneumatic "
       "actuator 'chamber', volume ratio in [1, 120]) around the helix of radius helix_radius from "
       "z = 8 to 92, meshed by CGAL Mesh_3 from generated surfaces, T(S_c, S_b) "
-      "(solver/remesh/tessellation.hpp). For large ratios use progressive remeshing (solver/remesh/remesh.hpp). "
+      "(solver/remesh/tessellation.hpp). For large ratios use progressive remeshing "
+      "(solver/remesh/remesh.hpp). "
       "Markers: tip (face z = 100), tip_rim (its vertex nearest (10, 0, 100)).",
       kTwistDefaultRes,
       "Mesh_3 cell size 8/res mm (facet size the same, facet distance 0.05 of it), integer in "
       "[1, 6]; 6.2k / 10.8k / 18.0k / 29.2k tets at res 1 / 2 / 3 / 4 (docs/remeshing.md)",
       {{"helix_radius", 5.0, 2.0, 7.0, "radius of the chamber's helical centreline, mm"},
-       {"tube_radius", 2.5, 1.0, 4.0, "radius of the chamber tube, mm (helix_radius + tube_radius <= 9)"},
+       {"tube_radius", 2.5, 1.0, 4.0,
+        "radius of the chamber tube, mm (helix_radius + tube_radius <= 9)"},
        {"turns", kTwistDefaultTurns, 1.0, 8.0, "turns of the helix between z = 8 and z = 92"},
        {"hyperelastic", 1.0, 0.0, 1.0,
-        "1: Ecoflex 00-30 Mooney-Rivlin body (Eq. 3.6-3.7); 0: Ch. 2 shape blending with R_omega = 1"},
+        "1: Ecoflex 00-30 Mooney-Rivlin body (Eq. 3.6-3.7); 0: Ch. 2 shape blending with R_omega = "
+        "1"},
        {"strip", 0.0, 0.0, 6.0,
-        "thickness (mm, from the +x side) of a strain-limiting strip along the body (region 2); 0: none. "
+        "thickness (mm, from the +x side) of a strain-limiting strip along the body (region 2); 0: "
+        "none. "
         "With a strip the robot bends toward +x as it twists, and coils (Fig. 3.8)"},
        {"strip_weight", 20.0, 1.0, 1000.0, "the strip's element weight, relative to the body's"}}};
   return {info, kTwistMinRes, kTwistMaxRes, &MakeTwistingRobot};
@@ -231,10 +246,12 @@ RobotEntry TwistingRobotEntry() {
 }  // namespace robots_detail
 
 double TwistAboutAxisDegrees(const Eigen::Ref<const Eigen::MatrixX3d>& P,
-                             const Eigen::Ref<const Eigen::MatrixX3d>& Q, const Eigen::Vector3d& axis) {
+                             const Eigen::Ref<const Eigen::MatrixX3d>& Q,
+                             const Eigen::Vector3d& axis) {
   if (P.rows() != Q.rows() || P.rows() < 3)
-    throw std::invalid_argument("TwistAboutAxisDegrees: expected two point sets of the same size >= 3, got " +
-                                std::to_string(P.rows()) + " and " + std::to_string(Q.rows()));
+    throw std::invalid_argument(
+        "TwistAboutAxisDegrees: expected two point sets of the same size >= 3, got " +
+        std::to_string(P.rows()) + " and " + std::to_string(Q.rows()));
   const Eigen::RowVector3d pc = P.colwise().mean(), qc = Q.colwise().mean();
   const Eigen::MatrixX3d Pc = P.rowwise() - pc, Qc = Q.rowwise() - qc;
   // R maximises tr(R^T Qc^T Pc): the rotation taking the rest points onto the deformed ones.
@@ -248,17 +265,19 @@ double TwistAboutAxisDegrees(const Eigen::Ref<const Eigen::MatrixX3d>& P,
   return deg;
 }
 
-std::vector<double> TwistProfileDegrees(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX3d>& X,
-                                        double length, int sections, int body_region,
-                                        const std::string& tip) {
+std::vector<double> TwistProfileDegrees(const Scene& scene,
+                                        const Eigen::Ref<const Eigen::MatrixX3d>& X, double length,
+                                        int sections, int body_region, const std::string& tip) {
   const Mesh& m = scene.mesh;
   if (X.rows() != m.num_vertices())
     throw std::invalid_argument("TwistProfileDegrees: positions have " + std::to_string(X.rows()) +
-                                " rows, the mesh " + std::to_string(m.num_vertices()) + " vertices");
+                                " rows, the mesh " + std::to_string(m.num_vertices()) +
+                                " vertices");
   if (sections < 1 || !(length > 0))
     throw std::invalid_argument("TwistProfileDegrees: expected sections >= 1 and length > 0");
   const int mi = scene.marker_index(tip);
-  if (mi < 0) throw std::invalid_argument("TwistProfileDegrees: the scene has no marker '" + tip + "'");
+  if (mi < 0)
+    throw std::invalid_argument("TwistProfileDegrees: the scene has no marker '" + tip + "'");
   std::vector<char> in_body(m.num_vertices(), 0);
   for (const auto& e : m.elements)
     if (e.region == body_region)
@@ -277,7 +296,8 @@ std::vector<double> TwistProfileDegrees(const Scene& scene, const Eigen::Ref<con
     const auto& ids = slab[s];
     if (ids.size() < 3)
       throw std::invalid_argument("TwistProfileDegrees: section " + std::to_string(s) + " has " +
-                                  std::to_string(ids.size()) + " body vertices; expected >= 3 (fewer sections?)");
+                                  std::to_string(ids.size()) +
+                                  " body vertices; expected >= 3 (fewer sections?)");
     Eigen::MatrixX3d P(ids.size(), 3), Q(ids.size(), 3);
     for (size_t i = 0; i < ids.size(); ++i) {
       P.row(i) = m.vertices.row(ids[i]);

@@ -47,7 +47,8 @@ TriangleSurface MakeHelicalTubeSurface(double helix_radius, double turns, double
 
 /// The body S_b and chamber S_c surfaces of the twisting robot with design parameters
 /// `params` (helix_radius, tube_radius, turns; defaults as in the file comment; others ignored).
-void TwistingRobotSurfaces(const RobotParams& params, TriangleSurface* chamber, TriangleSurface* body);
+void TwistingRobotSurfaces(const RobotParams& params, TriangleSurface* chamber,
+                           TriangleSurface* body);
 
 /// Mesh_3 sizing of the twisting robot at resolution res (1..6): cell_size = facet_size =
 /// 8 / res mm, chamber_cell_size = min(cell_size, 0.8 tube_radius) (so the tube has interior
@@ -66,7 +67,8 @@ Scene MakeTwistingRobot(int res, const RobotParams& params);
 /// (Kabsch) is split as R = R_swing R_twist with R_twist about `axis` (unit, rest frame), and the
 /// angle of R_twist is returned (right-hand rule about `axis`).
 double TwistAboutAxisDegrees(const Eigen::Ref<const Eigen::MatrixX3d>& P,
-                             const Eigen::Ref<const Eigen::MatrixX3d>& Q, const Eigen::Vector3d& axis);
+                             const Eigen::Ref<const Eigen::MatrixX3d>& Q,
+                             const Eigen::Vector3d& axis);
 
 /// Twist profile of a robot along the z axis: the body-region vertices (region `body_region`)
 /// whose rest z lies within each of `sections` equal slabs of [0, length] are fitted with
@@ -75,8 +77,9 @@ double TwistAboutAxisDegrees(const Eigen::Ref<const Eigen::MatrixX3d>& P,
 /// differ by at most 180 degrees: the result can exceed one turn. Returns `sections` angles
 /// (degrees); X: #V x 3 positions (mm). Throws std::invalid_argument if a slab has < 3 vertices
 /// or the marker is missing.
-std::vector<double> TwistProfileDegrees(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX3d>& X,
-                                        double length, int sections = 20, int body_region = 0,
+std::vector<double> TwistProfileDegrees(const Scene& scene,
+                                        const Eigen::Ref<const Eigen::MatrixX3d>& X, double length,
+                                        int sections = 20, int body_region = 0,
                                         const std::string& tip = "tip");
 
 }  // namespace softkin

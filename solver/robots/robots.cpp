@@ -20,16 +20,11 @@ using robots_detail::RobotEntry;
 /// Every robot, in ListRobots() order.
 const std::vector<RobotEntry>& Registry() {
   static const std::vector<RobotEntry> kRobots = {
-      robots_detail::PneumaticFingerEntry(),
-      robots_detail::ThreeChamberEntry(),
-      robots_detail::CableFingerEntry(),
-      robots_detail::FingerManipulatorEntry(),
-      robots_detail::MultiSegmentGripperEntry(),
-      robots_detail::DeaCrawlerEntry(),
-      robots_detail::BimaterialBarEntry(),
-      robots_detail::CableGripperEntry(),
-      robots_detail::SelfCollisionFingerEntry(),
-      robots_detail::MembraneEntry(),
+      robots_detail::PneumaticFingerEntry(),     robots_detail::ThreeChamberEntry(),
+      robots_detail::CableFingerEntry(),         robots_detail::FingerManipulatorEntry(),
+      robots_detail::MultiSegmentGripperEntry(), robots_detail::DeaCrawlerEntry(),
+      robots_detail::BimaterialBarEntry(),       robots_detail::CableGripperEntry(),
+      robots_detail::SelfCollisionFingerEntry(), robots_detail::MembraneEntry(),
       robots_detail::TwistingRobotEntry(),
   };
   return kRobots;
@@ -64,8 +59,8 @@ Scene MakeRobot(const std::string& name, int res, const RobotParams& params) {
       }
       if (!(value >= it->lo && value <= it->hi))
         throw std::invalid_argument(name + ": parameter '" + key + "' must be in [" +
-                                    FormatNumber(it->lo) + ", " + FormatNumber(it->hi) +
-                                    "], got " + FormatNumber(value));
+                                    FormatNumber(it->lo) + ", " + FormatNumber(it->hi) + "], got " +
+                                    FormatNumber(value));
       full[key] = value;
     }
     return r.make(res, full);

@@ -48,7 +48,8 @@ double ShearModulus(const std::string& named) {
 Scene MakeSelfCollisionFinger(int res, const RobotParams& P) {
   const double h = kFingerWidth / res;
   const int ny = res, nz = static_cast<int>(std::lround(kFingerHeight / h));
-  const int base = Cells(kFingerBase, h), floor = Cells(kFingerFloor, h), wall = Cells(P.at("wall"), h);
+  const int base = Cells(kFingerBase, h), floor = Cells(kFingerFloor, h),
+            wall = Cells(P.at("wall"), h);
   const int cavity = Cells(kScfCavity, h);
   const int pitch = 2 * wall + cavity;
   const int nx = static_cast<int>(std::lround(kFingerLength / h));
@@ -59,7 +60,8 @@ Scene MakeSelfCollisionFinger(int res, const RobotParams& P) {
     if (k < base) return 2;
     if (k < base + floor || i < proximal) return 0;
     const int w = (i - proximal) % pitch;
-    const bool inside = w >= wall && w < wall + cavity && j >= wall && j < ny - wall && k < nz - wall;
+    const bool inside =
+        w >= wall && w < wall + cavity && j >= wall && j < ny - wall && k < nz - wall;
     return inside ? 1 : 0;
   };
   Mesh mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz), cell);
@@ -68,9 +70,12 @@ Scene MakeSelfCollisionFinger(int res, const RobotParams& P) {
   const double z_floor = (base + floor) * h, tol = 1e-6 * h;
   for (int q = chambers - 1; q >= 1; --q) {
     const double xs = (proximal + q * pitch) * h;
-    CutSlit(&mesh,
-            [&](const Eigen::Vector3d& p) { return std::abs(p.x() - xs) < tol && p.z() > z_floor + tol; },
-            [&](const Eigen::Vector3d& c) { return c.x() > xs; }, Eigen::Vector3d(kScfGap, 0, 0));
+    CutSlit(
+        &mesh,
+        [&](const Eigen::Vector3d& p) {
+          return std::abs(p.x() - xs) < tol && p.z() > z_floor + tol;
+        },
+        [&](const Eigen::Vector3d& c) { return c.x() > xs; }, Eigen::Vector3d(kScfGap, 0, 0));
   }
   Scene s;
   s.name = "selfcollision_finger";
@@ -100,17 +105,20 @@ Scene MakeSelfCollisionFinger(int res, const RobotParams& P) {
 RobotEntry SelfCollisionFingerEntry() {
   const RobotInfo info = {
       "selfcollision_finger",
-      "PneuNet finger with 0.2 mm slits between its chambers, whose walls press on each other as they swell "
+      "PneuNet finger with 0.2 mm slits between its chambers, whose walls press on each other as "
+      "they swell "
       "(thesis Sec. 3.4.2, Fig. 3.9-3.10): 120 x 20 x 15 mm, x = long axis (x = 0 fixed), "
       "inextensible base layer (region 2), Mooney-Rivlin body (region 0; material 0 = Ecoflex "
       "00-30, 1 = Dragon Skin 20, weighted by shear modulus), cavities (region 1) = pneumatic "
       "actuator 'chamber' (volume ratio in [1, 6]). Self-collision response on. Markers: tip, "
       "tip_top, tip_bottom.",
-      kScfDefaultRes, "cells across the 20 mm width (cell size 20/res mm), integer in [5, 32]",
+      kScfDefaultRes,
+      "cells across the 20 mm width (cell size 20/res mm), integer in [5, 32]",
       {{"material", 0.0, 0.0, 1.0, "0: Ecoflex 00-30, 1: Dragon Skin 20 (rounded)"},
        {"wall", kFingerWall, 1.0, 5.0,
         "chamber wall thickness, mm, snapped to whole cells (at least one): one tet layer at the "
-        "default 1.5 mm, whose walls invert under contact on fine meshes (docs/collision_response.md)"}}};
+        "default 1.5 mm, whose walls invert under contact on fine meshes "
+        "(docs/collision_response.md)"}}};
   return {info, kScfMinRes, kScfMaxRes, &MakeSelfCollisionFinger};
 }
 

@@ -12,21 +12,41 @@ namespace softkin {
 
 const char* ActuatorTypeToString(ActuatorType t) {
   switch (t) {
-    case ActuatorType::Pneumatic: return "pneumatic";
-    case ActuatorType::Cable: return "cable";
-    case ActuatorType::Dea: return "dea";
-    case ActuatorType::Displacement: return "displacement";
-    case ActuatorType::Twist: return "twist";
+    case ActuatorType::Pneumatic:
+      return "pneumatic";
+    case ActuatorType::Cable:
+      return "cable";
+    case ActuatorType::Dea:
+      return "dea";
+    case ActuatorType::Displacement:
+      return "displacement";
+    case ActuatorType::Twist:
+      return "twist";
   }
   return "unknown";
 }
 
 bool ActuatorTypeFromString(const std::string& s, ActuatorType* t) {
-  if (s == "pneumatic") { *t = ActuatorType::Pneumatic; return true; }
-  if (s == "cable") { *t = ActuatorType::Cable; return true; }
-  if (s == "dea") { *t = ActuatorType::Dea; return true; }
-  if (s == "displacement") { *t = ActuatorType::Displacement; return true; }
-  if (s == "twist") { *t = ActuatorType::Twist; return true; }
+  if (s == "pneumatic") {
+    *t = ActuatorType::Pneumatic;
+    return true;
+  }
+  if (s == "cable") {
+    *t = ActuatorType::Cable;
+    return true;
+  }
+  if (s == "dea") {
+    *t = ActuatorType::Dea;
+    return true;
+  }
+  if (s == "displacement") {
+    *t = ActuatorType::Displacement;
+    return true;
+  }
+  if (s == "twist") {
+    *t = ActuatorType::Twist;
+    return true;
+  }
   return false;
 }
 
@@ -90,15 +110,16 @@ std::string BodyMaterialError(int tag, const Material& mat) {
   if (!(mat.r_omega >= 0.0 && mat.r_omega <= 1.0))
     return "body region " + std::to_string(tag) + ": r_omega must be in [0, 1], got " +
            std::to_string(mat.r_omega);
-  if (!(mat.weight > 0.0))
-    return "body region " + std::to_string(tag) + ": weight must be > 0";
+  if (!(mat.weight > 0.0)) return "body region " + std::to_string(tag) + ": weight must be > 0";
   if (mat.law != "blend" && mat.law != "mooney-rivlin")
     return "body region " + std::to_string(tag) +
            ": law must be \"blend\" or \"mooney-rivlin\", got \"" + mat.law + "\"";
   if (mat.hyperelastic() && !(mat.c1 >= 0 && mat.c2 >= 0 && mat.c1 + mat.c2 > 0 && mat.r_omega > 0))
-    return "body region " + std::to_string(tag) + ": a mooney-rivlin material needs c1, c2 >= 0 "
-           "with c1 + c2 > 0 (MPa) and r_omega > 0, got c1 = " + std::to_string(mat.c1) +
-           ", c2 = " + std::to_string(mat.c2) + ", r_omega = " + std::to_string(mat.r_omega);
+    return "body region " + std::to_string(tag) +
+           ": a mooney-rivlin material needs c1, c2 >= 0 "
+           "with c1 + c2 > 0 (MPa) and r_omega > 0, got c1 = " +
+           std::to_string(mat.c1) + ", c2 = " + std::to_string(mat.c2) +
+           ", r_omega = " + std::to_string(mat.r_omega);
   return "";
 }
 
@@ -124,14 +145,12 @@ std::string ActuatorError(const Actuator& a, int num_vertices, std::set<int>* mo
     for (int v : a.vertices) {
       if (v < 0 || v >= num_vertices)
         return what + ": moved vertex " + std::to_string(v) + " is out of range";
-      if (!own.insert(v).second)
-        return what + ": vertex " + std::to_string(v) + " is listed twice";
+      if (!own.insert(v).second) return what + ": vertex " + std::to_string(v) + " is listed twice";
       moved->insert(v);
     }
     if (!(a.axis.allFinite() && a.axis.norm() > 0)) return what + ": expected a non-zero axis";
     if (!a.centre.allFinite()) return what + ": the centre must be finite";
-    if (!(std::isfinite(a.min) && std::isfinite(a.max)))
-      return what + ": expected a finite range";
+    if (!(std::isfinite(a.min) && std::isfinite(a.max))) return what + ": expected a finite range";
     return "";
   }
   if (a.is_signed()) {
@@ -179,8 +198,8 @@ void Scene::validate() const {
     for (int r : all) {
       auto it = role.find(r);
       if (it != role.end())
-        fail("region " + std::to_string(r) + " is both " + it->second + " and actuator '" +
-             a.name + "'");
+        fail("region " + std::to_string(r) + " is both " + it->second + " and actuator '" + a.name +
+             "'");
       role[r] = "actuator '" + a.name + "'";
     }
   }
@@ -188,8 +207,9 @@ void Scene::validate() const {
   for (const auto& e : mesh.elements) used.insert(e.region);
   if (!region_rest.regions.empty()) {
     if (region_rest.positions.rows() != mesh.num_vertices())
-      fail("region_rest: expected one row of rest positions per vertex (" + std::to_string(mesh.num_vertices()) +
-           "), got " + std::to_string(region_rest.positions.rows()));
+      fail("region_rest: expected one row of rest positions per vertex (" +
+           std::to_string(mesh.num_vertices()) + "), got " +
+           std::to_string(region_rest.positions.rows()));
     if (!region_rest.positions.allFinite()) fail("region_rest: expected finite rest positions");
     for (int r : region_rest.regions)
       if (!used.count(r)) fail("region_rest: region " + std::to_string(r) + " has no elements");
@@ -250,7 +270,8 @@ void Scene::validate() const {
   if (!solver.IsValid(&why)) fail("solver options: " + why);
 }
 
-std::vector<int> VerticesInBox(const Mesh& m, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+std::vector<int> VerticesInBox(const Mesh& m, const Eigen::Vector3d& lo,
+                               const Eigen::Vector3d& hi) {
   std::vector<int> out;
   for (int i = 0; i < m.num_vertices(); ++i) {
     Eigen::Vector3d x = m.vertices.row(i).transpose();
@@ -284,7 +305,10 @@ int NearestVertex(const Mesh& m, const Eigen::Vector3d& p) {
   double bd = 0;
   for (int i = 0; i < m.num_vertices(); ++i) {
     double d = (m.vertices.row(i).transpose() - p).squaredNorm();
-    if (best < 0 || d < bd) { best = i; bd = d; }
+    if (best < 0 || d < bd) {
+      best = i;
+      bd = d;
+    }
   }
   return best;
 }

@@ -43,19 +43,20 @@ bool ActuatorTypeFromString(const std::string& s, ActuatorType* t);
 /// Pneumatic: value = total volume ratio alpha (rest 1). Signed pneumatic (non-empty
 /// `negative_regions`, thesis Sec. 5.3.1): value v (rest 0), v > 0 drives the chambers in `regions`
 /// to volume ratio 1 + gain v, v < 0 those in `negative_regions` to 1 + gain |v|; the other side
-/// is vented (its elements follow the deformation with no energy: targets.hpp, kVented). Cable: shortening ratio s (rest 1). DEA: area ratio lambda (rest 1).
-/// Displacement: translation (mm) of `vertices` along `axis`. Twist: rotation (degrees, right-hand
-/// rule) of `vertices` about the line through `centre` along `axis`. Motion actuators have no
-/// regions; their vertices are held (every coordinate) at the moved positions. A vertex moved by
-/// several motion actuators gets their motions composed in actuator order (each applied to the
-/// position left by the previous ones; a twist's centre and axis are fixed in space).
+/// is vented (its elements follow the deformation with no energy: targets.hpp, kVented). Cable:
+/// shortening ratio s (rest 1). DEA: area ratio lambda (rest 1). Displacement: translation (mm) of
+/// `vertices` along `axis`. Twist: rotation (degrees, right-hand rule) of `vertices` about the line
+/// through `centre` along `axis`. Motion actuators have no regions; their vertices are held (every
+/// coordinate) at the moved positions. A vertex moved by several motion actuators gets their
+/// motions composed in actuator order (each applied to the position left by the previous ones; a
+/// twist's centre and axis are fixed in space).
 struct Actuator {
   std::string name;
   ActuatorType type = ActuatorType::Pneumatic;
   std::vector<int> regions;
-  double min = 1.0;   ///< lower bound of the actuation value
-  double max = 2.0;   ///< upper bound of the actuation value
-  double rest = 1.0;  ///< value at which the actuator is at rest
+  double min = 1.0;     ///< lower bound of the actuation value
+  double max = 2.0;     ///< upper bound of the actuation value
+  double rest = 1.0;    ///< value at which the actuator is at rest
   double weight = 5.0;  ///< w_i of its elements (Sec. 2.5: 5 vs 1 for body elements)
   /// Cable only: the cable's path, a polyline of >= 2 points (mm), from its anchored end to where
   /// it is pulled. Its length is L; the part inside the actuator's elements is sum l_i, the rest
@@ -97,9 +98,9 @@ struct Marker {
 struct Scene {
   std::string name;
   Mesh mesh;
-  std::map<int, Material> body;      ///< region tag -> body material
-  std::vector<Actuator> actuators;   ///< in actuation-vector order
-  std::vector<int> fixed;            ///< sorted, unique vertex indices held at rest positions
+  std::map<int, Material> body;     ///< region tag -> body material
+  std::vector<Actuator> actuators;  ///< in actuation-vector order
+  std::vector<int> fixed;           ///< sorted, unique vertex indices held at rest positions
   /// Vertices with only some coordinates held at their rest values: fixed_axis[d] lists (sorted,
   /// unique) the vertices whose coordinate d is held, e.g. fixed_axis[2] for vertices sliding on a
   /// plane z = const. Vertices in `fixed` need not be repeated here.
@@ -108,16 +109,16 @@ struct Scene {
   /// Static obstacles (closed, outward-oriented surfaces, mm) the robot must stay out of (Eq. 3.4);
   /// the local-global solvers respond to them with springs (FkOptions::collision).
   std::vector<TriangleSurface> obstacles;
-  FkOptions solver;                  ///< default solver options for this scene
-  /// Rest positions for the elements of some regions when they differ from mesh.vertices. Progressive
-  /// remeshing (remesh.hpp, thesis Algorithm 2) gives a re-tessellated chamber the shape it was
-  /// meshed in as its rest shape, while the body tets sharing its interface vertices keep theirs
-  /// (mesh.vertices). Empty `regions`: none. Such a scene has no zero-energy state (the interface
-  /// vertices rest differently for the two sides), so warm-start its solves from the state it was
-  /// remeshed in; exporters that need one rest mesh (CalculiX) refuse it.
+  FkOptions solver;  ///< default solver options for this scene
+  /// Rest positions for the elements of some regions when they differ from mesh.vertices.
+  /// Progressive remeshing (remesh.hpp, thesis Algorithm 2) gives a re-tessellated chamber the
+  /// shape it was meshed in as its rest shape, while the body tets sharing its interface vertices
+  /// keep theirs (mesh.vertices). Empty `regions`: none. Such a scene has no zero-energy state (the
+  /// interface vertices rest differently for the two sides), so warm-start its solves from the
+  /// state it was remeshed in; exporters that need one rest mesh (CalculiX) refuse it.
   struct RegionRest {
-    std::vector<int> regions;     ///< region tags whose elements use `positions`
-    Eigen::MatrixX3d positions;   ///< #V x 3, mm (only the rows of those elements' vertices matter)
+    std::vector<int> regions;    ///< region tags whose elements use `positions`
+    Eigen::MatrixX3d positions;  ///< #V x 3, mm (only the rows of those elements' vertices matter)
   } region_rest;
 
   int num_actuators() const { return static_cast<int>(actuators.size()); }

@@ -50,7 +50,9 @@ json ParseText(const std::string& text, const std::string& source) {
   };
   json::parser_callback_t cb = [&](int, json::parse_event_t ev, json& parsed) {
     switch (ev) {
-      case json::parse_event_t::object_start: stack.push_back(Frame{}); break;
+      case json::parse_event_t::object_start:
+        stack.push_back(Frame{});
+        break;
       case json::parse_event_t::array_start: {
         Frame f;
         f.array = true;
@@ -170,8 +172,7 @@ void SceneParser::CheckObject(const json& obj, const std::string& pattern, const
           known = true;
           roles.insert(roles.end(), s.roles.begin(), s.roles.end());
         }
-      if (known && !any_role)
-      {
+      if (known && !any_role) {
         const std::string word =
             (pattern == "motions[]" || pattern == "obstacles[]") ? "type" : "role";
         Fail(Join(path, key) + ": not allowed for " + word + " '" + role + "' (only for " + word +
@@ -183,8 +184,8 @@ void SceneParser::CheckObject(const json& obj, const std::string& pattern, const
           hint = "did you mean '" + a + "'? ";
           break;
         }
-      Fail(At(path) + "unknown key '" + key + "' (" + hint + "expected one of: " +
-           ListText(allowed) + ")");
+      Fail(At(path) + "unknown key '" + key + "' (" + hint +
+           "expected one of: " + ListText(allowed) + ")");
     }
     if (!k->with.empty() && !obj.contains(k->with))
       Fail(Join(path, key) + ": only allowed together with '" + k->with + "'");
@@ -260,7 +261,8 @@ Scene SceneParser::Build(const json& root) {
 
 }  // namespace scene_json_detail
 
-Scene ParseSceneJson(const std::string& text, const std::string& source, const std::string& base_dir) {
+Scene ParseSceneJson(const std::string& text, const std::string& source,
+                     const std::string& base_dir) {
   const scene_json_detail::json root = scene_json_detail::ParseText(text, source);
   return scene_json_detail::SceneParser(source, base_dir).Build(root);
 }

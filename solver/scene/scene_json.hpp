@@ -13,7 +13,8 @@ namespace softkin {
 /// Loads a scene JSON; relative paths inside it are relative to the JSON's folder.
 Scene LoadSceneJson(const std::string& path);
 /// Parses scene JSON text; `source` names it in messages, `base_dir` resolves relative paths.
-Scene ParseSceneJson(const std::string& text, const std::string& source, const std::string& base_dir);
+Scene ParseSceneJson(const std::string& text, const std::string& source,
+                     const std::string& base_dir);
 /// Human-readable schema: every key with its type, default and doc line.
 std::string SceneSchema();
 

@@ -24,12 +24,18 @@ void SceneParser::ReadMeshSection(const json& m, Scene* scene) const {
   const std::string tag_array = Get(m, "mesh", "tag_array").get<std::string>();
   if (format == "auto") {
     std::string ext = file.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (ext == ".tet") format = "tet";
-    else if (ext == ".node" || ext == ".ele") format = "tetgen";
-    else if (ext == ".msh") format = "gmsh";
-    else if (ext == ".vtk") format = "vtk";
-    else if (ext.empty() && fs::exists(file.string() + ".node")) format = "tetgen";
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return std::tolower(c); });
+    if (ext == ".tet")
+      format = "tet";
+    else if (ext == ".node" || ext == ".ele")
+      format = "tetgen";
+    else if (ext == ".msh")
+      format = "gmsh";
+    else if (ext == ".vtk")
+      format = "vtk";
+    else if (ext.empty() && fs::exists(file.string() + ".node"))
+      format = "tetgen";
     else
       Fail("mesh.format: cannot tell the mesh format of '" + file.string() +
            "' from its extension; expected a .tet, .node, .ele, .msh or .vtk file, or mesh.format "
@@ -46,8 +52,8 @@ void SceneParser::ReadMeshSection(const json& m, Scene* scene) const {
     fs::path base = (ext == ".node" || ext == ".ele") ? fs::path(file).replace_extension() : file;
     for (const char* e : {".node", ".ele"})
       if (!fs::is_regular_file(base.string() + e))
-        Fail("mesh.file: file not found: '" + base.string() + e + "' (from mesh.file \"" + file_key +
-             "\"; expected an existing TetGen .node and .ele pair)");
+        Fail("mesh.file: file not found: '" + base.string() + e + "' (from mesh.file \"" +
+             file_key + "\"; expected an existing TetGen .node and .ele pair)");
     read_path = base;
   } else if (!fs::is_regular_file(file)) {
     Fail("mesh.file: file not found: '" + file.string() + "' (from mesh.file \"" + file_key +
@@ -62,10 +68,14 @@ void SceneParser::ReadMeshSection(const json& m, Scene* scene) const {
   }
 
   try {
-    if (format == "tet") scene->mesh = ReadTet(read_path.string(), labels_path.string());
-    else if (format == "tetgen") scene->mesh = ReadTetGen(read_path.string());
-    else if (format == "gmsh") scene->mesh = ReadGmsh(read_path.string());
-    else scene->mesh = ReadVtk(read_path.string(), tag_array);
+    if (format == "tet")
+      scene->mesh = ReadTet(read_path.string(), labels_path.string());
+    else if (format == "tetgen")
+      scene->mesh = ReadTetGen(read_path.string());
+    else if (format == "gmsh")
+      scene->mesh = ReadGmsh(read_path.string());
+    else
+      scene->mesh = ReadVtk(read_path.string(), tag_array);
   } catch (const std::exception& e) {
     // Keep the reader's "<file>:<line>: ..." message intact; add the key it came from.
     const std::string what = e.what();

@@ -33,8 +33,8 @@ std::vector<TriangleSurface> SceneParser::ReadObstacles(const json& obstacles) c
       if (type == "box") {
         s = MakeBoxSurface(AsVec(o.at("min")), AsVec(o.at("max")));
       } else if (type == "cylinder") {
-        s = MakeCylinderSurface(AsVec(o.at("base")), AsVec(o.at("axis")), o.at("radius").get<double>(),
-                                o.at("height").get<double>(),
+        s = MakeCylinderSurface(AsVec(o.at("base")), AsVec(o.at("axis")),
+                                o.at("radius").get<double>(), o.at("height").get<double>(),
                                 AsInt(Get(o, "obstacles[]", "segments", type)));
       } else {
         s = ReadSurfaceMesh(file.string());

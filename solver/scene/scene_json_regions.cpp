@@ -18,9 +18,9 @@ struct SceneParser::ActuatorEntry {
     double value;
     std::string path;
   };
-  int index;                  ///< in scene->actuators
+  int index;  ///< in scene->actuators
   std::string role, role_path;
-  std::string negative_path;  ///< the first region with side "negative" (signed actuator)
+  std::string negative_path;           ///< the first region with side "negative" (signed actuator)
   std::map<std::string, Given> given;  ///< range keys given by the entries, with where from
 };
 
@@ -57,7 +57,7 @@ void SceneParser::ReadRegions(const json& regions, Scene* scene) const {
 }
 
 Material SceneParser::ReadBodyMaterial(const json& r, const std::string& path,
-                                      const std::string& role) const {
+                                       const std::string& role) const {
   Material mat;
   mat.name = Get(r, "regions[]", "material", role).get<std::string>();
   mat.r_omega = Get(r, "regions[]", "r_omega", role).get<double>();
@@ -79,7 +79,8 @@ Material SceneParser::ReadBodyMaterial(const json& r, const std::string& path,
     mat.c1 = r.contains("c1") ? r.at("c1").get<double>() : mr.c1;
     mat.c2 = r.contains("c2") ? r.at("c2").get<double>() : mr.c2;
     if (!(mat.c1 + mat.c2 > 0)) Fail(path + ": expected c1 + c2 > 0 for law mooney-rivlin");
-    if (!(mat.r_omega > 0)) Fail(path + ".r_omega: expected a zero-strain R_omega > 0 for law mooney-rivlin");
+    if (!(mat.r_omega > 0))
+      Fail(path + ".r_omega: expected a zero-strain R_omega > 0 for law mooney-rivlin");
   }
   return mat;
 }
@@ -141,7 +142,8 @@ void SceneParser::FinishActuator(const std::string& name, const ActuatorEntry& i
   Actuator& a = *out;
   auto value = [&](const char* key) {
     auto g = info.given.find(key);
-    return g != info.given.end() ? g->second.value : Spec("regions[]", key, info.role)->def.get<double>();
+    return g != info.given.end() ? g->second.value
+                                 : Spec("regions[]", key, info.role)->def.get<double>();
   };
   const std::string entry = info.role_path.substr(0, info.role_path.size() - 5);
   auto where = [&](const char* key) {
@@ -172,7 +174,8 @@ void SceneParser::FinishActuator(const std::string& name, const ActuatorEntry& i
   }
   if (info.given.count("gain"))
     Fail(where("gain") + ": actuator '" + name +
-         "' is not signed (no region with side \"negative\"); gain applies to signed actuators only");
+         "' is not signed (no region with side \"negative\"); gain applies to signed actuators "
+         "only");
   a.min = value("min");
   a.max = value("max");
   a.rest = value("rest");
@@ -180,10 +183,9 @@ void SceneParser::FinishActuator(const std::string& name, const ActuatorEntry& i
     if (!(value(key) > 0.0))
       Fail(where(key) + ": actuator '" + name + "': expected a ratio > 0, got " + Num(value(key)));
   if (!(a.min <= a.rest && a.rest <= a.max)) {
-    Fail(entry + ": actuator '" + name +
-         "': expected min <= rest <= max, got min " + Num(a.min) + " (" + where("min") +
-         "), rest " + Num(a.rest) + " (" + where("rest") + "), max " + Num(a.max) + " (" +
-         where("max") + ")");
+    Fail(entry + ": actuator '" + name + "': expected min <= rest <= max, got min " + Num(a.min) +
+         " (" + where("min") + "), rest " + Num(a.rest) + " (" + where("rest") + "), max " +
+         Num(a.max) + " (" + where("max") + ")");
   }
 }
 

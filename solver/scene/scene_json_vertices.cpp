@@ -49,13 +49,14 @@ std::vector<int> SceneParser::ReadIndexFile(const json& entry, const std::string
     while (tokens >> tok) {
       long long v = 0;
       const auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), v);
-      const std::string where = path + ".file: " + file.string() + ":" + std::to_string(line_no) + ": ";
+      const std::string where =
+          path + ".file: " + file.string() + ":" + std::to_string(line_no) + ": ";
       if (ec != std::errc() || ptr != tok.data() + tok.size())
         Fail(where + "expected an integer vertex index, got '" + tok + "'");
       if (v - base < 0 || v - base >= n)
         Fail(where + "vertex index " + tok + " is out of range; expected " + std::to_string(base) +
-             " to " + std::to_string(n - 1 + base) + " (" + std::to_string(n) +
-             " vertices, base " + std::to_string(base) + ")");
+             " to " + std::to_string(n - 1 + base) + " (" + std::to_string(n) + " vertices, base " +
+             std::to_string(base) + ")");
       out.push_back(static_cast<int>(v - base));
     }
   }
@@ -87,7 +88,8 @@ std::vector<int> SceneParser::ReadSelection(const json& f, const std::string& pa
     const double tol = Get(p, pattern + ".plane", "tolerance").get<double>();
     sel = VerticesOnPlane(mesh, point, normal, tol);
     if (sel.empty())
-      Fail(path + ".plane selects no vertex (tolerance " + Num(tol) + "; " + BoundsText(mesh) + ")");
+      Fail(path + ".plane selects no vertex (tolerance " + Num(tol) + "; " + BoundsText(mesh) +
+           ")");
   } else {
     sel = ReadIndexFile(f, pattern, path, mesh);
   }
@@ -109,8 +111,10 @@ void SceneParser::ReadFixed(const json& fixed, Scene* scene) const {
     for (char c : axes) {
       const int d = c == 'x' ? 0 : c == 'y' ? 1 : c == 'z' ? 2 : -1;
       if (d < 0 || held[d])
-        Fail(path + ".axes: expected some of the letters x, y, z, each at most once (e.g. \"xyz\", "
-             "\"z\"), got \"" + axes + "\"");
+        Fail(path +
+             ".axes: expected some of the letters x, y, z, each at most once (e.g. \"xyz\", "
+             "\"z\"), got \"" +
+             axes + "\"");
       held[d] = true;
     }
     if (axes.empty())

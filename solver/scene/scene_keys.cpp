@@ -39,26 +39,31 @@ constexpr Need R = Need::Required, Opt = Need::Optional, Sel = Need::Selector;
 /// name, mesh.
 void AddMeshKeys(std::vector<KeySpec>* t) {
   t->push_back(Key("name", S, Opt, "Scene name, used in messages and output names.")
-                   .Def("").DefText("the JSON file's name without extension"));
+                   .Def("")
+                   .DefText("the JSON file's name without extension"));
   t->push_back(Key("mesh", O, R, "The volumetric mesh and how to read it."));
   t->push_back(Key("mesh.file", S, R,
                    "Mesh file, relative to the JSON's folder (TetGen: the .node or .ele file, or "
                    "the base name)."));
   t->push_back(Key("mesh.format", S, Opt,
                    "Reader; auto picks it from the extension (.tet, .node/.ele, .msh, .vtk).")
-                   .Def("auto").Choices({"auto", "tet", "tetgen", "gmsh", "vtk"}));
+                   .Def("auto")
+                   .Choices({"auto", "tet", "tetgen", "gmsh", "vtk"}));
   t->push_back(Key("mesh.labels", S, Opt,
                    "tet only: file with one region tag per tet, in tet order, relative to the "
                    "JSON's folder (without it every tet is region 0).")
-                   .Def("").DefText("none"));
+                   .Def("")
+                   .DefText("none"));
   t->push_back(Key("mesh.tag_array", S, Opt,
                    "vtk only: integer cell-data array holding the region tags (none: the first "
                    "integer cell-data array).")
-                   .Def("").DefText("none"));
+                   .Def("")
+                   .DefText("none"));
   t->push_back(Key("mesh.scale", N, Opt,
                    "Multiplies every vertex coordinate (e.g. 1000 for a mesh in metres); all "
                    "coordinates below are in scaled units.")
-                   .Def(1.0).Above(0.0));
+                   .Def(1.0)
+                   .Above(0.0));
 }
 
 /// regions[]: body materials and actuator regions.
@@ -68,8 +73,8 @@ void AddRegionKeys(std::vector<KeySpec>* t) {
   t->push_back(Key("regions", A, R,
                    "Role of each region tag; every tag that has elements needs exactly one "
                    "entry."));
-  t->push_back(Key("regions[].tag", I, R,
-                   "Region tag in the mesh (label, physical group, attribute)."));
+  t->push_back(
+      Key("regions[].tag", I, R, "Region tag in the mesh (label, physical group, attribute)."));
   t->push_back(Key("regions[].role", S, R,
                    "body: passive material; pneumatic, cable, dea: the region's elements drive an "
                    "actuator.")
@@ -77,26 +82,39 @@ void AddRegionKeys(std::vector<KeySpec>* t) {
   t->push_back(Key("regions[].material", S, Opt,
                    "Material name. With law mooney-rivlin, a named material (ecoflex-00-30, "
                    "dragon-skin-20; thesis Sec. 3.4) supplies c1 and c2; otherwise informational.")
-                   .Def(mat.name).Roles({"body"}));
+                   .Def(mat.name)
+                   .Roles({"body"}));
   t->push_back(Key("regions[].law", S, Opt,
                    "Body material law: blend (Ch. 2 shape blending, Eq. 2.5, constant r_omega) or "
                    "mooney-rivlin (hyperelastic target, Eq. 3.6-3.7: R_omega a function of strain "
                    "fitted to c1, c2, with r_omega its zero-strain value; docs/materials.md).")
-                   .Def(mat.law).Choices({"blend", "mooney-rivlin"}).Roles({"body"}));
+                   .Def(mat.law)
+                   .Choices({"blend", "mooney-rivlin"})
+                   .Roles({"body"}));
   t->push_back(Key("regions[].c1", N, Opt,
                    "mooney-rivlin: c1, MPa (>= 0). Needed unless 'material' names a known "
                    "material.")
-                   .Def(0.0).DefText("from material").AtLeast(0.0).Roles({"body"}));
+                   .Def(0.0)
+                   .DefText("from material")
+                   .AtLeast(0.0)
+                   .Roles({"body"}));
   t->push_back(Key("regions[].c2", N, Opt,
                    "mooney-rivlin: c2, MPa (>= 0). Needed unless 'material' names a known "
                    "material.")
-                   .Def(0.0).DefText("from material").AtLeast(0.0).Roles({"body"}));
+                   .Def(0.0)
+                   .DefText("from material")
+                   .AtLeast(0.0)
+                   .Roles({"body"}));
   t->push_back(Key("regions[].r_omega", N, Opt,
                    "Shape-blending parameter R_omega (Eq. 2.5): 1 = rigid target "
                    "(as-rigid-as-possible), 0 = volume-preserving soft target.")
-                   .Def(mat.r_omega).In(0.0, 1.0).Roles({"body"}));
+                   .Def(mat.r_omega)
+                   .In(0.0, 1.0)
+                   .Roles({"body"}));
   t->push_back(Key("regions[].weight", N, Opt, "Element weight w_i (Eq. 2.10) of body elements.")
-                   .Def(mat.weight).Above(0.0).Roles({"body"}));
+                   .Def(mat.weight)
+                   .Above(0.0)
+                   .Roles({"body"}));
   t->push_back(Key("regions[].name", S, R,
                    "Actuator name; regions with the same name form one actuator. Actuators are "
                    "ordered by first appearance (the actuation vector's order).")
@@ -114,19 +132,27 @@ void AddRegionKeys(std::vector<KeySpec>* t) {
                    .Roles(kActuatorRoles));
   t->push_back(Key("regions[].rest", N, Opt,
                    "Actuation value at which the actuator is at rest (signed pneumatic: 0).")
-                   .Def(act.rest).DefText(Num(act.rest) + " (signed: 0)").Roles(kActuatorRoles));
+                   .Def(act.rest)
+                   .DefText(Num(act.rest) + " (signed: 0)")
+                   .Roles(kActuatorRoles));
   t->push_back(Key("regions[].side", S, Opt,
                    "pneumatic: which chamber set of the actuator this region belongs to. An "
                    "actuator with a negative region is signed (Sec. 5.3.1): value v > 0 inflates "
                    "its positive regions to volume ratio 1 + gain v, v < 0 its negative ones to "
                    "1 + gain |v|; the other side is vented.")
-                   .Def("positive").Choices({"positive", "negative"}).Roles({"pneumatic"}));
+                   .Def("positive")
+                   .Choices({"positive", "negative"})
+                   .Roles({"pneumatic"}));
   t->push_back(Key("regions[].gain", N, Opt,
                    "Signed pneumatic only: volume ratio per unit of |value| (e.g. per bar).")
-                   .Def(act.gain).Above(0.0).Roles({"pneumatic"}));
+                   .Def(act.gain)
+                   .Above(0.0)
+                   .Roles({"pneumatic"}));
   t->push_back(Key("regions[].weight", N, Opt,
                    "Element weight w_i (Eq. 2.10) of actuation elements (Sec. 2.5 uses 5).")
-                   .Def(act.weight).Above(0.0).Roles(kActuatorRoles));
+                   .Def(act.weight)
+                   .Above(0.0)
+                   .Roles(kActuatorRoles));
   t->push_back(Key("regions[].path", Type::Polyline, R,
                    "cable: the cable's path through the body, from its anchored end to where it "
                    "is pulled (mm). Elements take the direction of the nearest segment; the path "
@@ -146,7 +172,8 @@ void AddSelectorKeys(const std::string& p, std::vector<KeySpec>* t) {
   t->push_back(Key(p + ".plane.point", V, R, "A point on the plane [x, y, z]."));
   t->push_back(Key(p + ".plane.normal", V, R, "Plane normal [x, y, z] (non-zero; normalised)."));
   t->push_back(Key(p + ".plane.tolerance", N, Opt, "Largest distance from the plane.")
-                   .Def(1e-6).AtLeast(0.0));
+                   .Def(1e-6)
+                   .AtLeast(0.0));
   t->push_back(Key(p + ".file", S, Sel,
                    "Text file of vertex indices (whitespace-separated, '#' starts a comment), "
                    "relative to the JSON's folder."));
@@ -169,7 +196,8 @@ void AddFixedAndMotionKeys(std::vector<KeySpec>* t) {
                    "region actuators in the actuation vector, in this order; rest 0. The moved "
                    "vertices are held at the moved positions; a vertex moved by several motions "
                    "gets them composed in order.")
-                   .Def(json::array()).DefText("[]"));
+                   .Def(json::array())
+                   .DefText("[]"));
   t->push_back(Key("motions[].name", S, R, "Actuator name, unique among all actuators."));
   t->push_back(Key("motions[].type", S, R,
                    "displacement: translation (mm) along `axis`; twist: rotation (degrees, "
@@ -179,7 +207,8 @@ void AddFixedAndMotionKeys(std::vector<KeySpec>* t) {
   t->push_back(Key("motions[].axis", V, R,
                    "Direction of the translation, or the rotation axis (non-zero; normalised)."));
   t->push_back(Key("motions[].centre", V, Opt, "A point on the rotation axis.")
-                   .Def(json::array({0.0, 0.0, 0.0})).Roles({"twist"}));
+                   .Def(json::array({0.0, 0.0, 0.0}))
+                   .Roles({"twist"}));
   t->push_back(Key("motions[].min", N, R, "Lower bound of the value (mm or degrees), <= 0."));
   t->push_back(Key("motions[].max", N, R, "Upper bound of the value (mm or degrees), >= 0."));
 }
@@ -193,7 +222,7 @@ void AddMarkerKeys(std::vector<KeySpec>* t) {
   t->push_back(Key("markers[].vertex", I, Sel, "One vertex, by 0-based index."));
   t->push_back(Key("markers[].nearest", V, Sel, "The vertex nearest to this point [x, y, z]."));
   t->push_back(Key("markers[].box", O, Sel,
-                 "The mean of the vertices inside an axis-aligned box (bounds included)."));
+                   "The mean of the vertices inside an axis-aligned box (bounds included)."));
   t->push_back(Key("markers[].box.min", V, R, "Lower corner [x, y, z]."));
   t->push_back(Key("markers[].box.max", V, R, "Upper corner [x, y, z]."));
 }
@@ -203,7 +232,8 @@ void AddObstacleKeys(std::vector<KeySpec>* t) {
   t->push_back(Key("obstacles", A, Opt,
                    "Static obstacles the robot must stay out of (Eq. 3.4): closed surfaces; the "
                    "local-global solvers respond to them with springs (solver.collision).")
-                   .Def(json::array()).DefText("[]"));
+                   .Def(json::array())
+                   .DefText("[]"));
   t->push_back(Key("obstacles[].type", S, R,
                    "box: axis-aligned box; cylinder: closed cylinder; file: a closed, consistently "
                    "oriented OBJ or STL surface.")
@@ -218,12 +248,15 @@ void AddObstacleKeys(std::vector<KeySpec>* t) {
   t->push_back(
       Key("obstacles[].radius", N, R, "Cylinder radius (mm).").Above(0.0).Roles({"cylinder"}));
   t->push_back(Key("obstacles[].height", N, R, "Cylinder length along the axis (mm).")
-                   .Above(0.0).Roles({"cylinder"}));
+                   .Above(0.0)
+                   .Roles({"cylinder"}));
   t->push_back(Key("obstacles[].segments", I, Opt, "Number of sides of the cylinder's polygon.")
-                   .Def(48).AtLeast(3).Roles({"cylinder"}));
-  t->push_back(Key("obstacles[].file", S, R,
-                   "Surface file (.obj or .stl), relative to the JSON's folder.")
-                   .Roles({"file"}));
+                   .Def(48)
+                   .AtLeast(3)
+                   .Roles({"cylinder"}));
+  t->push_back(
+      Key("obstacles[].file", S, R, "Surface file (.obj or .stl), relative to the JSON's folder.")
+          .Roles({"file"}));
 }
 
 /// solver: the scene's default FkOptions.
@@ -241,27 +274,34 @@ void AddSolverKeys(std::vector<KeySpec>* t) {
                    .Choices({"lg", "lg-aa", "ceres", "ipopt-lbfgs", "ipopt-newton", "ipopt-hard",
                              "calculix-linear", "calculix-nonlinear"}));
   t->push_back(Key("solver.max_iterations", I, Opt, "Iteration limit (per continuation step).")
-                   .Def(fk.max_iterations).AtLeast(1));
+                   .Def(fk.max_iterations)
+                   .AtLeast(1));
   t->push_back(Key("solver.tolerance", N, Opt,
                    "Converged when every vertex moves less than tolerance x model size in one "
                    "iteration ...")
-                   .Def(fk.tolerance).Above(0.0));
+                   .Def(fk.tolerance)
+                   .Above(0.0));
   t->push_back(Key("solver.gradient_tolerance", N, Opt,
                    "... and the energy gradient norm is below this fraction of its first value.")
-                   .Def(fk.gradient_tolerance).Above(0.0));
-  t->push_back(Key("solver.anderson_window", I, Opt,
-                   "History length of Anderson acceleration (lg-aa).")
-                   .Def(fk.anderson_window).In(1, 50));
+                   .Def(fk.gradient_tolerance)
+                   .Above(0.0));
+  t->push_back(
+      Key("solver.anderson_window", I, Opt, "History length of Anderson acceleration (lg-aa).")
+          .Def(fk.anderson_window)
+          .In(1, 50));
   t->push_back(Key("solver.anderson_safeguard", S, Opt,
                    "Keep an Anderson step if it lowers the energy or the fixed-point residual "
                    "(hybrid), only if it does not raise the energy (energy), or always (none).")
-                   .Def(fk.anderson_safeguard).Choices({"hybrid", "energy", "none"}));
+                   .Def(fk.anderson_safeguard)
+                   .Choices({"hybrid", "energy", "none"}));
   t->push_back(Key("solver.continuation_steps", I, Opt,
                    "Apply the actuation in this many equal steps, warm-starting each.")
-                   .Def(fk.continuation_steps).AtLeast(1));
-  t->push_back(Key("solver.threads", I, Opt,
-                   "OpenMP threads for the local step (0: library default).")
-                   .Def(fk.threads).AtLeast(0));
+                   .Def(fk.continuation_steps)
+                   .AtLeast(1));
+  t->push_back(
+      Key("solver.threads", I, Opt, "OpenMP threads for the local step (0: library default).")
+          .Def(fk.threads)
+          .AtLeast(0));
 }
 
 /// solver.collision: its CollisionOptions.
@@ -274,41 +314,48 @@ void AddCollisionKeys(std::vector<KeySpec>* t) {
                    "Respond to self-collision: boundary vertices inside tets not incident to them "
                    "(tet meshes only).")
                    .Def(co.self));
-  t->push_back(Key("solver.collision.obstacles", Type::Bool, Opt,
-                   "Respond to the scene's obstacles.")
-                   .Def(co.obstacles));
+  t->push_back(
+      Key("solver.collision.obstacles", Type::Bool, Opt, "Respond to the scene's obstacles.")
+          .Def(co.obstacles));
   t->push_back(Key("solver.collision.epsilon", N, Opt,
                    "Offset of the contact boundary (mm): springs pull vertices this far beyond it "
                    "and release them once they are this far beyond their target (Eq. 3.8).")
-                   .Def(co.epsilon).AtLeast(0.0));
+                   .Def(co.epsilon)
+                   .AtLeast(0.0));
   t->push_back(Key("solver.collision.stiffness", N, Opt,
                    "Spring stiffness k (Eq. 3.5) relative to the median diagonal entry of the "
                    "global matrix over the boundary vertices.")
-                   .Def(co.stiffness).Above(0.0));
+                   .Def(co.stiffness)
+                   .Above(0.0));
   t->push_back(Key("solver.collision.check_interval", I, Opt,
                    "Run collision detection every this many iterations (and before stopping).")
-                   .Def(co.check_interval).AtLeast(1));
+                   .Def(co.check_interval)
+                   .AtLeast(1));
   t->push_back(Key("solver.collision.update", S, Opt,
                    "How the factor follows the spring set: CHOLMOD update/downdate, or a numeric "
                    "refactorisation.")
-                   .Def(co.update).Choices({"updown", "refactor"}));
+                   .Def(co.update)
+                   .Choices({"updown", "refactor"}));
   t->push_back(Key("solver.collision.self_target", S, Opt,
                    "Where a self-collided vertex is sent: 'walk' along -n(v) through the collided "
                    "region (the thesis's rule) for every contact, or 'auto': the same within one "
                    "body, the closest facing point of the other body's surface between separate "
                    "bodies.")
-                   .Def(co.self_target).Choices({"auto", "walk"}));
+                   .Def(co.self_target)
+                   .Choices({"auto", "walk"}));
   t->push_back(Key("solver.collision.self_spring", S, Opt,
                    "What a self-collision spring pulls its vertex to: a fixed 'target' half way "
                    "to the exit point (Eq. 3.5), or 'pair': the exit point as a point of the "
                    "exit face, which moves with the face and loads both sides equally.")
-                   .Def(co.self_spring).Choices({"target", "pair"}));
+                   .Def(co.self_spring)
+                   .Choices({"target", "pair"}));
   t->push_back(Key("solver.collision.obstacle_spring", S, Opt,
                    "What an obstacle spring resists: 'plane', only the normal part of the offset "
                    "to the closest point plus eps, against the obstacle's tangent plane "
                    "(frictionless), or 'point', the whole offset (Eq. 3.5 as written; it holds "
                    "the vertex tangentially between checks, so sliding contacts creep).")
-                   .Def(co.obstacle_spring).Choices({"plane", "point"}));
+                   .Def(co.obstacle_spring)
+                   .Choices({"plane", "point"}));
 }
 
 std::string RangeText(const KeySpec& k) {
@@ -384,16 +431,23 @@ std::string IntListText(const std::vector<int>& v) {
 std::string TypeText(const KeySpec& k, bool with_article) {
   auto art = [&](const char* a, const char* s) { return std::string(with_article ? a : "") + s; };
   switch (k.type) {
-    case Type::Object: return art("an ", "object");
-    case Type::ObjectArray: return art("an ", "array of objects");
+    case Type::Object:
+      return art("an ", "object");
+    case Type::ObjectArray:
+      return art("an ", "array of objects");
     case Type::String:
       if (!k.choices.empty()) return "one of: " + ListText(k.choices);
       return art("a ", "string");
-    case Type::Number: return art("a ", "number") + RangeText(k);
-    case Type::Integer: return art("an ", "integer") + RangeText(k);
-    case Type::Vec3: return art("an ", "array of 3 numbers [x, y, z]");
-    case Type::Polyline: return art("an ", "array of >= 2 points [[x, y, z], ...]");
-    case Type::Bool: return art("a ", "boolean (true or false)");
+    case Type::Number:
+      return art("a ", "number") + RangeText(k);
+    case Type::Integer:
+      return art("an ", "integer") + RangeText(k);
+    case Type::Vec3:
+      return art("an ", "array of 3 numbers [x, y, z]");
+    case Type::Polyline:
+      return art("an ", "array of >= 2 points [[x, y, z], ...]");
+    case Type::Bool:
+      return art("a ", "boolean (true or false)");
   }
   return "?";
 }
@@ -440,14 +494,18 @@ int AsInt(const json& v) {
 
 bool ValueOk(const KeySpec& k, const json& v) {
   switch (k.type) {
-    case Type::Object: return v.is_object();
-    case Type::ObjectArray: return v.is_array();
+    case Type::Object:
+      return v.is_object();
+    case Type::ObjectArray:
+      return v.is_array();
     case Type::String:
       if (!v.is_string()) return false;
       return k.choices.empty() ||
              std::find(k.choices.begin(), k.choices.end(), v.get<std::string>()) != k.choices.end();
-    case Type::Number: return v.is_number() && std::isfinite(v.get<double>()) && InRange(k, v.get<double>());
-    case Type::Integer: return IsInt(v) && InRange(k, AsInt(v));
+    case Type::Number:
+      return v.is_number() && std::isfinite(v.get<double>()) && InRange(k, v.get<double>());
+    case Type::Integer:
+      return IsInt(v) && InRange(k, AsInt(v));
     case Type::Vec3:
       if (!v.is_array() || v.size() != 3) return false;
       for (const auto& e : v)
@@ -461,7 +519,8 @@ bool ValueOk(const KeySpec& k, const json& v) {
           if (!e.is_number() || !std::isfinite(e.get<double>())) return false;
       }
       return true;
-    case Type::Bool: return v.is_boolean();
+    case Type::Bool:
+      return v.is_boolean();
   }
   return false;
 }
@@ -481,18 +540,26 @@ std::string SceneSchema() {
   o << "SoftKin scene JSON\n"
        "==================\n"
        "Key paths: a.b is key b of object a; a[] is each element of array a.\n"
-       "Relative file paths are relative to the scene JSON's folder. Coordinates are in mesh units\n"
+       "Relative file paths are relative to the scene JSON's folder. Coordinates are in mesh "
+       "units\n"
        "after mesh.scale. Unknown keys, duplicate keys and wrong types are errors. Keys marked\n"
        "'selector' form a group: each object needs exactly one key of its group.\n"
-       "Each key: key path, type, default (or required / selector) [condition]; then its doc line.\n"
+       "Each key: key path, type, default (or required / selector) [condition]; then its doc "
+       "line.\n"
        "\n"
        "Keys:\n";
   for (const auto& k : KeyTable()) {
     std::string def;
     switch (k.need) {
-      case Need::Required: def = "required"; break;
-      case Need::Selector: def = "selector"; break;
-      case Need::Optional: def = "default " + (k.def_text.empty() ? k.def.dump() : k.def_text); break;
+      case Need::Required:
+        def = "required";
+        break;
+      case Need::Selector:
+        def = "selector";
+        break;
+      case Need::Optional:
+        def = "default " + (k.def_text.empty() ? k.def.dump() : k.def_text);
+        break;
     }
     if (!k.roles.empty())
       def += std::string(k.path.rfind("motions", 0) == 0 || k.path.rfind("obstacles", 0) == 0

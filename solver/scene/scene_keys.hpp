@@ -29,23 +29,51 @@ struct KeySpec {
   std::string path;  ///< "a.b" = key b of object a; "a[]" = each element of array a
   Type type = Type::String;
   Need need = Need::Optional;
-  json def;                        ///< default value of an Optional key
-  std::string def_text;            ///< shown in the schema instead of def.dump() when non-empty
-  std::vector<std::string> roles;  ///< regions[] keys: roles allowing the key (empty: every role)
-  std::string with;                ///< sibling key this key needs (empty: none)
-  double lo = -kInf, hi = kInf;    ///< numeric range
-  bool lo_open = false;            ///< lo excluded
+  json def;                          ///< default value of an Optional key
+  std::string def_text;              ///< shown in the schema instead of def.dump() when non-empty
+  std::vector<std::string> roles;    ///< regions[] keys: roles allowing the key (empty: every role)
+  std::string with;                  ///< sibling key this key needs (empty: none)
+  double lo = -kInf, hi = kInf;      ///< numeric range
+  bool lo_open = false;              ///< lo excluded
   std::vector<std::string> choices;  ///< allowed string values (empty: any)
   std::string doc;
 
-  KeySpec& Def(json v) { def = std::move(v); return *this; }
-  KeySpec& DefText(std::string t) { def_text = std::move(t); return *this; }
-  KeySpec& Roles(std::vector<std::string> r) { roles = std::move(r); return *this; }
-  KeySpec& With(std::string w) { with = std::move(w); return *this; }
-  KeySpec& AtLeast(double v) { lo = v; lo_open = false; return *this; }
-  KeySpec& Above(double v) { lo = v; lo_open = true; return *this; }
-  KeySpec& In(double a, double b) { lo = a; hi = b; lo_open = false; return *this; }
-  KeySpec& Choices(std::vector<std::string> c) { choices = std::move(c); return *this; }
+  KeySpec& Def(json v) {
+    def = std::move(v);
+    return *this;
+  }
+  KeySpec& DefText(std::string t) {
+    def_text = std::move(t);
+    return *this;
+  }
+  KeySpec& Roles(std::vector<std::string> r) {
+    roles = std::move(r);
+    return *this;
+  }
+  KeySpec& With(std::string w) {
+    with = std::move(w);
+    return *this;
+  }
+  KeySpec& AtLeast(double v) {
+    lo = v;
+    lo_open = false;
+    return *this;
+  }
+  KeySpec& Above(double v) {
+    lo = v;
+    lo_open = true;
+    return *this;
+  }
+  KeySpec& In(double a, double b) {
+    lo = a;
+    hi = b;
+    lo_open = false;
+    return *this;
+  }
+  KeySpec& Choices(std::vector<std::string> c) {
+    choices = std::move(c);
+    return *this;
+  }
 
   bool allows_role(const std::string& role) const {
     return roles.empty() || std::find(roles.begin(), roles.end(), role) != roles.end();

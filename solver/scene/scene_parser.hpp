@@ -32,14 +32,19 @@ class SceneParser {
   struct ActuatorEntry;
   using ActuatorEntries = std::map<std::string, ActuatorEntry>;
 
-  [[noreturn]] void Fail(const std::string& msg) const { throw std::invalid_argument(src_ + ": " + msg); }
-  static std::string At(const std::string& path) { return path.empty() ? std::string() : path + ": "; }
+  [[noreturn]] void Fail(const std::string& msg) const {
+    throw std::invalid_argument(src_ + ": " + msg);
+  }
+  static std::string At(const std::string& path) {
+    return path.empty() ? std::string() : path + ": ";
+  }
 
   // ---- Validation against the key table (scene_json.cpp) ----
 
   /// Specs of the keys of objects at `pattern` (e.g. "fixed[]") that apply to `role`.
   std::vector<const KeySpec*> Children(const std::string& pattern, const std::string& role) const;
-  const KeySpec* Spec(const std::string& pattern, const std::string& key, const std::string& role) const;
+  const KeySpec* Spec(const std::string& pattern, const std::string& key,
+                      const std::string& role) const;
   /// Value of key (or its default); the key must have been checked by CheckObject.
   json Get(const json& obj, const std::string& pattern, const std::string& key,
            const std::string& role = "") const;

@@ -21,15 +21,21 @@
 namespace softkin {
 
 bool EquilibriumJacobianOptions::IsValid(std::string* why) const {
-  auto bad = [&](const std::string& m) { if (why) *why = m; return false; };
-  if (!(tolerance > 0.0 && tolerance < 1.0)) return bad("implicit.tolerance: expected a number in (0, 1)");
+  auto bad = [&](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (!(tolerance > 0.0 && tolerance < 1.0))
+    return bad("implicit.tolerance: expected a number in (0, 1)");
   if (max_iterations < 1) return bad("implicit.max_iterations: expected an integer >= 1");
-  if (restart < 1 || restart > 1000) return bad("implicit.restart: expected an integer in [1, 1000]");
+  if (restart < 1 || restart > 1000)
+    return bad("implicit.restart: expected an integer in [1, 1000]");
   if (threads < 0) return bad("implicit.threads: expected an integer >= 0");
   if (krylov != "gmres" && krylov != "bicgstab")
     return bad("implicit.krylov: expected one of gmres, bicgstab; got '" + krylov + "'");
   if (preconditioner != "A_ff" && preconditioner != "local")
-    return bad("implicit.preconditioner: expected one of A_ff, local; got '" + preconditioner + "'");
+    return bad("implicit.preconditioner: expected one of A_ff, local; got '" + preconditioner +
+               "'");
   return true;
 }
 
@@ -43,8 +49,8 @@ std::string EquilibriumJacobianUnsupported(const Model& model) {
   return "";
 }
 
-Eigen::MatrixX3d PrescribedDerivative(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& c,
-                                      int a) {
+Eigen::MatrixX3d PrescribedDerivative(const Model& model,
+                                      const Eigen::Ref<const Eigen::VectorXd>& c, int a) {
   Eigen::MatrixX3d dXc = Eigen::MatrixX3d::Zero(model.num_vertices(), 3);
   const Actuator& act = model.scene().actuators[a];
   if (!act.is_motion()) return dXc;
@@ -138,9 +144,10 @@ class FreeOperator {
 /// values comes from (an entry of A's pattern, d, d'), and CHOLMOD's symbolic analysis.
 struct EquilibriumJacobianWorkspace::Impl {
   const Model* model = nullptr;
-  std::vector<int> elem_pos;     ///< element i, local (q, qc): A value index of (v_q, v_qc); 36 per element
-  Eigen::SparseMatrix<double> P; ///< free-layout pattern and values
-  std::vector<int> p_src;        ///< per P value: 9 * (A entry) + 3 d + d'
+  std::vector<int>
+      elem_pos;  ///< element i, local (q, qc): A value index of (v_q, v_qc); 36 per element
+  Eigen::SparseMatrix<double> P;  ///< free-layout pattern and values
+  std::vector<int> p_src;         ///< per P value: 9 * (A entry) + 3 d + d'
   LocalPreconditioner llt;
   bool analyzed = false;
   bool has_factor = false;  ///< llt holds a numeric factor (of some earlier state)
@@ -150,7 +157,7 @@ struct EquilibriumJacobianWorkspace::Impl {
   bool not_positive_definite = false;
   /// A_ff - sym(K_local) was indefinite once: assemble the per-element PSD projection directly.
   bool project = false;
-  int fresh_rounds = -1;    ///< GMRES rounds of the first solve after the last factorisation
+  int fresh_rounds = -1;  ///< GMRES rounds of the first solve after the last factorisation
   std::vector<std::vector<double>> blocks;  ///< per thread: 9 values per A entry (K_local)
   int factorizations = 0;
 
@@ -169,12 +176,14 @@ struct EquilibriumJacobianWorkspace::Impl {
     elem_pos.assign(36 * els.size(), -1);
     for (size_t i = 0; i < els.size(); ++i)
       for (int q = 0; q < els[i].k; ++q)
-        for (int qc = 0; qc < els[i].k; ++qc) elem_pos[36 * i + 6 * q + qc] = find(els[i].v[q], els[i].v[qc]);
+        for (int qc = 0; qc < els[i].k; ++qc)
+          elem_pos[36 * i + 6 * q + qc] = find(els[i].v[q], els[i].v[qc]);
     std::vector<int> fidx(3 * static_cast<size_t>(nv), -1);
     for (int d = 0; d < 3; ++d) {
       const auto& fv = m.free_vertices(d);
       const int o = m.free_offset(d);
-      for (size_t i = 0; i < fv.size(); ++i) fidx[3 * static_cast<size_t>(fv[i]) + d] = o + static_cast<int>(i);
+      for (size_t i = 0; i < fv.size(); ++i)
+        fidx[3 * static_cast<size_t>(fv[i]) + d] = o + static_cast<int>(i);
     }
     // The pattern: every (free a, free b) of a vertex pair of A, all 9 coordinate pairs. The
     // values of the first assembly are the source ids, read back to map P's storage.
@@ -185,7 +194,8 @@ struct EquilibriumJacobianWorkspace::Impl {
         const int row = A.innerIndexPtr()[p];
         for (int d = 0; d < 3; ++d)
           for (int dd = 0; dd < 3; ++dd) {
-            const int a = fidx[3 * static_cast<size_t>(row) + d], b = fidx[3 * static_cast<size_t>(col) + dd];
+            const int a = fidx[3 * static_cast<size_t>(row) + d],
+                      b = fidx[3 * static_cast<size_t>(col) + dd];
             if (a >= 0 && b >= 0) t.emplace_back(a, b, 9.0 * p + 3 * d + dd);
           }
       }
@@ -194,7 +204,8 @@ struct EquilibriumJacobianWorkspace::Impl {
     P.makeCompressed();
     has_factor = false;
     p_src.resize(P.nonZeros());
-    for (Eigen::Index k = 0; k < P.nonZeros(); ++k) p_src[k] = static_cast<int>(std::lround(P.valuePtr()[k]));
+    for (Eigen::Index k = 0; k < P.nonZeros(); ++k)
+      p_src[k] = static_cast<int>(std::lround(P.valuePtr()[k]));
     analyzed = false;
   }
 };
@@ -227,15 +238,18 @@ bool FactorLocalPreconditioner(const Model& model, const EquilibriumLinearizatio
       LocalBlock H = -0.5 * (Kb + Kb.transpose());
       for (int q = 0; q < k; ++q)
         for (int qc = 0; qc < k; ++qc)
-          for (int d = 0; d < 3; ++d) H(3 * q + d, 3 * qc + d) += e.wv * ((q == qc ? 1.0 : 0.0) - 1.0 / k);
+          for (int d = 0; d < 3; ++d)
+            H(3 * q + d, 3 * qc + d) += e.wv * ((q == qc ? 1.0 : 0.0) - 1.0 / k);
       if (project) {
         Eigen::SelfAdjointEigenSolver<LocalBlock> es(H);
-        H = es.eigenvectors() * es.eigenvalues().cwiseAbs().asDiagonal() * es.eigenvectors().transpose();
+        H = es.eigenvectors() * es.eigenvalues().cwiseAbs().asDiagonal() *
+            es.eigenvectors().transpose();
       }
       double* out = w->blocks[t].data();
       for (int q = 0; q < k; ++q)
         for (int qc = 0; qc < k; ++qc) {
-          const size_t p = static_cast<size_t>(w->elem_pos[36 * static_cast<size_t>(i) + 6 * q + qc]);
+          const size_t p =
+              static_cast<size_t>(w->elem_pos[36 * static_cast<size_t>(i) + 6 * q + qc]);
           for (int d = 0; d < 3; ++d)
             for (int dd = 0; dd < 3; ++dd) out[9 * p + 3 * d + dd] += H(3 * q + d, 3 * qc + dd);
         }
@@ -274,8 +288,11 @@ class GmresColumn {
  public:
   /// b = prec(rhs) (#free), y0 the start (#free), restart/max_it/tol as the options.
   GmresColumn(Eigen::VectorXd b, Eigen::VectorXd y0, int restart, int max_it, double tol)
-      : b_(std::move(b)), y_(std::move(y0)), m_(std::max(1, std::min(restart, max_it))),
-        max_it_(max_it), tol_(tol) {
+      : b_(std::move(b)),
+        y_(std::move(y0)),
+        m_(std::max(1, std::min(restart, max_it))),
+        max_it_(max_it),
+        tol_(tol) {
     beta0_ = b_.norm();
     if (!(beta0_ > 0.0)) {
       done_ = true;  // rhs = 0: y = 0 exactly
@@ -504,8 +521,8 @@ bool SetLocalPreconditioner(const Model& model, const EquilibriumLinearization& 
                       ws->has_factor && !ws->stale;
   if (reused || FactorLocalPreconditioner(model, lin, options.threads, ws)) {
     op->SetPreconditioner(&ws->llt);
-    res->preconditioner = std::string(reused ? "local (reused)" : "local") +
-                          (ws->project ? ", projected" : "");
+    res->preconditioner =
+        std::string(reused ? "local (reused)" : "local") + (ws->project ? ", projected" : "");
   } else {
     op->SetPreconditioner(nullptr);
     res->preconditioner = "A_ff (the local preconditioner is not positive definite)";
@@ -589,9 +606,9 @@ bool AssembleDxdc(const Model& model, const FreeOperator& op, const std::vector<
     if (!Yf.col(j).allFinite() || !(rels[j] <= options.tolerance)) {
       std::ostringstream s;
       s << "implicit Jacobian: " << (options.krylov == "bicgstab" ? "BiCGSTAB" : "GMRES")
-        << " for actuator '" << model.scene().actuators[a].name
-        << "' stopped at relative residual " << rels[j] << " after " << res->iterations[j]
-        << " iterations (tolerance " << options.tolerance << ")";
+        << " for actuator '" << model.scene().actuators[a].name << "' stopped at relative residual "
+        << rels[j] << " after " << res->iterations[j] << " iterations (tolerance "
+        << options.tolerance << ")";
       res->message = s.str();
       res->dXdc.resize(0, 0);
       return false;

@@ -21,11 +21,11 @@
 ///     dr_i = (sigma dm_i + m_i dsigma) / mu_i with dsigma = -sigma d(sum m_j) / sum m_j +
 ///     (M + L_R) drho / sum m_j: a per-group rank-one coupling, applied as such.
 /// H is not symmetric in general (the blended and ratio-coupled targets are not minimisers of one
-/// energy), so the linear solve is restarted GMRES (all columns in lockstep, one batched product per
-/// round), left-preconditioned by A_ff^-1 with the
-/// model's prefactored CHOLMOD factor (Model::SolveFree): the preconditioned operator is
-/// I - A_ff^-1 K_ff, the identity minus the Jacobian of the local-global map, whose spectrum the
-/// local-global iteration itself contracts; GMRES needs far fewer products than that iteration.
+/// energy), so the linear solve is restarted GMRES (all columns in lockstep, one batched product
+/// per round), left-preconditioned by A_ff^-1 with the model's prefactored CHOLMOD factor
+/// (Model::SolveFree): the preconditioned operator is I - A_ff^-1 K_ff, the identity minus the
+/// Jacobian of the local-global map, whose spectrum the local-global iteration itself contracts;
+/// GMRES needs far fewer products than that iteration.
 ///
 /// Supported: body elements with the blend law (Eq. 2.3-2.5), pneumatic, cable and DEA actuation
 /// elements (vented chambers too), fixed / held coordinates and motion actuators. Not supported
@@ -139,11 +139,11 @@ class EquilibriumLinearization {
   void ElementTargetDerivative(int i, bool vented, const ElemRows& dD, double dr,
                                const ElemRows& Ps, const ElemRows& dPs0, ElemRows* dT) const;
   struct ElementCache {
-    Eigen::Matrix3d R;     ///< best rotation of the element's target
-    Eigen::Matrix3d Sinv;  ///< (tr(S) I - S)^-1, S = R^T M
-    double s = 1.0;        ///< blend scale (body, r_omega < 1)
-    double vol = 0.0;      ///< current volume (body blend) or 0
-    bool s_active = false; ///< blend scale not clamped: it varies with X
+    Eigen::Matrix3d R;      ///< best rotation of the element's target
+    Eigen::Matrix3d Sinv;   ///< (tr(S) I - S)^-1, S = R^T M
+    double s = 1.0;         ///< blend scale (body, r_omega < 1)
+    double vol = 0.0;       ///< current volume (body blend) or 0
+    bool s_active = false;  ///< blend scale not clamped: it varies with X
   };
   struct GroupCache {
     bool vented = false;
@@ -156,13 +156,13 @@ class EquilibriumLinearization {
   std::vector<double> ratios_;
   std::vector<ElementCache> cache_;
   std::vector<GroupCache> groups_;
-  std::vector<ElemRows> rows_;         ///< centred current rows D (blended bodies, cable, DEA)
-  std::vector<ElemRows> vol_grad_;     ///< d Vol / dD of blended bodies with an active scale
-  std::vector<double> measure_;        ///< m_i (floored) of actuation elements
-  std::vector<char> measure_active_;   ///< m_i above its floor
-  std::vector<ElemRows> measure_grad_; ///< dm_i/dD of actuation elements (others unused)
-  std::vector<double> dratio_;         ///< scratch: dr_i per direction (#E x m)
-  std::vector<ElemRows> weighted_;     ///< scratch: w_i Vol_i dT_i per direction (#E x m)
+  std::vector<ElemRows> rows_;          ///< centred current rows D (blended bodies, cable, DEA)
+  std::vector<ElemRows> vol_grad_;      ///< d Vol / dD of blended bodies with an active scale
+  std::vector<double> measure_;         ///< m_i (floored) of actuation elements
+  std::vector<char> measure_active_;    ///< m_i above its floor
+  std::vector<ElemRows> measure_grad_;  ///< dm_i/dD of actuation elements (others unused)
+  std::vector<double> dratio_;          ///< scratch: dr_i per direction (#E x m)
+  std::vector<ElemRows> weighted_;      ///< scratch: w_i Vol_i dT_i per direction (#E x m)
   int threads_ = 0;
 };
 
@@ -176,11 +176,12 @@ struct EquilibriumJacobianResult {
   /// Operator products per column (GMRES / BiCGSTAB iterations plus the residual checks).
   std::vector<int> iterations;
   std::vector<double> residuals;  ///< final ||H y - rhs|| / ||rhs|| per column (unpreconditioned)
-  /// Batched operator applications (lockstep rounds; equals the sum of iterations without lockstep).
+  /// Batched operator applications (lockstep rounds; equals the sum of iterations without
+  /// lockstep).
   int rounds = 0;
   double time_s = 0.0;
-  std::string preconditioner;         ///< what preconditioned the solve (and why, on a fallback)
-  double preconditioner_time_s = 0.0; ///< assembling and factoring it ("local")
+  std::string preconditioner;          ///< what preconditioned the solve (and why, on a fallback)
+  double preconditioner_time_s = 0.0;  ///< assembling and factoring it ("local")
 };
 
 /// dX/dc at the equilibrium X (#V x 3, a converged local-global state for actuation c) for the
@@ -203,7 +204,7 @@ EquilibriumJacobianResult ComputeEquilibriumJacobian(
 /// actuators (their vertices' rigid motion), computed by a central difference of
 /// Model::ApplyConstraints with a step of 1e-6 of the actuator's range (translations are exact;
 /// rotations have an O(step^2) error of ~1e-12 relative).
-Eigen::MatrixX3d PrescribedDerivative(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& c,
-                                      int a);
+Eigen::MatrixX3d PrescribedDerivative(const Model& model,
+                                      const Eigen::Ref<const Eigen::VectorXd>& c, int a);
 
 }  // namespace softkin

@@ -31,7 +31,8 @@ inline Eigen::Matrix3d Skew(const Eigen::Vector3d& w) {
 }
 
 /// Rows of element e from X, centred.
-inline void Gather(const ModelElement& e, const Eigen::Ref<const Eigen::MatrixX3d>& X, ElemRows* D) {
+inline void Gather(const ModelElement& e, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+                   ElemRows* D) {
   for (int j = 0; j < e.k; ++j) D->row(j) = X.row(e.v[j]);
   CenterRows(*D, e.k);
 }
@@ -58,7 +59,8 @@ inline Eigen::Matrix3d PolarDerivativeW(const Eigen::Matrix3d& R, const Eigen::M
 
 }  // namespace
 
-bool EquilibriumLinearization::Setup(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
+bool EquilibriumLinearization::Setup(const Model& model,
+                                     const Eigen::Ref<const Eigen::MatrixX3d>& X,
                                      const Eigen::Ref<const Eigen::VectorXd>& c, std::string* why,
                                      int threads) {
   model_ = &model;
@@ -232,7 +234,8 @@ void EquilibriumLinearization::ForEachLocalBlock(
         CenterRows(dD, e.k);
         double dr = 0.0;
         if (sigma > 0.0 && measure_active_[i])
-          dr = sigma * measure_grad_[i].topRows(e.k).cwiseProduct(dD.topRows(e.k)).sum() / e.measure0;
+          dr = sigma * measure_grad_[i].topRows(e.k).cwiseProduct(dD.topRows(e.k)).sum() /
+               e.measure0;
         ElementTargetDerivative(i, vented, dD, dr, Ps, dPs0, &dT);
         for (int q = 0; q < e.k; ++q)
           for (int d = 0; d < 3; ++d) Kb(3 * q + d, 3 * qc + dc) = e.wv * dT(q, d);
@@ -249,7 +252,8 @@ Eigen::SparseMatrix<double> EquilibriumLinearization::LocalStiffness() const {
     const ModelElement& e = els[i];
     for (int a = 0; a < 3 * e.k; ++a)
       for (int b = 0; b < 3 * e.k; ++b)
-        if (Kb(a, b) != 0.0) parts[t].emplace_back(3 * e.v[a / 3] + a % 3, 3 * e.v[b / 3] + b % 3, Kb(a, b));
+        if (Kb(a, b) != 0.0)
+          parts[t].emplace_back(3 * e.v[a / 3] + a % 3, 3 * e.v[b / 3] + b % 3, Kb(a, b));
   });
   std::vector<Eigen::Triplet<double>> all;
   for (const auto& p : parts) all.insert(all.end(), p.begin(), p.end());
@@ -269,7 +273,8 @@ void EquilibriumLinearization::ApplyRhsDerivativeBatch(const Eigen::Ref<const Ei
   const int m = static_cast<int>(dc.cols());
   assert(dX.rows() == nv && dX.cols() == 3 * m && dc.rows() == model.num_actuators());
   dratio_.assign(static_cast<size_t>(ne) * m, 0.0);
-  if (weighted_.size() != static_cast<size_t>(ne) * m) weighted_.resize(static_cast<size_t>(ne) * m);
+  if (weighted_.size() != static_cast<size_t>(ne) * m)
+    weighted_.resize(static_cast<size_t>(ne) * m);
   // Rows of element e in direction j, centred.
   auto gather = [&](const ModelElement& e, int j, ElemRows* D) {
     for (int q = 0; q < e.k; ++q)
@@ -324,7 +329,8 @@ void EquilibriumLinearization::ApplyRhsDerivativeBatch(const Eigen::Ref<const Ei
     for (int j = 0; j < m; ++j) {
       ElemRows dD, dT;
       gather(e, j, &dD);
-      ElementTargetDerivative(i, vented, dD, dratio_[static_cast<size_t>(i) * m + j], Ps, dPs0, &dT);
+      ElementTargetDerivative(i, vented, dD, dratio_[static_cast<size_t>(i) * m + j], Ps, dPs0,
+                              &dT);
       weighted_[static_cast<size_t>(i) * m + j] = e.wv * dT;
     }
   }

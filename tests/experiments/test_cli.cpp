@@ -66,7 +66,7 @@ TEST(Cli, RobotsJsonListsActuatorsAndMarkers) {
 TEST(Cli, FkWritesTheDocumentedJson) {
   const std::string dir = TempDir("fk");
   const CliRun r = Cli("fk --robot three_chamber --res 3 --actuation 1.3,1,1 --json " + dir +
-                    "/fk.json --vtu " + dir + "/fk.vtu");
+                       "/fk.json --vtu " + dir + "/fk.vtu");
   ASSERT_EQ(r.code, 0) << r.out;
   std::ifstream f(dir + "/fk.json");
   const auto j = nlohmann::json::parse(f);
@@ -85,15 +85,17 @@ TEST(Cli, FkWritesTheDocumentedJson) {
 // no collision object.
 TEST(Cli, FkJsonCarriesTheCollisionCheck) {
   const std::string dir = TempDir("fk_collision");
-  const CliRun r = Cli("fk --robot selfcollision_finger --res 5 --actuation 1.5 --json " + dir + "/fk.json");
+  const CliRun r =
+      Cli("fk --robot selfcollision_finger --res 5 --actuation 1.5 --json " + dir + "/fk.json");
   ASSERT_EQ(r.code, 0) << r.out;
   std::ifstream f(dir + "/fk.json");
   const auto j = nlohmann::json::parse(f);
   ASSERT_TRUE(j.contains("collision")) << j.dump();
   const auto& c = j["collision"];
-  for (const char* k : {"collision_free", "self_contacts", "obstacle_contacts", "max_penetration_mm",
-                        "inverted_elements", "inverted_body_elements", "tangled_contacts", "springs",
-                        "unresolved_contacts", "check_s", "response_s"})
+  for (const char* k :
+       {"collision_free", "self_contacts", "obstacle_contacts", "max_penetration_mm",
+        "inverted_elements", "inverted_body_elements", "tangled_contacts", "springs",
+        "unresolved_contacts", "check_s", "response_s"})
     EXPECT_TRUE(c.contains(k)) << k;
   // The finger's walls press on each other at this inflation: springs hold them apart, and the
   // final state passes the exact check.
@@ -102,7 +104,8 @@ TEST(Cli, FkJsonCarriesTheCollisionCheck) {
   EXPECT_GT(c["springs"].get<int>(), 0);
   EXPECT_GT(c["check_s"].get<double>(), 0.0);
 
-  const CliRun plain = Cli("fk --robot three_chamber --res 3 --actuation 1.3,1,1 --json " + dir + "/plain.json");
+  const CliRun plain =
+      Cli("fk --robot three_chamber --res 3 --actuation 1.3,1,1 --json " + dir + "/plain.json");
   ASSERT_EQ(plain.code, 0) << plain.out;
   std::ifstream g(dir + "/plain.json");
   EXPECT_FALSE(nlohmann::json::parse(g).contains("collision"));
@@ -110,14 +113,17 @@ TEST(Cli, FkJsonCarriesTheCollisionCheck) {
 
 TEST(Cli, FkReportsEachContinuationStep) {
   const std::string dir = TempDir("fk_steps");
-  const CliRun r = Cli("fk --robot three_chamber --res 3 --actuation 1.3,1,1 --continuation 3 --json " +
-                       dir + "/fk.json");
+  const CliRun r =
+      Cli("fk --robot three_chamber --res 3 --actuation 1.3,1,1 --continuation 3 --json " + dir +
+          "/fk.json");
   ASSERT_EQ(r.code, 0) << r.out;
-  for (const char* line : {"fk: step 1/3: converged", "fk: step 2/3: converged", "fk: step 3/3: converged"})
+  for (const char* line :
+       {"fk: step 1/3: converged", "fk: step 2/3: converged", "fk: step 3/3: converged"})
     EXPECT_NE(r.out.find(line), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("step 4/3"), std::string::npos) << r.out;
   // Without continuation there is one step and no step report.
-  const CliRun one = Cli("fk --robot three_chamber --res 3 --actuation 1.3,1,1 --json " + dir + "/fk1.json");
+  const CliRun one =
+      Cli("fk --robot three_chamber --res 3 --actuation 1.3,1,1 --json " + dir + "/fk1.json");
   ASSERT_EQ(one.code, 0) << one.out;
   EXPECT_EQ(one.out.find("fk: step"), std::string::npos) << one.out;
 }
@@ -144,7 +150,8 @@ TEST(Cli, BadValuesNameTheOptionAndWhatWasExpected) {
   // A scene the chosen solver cannot express is the solver's error, not the actuation's.
   r = Cli("fk --robot dea_crawler --res 4 --actuation 0.8 --solver calculix-linear");
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.out.find("--solver calculix-linear: calculix: element 0 is a prism"), std::string::npos)
+  EXPECT_NE(r.out.find("--solver calculix-linear: calculix: element 0 is a prism"),
+            std::string::npos)
       << r.out;
 }
 
@@ -154,7 +161,8 @@ TEST(Cli, CalibratePrintsTheRatioAndRejectsBadValues) {
   EXPECT_NE(r.out.find("R_omega^A / R_omega^B = 5.6"), std::string::npos) << r.out;
   r = Cli("calibrate --rm -1 --res 2");
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.out.find("rm = -1, expected a finite elasticity ratio > 0"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("rm = -1, expected a finite elasticity ratio > 0"), std::string::npos)
+      << r.out;
   r = Cli("calibrate --rm 3 --interface 2");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.out.find("interface = 2, expected a fraction of the length in [0.05, 0.95]"),
@@ -214,7 +222,8 @@ TEST(Cli, RunWritesSummaryWithConfigCommitAndMachine) {
   EXPECT_EQ(j["config"]["robots"][0], "three_chamber");
   EXPECT_TRUE(std::filesystem::exists(dir + "/tiny_aa/aa_ablation.csv"));
 
-  std::ofstream(cfg) << R"({"name": "tiny_aa", "experiment": "aa_ablation", "seed": 3, "robts": []})";
+  std::ofstream(cfg)
+      << R"({"name": "tiny_aa", "experiment": "aa_ablation", "seed": 3, "robts": []})";
   r = Cli("run " + cfg + " --no-plot --results " + dir);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.out.find("robts"), std::string::npos) << r.out;
@@ -231,7 +240,8 @@ void WriteBoxObj(const std::string& path, double lo, double hi) {
     f << "v " << (i & 1 ? hi : lo) << " " << (i & 2 ? hi : lo) << " " << (i & 4 ? hi : lo) << "\n";
   const int t[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
                         {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  for (const auto& tri : t) f << "f " << tri[0] + 1 << " " << tri[1] + 1 << " " << tri[2] + 1 << "\n";
+  for (const auto& tri : t)
+    f << "f " << tri[0] + 1 << " " << tri[1] + 1 << " " << tri[2] + 1 << "\n";
 }
 
 TEST(Cli, TessellateMeshesABoxChamberInABoxBody) {
@@ -241,8 +251,8 @@ TEST(Cli, TessellateMeshesABoxChamberInABoxBody) {
   CliRun r = Cli("tessellate --help");
   EXPECT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("--chamber"), std::string::npos) << r.out;
-  r = Cli("tessellate --body " + dir + "/body.obj --chamber " + dir + "/chamber.obj --size 1 --out " + dir +
-          "/mesh.vtk --json " + dir + "/report.json");
+  r = Cli("tessellate --body " + dir + "/body.obj --chamber " + dir +
+          "/chamber.obj --size 1 --out " + dir + "/mesh.vtk --json " + dir + "/report.json");
   ASSERT_EQ(r.code, 0) << r.out;
   std::ifstream f(dir + "/report.json");
   const auto j = nlohmann::json::parse(f);
@@ -256,15 +266,18 @@ TEST(Cli, TessellateMeshesABoxChamberInABoxBody) {
   EXPECT_NE(text.find("CELL_TYPES"), std::string::npos);
   // A chamber that sticks out of the body is rejected, naming the file.
   WriteBoxObj(dir + "/big.obj", -2, 4);
-  r = Cli("tessellate --body " + dir + "/body.obj --chamber " + dir + "/big.obj --out " + dir + "/bad.vtk");
+  r = Cli("tessellate --body " + dir + "/body.obj --chamber " + dir + "/big.obj --out " + dir +
+          "/bad.vtk");
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("big.obj"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("strictly inside"), std::string::npos) << r.out;
   // Bad sizes and output formats name the flag.
-  r = Cli("tessellate --body " + dir + "/body.obj --chamber " + dir + "/chamber.obj --size -1 --out " + dir + "/m.vtk");
+  r = Cli("tessellate --body " + dir + "/body.obj --chamber " + dir +
+          "/chamber.obj --size -1 --out " + dir + "/m.vtk");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.out.find("--size"), std::string::npos) << r.out;
-  r = Cli("tessellate --body " + dir + "/body.obj --chamber " + dir + "/chamber.obj --out " + dir + "/m.xyz");
+  r = Cli("tessellate --body " + dir + "/body.obj --chamber " + dir + "/chamber.obj --out " + dir +
+          "/m.xyz");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.out.find("--out"), std::string::npos) << r.out;
 }
@@ -292,8 +305,8 @@ TEST(Cli, IkHelpDocumentsEveryOption) {
   const CliRun r = Cli("ik --help");
   ASSERT_EQ(r.code, 0) << r.out;
   for (const char* k : {"--robot", "--scene", "--target", "--trajectory", "--point", "--method",
-                        "--jacobian", "--lambda", "--max-iterations", "--samples", "--cache", "--out",
-                        "--resume", "nlopt-bobyqa", "fd-warm"})
+                        "--jacobian", "--lambda", "--max-iterations", "--samples", "--cache",
+                        "--out", "--resume", "nlopt-bobyqa", "fd-warm"})
     EXPECT_NE(r.out.find(k), std::string::npos) << k;
 }
 
@@ -311,7 +324,8 @@ TEST(Cli, IkBadInputExitsWithCode2AndNamesTheOptionOrFileLine) {
   const std::vector<Case> cases = {
       {"ik --robot no_such_robot --target 1,2,3" + out, {"known robots"}},
       {base + " --target 1,2,3 --point nose" + out, {"--point", "nose", "tip_top"}},
-      {base + " --target 1,2,3 --method magic" + out, {"--method", "magic", "softls", "gauss-newton"}},
+      {base + " --target 1,2,3 --method magic" + out,
+       {"--method", "magic", "softls", "gauss-newton"}},
       {base + " --target 1,2,3 --jacobian exact" + out, {"--jacobian", "fd-warm"}},
       {base + " --target 1,2" + out, {"--target", "x,y,z"}},
       {base + " --target 1,abc,3" + out, {"--target", "expected"}},
@@ -328,7 +342,8 @@ TEST(Cli, IkBadInputExitsWithCode2AndNamesTheOptionOrFileLine) {
   for (const auto& c : cases) {
     const CliRun r = Cli(c.args);
     EXPECT_EQ(r.code, 2) << c.args << "\n" << r.out;
-    for (const auto& e : c.expect) EXPECT_NE(r.out.find(e), std::string::npos) << c.args << "\n" << r.out;
+    for (const auto& e : c.expect)
+      EXPECT_NE(r.out.find(e), std::string::npos) << c.args << "\n" << r.out;
   }
 }
 
@@ -336,15 +351,17 @@ TEST(Cli, IkReachesAForwardSolvedTargetAndResumesATrajectory) {
   const std::string dir = TempDir("ik_run");
   // A reachable target: where the tip goes at a known actuation.
   // Loose forward solves (gradient ratio 1e-3) keep this test short; the tip moves by ~0.05 mm.
-  CliRun r = Cli("fk --robot cable_finger --res 5 --actuation 0.9,0.85,0.95 --gradient-tolerance 1e-3 --json " +
-                 dir + "/fk.json");
+  CliRun r =
+      Cli("fk --robot cable_finger --res 5 --actuation 0.9,0.85,0.95 --gradient-tolerance 1e-3 "
+          "--json " +
+          dir + "/fk.json");
   ASSERT_EQ(r.code, 0) << r.out;
   std::ifstream f(dir + "/fk.json");
   const auto tip = nlohmann::json::parse(f)["markers"]["tip"];
   std::ostringstream target;
   target << tip[0].get<double>() << "," << tip[1].get<double>() << "," << tip[2].get<double>();
-  r = Cli("ik --robot cable_finger --res 5 --target " + target.str() + " --samples 2 --gradient-tolerance 1e-3 --method gauss-newton --out " +
-          dir + "/one.csv");
+  r = Cli("ik --robot cable_finger --res 5 --target " + target.str() +
+          " --samples 2 --gradient-tolerance 1e-3 --method gauss-newton --out " + dir + "/one.csv");
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("[1/1]"), std::string::npos) << r.out;  // progress on stderr
   std::string text = ReadText(dir + "/one.csv");
@@ -358,14 +375,17 @@ TEST(Cli, IkReachesAForwardSolvedTargetAndResumesATrajectory) {
     EXPECT_LE(std::stod(cell), 0.2) << text;
   }
 
-  // A three-waypoint path near that target; interrupt it after one row (plus half a row) and resume.
+  // A three-waypoint path near that target; interrupt it after one row (plus half a row) and
+  // resume.
   const double x = tip[0].get<double>(), y = tip[1].get<double>(), z = tip[2].get<double>();
   std::ofstream(dir + "/path.txt") << x << " " << y << " " << z << "\n"
                                    << x << " " << y << " " << z + 1 << "\n"
                                    << x - 1 << " " << y << " " << z + 1 << "\n";
-  const std::string run = "ik --robot cable_finger --res 5 --trajectory " + dir + "/path.txt --samples 2 "
-                          "--gradient-tolerance 1e-3 --method gauss-newton --jacobian implicit --cache " + dir +
-                          "/samples.csv --out " + dir + "/path.csv";
+  const std::string run =
+      "ik --robot cable_finger --res 5 --trajectory " + dir +
+      "/path.txt --samples 2 "
+      "--gradient-tolerance 1e-3 --method gauss-newton --jacobian implicit --cache " +
+      dir + "/samples.csv --out " + dir + "/path.csv";
   r = Cli(run);
   ASSERT_EQ(r.code, 0) << r.out;
   const std::string full = ReadText(dir + "/path.csv");
@@ -385,9 +405,10 @@ TEST(Cli, IkReachesAForwardSolvedTargetAndResumesATrajectory) {
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("nothing to do"), std::string::npos) << r.out;
   // Resuming against another path is refused with the CSV line.
-  std::ofstream(dir + "/other.txt") << x + 5 << " " << y << " " << z << "\n" << x << " " << y << " " << z << "\n";
-  r = Cli("ik --robot cable_finger --res 5 --trajectory " + dir + "/other.txt --samples 2 --out " + dir +
-          "/path.csv --resume");
+  std::ofstream(dir + "/other.txt") << x + 5 << " " << y << " " << z << "\n"
+                                    << x << " " << y << " " << z << "\n";
+  r = Cli("ik --robot cable_finger --res 5 --trajectory " + dir + "/other.txt --samples 2 --out " +
+          dir + "/path.csv --resume");
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("path.csv:2"), std::string::npos) << r.out;
 }
@@ -401,18 +422,21 @@ TEST(Cli, CollisionCostsRejectsABadRemeshKeyBeforeRunningAny) {
            {R"({"alpha_max": "four"})", "robots[1].remesh.alpha_max: expected a finite number"},
            {R"({"alpha": 4})", "robots[1].remesh.alpha: expected one of alpha_max, d_max, method"},
            {R"({"method": "all"})", "robots[1].remesh.method: expected auto, chamber or whole"},
-           {R"({"chamber_rest": "deformed"})", "robots[1].remesh.chamber_rest: expected remeshed or original"},
+           {R"({"chamber_rest": "deformed"})",
+            "robots[1].remesh.chamber_rest: expected remeshed or original"},
            {R"({"d_max": 0.5})", "robots[1].remesh.d_max: expected"},
            {R"([4])", "robots[1].remesh: expected an object"}}) {
     SCOPED_TRACE(remesh);
     std::ofstream(cfg) << R"({"name": "bad_costs", "experiment": "collision_costs", "seed": 1,
       "robots": [{"robot": "selfcollision_finger", "res": 5, "steps": 1, "actuation": {"chamber": 1.5}},
                  {"robot": "twisting_robot", "res": 1, "steps": 2, "actuation": {"chamber": 3.0},
-                  "remesh": )" << remesh << "}]}";
+                  "remesh": )"
+                       << remesh << "}]}";
     const CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
     EXPECT_NE(r.code, 0);
     EXPECT_NE(r.out.find(cfg + ": " + message), std::string::npos) << r.out;
-    EXPECT_EQ(r.out.find("[selfcollision_finger 1/1]"), std::string::npos) << r.out;  // robot 0 never ran
+    EXPECT_EQ(r.out.find("[selfcollision_finger 1/1]"), std::string::npos)
+        << r.out;  // robot 0 never ran
   }
   // A robot's own collision options are checked up front too.
   std::ofstream(cfg) << R"({"name": "bad_costs", "experiment": "collision_costs", "seed": 1,
@@ -421,7 +445,8 @@ TEST(Cli, CollisionCostsRejectsABadRemeshKeyBeforeRunningAny) {
                 "collision": {"stiffness": "soft"}}]})";
   const CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
   EXPECT_NE(r.code, 0);
-  EXPECT_NE(r.out.find(cfg + ": robots[1].collision.stiffness: expected a number, got \"soft\""), std::string::npos)
+  EXPECT_NE(r.out.find(cfg + ": robots[1].collision.stiffness: expected a number, got \"soft\""),
+            std::string::npos)
       << r.out;
   EXPECT_EQ(r.out.find("[selfcollision_finger 1/1]"), std::string::npos) << r.out;
 }
@@ -437,8 +462,10 @@ TEST(Cli, CollisionSweepRejectsABadVariantBeforeRunningAny) {
                  {"name": "bad", "collision": {"self": true, "self_spring": "glue"}}]})";
   const CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
   EXPECT_NE(r.code, 0);
-  EXPECT_NE(r.out.find(cfg + ": variants[1]: collision.self_spring: expected one of target, pair; got 'glue'"),
-            std::string::npos)
+  EXPECT_NE(
+      r.out.find(cfg +
+                 ": variants[1]: collision.self_spring: expected one of target, pair; got 'glue'"),
+      std::string::npos)
       << r.out;
   EXPECT_EQ(r.out.find("[ok 1/1]"), std::string::npos) << r.out;  // variant 0 never ran
   EXPECT_FALSE(std::filesystem::exists(dir + "/bad_sweep/steps.csv"));
@@ -462,8 +489,8 @@ TEST(Cli, IkExperimentsRunTinyConfigsAndRejectBadPaths) {
     const auto& p = j["paths"][0];
     EXPECT_EQ(p["waypoints"], 2);
     EXPECT_EQ(p["thesis"]["total_time_s"], 1);
-    for (const char* k : {"mean_error_mm", "max_error_mm", "total_time_s", "max_jump", "max_reached_step_mm",
-                          "fk_solves", "beyond_lambda"})
+    for (const char* k : {"mean_error_mm", "max_error_mm", "total_time_s", "max_jump",
+                          "max_reached_step_mm", "fk_solves", "beyond_lambda"})
       EXPECT_TRUE(p.contains(k)) << k;
     EXPECT_EQ(j["samples"]["n"], 8);
     EXPECT_TRUE(std::filesystem::exists(dir + "/tiny_traj/path_seg.csv"));
@@ -509,12 +536,16 @@ namespace {
 TEST(Cli, TrainAndLearnedIkFromADataset) {
   const std::string dir = TempDir("learn");
   // 27 samples of the coarse three_chamber with implicit Jacobians, loose forward solves.
-  CliRun r = Cli("dataset --robot three_chamber --res 3 --grid 3 --jacobian implicit --gradient-tolerance 1e-3 --quiet --out " +
-                 dir + "/d.csv");
+  CliRun r =
+      Cli("dataset --robot three_chamber --res 3 --grid 3 --jacobian implicit --gradient-tolerance "
+          "1e-3 --quiet --out " +
+          dir + "/d.csv");
   ASSERT_EQ(r.code, 0) << r.out;
-  r = Cli("train --dataset " + dir + "/d.csv --out " + dir + "/nets --hidden 6 --hidden-jac 6 --hidden-ik 6 --epochs 40 --threads 1 --quiet");
+  r = Cli("train --dataset " + dir + "/d.csv --out " + dir +
+          "/nets --hidden 6 --hidden-jac 6 --hidden-ik 6 --epochs 40 --threads 1 --quiet");
   ASSERT_EQ(r.code, 0) << r.out;
-  EXPECT_NE(r.out.find("% of the"), std::string::npos) << r.out;  // N_fk error as % of the workspace
+  EXPECT_NE(r.out.find("% of the"), std::string::npos)
+      << r.out;  // N_fk error as % of the workspace
   for (const char* f : {"nets.json", "fk.fnn", "jac.fnn", "ik.fnn"})
     EXPECT_TRUE(std::filesystem::exists(dir + "/nets/" + f)) << f;
   std::ifstream nj(dir + "/nets/nets.json");
@@ -525,13 +556,15 @@ TEST(Cli, TrainAndLearnedIkFromADataset) {
 
   // One target (the rest tip region), learned and direct.
   for (const char* method : {"learned", "direct"}) {
-    r = Cli(std::string("ik --nets ") + dir + "/nets --method " + method + " --target 0,136,0 --quiet --out " + dir + "/ik.csv");
+    r = Cli(std::string("ik --nets ") + dir + "/nets --method " + method +
+            " --target 0,136,0 --quiet --out " + dir + "/ik.csv");
     ASSERT_EQ(r.code, 0) << method << "\n" << r.out;
     const std::string text = ReadText(dir + "/ik.csv");
     EXPECT_EQ(CountLines(text), 2) << text;
     EXPECT_EQ(text.find("nan"), std::string::npos) << text;
   }
-  // Interactive: rows on stdout for good lines, a message naming the line for a bad one, 'quit' stops.
+  // Interactive: rows on stdout for good lines, a message naming the line for a bad one, 'quit'
+  // stops.
   std::ofstream(dir + "/in.txt") << "2 140 -3\nnot a point\n-4,138,2\nquit\n5 5 5\n";
   r = Cli("ik --nets " + dir + "/nets --method learned --interactive --quiet < " + dir + "/in.txt");
   ASSERT_EQ(r.code, 0) << r.out;
@@ -541,10 +574,12 @@ TEST(Cli, TrainAndLearnedIkFromADataset) {
   EXPECT_NE(r.out.find("\n1,-4,138,2,"), std::string::npos) << r.out;
 
   // Bad input: exit 2 with the option named.
-  r = Cli("ik --nets " + dir + "/missing --method learned --target 0,136,0 --out " + dir + "/x.csv");
+  r = Cli("ik --nets " + dir + "/missing --method learned --target 0,136,0 --out " + dir +
+          "/x.csv");
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("--nets"), std::string::npos) << r.out;
-  r = Cli("ik --nets " + dir + "/nets --method learned --s2r --target 0,136,0 --out " + dir + "/x.csv");
+  r = Cli("ik --nets " + dir + "/nets --method learned --s2r --target 0,136,0 --out " + dir +
+          "/x.csv");
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("no s2r network"), std::string::npos) << r.out;
   r = Cli("ik --method learned --target 0,136,0 --out " + dir + "/x.csv");
@@ -586,7 +621,8 @@ TEST(Cli, ArchitectureSweepResumesFinishedNetworks) {
   std::ofstream(dir + "/tiny_arch/architecture.jsonl") << journal.substr(0, second_line + 20);
   r = Cli("run " + cfg + " --no-plot --results " + dir);
   ASSERT_EQ(r.code, 0) << r.out;
-  EXPECT_NE(r.out.find("architecture.jsonl:2: not a complete JSON record"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("architecture.jsonl:2: not a complete JSON record"), std::string::npos)
+      << r.out;
   const auto third = summary();
   EXPECT_EQ(third["resumed_rows"], 1);
   EXPECT_EQ(third["rows"][0], first["rows"][0]);

@@ -20,9 +20,8 @@ std::string WriteTemp(const std::string& name, const std::string& text) {
 }
 
 TEST(Config, FailNamesNestedKeysWithTheValueFoundThere) {
-  const std::string path = WriteTemp(
-      "softkin_config_nested.json",
-      R"({"name": "x", "experiment": "collision_costs", "seed": 1,
+  const std::string path = WriteTemp("softkin_config_nested.json",
+                                     R"({"name": "x", "experiment": "collision_costs", "seed": 1,
           "robots": [{"robot": "membrane", "robot_params": {"a": "b"}}]})");
   const Config cfg = Config::Load(path, false);
   auto message = [&](const std::string& key) {
@@ -35,7 +34,8 @@ TEST(Config, FailNamesNestedKeysWithTheValueFoundThere) {
   };
   EXPECT_EQ(message("robots[0].robot_params.a"),
             path + ": robots[0].robot_params.a: expected a number, got \"b\"");
-  EXPECT_EQ(message("robots[0].robot"), path + ": robots[0].robot: expected a number, got \"membrane\"");
+  EXPECT_EQ(message("robots[0].robot"),
+            path + ": robots[0].robot: expected a number, got \"membrane\"");
   // Keys that lead nowhere are reported as missing.
   EXPECT_EQ(message("robots[3].robot"), path + ": robots[3].robot: expected a number (missing)");
   EXPECT_EQ(message("robots[0].res"), path + ": robots[0].res: expected a number (missing)");

@@ -20,7 +20,10 @@ class LinearKinematics : public Kinematics {
  public:
   LinearKinematics(Eigen::MatrixXd A, Eigen::MatrixX3d b, Eigen::VectorXd lo, Eigen::VectorXd hi,
                    std::vector<std::string> names)
-      : A_(std::move(A)), b_(std::move(b)), lo_(std::move(lo)), hi_(std::move(hi)),
+      : A_(std::move(A)),
+        b_(std::move(b)),
+        lo_(std::move(lo)),
+        hi_(std::move(hi)),
         names_(std::move(names)) {}
   /// A seeded random well-conditioned map: 3 actuators in [0, 10], points "tip", "p1", ...
   static LinearKinematics Random(int num_points, unsigned seed) {
@@ -33,7 +36,8 @@ class LinearKinematics : public Kinematics {
     for (int i = 0; i < num_points; ++i) b.row(i) << 10 * u(rng), 10 * u(rng), 50 + 10 * u(rng);
     std::vector<std::string> names{"tip"};
     for (int i = 1; i < num_points; ++i) names.push_back("p" + std::to_string(i));
-    return LinearKinematics(A, b, Eigen::VectorXd::Zero(3), Eigen::VectorXd::Constant(3, 10.0), names);
+    return LinearKinematics(A, b, Eigen::VectorXd::Zero(3), Eigen::VectorXd::Constant(3, 10.0),
+                            names);
   }
   std::string name() const override { return "linear"; }
   int num_actuators() const override { return static_cast<int>(A_.cols()); }
@@ -103,13 +107,13 @@ class RecordingKinematics : public Kinematics {
 inline ::testing::AssertionResult NearMatrix(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
                                              double rtol, double atol) {
   if (a.rows() != b.rows() || a.cols() != b.cols())
-    return ::testing::AssertionFailure() << "shape " << a.rows() << "x" << a.cols() << " vs "
-                                         << b.rows() << "x" << b.cols();
+    return ::testing::AssertionFailure()
+           << "shape " << a.rows() << "x" << a.cols() << " vs " << b.rows() << "x" << b.cols();
   for (int i = 0; i < a.rows(); ++i)
     for (int j = 0; j < a.cols(); ++j)
       if (!(std::abs(a(i, j) - b(i, j)) <= atol + rtol * std::abs(b(i, j))))
-        return ::testing::AssertionFailure() << "entry (" << i << ", " << j << "): " << a(i, j)
-                                             << " vs " << b(i, j);
+        return ::testing::AssertionFailure()
+               << "entry (" << i << ", " << j << "): " << a(i, j) << " vs " << b(i, j);
   return ::testing::AssertionSuccess();
 }
 

@@ -75,8 +75,9 @@ TEST(CircleFit, DiameterDerivativeMatchesFiniteDifferences) {
                                    1.5 + trial, 7 + trial);
     for (int i = 0; i < p.rows(); ++i) p.row(i) += 0.5 * Eigen::RowVector3d(g(rng), g(rng), g(rng));
     for (bool given : {false, true}) {
-      const Eigen::Vector3d pn = given ? Eigen::Vector3d(n + 0.1 * Eigen::Vector3d(g(rng), g(rng), g(rng)))
-                                       : Eigen::Vector3d::Zero();
+      const Eigen::Vector3d pn =
+          given ? Eigen::Vector3d(n + 0.1 * Eigen::Vector3d(g(rng), g(rng), g(rng)))
+                : Eigen::Vector3d::Zero();
       const CircleFit f = FitCircle(p, pn, true);
       ASSERT_TRUE(f.ok) << f.message;
       const Eigen::MatrixXd fd = test::FdGradient(
@@ -86,7 +87,8 @@ TEST(CircleFit, DiameterDerivativeMatchesFiniteDifferences) {
             return fx.diameter;
           },
           p, 1e-6);
-      EXPECT_TRUE(test::NearMatrix(f.d_diameter, fd, 1e-5, 1e-7)) << "trial " << trial << " given " << given;
+      EXPECT_TRUE(test::NearMatrix(f.d_diameter, fd, 1e-5, 1e-7))
+          << "trial " << trial << " given " << given;
       ++checked;
     }
   }

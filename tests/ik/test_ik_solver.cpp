@@ -26,10 +26,10 @@ TEST(IkSolver, EnumStringsRoundTrip) {
   EXPECT_EQ(IkMethodNames(),
             "softls, nlopt-mma, nlopt-lbfgs, nlopt-slsqp, nlopt-ccsaq, nlopt-bobyqa, gauss-newton, "
             "broyden");
-  for (IkTermination t : {IkTermination::kConverged, IkTermination::kNoProgress,
-                          IkTermination::kMaxIterations, IkTermination::kMaxEvaluations,
-                          IkTermination::kMaxTime, IkTermination::kKinematicsFailure,
-                          IkTermination::kObjectiveFailure, IkTermination::kSolverFailure}) {
+  for (IkTermination t :
+       {IkTermination::kConverged, IkTermination::kNoProgress, IkTermination::kMaxIterations,
+        IkTermination::kMaxEvaluations, IkTermination::kMaxTime, IkTermination::kKinematicsFailure,
+        IkTermination::kObjectiveFailure, IkTermination::kSolverFailure}) {
     IkTermination back = IkTermination::kConverged;
     ASSERT_TRUE(StringToIkTermination(IkTerminationToString(t), &back));
     EXPECT_EQ(back, t);
@@ -127,9 +127,8 @@ TEST(IkSolver, EveryMethodRecoversKnownActuationsOnThePccModel) {
       opt.max_evaluations = 5000;
       // From the middle of the box (what the trajectory's sampled guess gives on average).
       const IkResult r = SolveIk(pcc, o, Eigen::Vector3d(10, 10, 10), opt);
-      SCOPED_TRACE(r.summary.BriefReport() + " for c = " +
-                   std::to_string(c_true[0]) + "," + std::to_string(c_true[1]) + "," +
-                   std::to_string(c_true[2]));
+      SCOPED_TRACE(r.summary.BriefReport() + " for c = " + std::to_string(c_true[0]) + "," +
+                   std::to_string(c_true[1]) + "," + std::to_string(c_true[2]));
       EXPECT_TRUE(r.summary.converged());
       EXPECT_LE((r.p.row(0).transpose() - target).norm(), 0.2);
       EXPECT_TRUE((r.c.array() >= 0).all() && (r.c.array() <= 20).all());
@@ -144,7 +143,8 @@ TEST(IkSolver, ShapeMatchingRecoversTheWholeShape) {
     PccKinematics pcc;
     const Eigen::Vector3d c_true(6, 14, 2);
     const Eigen::MatrixX3d shape = pcc.Evaluate(c_true, false).p.bottomRows(8);
-    const ShapeMatchingObjective o = ShapeMatchingObjective::ForGroup(pcc.point_names(), "backbone", shape);
+    const ShapeMatchingObjective o =
+        ShapeMatchingObjective::ForGroup(pcc.point_names(), "backbone", shape);
     IkOptions opt;
     opt.method = m;
     opt.lambda = 1e-8;
@@ -202,7 +202,8 @@ TEST(IkSolver, AFailingKinematicsStopsEveryMethodWithItsMessage) {
 TEST(IkSolver, GaussNewtonTakesNoJacobianWhereItStops) {
   PccKinematics pcc;
   for (const Eigen::Vector3d& c_true : {Eigen::Vector3d(5, 5, 9), Eigen::Vector3d(12, 3, 7)}) {
-    PointTrackingObjective o(pcc.point_names(), "tip", pcc.Evaluate(c_true, false).p.row(0).transpose());
+    PointTrackingObjective o(pcc.point_names(), "tip",
+                             pcc.Evaluate(c_true, false).p.row(0).transpose());
     IkOptions opt;
     opt.method = IkMethod::kGaussNewton;
     const IkResult r = SolveIk(pcc, o, pcc.rest(), opt);
@@ -244,7 +245,8 @@ TEST(IkSolver, BroydenRecoversFromAWrongJacobian) {
   PccKinematics pcc;
   const Eigen::Vector3d c0(10, 10, 10);
   for (const Eigen::Vector3d& c_true : {Eigen::Vector3d(5, 5, 9), Eigen::Vector3d(12, 3, 7)}) {
-    PointTrackingObjective o(pcc.point_names(), "tip", pcc.Evaluate(c_true, false).p.row(0).transpose());
+    PointTrackingObjective o(pcc.point_names(), "tip",
+                             pcc.Evaluate(c_true, false).p.row(0).transpose());
     IkOptions opt;
     opt.method = IkMethod::kBroyden;
     opt.initial_jacobian = -pcc.Evaluate(c0, true).J;
@@ -268,7 +270,8 @@ TEST(IkSolver, BroydenRecoversFromAWrongJacobian) {
 
 TEST(IkSolver, BriefReportSaysWhatHappened) {
   PccKinematics pcc;
-  PointTrackingObjective o(pcc.point_names(), "tip", pcc.Evaluate(Eigen::Vector3d(5, 5, 9), false).p.row(0).transpose());
+  PointTrackingObjective o(pcc.point_names(), "tip",
+                           pcc.Evaluate(Eigen::Vector3d(5, 5, 9), false).p.row(0).transpose());
   IkOptions opt;
   opt.method = IkMethod::kGaussNewton;
   const IkResult r = SolveIk(pcc, o, pcc.rest(), opt);

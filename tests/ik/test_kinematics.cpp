@@ -40,7 +40,8 @@ TEST(Kinematics, InputCheckNamesTheActuatorAndTheRange) {
   LinearKinematics k;
   EXPECT_EQ(CheckKinematicsInput(k, Eigen::Vector2d(1, 0)), "");
   EXPECT_EQ(CheckKinematicsInput(k, Eigen::Vector2d(2, 1)), "");  // bounds are inclusive
-  EXPECT_NE(CheckKinematicsInput(k, Eigen::Vector3d(1, 0, 0)).find("expected 2"), std::string::npos);
+  EXPECT_NE(CheckKinematicsInput(k, Eigen::Vector3d(1, 0, 0)).find("expected 2"),
+            std::string::npos);
   const std::string out = CheckKinematicsInput(k, Eigen::Vector2d(1, 1.5));
   EXPECT_NE(out.find("actuator 1"), std::string::npos) << out;
   EXPECT_NE(out.find("[-1, 1]"), std::string::npos) << out;

@@ -54,7 +54,8 @@ class ObjectivesTest : public ::testing::Test {
 TEST_F(ObjectivesTest, PointTracking) {
   PointTrackingObjective o(names, "tip", Eigen::Vector3d(10, -5, 80));
   CheckObjective(o, p);
-  EXPECT_NEAR(o.Evaluate(p, nullptr), (p.row(0) - Eigen::RowVector3d(10, -5, 80)).squaredNorm(), 1e-12);
+  EXPECT_NEAR(o.Evaluate(p, nullptr), (p.row(0) - Eigen::RowVector3d(10, -5, 80)).squaredNorm(),
+              1e-12);
   PointTrackingObjective at(names, "backbone[3]", p.row(4).transpose());
   EXPECT_EQ(at.Evaluate(p, nullptr), 0.0);
 }
@@ -109,8 +110,7 @@ TEST_F(ObjectivesTest, GraspFitsTheArcsCurvature) {
   EXPECT_NEAR(fitted.FittedDiameter(p), 2.0 / kappa, 1e-6);
   CheckObjective(fitted, p, 1e-5);
   // With the bending plane's normal given (the tip, a backbone point and the base span it).
-  const Eigen::Vector3d n =
-      Eigen::Vector3d(p.row(0)).cross(Eigen::Vector3d(p.row(3))).normalized();
+  const Eigen::Vector3d n = Eigen::Vector3d(p.row(0)).cross(Eigen::Vector3d(p.row(3))).normalized();
   gp.plane_normal = n;
   GraspObjective given(names, gp);
   EXPECT_NEAR(given.FittedDiameter(p), 2.0 / kappa, 1e-6);
@@ -184,7 +184,8 @@ TEST_F(ObjectivesTest, MissingPointsAreNamedInTheError) {
   pp.p0 = "tip";
   pp.normal.points = {"tip"};
   EXPECT_THROW(PickObjective(names, pp), std::invalid_argument);
-  EXPECT_THROW(PointTrackingObjective(names, "tip", Eigen::Vector3d(0, NAN, 0)), std::invalid_argument);
+  EXPECT_THROW(PointTrackingObjective(names, "tip", Eigen::Vector3d(0, NAN, 0)),
+               std::invalid_argument);
   PointTrackingObjective o(names, "tip", Eigen::Vector3d::Zero());
   EXPECT_THROW(o.Evaluate(Eigen::MatrixX3d::Zero(3, 3), nullptr), std::invalid_argument);
 }

@@ -22,7 +22,8 @@ Eigen::Vector3d Tip(PccChamberKinematics& k, const Eigen::Vector3d& c) {
 
 TEST(PccChamber, EqualChambersGiveAStraightLongerActuator) {
   PccChamberKinematics k;
-  EXPECT_TRUE(test::NearMatrix(Tip(k, Eigen::Vector3d(1, 1, 1)).transpose(), Eigen::RowVector3d(0, 136, 0), 0, 1e-12));
+  EXPECT_TRUE(test::NearMatrix(Tip(k, Eigen::Vector3d(1, 1, 1)).transpose(),
+                               Eigen::RowVector3d(0, 136, 0), 0, 1e-12));
   const PccChamberParams& p = k.params();
   for (double c : {1.5, 2.0, 3.0}) {
     const Eigen::Vector3d t = Tip(k, Eigen::Vector3d(c, c, c));
@@ -56,7 +57,8 @@ TEST(PccChamber, RotatingTheActuationRotatesTheTipBy120Degrees) {
   // Chamber k takes actuator k-1's value: the pattern turns by +120 degrees in phi.
   const Eigen::Vector3d t1 = Tip(k, Eigen::Vector3d(c[2], c[0], c[1]));
   const double a = 120.0 * kPi / 180.0;
-  const Eigen::Vector2d r(std::cos(a) * t0.x() - std::sin(a) * t0.z(), std::sin(a) * t0.x() + std::cos(a) * t0.z());
+  const Eigen::Vector2d r(std::cos(a) * t0.x() - std::sin(a) * t0.z(),
+                          std::sin(a) * t0.x() + std::cos(a) * t0.z());
   EXPECT_NEAR(t1.x(), r.x(), 1e-10);
   EXPECT_NEAR(t1.z(), r.y(), 1e-10);
   EXPECT_NEAR(t1.y(), t0.y(), 1e-10);
@@ -69,7 +71,8 @@ TEST(PccChamber, TipLiesOnTheArcPlusTheTangentCap) {
   const Eigen::Vector3d c(2.6, 1.2, 1.0);
   const PccArc arc = k.ArcParameters(c);
   ASSERT_GT(arc.kappa, 1e-3);
-  const Eigen::Vector3d centre(std::cos(arc.phi) / arc.kappa, p.base, std::sin(arc.phi) / arc.kappa);
+  const Eigen::Vector3d centre(std::cos(arc.phi) / arc.kappa, p.base,
+                               std::sin(arc.phi) / arc.kappa);
   const Eigen::Vector3d t = Tip(k, c);
   EXPECT_NEAR((t - centre).norm(), 1.0 / arc.kappa, 1e-9);
   // The angle swept is kappa * l.
@@ -122,7 +125,8 @@ TEST(PccChamber, FitRecoversGainOffsetAndCap) {
   }
   const PccFitResult f = FitPccChamber(C, P);  // from the defaults 0.3, 13, 8
   EXPECT_GT(f.rms_start_mm, 1.0);
-  EXPECT_LT(f.rms_mm, 1e-6) << f.iterations << " iterations, gain " << f.params.gain << " offset " << f.params.offset;
+  EXPECT_LT(f.rms_mm, 1e-6) << f.iterations << " iterations, gain " << f.params.gain << " offset "
+                            << f.params.offset;
   EXPECT_NEAR(f.params.gain, 0.22, 1e-6);
   EXPECT_NEAR(f.params.offset, 15.5, 1e-5);
   EXPECT_NEAR(f.params.cap, 5.0, 1e-5);

@@ -17,8 +17,7 @@ TEST(PccKinematics, RestIsStraightAndEvenlySpaced) {
   const int K = k.params().backbone_points;
   EXPECT_EQ(k.num_points(), K + 1);
   EXPECT_TRUE(test::NearMatrix(e.p.row(0), Eigen::RowVector3d(0, 0, 100), 0, 1e-12));
-  for (int j = 0; j < K; ++j)
-    EXPECT_NEAR(e.p(1 + j, 2), 100.0 * (j + 1) / K, 1e-12) << j;
+  for (int j = 0; j < K; ++j) EXPECT_NEAR(e.p(1 + j, 2), 100.0 * (j + 1) / K, 1e-12) << j;
   EXPECT_EQ(e.J.rows(), 3 * k.num_points());
   EXPECT_EQ(k.total_fk_solves(), 1);
 }
@@ -45,7 +44,7 @@ TEST(PccKinematics, PointsLieOnTheArcOfCurvatureKappa) {
 TEST(PccKinematics, PullingOneCableBendsTowardsIt) {
   PccKinematics k;
   const KinematicsEval e = k.Evaluate(Eigen::Vector3d(10, 0, 0), false);
-  EXPECT_GT(e.p(0, 0), 5.0);                 // cable 0 lies along +x
+  EXPECT_GT(e.p(0, 0), 5.0);  // cable 0 lies along +x
   EXPECT_NEAR(e.p(0, 1), 0.0, 1e-12);
 }
 
@@ -74,8 +73,10 @@ TEST(PccKinematics, JacobianMatchesCentralDifferences) {
         return Eigen::MatrixX3d(k.Evaluate(cc, false).p);
       };
       Eigen::MatrixX3d d;
-      if (sgn == 0.0) d = (at(h) - at(-h)) / (2 * h);
-      else d = sgn * (-3.0 * at(0) + 4.0 * at(sgn * h) - at(2 * sgn * h)) / (2 * h);
+      if (sgn == 0.0)
+        d = (at(h) - at(-h)) / (2 * h);
+      else
+        d = sgn * (-3.0 * at(0) + 4.0 * at(sgn * h) - at(2 * sgn * h)) / (2 * h);
       for (int i = 0; i < d.rows(); ++i)
         for (int dd = 0; dd < 3; ++dd) fd(3 * i + dd, a) = d(i, dd);
     }

@@ -94,7 +94,8 @@ void CheckModesAgree(const std::string& robot, int res, const std::vector<Eigen:
     ASSERT_EQ(i.J.cols(), s.num_actuators());
     EXPECT_GT(r.J.norm(), 1.0);  // mm per unit actuation: not a degenerate comparison
     EXPECT_LT(RelErr(i.J, r.J), 1e-4) << "c = " << c.transpose() << "\nimplicit\n"
-                                       << i.J << "\nfd\n" << r.J;
+                                      << i.J << "\nfd\n"
+                                      << r.J;
     EXPECT_LT((i.p - r.p).norm(), 1e-6 * model->size());
     if (compared++ > 0 || !check_default_fd) continue;
     const KinematicsEval f = fd.Evaluate(c, true), w = fdw.Evaluate(c, true);
@@ -156,8 +157,8 @@ TEST(Kinematics, ThreeChamberJacobianRespectsTheRobotsSymmetry) {
   Eigen::Matrix3d Rot;
   Rot << std::cos(th), 0, -std::sin(th), 0, 1, 0, std::sin(th), 0, std::cos(th);
   const Eigen::Vector3d tip = e.p.row(0).transpose(), tipr = er.p.row(0).transpose();
-  EXPECT_LT((Rot * tip - tipr).norm(), 1e-5 * k.model().size()) << tip.transpose() << " / "
-                                                                 << tipr.transpose();
+  EXPECT_LT((Rot * tip - tipr).norm(), 1e-5 * k.model().size())
+      << tip.transpose() << " / " << tipr.transpose();
   const Eigen::Matrix3d J = e.J.topRows(3), Jr = er.J.topRows(3);
   // Chamber a's column at c maps to chamber (a + 1) mod 3's column at cr.
   Eigen::Matrix3d expect;
@@ -307,8 +308,8 @@ TEST(Kinematics, AStartThatCrawlsIsSolvedAgainFromRest) {
   const Scene s = MakeRobot("cable_finger", 6);
   auto model = std::make_shared<const Model>(s);
   const FkOptions fk = AsIkMethodsRunsIt(s);
-  const std::vector<Eigen::VectorXd> path = {Vec({1, 0.5, 1}), Vec({1, 1, 0.5}), Vec({0.5, 0.5, 0.5}),
-                                             Vec({0.746491, 0.5, 0.514275})};
+  const std::vector<Eigen::VectorXd> path = {Vec({1, 0.5, 1}), Vec({1, 1, 0.5}),
+                                             Vec({0.5, 0.5, 0.5}), Vec({0.746491, 0.5, 0.514275})};
   const Eigen::VectorXd c = Vec({0.974649, 0.501302, 0.926934});
   SimulatorKinematicsOptions o = Mode(JacobianMode::kFdWarm);
   o.points = {"tip"};

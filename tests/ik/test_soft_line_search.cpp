@@ -30,10 +30,10 @@ void ExpectStrictlyDecreasing(const IkSummary& s) {
 TEST(SoftLineSearch, NeverIncreasesAndStaysInTheBox) {
   PccKinematics pcc;
   const std::vector<Eigen::Vector3d> targets = {
-      Eigen::Vector3d(20, 10, 90),    // reachable
-      Eigen::Vector3d(-30, 25, 70),   // reachable, far from rest
-      Eigen::Vector3d(200, 0, 0),     // unreachable: the search ends at the box / a minimum
-      Eigen::Vector3d(0, 0, 150)};    // unreachable above the rest tip
+      Eigen::Vector3d(20, 10, 90),   // reachable
+      Eigen::Vector3d(-30, 25, 70),  // reachable, far from rest
+      Eigen::Vector3d(200, 0, 0),    // unreachable: the search ends at the box / a minimum
+      Eigen::Vector3d(0, 0, 150)};   // unreachable above the rest tip
   int runs = 0;
   for (bool normalize : {true, false})
     for (const Eigen::Vector3d& t : targets) {
@@ -82,7 +82,8 @@ TEST(SoftLineSearch, FailedTrialsAreTreatedAsNoDecrease) {
   PccKinematics pcc;
   test::RecordingKinematics rec(pcc);
   rec.fail_if = [](const Eigen::VectorXd& c) { return c[1] > 8.0; };  // the "simulator" fails there
-  PointTrackingObjective o(rec.point_names(), "tip", pcc.Evaluate(Eigen::Vector3d(2, 12, 2), false).p.row(0).transpose());
+  PointTrackingObjective o(rec.point_names(), "tip",
+                           pcc.Evaluate(Eigen::Vector3d(2, 12, 2), false).p.row(0).transpose());
   IkOptions opt;
   opt.max_iterations = 50;
   const IkResult r = SolveIk(rec, o, rec.rest(), opt);
@@ -108,12 +109,14 @@ TEST(SoftLineSearch, ShrinkingStopsBelowTheParameterTolerance) {
   opt.parameter_tolerance = 1e-6;
   const IkResult r = SolveIk(rec, o, c0, opt);
   EXPECT_EQ(r.summary.termination, IkTermination::kNoProgress);
-  EXPECT_NE(r.summary.message.find("below parameter_tolerance"), std::string::npos) << r.summary.message;
+  EXPECT_NE(r.summary.message.find("below parameter_tolerance"), std::string::npos)
+      << r.summary.message;
   ASSERT_GE(rec.calls.size(), 3u);
   EXPECT_LT(rec.calls.size(), 1u + opt.max_shrinks);
   const Eigen::VectorXd range = pcc.upper() - pcc.lower();
   for (size_t i = 1; i < rec.calls.size(); ++i)  // every trial moved by more than the tolerance
-    EXPECT_GT((rec.calls[i] - c0).cwiseAbs().cwiseQuotient(range).maxCoeff(), opt.parameter_tolerance)
+    EXPECT_GT((rec.calls[i] - c0).cwiseAbs().cwiseQuotient(range).maxCoeff(),
+              opt.parameter_tolerance)
         << "trial " << i;
   EXPECT_EQ(r.c, c0);
 }

@@ -53,7 +53,8 @@ TEST(SubsetKinematics, RejectsBadSubsets) {
   EXPECT_THROW(SubsetKinematics(base, {}, fixed), std::invalid_argument);
   EXPECT_THROW(SubsetKinematics(base, {0, 0}, fixed), std::invalid_argument);
   EXPECT_THROW(SubsetKinematics(base, {3}, fixed), std::invalid_argument);
-  EXPECT_THROW(SubsetKinematics(base, {0}, Eigen::VectorXd::Constant(3, 11.0)), std::invalid_argument);
+  EXPECT_THROW(SubsetKinematics(base, {0}, Eigen::VectorXd::Constant(3, 11.0)),
+               std::invalid_argument);
   SubsetKinematics sub(base, {1}, fixed);
   EXPECT_FALSE(sub.Evaluate(Eigen::VectorXd::Constant(1, -1.0), false).ok);
 }

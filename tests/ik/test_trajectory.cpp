@@ -67,7 +67,8 @@ TEST(Trajectory, BroydenHandsTheJacobianOnAlongThePath) {
     struct Counting : test::RecordingKinematics {
       using test::RecordingKinematics::RecordingKinematics;
       int* jac = nullptr;
-      KinematicsEval Evaluate(const Eigen::Ref<const Eigen::VectorXd>& c, bool with_jacobian) override {
+      KinematicsEval Evaluate(const Eigen::Ref<const Eigen::VectorXd>& c,
+                              bool with_jacobian) override {
         if (with_jacobian) ++*jac;
         return test::RecordingKinematics::Evaluate(c, with_jacobian);
       }
@@ -84,7 +85,7 @@ TEST(Trajectory, BroydenHandsTheJacobianOnAlongThePath) {
     EXPECT_LT(r.max_jump, 3.0);
     (m == IkMethod::kBroyden ? j_br : j_gn) = with_j;  // the sampling takes no J
   }
-  EXPECT_GE(j_gn, 40);       // at least one J per waypoint
+  EXPECT_GE(j_gn, 40);        // at least one J per waypoint
   EXPECT_LT(j_br, j_gn / 2);  // most waypoints need none
   EXPECT_GE(j_br, 1);
 }
@@ -101,7 +102,8 @@ TEST(Trajectory, FirstWaypointTriesTheNextClosestSamples) {
   const std::vector<int> order = ClosestSamples(all, path.row(0).transpose(), 125);
   ASSERT_EQ(order.size(), 125u);
   for (size_t i = 1; i < order.size(); ++i)
-    EXPECT_LE((all.p.row(order[i - 1]) - path.row(0)).norm(), (all.p.row(order[i]) - path.row(0)).norm());
+    EXPECT_LE((all.p.row(order[i - 1]) - path.row(0)).norm(),
+              (all.p.row(order[i]) - path.row(0)).norm());
   EXPECT_EQ(order.front(), ClosestSample(all, path.row(0).transpose()));
   const Eigen::VectorXd bad = all.c.row(order[0]).transpose();
   for (int starts : {1, 3}) {
@@ -109,7 +111,9 @@ TEST(Trajectory, FirstWaypointTriesTheNextClosestSamples) {
     test::RecordingKinematics rec(k);
     // The 125 sampling evaluations see no failure; the solve from the closest sample fails at
     // its start.
-    rec.fail_if = [&](const Eigen::VectorXd& c) { return rec.calls.size() > 125 && (c - bad).norm() < 1e-9; };
+    rec.fail_if = [&](const Eigen::VectorXd& c) {
+      return rec.calls.size() > 125 && (c - bad).norm() < 1e-9;
+    };
     TrajectoryOptions opt;
     opt.ik.method = IkMethod::kGaussNewton;
     opt.first_waypoint_starts = starts;
@@ -125,7 +129,8 @@ TEST(Trajectory, FirstWaypointTriesTheNextClosestSamples) {
     EXPECT_EQ(r.initial_starts_tried, 2);
     EXPECT_EQ(r.initial_sample, order[1]);
     EXPECT_TRUE(r.initial_guess.isApprox(all.c.row(order[1]).transpose()));
-    EXPECT_NE(r.waypoints[0].message.find("2 sample(s)"), std::string::npos) << r.waypoints[0].message;
+    EXPECT_NE(r.waypoints[0].message.find("2 sample(s)"), std::string::npos)
+        << r.waypoints[0].message;
     EXPECT_EQ(r.converged, 3);
   }
   TrajectoryOptions zero;

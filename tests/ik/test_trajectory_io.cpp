@@ -12,7 +12,8 @@ namespace softkin {
 namespace {
 
 std::string Write(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + "/softkin_" + std::to_string(::getpid()) + "_" + name;
+  const std::string path =
+      ::testing::TempDir() + "/softkin_" + std::to_string(::getpid()) + "_" + name;
   std::ofstream(path) << text;
   return path;
 }
@@ -31,7 +32,8 @@ void ExpectError(const std::string& text, const std::string& line_tag, const std
 }
 
 TEST(WaypointFile, ReadsTheFlowerTrajectory) {
-  const Eigen::MatrixX3d w = ReadWaypoints(std::string(SOFTKIN_THESIS_DATA) + "/flower_trajectory.txt");
+  const Eigen::MatrixX3d w =
+      ReadWaypoints(std::string(SOFTKIN_THESIS_DATA) + "/flower_trajectory.txt");
   // 121 lines (the README says 120): the last one, without a newline, closes the loop.
   ASSERT_EQ(w.rows(), 121);
   EXPECT_EQ(w.row(120), w.row(0));

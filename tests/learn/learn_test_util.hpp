@@ -20,11 +20,11 @@ namespace softkin {
 namespace test {
 
 /// Success iff |a - b| <= atol + rtol |b| entrywise; otherwise names the worst (row, col).
-inline ::testing::AssertionResult NearMatrix(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, double rtol,
-                                             double atol) {
+inline ::testing::AssertionResult NearMatrix(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
+                                             double rtol, double atol) {
   if (a.rows() != b.rows() || a.cols() != b.cols())
-    return ::testing::AssertionFailure() << "shape " << a.rows() << "x" << a.cols() << " vs " << b.rows() << "x"
-                                         << b.cols();
+    return ::testing::AssertionFailure()
+           << "shape " << a.rows() << "x" << a.cols() << " vs " << b.rows() << "x" << b.cols();
   double worst = 0.0;
   Eigen::Index wi = -1, wj = -1;
   for (Eigen::Index j = 0; j < a.cols(); ++j)
@@ -37,13 +37,15 @@ inline ::testing::AssertionResult NearMatrix(const Eigen::MatrixXd& a, const Eig
       }
     }
   if (wi < 0) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "entry (" << wi << ", " << wj << "): " << a(wi, wj) << " vs "
-                                       << b(wi, wj) << " (rtol " << rtol << ", atol " << atol << ")";
+  return ::testing::AssertionFailure()
+         << "entry (" << wi << ", " << wj << "): " << a(wi, wj) << " vs " << b(wi, wj) << " (rtol "
+         << rtol << ", atol " << atol << ")";
 }
 
 /// Central differences of f: R^n -> R^m at x with step h (m x n).
-inline Eigen::MatrixXd CentralDifferences(const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f,
-                                          const Eigen::VectorXd& x, double h) {
+inline Eigen::MatrixXd CentralDifferences(
+    const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f, const Eigen::VectorXd& x,
+    double h) {
   const Eigen::VectorXd f0 = f(x);
   Eigen::MatrixXd J(f0.size(), x.size());
   for (Eigen::Index j = 0; j < x.size(); ++j) {

@@ -50,7 +50,8 @@ TEST(CeresTrainer, ReachesTheLossOfTheInHouseTrainer) {
   // The reported mse is the network's own.
   EXPECT_NEAR(NormalizedMse(ceres_net, data), cs.final_mse, 1e-10 * cs.initial_mse);
   ASSERT_EQ(cs.train_mse.size(), cs.time_s.size());
-  for (std::size_t k = 1; k < cs.train_mse.size(); ++k) EXPECT_LE(cs.train_mse[k], cs.train_mse[k - 1]) << k;
+  for (std::size_t k = 1; k < cs.train_mse.size(); ++k)
+    EXPECT_LE(cs.train_mse[k], cs.train_mse[k - 1]) << k;
 }
 
 }  // namespace

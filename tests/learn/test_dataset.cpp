@@ -63,7 +63,8 @@ class DatasetTest : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = fs::temp_directory_path() /
-           ("softkin_dataset_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+           ("softkin_dataset_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -98,7 +99,8 @@ DatasetSampling Grid(int n, int block) {
 }
 
 TEST(DatasetSampling, SerpentineVisitsEveryGridPointOnceWithUnitSteps) {
-  for (const auto& [n, m] : std::vector<std::pair<int, int>>{{4, 3}, {5, 2}, {3, 4}, {7, 1}, {2, 5}}) {
+  for (const auto& [n, m] :
+       std::vector<std::pair<int, int>>{{4, 3}, {5, 2}, {3, 4}, {7, 1}, {2, 5}}) {
     DatasetSampling s;
     s.grid = n;
     const long long total = DatasetSize(s, m);
@@ -216,14 +218,16 @@ TEST_F(DatasetTest, MergedShardsEqualTheUnshardedRun) {
 
   // A missing shard, a duplicated one, and an incomplete one are errors.
   EXPECT_THROW(MergeDatasets({files[0], files[1]}, Path("m2.csv")), std::invalid_argument);
-  EXPECT_THROW(MergeDatasets({files[0], files[1], files[1]}, Path("m3.csv")), std::invalid_argument);
+  EXPECT_THROW(MergeDatasets({files[0], files[1], files[1]}, Path("m3.csv")),
+               std::invalid_argument);
   const std::string t = Read(Path("shard1.csv"));
   Write(Path("shard1.csv"), t.substr(0, t.rfind('\n', t.size() - 2) + 1));
   try {
     MergeDatasets(files, Path("m4.csv"));
     FAIL() << "an incomplete shard was merged";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("shard1.csv is incomplete"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("shard1.csv is incomplete"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -320,7 +324,8 @@ TEST_F(DatasetTest, CorruptFilesAreRejectedWithFileAndLine) {
     l[7].replace(p, l[7].find(',', p) - p, "nan");
     cases.push_back({"nan", join(l), ":8: column c0: expected a finite number"});
   }
-  cases.push_back({"truncated", good.substr(0, good.size() - 5), ":28: the last line has no line break"});
+  cases.push_back(
+      {"truncated", good.substr(0, good.size() - 5), ":28: the last line has no line break"});
   {
     auto l = lines;
     l[0] = "index,status,c0,c1,c2,tip_x,tip_y,message";
@@ -344,7 +349,8 @@ TEST(DatasetSplit, SeededDisjointAndComplete) {
   SampleSet all;
   all.X = Eigen::VectorXd::LinSpaced(1000, 0.0, 999.0);  // row i holds i
   all.Y = 2.0 * all.X;
-  const TrainTestSets a = SplitTrainTest(all, 5), b = SplitTrainTest(all, 5), c = SplitTrainTest(all, 6);
+  const TrainTestSets a = SplitTrainTest(all, 5), b = SplitTrainTest(all, 5),
+                      c = SplitTrainTest(all, 6);
   EXPECT_EQ(a.train_rows, b.train_rows);
   EXPECT_EQ(a.train.X, b.train.X);
   EXPECT_NE(a.train_rows, c.train_rows);

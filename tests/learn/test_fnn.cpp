@@ -1,5 +1,6 @@
 // The FNN: Eq. 5.7, normalisation identities, Jacobians against finite differences, the parameter
-// layout, Nguyen-Widrow init, and the softkin-fnn v1 file round trip and its rejection of corrupt files.
+// layout, Nguyen-Widrow init, and the softkin-fnn v1 file round trip and its rejection of corrupt
+// files.
 #include "softkin/learn/fnn.hpp"
 
 #include "learn_test_util.hpp"
@@ -50,7 +51,8 @@ TEST(MinMaxMap, FitMapsTheRangeToMinusOneOne) {
 }
 
 TEST(MinMaxMap, RejectsBadRanges) {
-  EXPECT_THROW(MinMaxMap(Eigen::Vector2d(0, 2), Eigen::Vector2d(1, 1)), std::invalid_argument);  // min > max
+  EXPECT_THROW(MinMaxMap(Eigen::Vector2d(0, 2), Eigen::Vector2d(1, 1)),
+               std::invalid_argument);  // min > max
   EXPECT_THROW(MinMaxMap(Eigen::Vector2d(0, 0), Eigen::Vector3d(1, 1, 1)), std::invalid_argument);
   EXPECT_THROW(MinMaxMap::Fit(Eigen::MatrixXd(0, 2)), std::invalid_argument);
   Eigen::MatrixXd bad = Eigen::MatrixXd::Ones(3, 2);
@@ -76,7 +78,8 @@ TEST(Fnn, ShapeAndParameterLayout) {
     const int off = net.parameter_offset(l);
     const Eigen::MatrixXd& W = net.weights(l);
     for (int j = 0; j < W.cols(); ++j)
-      for (int i = 0; i < W.rows(); ++i) EXPECT_EQ(W(i, j), w(off + j * W.rows() + i)) << l << " " << i << " " << j;
+      for (int i = 0; i < W.rows(); ++i)
+        EXPECT_EQ(W(i, j), w(off + j * W.rows() + i)) << l << " " << i << " " << j;
     for (int i = 0; i < W.rows(); ++i) EXPECT_EQ(net.biases(l)(i), w(off + W.size() + i));
   }
   EXPECT_THROW(Fnn({3}), std::invalid_argument);
@@ -94,7 +97,8 @@ TEST(Fnn, ForwardMatchesTheDefinitionAndTheBatch) {
     // By hand: normalise, two tansig layers, linear, denormalise.
     Eigen::VectorXd a(3);
     net.input_map().Apply(X.row(s).transpose(), a);
-    for (int l = 1; l <= 2; ++l) a = (net.weights(l) * a + net.biases(l)).unaryExpr([](double v) { return Tansig(v); });
+    for (int l = 1; l <= 2; ++l)
+      a = (net.weights(l) * a + net.biases(l)).unaryExpr([](double v) { return Tansig(v); });
     Eigen::VectorXd z = net.weights(3) * a + net.biases(3), ref(2);
     net.output_map().Reverse(z, ref);
     net.Forward(X.row(s).transpose(), ws, y);
@@ -122,15 +126,16 @@ TEST(Fnn, InputJacobianMatchesCentralDifferencesThroughTheNormalisation) {
     const Eigen::MatrixXd J = net.InputJacobian(x);
     const Eigen::MatrixXd Jfd = test::CentralDifferences(f, x, 1e-5);
     ASSERT_GT(J.cwiseAbs().col(1).maxCoeff(), 0.0);  // the constant row still has a derivative
-    EXPECT_TRUE(NearMatrix(J, Jfd, 1e-6, 1e-9 * (1.0 + Jfd.cwiseAbs().maxCoeff()))) << "sample " << s;
+    EXPECT_TRUE(NearMatrix(J, Jfd, 1e-6, 1e-9 * (1.0 + Jfd.cwiseAbs().maxCoeff())))
+        << "sample " << s;
     EXPECT_TRUE(NearMatrix(Jb.middleRows(4 * s, 4), J, 0, 0)) << "sample " << s;
   }
 }
 
 TEST(Fnn, InputJacobianOfALinearNetworkIsItsScaledWeightMatrix) {
   Fnn net = test::RandomNetwork({2, 3}, 21);
-  const Eigen::MatrixXd expected = net.output_map().gain().cwiseInverse().asDiagonal() * net.weights(1) *
-                                   net.input_map().gain().asDiagonal();
+  const Eigen::MatrixXd expected = net.output_map().gain().cwiseInverse().asDiagonal() *
+                                   net.weights(1) * net.input_map().gain().asDiagonal();
   EXPECT_TRUE(NearMatrix(net.InputJacobian(Eigen::Vector2d(0.3, -1.0)), expected, 1e-14, 0));
 }
 
@@ -175,7 +180,8 @@ TEST(Fnn, NguyenWidrowIsSeededAndScaled) {
   EXPECT_GT((a.parameters() - c.parameters()).norm(), 1.0);
   for (int l = 1; l <= 2; ++l) {
     const double beta = 0.7 * std::pow(35.0, 1.0 / a.layer_sizes()[l - 1]);
-    for (int i = 0; i < 35; ++i) EXPECT_NEAR(a.weights(l).row(i).norm(), beta, 1e-12) << l << " " << i;
+    for (int i = 0; i < 35; ++i)
+      EXPECT_NEAR(a.weights(l).row(i).norm(), beta, 1e-12) << l << " " << i;
     EXPECT_LE(a.biases(l).cwiseAbs().maxCoeff(), beta);
   }
   EXPECT_LE(a.weights(3).cwiseAbs().maxCoeff(), 1.0 / std::sqrt(35.0));
@@ -271,7 +277,8 @@ TEST_F(CorruptFnnFile, WrongShapes) {
   ExpectRejected(Replace("parameters 13", "parameters 12"), "parameters");
   const std::size_t at = text_.find("input_min");
   const std::size_t eol = text_.find('\n', at);
-  ExpectRejected(text_.substr(0, eol) + " 0.5" + text_.substr(eol), "input_min");  // one value too many
+  ExpectRejected(text_.substr(0, eol) + " 0.5" + text_.substr(eol),
+                 "input_min");  // one value too many
 }
 
 TEST_F(CorruptFnnFile, NonFiniteOrInconsistentNumbers) {
@@ -283,7 +290,8 @@ TEST_F(CorruptFnnFile, NonFiniteOrInconsistentNumbers) {
   // input_max below input_min.
   const std::size_t mx = text_.find("input_max");
   const std::size_t mx_eol = text_.find('\n', mx);
-  ExpectRejected(text_.substr(0, mx) + "input_max -1e9 -1e9" + text_.substr(mx_eol), "input_max[0]");
+  ExpectRejected(text_.substr(0, mx) + "input_max -1e9 -1e9" + text_.substr(mx_eol),
+                 "input_max[0]");
 }
 
 TEST(FnnFileErrors, MissingFileIsNamed) {

@@ -50,10 +50,12 @@ TEST(LmOptions, InvalidFieldsAreNamed) {
 }
 
 TEST(LmTermination, StringsRoundTrip) {
-  for (LmTermination t : {LmTermination::kGoalReached, LmTermination::kMinGradient, LmTermination::kMuMax,
-                          LmTermination::kMaxEpochs, LmTermination::kMaxTime, LmTermination::kValidationStop}) {
+  for (LmTermination t :
+       {LmTermination::kGoalReached, LmTermination::kMinGradient, LmTermination::kMuMax,
+        LmTermination::kMaxEpochs, LmTermination::kMaxTime, LmTermination::kValidationStop}) {
     LmTermination back = LmTermination::kGoalReached;
-    ASSERT_TRUE(LmTerminationFromString(LmTerminationToString(t), &back)) << LmTerminationToString(t);
+    ASSERT_TRUE(LmTerminationFromString(LmTerminationToString(t), &back))
+        << LmTerminationToString(t);
     EXPECT_EQ(back, t);
   }
   LmTermination t = LmTermination::kMuMax;
@@ -79,7 +81,8 @@ TEST(LmTrainer, ConvergesToTheTeacherFromNearby) {
   const SampleSet data = test::TeacherData(teacher, 150, 102);
   Fnn net = teacher;
   const Eigen::VectorXd w_teacher = teacher.parameters();
-  net.set_parameters(w_teacher + 0.05 * test::UniformSamples(static_cast<int>(w_teacher.size()), 1, -1, 1, 103));
+  net.set_parameters(
+      w_teacher + 0.05 * test::UniformSamples(static_cast<int>(w_teacher.size()), 1, -1, 1, 103));
   LmOptions o;
   o.initialize = false;
   o.max_epochs = 30;
@@ -115,7 +118,8 @@ TEST(LmTrainer, FitsTeacherDataFromNguyenWidrowToNearZeroLoss) {
 }
 
 TEST(LmTrainer, BitwiseIdenticalForOneAndTwoThreads) {
-  // Several blocks (block_size 100 of 300 samples) and several column tiles of J^T J (W = 243 > 64).
+  // Several blocks (block_size 100 of 300 samples) and several column tiles of J^T J (W = 243 >
+  // 64).
   const Fnn teacher = test::RandomNetwork({3, 12, 12, 3}, 201);
   const SampleSet data = test::TeacherData(teacher, 300, 202);
   LmOptions o;
@@ -234,7 +238,8 @@ TEST(LmTrainer, RejectsBadInput) {
 }
 
 TEST(RandomSplit, IsASeededPartition) {
-  const SplitIndices a = RandomSplit(100, 0.7, 9), b = RandomSplit(100, 0.7, 9), c = RandomSplit(100, 0.7, 10);
+  const SplitIndices a = RandomSplit(100, 0.7, 9), b = RandomSplit(100, 0.7, 9),
+                     c = RandomSplit(100, 0.7, 10);
   EXPECT_EQ(a.first.size(), 70u);
   EXPECT_EQ(a.second.size(), 30u);
   EXPECT_EQ(a.first, b.first);

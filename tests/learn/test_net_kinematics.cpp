@@ -46,7 +46,8 @@ TEST(NetKinematics, FkDerivativeSourceMatchesFiniteDifferencesWithAndWithoutS2r)
       for (int q = 0; q < 2; ++q) v.segment<3>(3 * q) = ee.p.row(q).transpose();
       return v;
     };
-    EXPECT_TRUE(test::NearMatrix(e.J, test::CentralDifferences(f, c, 1e-5), 1e-6, 1e-7)) << "s2r " << s2r;
+    EXPECT_TRUE(test::NearMatrix(e.J, test::CentralDifferences(f, c, 1e-5), 1e-6, 1e-7))
+        << "s2r " << s2r;
   }
 }
 
@@ -213,7 +214,8 @@ TEST(TrainNets, LearnedIkOnTrainedNetworksReachesTheTrueTarget) {
   EXPECT_GT(width, 10.0);
   const double fk_pct = nets.info["fk"]["test_mean_pct_width"].get<double>();
   EXPECT_LT(fk_pct, 1.0) << nets.info["fk"].dump();
-  EXPECT_EQ(nets.info["dataset"]["train"].get<int>() + nets.info["dataset"]["test"].get<int>(), 512);
+  EXPECT_EQ(nets.info["dataset"]["train"].get<int>() + nets.info["dataset"]["test"].get<int>(),
+            512);
 
   // A target the truth reaches at a known actuation off the grid.
   const Eigen::Vector3d c_true(7.3, 2.1, 12.9);

@@ -40,7 +40,8 @@ TEST(TiledCholesky, BitwiseIdenticalForOneAndTwoThreads) {
   Eigen::MatrixXd A1 = H, A2 = H;
   ASSERT_TRUE(TiledCholeskyInPlace(A1, 64, 1));
   ASSERT_TRUE(TiledCholeskyInPlace(A2, 64, 2));
-  const Eigen::MatrixXd L1 = A1.triangularView<Eigen::Lower>(), L2 = A2.triangularView<Eigen::Lower>();
+  const Eigen::MatrixXd L1 = A1.triangularView<Eigen::Lower>(),
+                        L2 = A2.triangularView<Eigen::Lower>();
   EXPECT_EQ(std::memcmp(L1.data(), L2.data(), sizeof(double) * L1.size()), 0);
 }
 

@@ -40,8 +40,8 @@ inline Actuator Pneumatic(const std::string& name, std::vector<int> regions, dou
 }
 
 /// A cable actuator on `regions` along `path`, shortening ratio in [min, max], rest 1.
-inline Actuator Cable(const std::string& name, std::vector<int> regions, std::vector<Eigen::Vector3d> path,
-               double min = 0.3, double max = 1.0) {
+inline Actuator Cable(const std::string& name, std::vector<int> regions,
+                      std::vector<Eigen::Vector3d> path, double min = 0.3, double max = 1.0) {
   Actuator a;
   a.name = name;
   a.type = ActuatorType::Cable;
@@ -55,7 +55,7 @@ inline Actuator Cable(const std::string& name, std::vector<int> regions, std::ve
 
 /// A DEA actuator on `regions` (prism elements), area ratio in [min, max], rest 1.
 inline Actuator Dea(const std::string& name, std::vector<int> regions, double min = 0.5,
-             double max = 2.0) {
+                    double max = 2.0) {
   Actuator a;
   a.name = name;
   a.type = ActuatorType::Dea;
@@ -89,10 +89,9 @@ inline Scene VoxelScene(const Eigen::Vector3i& cells, double h, const CellRegion
                         const std::string& name = "voxel_test") {
   Scene s;
   s.name = name;
-  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, cells,
-                        [&region](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
-                          return region(c);
-                        });
+  s.mesh = VoxelTetMesh(
+      Eigen::Vector3d::Zero(), h, cells,
+      [&region](const Eigen::Vector3d&, const Eigen::Vector3i& c) { return region(c); });
   s.body = body;
   s.actuators = acts;
   FinishScene(&s);
@@ -170,8 +169,8 @@ inline ::testing::AssertionResult MatrixNear(const Eigen::MatrixXd& a, const Eig
   std::ostringstream os;
   os.precision(17);
   os << bad << " entr" << (bad == 1 ? "y" : "ies") << " differ by more than " << tol
-     << "; worst at (" << wi << ", " << wj << "): " << a(wi, wj) << " vs " << b(wi, wj)
-     << " (diff " << worst << ")";
+     << "; worst at (" << wi << ", " << wj << "): " << a(wi, wj) << " vs " << b(wi, wj) << " (diff "
+     << worst << ")";
   return ::testing::AssertionFailure() << os.str();
 }
 

@@ -40,8 +40,10 @@ Mesh ReadMesh(const std::string& path, MeshReport* report = nullptr);
 /// strain measure: ||F^T F - I||_F / 2 of the best-fit deformation gradient).
 /// `rest_regions` / `rest_positions` (#V x 3): elements of those regions measure their strain from
 /// rest_positions instead of mesh.vertices (a Scene's region_rest, e.g. a remeshed chamber).
-void WriteVtu(const std::string& path, const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X,
-              const std::vector<int>& rest_regions = {}, const Eigen::MatrixX3d* rest_positions = nullptr);
+void WriteVtu(const std::string& path, const Mesh& mesh,
+              const Eigen::Ref<const Eigen::MatrixX3d>& X,
+              const std::vector<int>& rest_regions = {},
+              const Eigen::MatrixX3d* rest_positions = nullptr);
 /// `.pvd` collection listing (time, file) pairs, files relative to the pvd's folder.
 void WritePvd(const std::string& path, const std::vector<std::pair<double, std::string>>& steps);
 /// Boundary surface (faces used by one element) as Wavefront `.obj` at positions X.

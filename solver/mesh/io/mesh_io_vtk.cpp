@@ -62,25 +62,39 @@ bool IsSkippedCellType(long long t) {
     case 76:
     case 77:  // Lagrange/Bezier 1D-2D
       return true;
-    default: return false;
+    default:
+      return false;
   }
 }
 
 const char* VtkCellName(long long t) {
   switch (t) {
-    case 10: return "tetra";
-    case 11: return "voxel";
-    case 12: return "hexahedron";
-    case 13: return "wedge";
-    case 14: return "pyramid";
-    case 15: return "pentagonal prism";
-    case 16: return "hexagonal prism";
-    case 24: return "quadratic tetra";
-    case 25: return "quadratic hexahedron";
-    case 26: return "quadratic wedge";
-    case 27: return "quadratic pyramid";
-    case 42: return "polyhedron";
-    default: return nullptr;
+    case 10:
+      return "tetra";
+    case 11:
+      return "voxel";
+    case 12:
+      return "hexahedron";
+    case 13:
+      return "wedge";
+    case 14:
+      return "pyramid";
+    case 15:
+      return "pentagonal prism";
+    case 16:
+      return "hexagonal prism";
+    case 24:
+      return "quadratic tetra";
+    case 25:
+      return "quadratic hexahedron";
+    case 26:
+      return "quadratic wedge";
+    case 27:
+      return "quadratic pyramid";
+    case 42:
+      return "polyhedron";
+    default:
+      return nullptr;
   }
 }
 

@@ -25,12 +25,23 @@ std::string XmlEscape(const std::string& s) {
   r.reserve(s.size());
   for (char c : s) {
     switch (c) {
-      case '&': r += "&amp;"; break;
-      case '<': r += "&lt;"; break;
-      case '>': r += "&gt;"; break;
-      case '"': r += "&quot;"; break;
-      case '\'': r += "&apos;"; break;
-      default: r += c;
+      case '&':
+        r += "&amp;";
+        break;
+      case '<':
+        r += "&lt;";
+        break;
+      case '>':
+        r += "&gt;";
+        break;
+      case '"':
+        r += "&quot;";
+        break;
+      case '\'':
+        r += "&apos;";
+        break;
+      default:
+        r += c;
     }
   }
   return r;
@@ -59,18 +70,21 @@ Mesh ReadMesh(const std::string& path, MeshReport* report) {
 }
 
 std::vector<double> ElementStrain(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X,
-                                  const std::vector<int>& rest_regions, const Eigen::MatrixX3d* rest_positions) {
+                                  const std::vector<int>& rest_regions,
+                                  const Eigen::MatrixX3d* rest_positions) {
   if (X.rows() != mesh.num_vertices())
     throw std::invalid_argument("ElementStrain: positions have " + std::to_string(X.rows()) +
                                 " rows; expected " + std::to_string(mesh.num_vertices()));
   if (!rest_regions.empty() && (!rest_positions || rest_positions->rows() != mesh.num_vertices()))
     throw std::invalid_argument("ElementStrain: expected rest positions with one row per vertex (" +
-                                std::to_string(mesh.num_vertices()) + ") for regions with their own rest shape");
+                                std::to_string(mesh.num_vertices()) +
+                                ") for regions with their own rest shape");
   std::vector<double> strain(mesh.elements.size());
   for (std::size_t i = 0; i < mesh.elements.size(); ++i) {
     const Element& e = mesh.elements[i];
     const int k = e.k();
-    const bool own = std::find(rest_regions.begin(), rest_regions.end(), e.region) != rest_regions.end();
+    const bool own =
+        std::find(rest_regions.begin(), rest_regions.end(), e.region) != rest_regions.end();
     const Eigen::MatrixX3d& rest = own ? *rest_positions : mesh.vertices;
     // Centred rest (P) and deformed (Q) positions; F minimises sum ||F p - q||^2:
     // F = (Q^T P) (P^T P)^{-1}. For a tet the affine map is exact, so this is the exact F.
@@ -103,8 +117,9 @@ std::vector<double> ElementStrain(const Mesh& mesh, const Eigen::Ref<const Eigen
   return strain;
 }
 
-void WriteVtu(const std::string& path, const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X,
-              const std::vector<int>& rest_regions, const Eigen::MatrixX3d* rest_positions) {
+void WriteVtu(const std::string& path, const Mesh& mesh,
+              const Eigen::Ref<const Eigen::MatrixX3d>& X, const std::vector<int>& rest_regions,
+              const Eigen::MatrixX3d* rest_positions) {
   CheckPositions(path, mesh, X);
   const std::vector<double> strain = ElementStrain(mesh, X, rest_regions, rest_positions);
   std::ofstream out = detail::OpenForWrite(path);

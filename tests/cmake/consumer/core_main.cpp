@@ -24,8 +24,8 @@ int main() {
     a.min = 1.0;
     a.max = 2.0;
     s.actuators.push_back(a);
-    s.fixed = softkin::VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(),
-                                       1e-9);
+    s.fixed =
+        softkin::VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), 1e-9);
     s.validate();
     auto model = std::make_shared<const softkin::Model>(s);
     softkin::LocalGlobalSolver solver(model, s.solver);

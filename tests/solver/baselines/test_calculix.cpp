@@ -1,6 +1,6 @@
-// The CalculiX baseline (solver/baselines/calculix.hpp): the .inp export parsed back and checked, the .dat
-// reader on good and bad files, and a tiny ccx run (the set-up installs calculix-ccx) whose
-// displacement field bends the bar the way lg-aa does.
+// The CalculiX baseline (solver/baselines/calculix.hpp): the .inp export parsed back and checked,
+// the .dat reader on good and bad files, and a tiny ccx run (the set-up installs calculix-ccx)
+// whose displacement field bends the bar the way lg-aa does.
 #include "softkin/solver/baselines/calculix.hpp"
 
 #include "softkin/solver/factory/fk_factory.hpp"
@@ -40,7 +40,8 @@ Scene BendingBar() {
 }
 
 fs::path TempFile(const std::string& name) {
-  return fs::temp_directory_path() / ("softkin_test_ccx_" + std::to_string(::getpid()) + "_" + name);
+  return fs::temp_directory_path() /
+         ("softkin_test_ccx_" + std::to_string(::getpid()) + "_" + name);
 }
 
 TEST(Calculix, InpExportParsesBack) {
@@ -167,8 +168,10 @@ TEST(Calculix, DatReaderAcceptsIncrementsAndRejectsBadFiles) {
     }
   };
   expect_error(" displacements (vx,vy,vz) for set NALL and time 1.0\n 1 0 0 0\n", "lacks node 2");
-  expect_error(" displacements (vx,vy,vz) for set NALL and time 1.0\n 3 0 0 0\n", ":2: node 3 out of range");
-  expect_error(" displacements (vx,vy,vz) for set NALL and time 1.0\n 1 0 0\n", ":2: expected node ux uy uz");
+  expect_error(" displacements (vx,vy,vz) for set NALL and time 1.0\n 3 0 0 0\n",
+               ":2: node 3 out of range");
+  expect_error(" displacements (vx,vy,vz) for set NALL and time 1.0\n 1 0 0\n",
+               ":2: expected node ux uy uz");
   fs::remove(p);
 }
 
@@ -198,7 +201,8 @@ TEST(Calculix, TinyRunBendsTheWayLgAaDoes) {
   const Eigen::Vector3d t0 = s.marker_positions(s.mesh.vertices).row(tip).transpose();
   const Eigen::Vector3d d_ref = s.marker_positions(ref.positions).row(tip).transpose() - t0;
   ASSERT_LT(d_ref.z(), -0.5) << "the test bar should bend towards -z";
-  if (FindCcx().empty()) GTEST_SKIP() << "ccx is not installed (scripts/setup.sh installs calculix-ccx)";
+  if (FindCcx().empty())
+    GTEST_SKIP() << "ccx is not installed (scripts/setup.sh installs calculix-ccx)";
   for (const char* name : {"calculix-linear", "calculix-nonlinear"}) {
     FkOptions o = s.solver;
     o.solver = name;
@@ -206,8 +210,8 @@ TEST(Calculix, TinyRunBendsTheWayLgAaDoes) {
     const FkResult r = SolveFk(s, c, &o);
     ASSERT_EQ(r.status, FkStatus::Converged) << r.BriefReport();
     const Eigen::Vector3d d = s.marker_positions(r.positions).row(tip).transpose() - t0;
-    std::printf("  %s: tip moved (%.3f, %.3f, %.3f) mm, lg-aa (%.3f, %.3f, %.3f); %s\n", name, d.x(),
-                d.y(), d.z(), d_ref.x(), d_ref.y(), d_ref.z(), r.BriefReport().c_str());
+    std::printf("  %s: tip moved (%.3f, %.3f, %.3f) mm, lg-aa (%.3f, %.3f, %.3f); %s\n", name,
+                d.x(), d.y(), d.z(), d_ref.x(), d_ref.y(), d_ref.z(), r.BriefReport().c_str());
     EXPECT_GT(d.dot(d_ref), 0.7 * d.norm() * d_ref.norm()) << name;
     EXPECT_LT(d.z(), 0.0) << name;
     // The fixed face does not move; the chamber has grown.

@@ -1,7 +1,7 @@
-// The FK energy handed to Ceres and Ipopt (solver/baselines/nlp_solvers.hpp): every energy-minimising solver
-// reaches the local-global solution on small meshes (tets and prisms, fixed, held and moved
-// vertices, signed actuators), the fixed-ratio gradient they use is checked against finite
-// differences, and what they cannot express is rejected with a clear status.
+// The FK energy handed to Ceres and Ipopt (solver/baselines/nlp_solvers.hpp): every
+// energy-minimising solver reaches the local-global solution on small meshes (tets and prisms,
+// fixed, held and moved vertices, signed actuators), the fixed-ratio gradient they use is checked
+// against finite differences, and what they cannot express is rejected with a clear status.
 #include "softkin/solver/fk/energy.hpp"
 #include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
@@ -22,19 +22,21 @@ namespace softkin {
 namespace {
 
 const std::vector<std::string> kNlpSolvers = {"ceres", "ipopt-lbfgs", "ipopt-newton"};
-const std::vector<std::string> kAllNlpSolvers = {"ceres", "ipopt-lbfgs", "ipopt-newton", "ipopt-hard"};
+const std::vector<std::string> kAllNlpSolvers = {"ceres", "ipopt-lbfgs", "ipopt-newton",
+                                                 "ipopt-hard"};
 
 /// A 5 x 3 x 3 bar of 2 mm cells with a 3-cell chamber inside (region 1), x = 0 fixed.
 Scene ChamberBar(double r_omega = 1.0) {
   return test::VoxelScene(
       Eigen::Vector3i(5, 3, 3), 2.0,
-      [](const Eigen::Vector3i& c) { return (c.x() >= 1 && c.x() <= 3 && c.y() == 1 && c.z() == 1) ? 1 : 0; },
+      [](const Eigen::Vector3i& c) {
+        return (c.x() >= 1 && c.x() <= 3 && c.y() == 1 && c.z() == 1) ? 1 : 0;
+      },
       {{0, Material{"body", r_omega, 1.0}}}, {test::Pneumatic("chamber", {1})}, "chamber_bar");
 }
 
-
 FkResult SolveWith(const Scene& s, const Eigen::VectorXd& c, const std::string& solver, double gtol,
-             int max_iterations = 20000) {
+                   int max_iterations = 20000) {
   FkOptions o = s.solver;
   o.solver = solver;
   o.gradient_tolerance = gtol;
@@ -96,7 +98,8 @@ TEST(NlpSolvers, RatioUpdateLoopStopsWhenTheOptimiserNoLongerMoves) {
   std::printf("  target 1e-30: %s\n", r.BriefReport().c_str());
   EXPECT_LT(r.iterations, 100000) << r.BriefReport();
   EXPECT_EQ(r.status, FkStatus::Diverged) << r.BriefReport();
-  EXPECT_NE(r.message.find("stalled: the optimiser no longer changes the positions"), std::string::npos)
+  EXPECT_NE(r.message.find("stalled: the optimiser no longer changes the positions"),
+            std::string::npos)
       << r.message;
   EXPECT_GT(r.gradient_ratio, 1e-28);
   EXPECT_LT((r.positions - ok.positions).rowwise().norm().maxCoeff(), 1e-6);
@@ -135,7 +138,8 @@ TEST(NlpSolvers, FixedRatioGradientMatchesFiniteDifferences) {
       Xp(v, d) += h;
       Xm(v, d) -= h;
       const double fd = (FixedRatioEnergyAndGradient(model, Xp, ratios, &Gd) -
-                         FixedRatioEnergyAndGradient(model, Xm, ratios, &Gd)) / (2 * h);
+                         FixedRatioEnergyAndGradient(model, Xm, ratios, &Gd)) /
+                        (2 * h);
       worst = std::max(worst, std::abs(fd - G(v, d)));
     }
   EXPECT_LT(worst, 1e-6 * G.norm()) << "worst |fd - grad| " << worst << ", |grad| " << G.norm();
@@ -185,8 +189,8 @@ TEST(NlpSolvers, HardConstraintsHitTheVolumeExactly) {
   const FkResult soft = SolveWith(s, c, "lg-aa", 1e-8);
   ASSERT_EQ(hard.status, FkStatus::Converged) << hard.BriefReport();
   ASSERT_EQ(soft.status, FkStatus::Converged) << soft.BriefReport();
-  std::printf("  volume ratio: ipopt-hard %.9f, lg-aa %.6f (asked 1.5); %s\n", hard.volume_ratios[0],
-              soft.volume_ratios[0], hard.BriefReport().c_str());
+  std::printf("  volume ratio: ipopt-hard %.9f, lg-aa %.6f (asked 1.5); %s\n",
+              hard.volume_ratios[0], soft.volume_ratios[0], hard.BriefReport().c_str());
   EXPECT_NEAR(hard.volume_ratios[0], 1.5, 1e-6);
   EXPECT_LT(soft.volume_ratios[0], 1.5);
   EXPECT_GT(soft.volume_ratios[0], 1.0);
@@ -211,7 +215,8 @@ TEST(NlpSolvers, BadInputGivesInvalidInputNotAThrow) {
     EXPECT_NE(r.message.find("expected a number in [1, 3]"), std::string::npos) << r.message;
     Eigen::MatrixX3d bad = model->rest_positions();
     bad(0, 0) = std::nan("");
-    EXPECT_EQ(solver->Solve(Eigen::VectorXd::Constant(1, 1.5), &bad).status, FkStatus::InvalidInput);
+    EXPECT_EQ(solver->Solve(Eigen::VectorXd::Constant(1, 1.5), &bad).status,
+              FkStatus::InvalidInput);
   }
   FkOptions o;
   o.solver = "ipopt";

@@ -1,7 +1,8 @@
-// Collision detection (solver/collision/collision.hpp, thesis Sec. 3.2.2): obstacle surfaces (readers,
-// closedness checks, inside and closest-point queries) and self-collision of a tet mesh (no false
-// positives at rest, a built overlap found exactly, the three broad phases and a brute-force
-// search give the same contacts on penetrating states, the filtered point-in-tet test is exact).
+// Collision detection (solver/collision/collision.hpp, thesis Sec. 3.2.2): obstacle surfaces
+// (readers, closedness checks, inside and closest-point queries) and self-collision of a tet mesh
+// (no false positives at rest, a built overlap found exactly, the three broad phases and a
+// brute-force search give the same contacts on penetrating states, the filtered point-in-tet test
+// is exact).
 #include "softkin/solver/collision/collision.hpp"
 
 #include "softkin/solver/mesh/mesh_gen.hpp"
@@ -49,7 +50,8 @@ void ExpectError(const fs::path& p, const std::vector<std::string>& parts) {
     ReadSurfaceMesh(p.string());
     ADD_FAILURE() << "accepted " << p;
   } catch (const std::invalid_argument& e) {
-    for (const auto& part : parts) EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+    for (const auto& part : parts)
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find(p.string()), std::string::npos) << e.what();
   }
 }
@@ -63,7 +65,8 @@ TEST(Collision, ObstacleQueries) {
   const Eigen::Vector3d c = box.ClosestPoint(Eigen::Vector3d(3.8, 1, 1.2), &n);
   EXPECT_TRUE(c.isApprox(Eigen::Vector3d(4, 1, 1.2), 1e-12)) << c.transpose();
   EXPECT_TRUE(n.isApprox(Eigen::Vector3d(1, 0, 0), 1e-12)) << n.transpose();
-  const Obstacle cyl(MakeCylinderSurface(Eigen::Vector3d(0, 0, -5), Eigen::Vector3d(0, 0, 1), 3.0, 10.0, 64));
+  const Obstacle cyl(
+      MakeCylinderSurface(Eigen::Vector3d(0, 0, -5), Eigen::Vector3d(0, 0, 1), 3.0, 10.0, 64));
   EXPECT_TRUE(cyl.Contains(Eigen::Vector3d(2.9, 0, 0)));
   EXPECT_FALSE(cyl.Contains(Eigen::Vector3d(3.1, 0, 0)));
   // From the axis side, the closest point is on the 64-gon's side: between the apothem and the
@@ -82,7 +85,8 @@ TEST(Collision, ObstacleQueries) {
 TEST(Collision, MovingSurfaceClosestPoints) {
   const TriangleSurface box = MakeBoxSurface(Eigen::Vector3d::Zero(), Eigen::Vector3d(2, 3, 4));
   std::vector<std::array<int, 3>> faces;
-  for (int f = 0; f < box.faces.rows(); ++f) faces.push_back({box.faces(f, 0), box.faces(f, 1), box.faces(f, 2)});
+  for (int f = 0; f < box.faces.rows(); ++f)
+    faces.push_back({box.faces(f, 0), box.faces(f, 1), box.faces(f, 2)});
   MovingSurface surface(faces);
   const Eigen::Vector3d shift(10, -5, 7);
   Eigen::MatrixX3d X = box.vertices;
@@ -110,7 +114,8 @@ TEST(Collision, MovingSurfaceClosestPoints) {
       ASSERT_TRUE(surface.ClosestFacing(p, -Eigen::Vector3d::UnitZ(), &top, &face));
       EXPECT_NEAR((top - (p + (4.0 - q.z()) * Eigen::Vector3d::UnitZ())).norm(), 0.0, 1e-9);
       const auto& t = faces[face];
-      EXPECT_NEAR(X(t[0], 2) + X(t[1], 2) + X(t[2], 2), 3 * (4.0 + shift.z()), 1e-9);  // a top triangle
+      EXPECT_NEAR(X(t[0], 2) + X(t[1], 2) + X(t[2], 2), 3 * (4.0 + shift.z()),
+                  1e-9);  // a top triangle
     }
   }
   EXPECT_GT(inside, 10);
@@ -141,7 +146,8 @@ TEST(Collision, ReadersAcceptObjAndBothStlForms) {
     char rec[50] = {};
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d p = s.vertices.row(s.faces(f, k));
-      ascii += "   vertex " + std::to_string(p.x()) + " " + std::to_string(p.y()) + " " + std::to_string(p.z()) + "\n";
+      ascii += "   vertex " + std::to_string(p.x()) + " " + std::to_string(p.y()) + " " +
+               std::to_string(p.z()) + "\n";
       const float xyz[3] = {float(p.x()), float(p.y()), float(p.z())};
       std::memcpy(rec + 12 + 12 * k, xyz, 12);
     }
@@ -159,13 +165,15 @@ TEST(Collision, ReadersAcceptObjAndBothStlForms) {
   }
   // An inside-out surface is turned outward.
   std::string flipped = kCubeObj;
-  for (const char* from : {"f 1 4 3 2", "f 5 6 7 8", "f 1 2 6 5", "f 2 3 7 6", "f 3 4 8 7", "f 4 1 5 8"}) {
+  for (const char* from :
+       {"f 1 4 3 2", "f 5 6 7 8", "f 1 2 6 5", "f 2 3 7 6", "f 3 4 8 7", "f 4 1 5 8"}) {
     std::string f(from);
     const std::string rev = "f " + std::string(1, f[8]) + " " + f[6] + " " + f[4] + " " + f[2];
     flipped.replace(flipped.find(f), f.size(), rev);
   }
   Write(Temp("flipped.obj"), flipped);
-  EXPECT_TRUE(Obstacle(ReadSurfaceMesh(Temp("flipped.obj").string())).Contains(Eigen::Vector3d(1, 1, 1)));
+  EXPECT_TRUE(
+      Obstacle(ReadSurfaceMesh(Temp("flipped.obj").string())).Contains(Eigen::Vector3d(1, 1, 1)));
 }
 
 TEST(Collision, CorruptedObstacleMeshesAreRejected) {
@@ -201,14 +209,15 @@ TEST(Collision, CorruptedObstacleMeshesAreRejected) {
 TEST(Collision, NoSelfContactAtRestOrUnderRigidMotion) {
   for (const char* robot : {"pneumatic_finger", "three_chamber"})
     for (auto method : kMethods) {
-    const Scene s = MakeRobot(robot, robot == std::string("three_chamber") ? 3 : 5);
-    SelfCollisionDetector d(s.mesh, method);
-    EXPECT_GT(d.boundary_vertices().size(), 100u);
-    EXPECT_TRUE(d.Detect().empty()) << robot;
-    const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
-    d.Update((s.mesh.vertices * R.transpose()).rowwise() + Eigen::RowVector3d(5, -2, 1));
-    EXPECT_TRUE(d.Detect().empty()) << robot;
-  }
+      const Scene s = MakeRobot(robot, robot == std::string("three_chamber") ? 3 : 5);
+      SelfCollisionDetector d(s.mesh, method);
+      EXPECT_GT(d.boundary_vertices().size(), 100u);
+      EXPECT_TRUE(d.Detect().empty()) << robot;
+      const Eigen::Matrix3d R =
+          Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+      d.Update((s.mesh.vertices * R.transpose()).rowwise() + Eigen::RowVector3d(5, -2, 1));
+      EXPECT_TRUE(d.Detect().empty()) << robot;
+    }
 }
 
 TEST(Collision, BuiltOverlapIsFoundExactly) {
@@ -216,8 +225,9 @@ TEST(Collision, BuiltOverlapIsFoundExactly) {
   // is then pushed 1.5 mm into the first. The second block's end face (now x = 1.5) lies in the
   // first block, and the first block's end face (x = 2) lies in the second: those 18 vertices, no
   // others. (They sit on faces shared by tets, which the test must not miss.)
-  const Mesh m = VoxelTetMesh(Eigen::Vector3d::Zero(), 1.0, Eigen::Vector3i(5, 2, 2),
-                              [](const Eigen::Vector3d&, const Eigen::Vector3i& c) { return c.x() == 2 ? -1 : 0; });
+  const Mesh m = VoxelTetMesh(
+      Eigen::Vector3d::Zero(), 1.0, Eigen::Vector3i(5, 2, 2),
+      [](const Eigen::Vector3d&, const Eigen::Vector3i& c) { return c.x() == 2 ? -1 : 0; });
   for (auto method : kMethods) {
     SelfCollisionDetector d(m, method);
     EXPECT_TRUE(d.Detect().empty());
@@ -255,7 +265,8 @@ TEST(Collision, RobotVerticesInsideAnObstacle) {
     const Eigen::Vector3d p = s.mesh.vertices.row(c.vertex);
     EXPECT_GT(p.x(), 100.0);
     EXPECT_NEAR(c.depth, (c.closest - p).norm(), 1e-12);
-    const double to_face = std::min({p.x() - 100.0, 130.0 - p.x(), p.y() + 5.0, 30.0 - p.y(), p.z() + 5.0, 30.0 - p.z()});
+    const double to_face = std::min(
+        {p.x() - 100.0, 130.0 - p.x(), p.y() + 5.0, 30.0 - p.y(), p.z() + 5.0, 30.0 - p.z()});
     EXPECT_NEAR(c.depth, to_face, 1e-9);
     EXPECT_GT(c.normal.norm(), 0.99);
   }
@@ -280,8 +291,10 @@ TEST(Collision, TetContainsPointIsExact) {
   for (int i = 0; i < 20000; ++i) {
     Eigen::Vector3d x(k(rng) / 1024.0, k(rng) / 1024.0, k(rng) / 1024.0);
     // Put a third of the points on the slanted face x + y + z = 4 or a coordinate plane.
-    if (snap(rng) == 0) x.z() = 4 - x.x() - x.y();
-    else if (snap(rng) == 0) x[snap(rng) % 3] = 0;
+    if (snap(rng) == 0)
+      x.z() = 4 - x.x() - x.y();
+    else if (snap(rng) == 0)
+      x[snap(rng) % 3] = 0;
     const double sum = x.sum();  // exact: few bits
     const bool truth = x.minCoeff() >= 0 && sum <= 4;
     on_boundary += truth && (x.minCoeff() == 0 || sum == 4);
@@ -303,7 +316,8 @@ TEST(Collision, TetContainsPointIsExact) {
   EXPECT_FALSE(TetContainsPoint(a, b, c, d, Eigen::Vector3d(1, 1, below)));
   EXPECT_TRUE(TetContainsPoint(a, b, c, d, Eigen::Vector3d(1, 1, 0)));
   EXPECT_TRUE(TetContainsPoint(a, b, c, d, Eigen::Vector3d(1, 1, std::nextafter(0.0, 1.0))));
-  EXPECT_FALSE(TetContainsPoint(a, b, c, d, Eigen::Vector3d(2, 2, std::nextafter(0.0, 1.0))));  // past x+y+z=4
+  EXPECT_FALSE(TetContainsPoint(a, b, c, d,
+                                Eigen::Vector3d(2, 2, std::nextafter(0.0, 1.0))));  // past x+y+z=4
   // A flat tet contains nothing, not even its own corners; a tiny tet is handled like a big one.
   EXPECT_FALSE(TetContainsPoint(a, b, c, Eigen::Vector3d(1, 1, 0), Eigen::Vector3d(1, 0.5, 0)));
   EXPECT_FALSE(TetContainsPoint(a, b, c, Eigen::Vector3d(1, 1, 0), a));
@@ -314,7 +328,8 @@ TEST(Collision, TetContainsPointIsExact) {
 }
 
 /// Reference answer: every boundary vertex against every non-incident tet, lowest tet first.
-std::vector<SelfContact> BruteForceContacts(const Mesh& m, const std::vector<int>& boundary, const Eigen::MatrixX3d& X) {
+std::vector<SelfContact> BruteForceContacts(const Mesh& m, const std::vector<int>& boundary,
+                                            const Eigen::MatrixX3d& X) {
   std::vector<SelfContact> out;
   for (int v : boundary)
     for (int t = 0; t < m.num_elements(); ++t) {
@@ -344,7 +359,8 @@ bool Same(const std::vector<SelfContact>& a, const std::vector<SelfContact>& b) 
 
 /// Penetrating states of a robot mesh: its far half along the longest axis pushed back into the
 /// near half, its top half folded down into the bottom half, and random vertex jitter (seeded).
-std::vector<std::pair<std::string, Eigen::MatrixX3d>> PenetratingStates(const Mesh& m, unsigned seed) {
+std::vector<std::pair<std::string, Eigen::MatrixX3d>> PenetratingStates(const Mesh& m,
+                                                                        unsigned seed) {
   const Eigen::MatrixX3d& X0 = m.vertices;
   const Eigen::RowVector3d lo = X0.colwise().minCoeff(), hi = X0.colwise().maxCoeff();
   const Eigen::RowVector3d mid = 0.5 * (lo + hi), ext = hi - lo;
@@ -374,7 +390,8 @@ std::vector<std::pair<std::string, Eigen::MatrixX3d>> PenetratingStates(const Me
 }
 
 TEST(Collision, AllMethodsAndBruteForceAgreeOnPenetratingStates) {
-  for (const auto& [robot, res] : {std::pair<std::string, int>{"pneumatic_finger", 5}, {"three_chamber", 3}}) {
+  for (const auto& [robot, res] :
+       {std::pair<std::string, int>{"pneumatic_finger", 5}, {"three_chamber", 3}}) {
     const Scene s = MakeRobot(robot, res);
     const Mesh& m = s.mesh;
     std::vector<std::unique_ptr<SelfCollisionDetector>> det;
@@ -387,13 +404,15 @@ TEST(Collision, AllMethodsAndBruteForceAgreeOnPenetratingStates) {
       for (size_t i = 0; i < det.size(); ++i) {
         det[i]->Update(X);
         const auto got = det[i]->Detect();
-        EXPECT_TRUE(Same(got, truth)) << robot << " " << name << " " << SelfCollisionMethodToString(kMethods[i])
-                                      << ": got " << Describe(got) << "; expected " << Describe(truth);
+        EXPECT_TRUE(Same(got, truth))
+            << robot << " " << name << " " << SelfCollisionMethodToString(kMethods[i]) << ": got "
+            << Describe(got) << "; expected " << Describe(truth);
         EXPECT_GE(det[i]->last_narrow_tests(), static_cast<long long>(truth.size()));
       }
       // The grid's filter decides nearly every test by itself.
       const auto& grid = *det[2];
-      EXPECT_LT(grid.last_exact_tests(), grid.last_narrow_tests() / 10 + 10) << robot << " " << name;
+      EXPECT_LT(grid.last_exact_tests(), grid.last_narrow_tests() / 10 + 10)
+          << robot << " " << name;
     }
     // Back at rest: nothing, with every method (the grid reuses its buffers).
     for (auto& d : det) {
@@ -465,7 +484,8 @@ TEST(Collision, SelfCollisionInputErrorsAndMethodNames) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("vertex 17"), std::string::npos) << e.what();
   }
-  for (auto m : kMethods) EXPECT_EQ(SelfCollisionMethodFromString(SelfCollisionMethodToString(m)), m);
+  for (auto m : kMethods)
+    EXPECT_EQ(SelfCollisionMethodFromString(SelfCollisionMethodToString(m)), m);
   try {
     SelfCollisionMethodFromString("bvh");
     ADD_FAILURE() << "accepted 'bvh'";
@@ -479,15 +499,18 @@ TEST(Collision, ObstacleContactsOfAVertexSubsetAndFarObstacles) {
   const Scene s = MakeRobot("pneumatic_finger", 5);
   const Eigen::MatrixX3d& X = s.mesh.vertices;
   std::vector<Obstacle> obs;
-  obs.emplace_back(MakeBoxSurface(Eigen::Vector3d(1000, 0, 0), Eigen::Vector3d(1010, 10, 10)));  // far away
-  obs.emplace_back(MakeCylinderSurface(Eigen::Vector3d(90, 10, -50), Eigen::Vector3d(0, 0, 1), 12.0, 100.0));
+  obs.emplace_back(
+      MakeBoxSurface(Eigen::Vector3d(1000, 0, 0), Eigen::Vector3d(1010, 10, 10)));  // far away
+  obs.emplace_back(
+      MakeCylinderSurface(Eigen::Vector3d(90, 10, -50), Eigen::Vector3d(0, 0, 1), 12.0, 100.0));
   std::vector<int> odd;
   for (int v = 1; v < X.rows(); v += 2) odd.push_back(v);
   const auto contacts = DetectObstacleContacts(obs, X, odd);
   // The same as asking every obstacle about every listed vertex.
   std::vector<int> expected;
   for (int v : odd)
-    if (obs[0].Contains(X.row(v).transpose()) || obs[1].Contains(X.row(v).transpose())) expected.push_back(v);
+    if (obs[0].Contains(X.row(v).transpose()) || obs[1].Contains(X.row(v).transpose()))
+      expected.push_back(v);
   ASSERT_FALSE(expected.empty());
   ASSERT_EQ(contacts.size(), expected.size());
   for (size_t i = 0; i < contacts.size(); ++i) {
@@ -500,7 +523,8 @@ TEST(Collision, ObstacleContactsOfAVertexSubsetAndFarObstacles) {
   std::vector<Obstacle> far;
   far.emplace_back(MakeBoxSurface(Eigen::Vector3d(1000, 0, 0), Eigen::Vector3d(1010, 10, 10)));
   EXPECT_TRUE(DetectObstacleContacts(far, X).empty());
-  EXPECT_THROW(DetectObstacleContacts(obs, X, {0, static_cast<int>(X.rows())}), std::invalid_argument);
+  EXPECT_THROW(DetectObstacleContacts(obs, X, {0, static_cast<int>(X.rows())}),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -1,8 +1,8 @@
-// Collision response by spring elements (solver/collision/collision_response.hpp, spring_system.hpp; thesis
-// Sec. 3.2.3, Eq. 3.5, 3.8, 3.9): the spring system solves A_ff + K exactly after any sequence of
-// updates and downdates; the spring energy, its gradient and the global system agree (finite
-// differences); a pressed-in state fails the exact collision check without response and passes
-// with it, for self-collision and for an obstacle.
+// Collision response by spring elements (solver/collision/collision_response.hpp,
+// spring_system.hpp; thesis Sec. 3.2.3, Eq. 3.5, 3.8, 3.9): the spring system solves A_ff + K
+// exactly after any sequence of updates and downdates; the spring energy, its gradient and the
+// global system agree (finite differences); a pressed-in state fails the exact collision check
+// without response and passes with it, for self-collision and for an obstacle.
 #include "softkin/solver/collision/collision_response.hpp"
 
 #include "softkin/solver/factory/fk_factory.hpp"
@@ -32,16 +32,16 @@ constexpr double kH = 2.0;  // cell size, mm
 Scene TwoBlocks() {
   Scene s;
   s.name = "two_blocks";
-  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), kH, Eigen::Vector3i(4, 4, 5),
-                        [](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
-                          return c[2] == 2 ? -1 : 0;
-                        });
+  s.mesh = VoxelTetMesh(
+      Eigen::Vector3d::Zero(), kH, Eigen::Vector3i(4, 4, 5),
+      [](const Eigen::Vector3d&, const Eigen::Vector3i& c) { return c[2] == 2 ? -1 : 0; });
   s.body[0] = Material{"body", 0.5, 1.0};
   s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 1e-9);
   Actuator press;
   press.name = "press";
   press.type = ActuatorType::Displacement;
-  press.vertices = VerticesOnPlane(s.mesh, Eigen::Vector3d(0, 0, 10), Eigen::Vector3d::UnitZ(), 1e-9);
+  press.vertices =
+      VerticesOnPlane(s.mesh, Eigen::Vector3d(0, 0, 10), Eigen::Vector3d::UnitZ(), 1e-9);
   press.axis = -Eigen::Vector3d::UnitZ();
   press.rest = press.min = 0.0;
   press.max = 6.0;
@@ -194,7 +194,8 @@ TEST(CollisionResponse, SpringEnergyGradientMatchesFiniteDifferences) {
     }
     // Move off the targets, so the gradient is not zero.
     Eigen::MatrixX3d Y = X;
-    for (int v = 0; v < Y.rows(); ++v) Y.row(v) += 0.1 * Eigen::RowVector3d(std::sin(v), std::cos(v), 0.3);
+    for (int v = 0; v < Y.rows(); ++v)
+      Y.row(v) += 0.1 * Eigen::RowVector3d(std::sin(v), std::cos(v), 0.3);
     // Analytic: dE_col/dx_free = 2 (K x - rhs) = 2 (AddSpringProduct - AddToRhs).
     Eigen::VectorXd Kx = Eigen::VectorXd::Zero(model.num_free_dofs()), Kt = Kx;
     Eigen::VectorXd yf;
@@ -359,7 +360,8 @@ TEST(CollisionResponse, BetweenBodiesTheTargetIsTheClosestSurfacePoint) {
     EXPECT_NE(resp.body(corner), resp.body(0));
     resp.Update(X);
     const auto& sp = resp.springs();
-    const auto it = std::find_if(sp.begin(), sp.end(), [&](const CollisionSpring& s) { return s.vertex == corner; });
+    const auto it = std::find_if(sp.begin(), sp.end(),
+                                 [&](const CollisionSpring& s) { return s.vertex == corner; });
     ASSERT_NE(it, sp.end()) << rule;
     if (std::string(rule) == "auto") {
       EXPECT_NEAR(it->depth, 1.0, 1e-9);
@@ -461,7 +463,7 @@ TEST(CollisionResponse, PressedBlocksAreCollisionFreeOnlyWithResponse) {
       if (std::abs(p.z() - 6.0) < 1e-9) zu += r.positions(q, 2) / 25;
       if (std::abs(p.z() - 4.0) < 1e-9) zl += r.positions(q, 2) / 25;
     }
-    EXPECT_LT(top, 0.0);  // the press pushes down on the upper block's top ...
+    EXPECT_LT(top, 0.0);     // the press pushes down on the upper block's top ...
     EXPECT_GT(bottom, 0.0);  // ... and the ground up on the lower block's bottom
     if (pair) {
       // Vertex-face springs pass the force on unchanged (action and reaction): the two
@@ -500,15 +502,18 @@ Scene BlockOverObstacle(const Eigen::Vector3d& axis, bool cylinder) {
   Actuator press;
   press.name = "press";
   press.type = ActuatorType::Displacement;
-  press.vertices = VerticesOnPlane(s.mesh, Eigen::Vector3d(0, 0, 6), Eigen::Vector3d::UnitZ(), 1e-9);
+  press.vertices =
+      VerticesOnPlane(s.mesh, Eigen::Vector3d(0, 0, 6), Eigen::Vector3d::UnitZ(), 1e-9);
   press.axis = axis.normalized();
   press.rest = press.min = 0.0;
   press.max = 6.0;
   s.actuators.push_back(press);
   if (cylinder)
-    s.obstacles.push_back(MakeCylinderSurface(Eigen::Vector3d(4, -10, -9), Eigen::Vector3d::UnitY(), 10.0, 28.0, 96));
+    s.obstacles.push_back(
+        MakeCylinderSurface(Eigen::Vector3d(4, -10, -9), Eigen::Vector3d::UnitY(), 10.0, 28.0, 96));
   else
-    s.obstacles.push_back(MakeBoxSurface(Eigen::Vector3d(-20, -20, -3), Eigen::Vector3d(30, 30, 1)));
+    s.obstacles.push_back(
+        MakeBoxSurface(Eigen::Vector3d(-20, -20, -3), Eigen::Vector3d(30, 30, 1)));
   s.validate();
   return s;
 }
@@ -592,14 +597,16 @@ TEST(CollisionResponse, PlaneObstacleSpringsSolveTheCoupledSystem) {
     const Eigen::SparseMatrix<double>& A = model.A_ff(d);
     for (int col = 0; col < A.outerSize(); ++col)
       for (Eigen::SparseMatrix<double>::InnerIterator it(A, col); it; ++it)
-        trip.emplace_back(model.free_offset(d) + it.row(), model.free_offset(d) + it.col(), it.value());
+        trip.emplace_back(model.free_offset(d) + it.row(), model.free_offset(d) + it.col(),
+                          it.value());
   }
   for (const auto& s : resp.springs())
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) {
         const int ia = model.free_index(a)[s.vertex], ib = model.free_index(b)[s.vertex];
         if (ia >= 0 && ib >= 0)
-          trip.emplace_back(model.free_offset(a) + ia, model.free_offset(b) + ib, k * s.normal[a] * s.normal[b]);
+          trip.emplace_back(model.free_offset(a) + ia, model.free_offset(b) + ib,
+                            k * s.normal[a] * s.normal[b]);
       }
   Eigen::SparseMatrix<double> M(nf, nf);
   M.setFromTriplets(trip.begin(), trip.end());
@@ -617,7 +624,8 @@ TEST(CollisionResponse, PlaneObstacleSpringsSolveTheCoupledSystem) {
 
   // Gradient of the spring energy against central differences, off the targets.
   Eigen::MatrixX3d Y = X;
-  for (int v = 0; v < Y.rows(); ++v) Y.row(v) += 0.1 * Eigen::RowVector3d(std::sin(v), std::cos(v), 0.3);
+  for (int v = 0; v < Y.rows(); ++v)
+    Y.row(v) += 0.1 * Eigen::RowVector3d(std::sin(v), std::cos(v), 0.3);
   model.ApplyConstraints(c, &Y);
   Eigen::VectorXd Kx = Eigen::VectorXd::Zero(nf), Kt = Kx, yf;
   model.GatherFree(Y, &yf);
@@ -672,18 +680,20 @@ TEST(CollisionResponse, PlaneObstacleSpringsLetTheContactSlide) {
   ASSERT_EQ(plane.status, FkStatus::Converged) << plane.BriefReport();
   EXPECT_TRUE(plane.collision.collision_free()) << plane.BriefReport();
   EXPECT_GT(plane.springs, 0);
-  EXPECT_GT(plane.positions.col(2).minCoeff(), 1.0 - 1e-9);  // on the box, not in it
-  EXPECT_LT(top_plane.z(), 0.0);                             // the press pushes down ...
+  EXPECT_GT(plane.positions.col(2).minCoeff(), 1.0 - 1e-9);           // on the box, not in it
+  EXPECT_LT(top_plane.z(), 0.0);                                      // the press pushes down ...
   EXPECT_LT(std::abs(top_plane.x()), 1e-3 * std::abs(top_plane.z()))  // ... and not sideways
       << "x reaction " << top_plane.x() << ", z " << top_plane.z();
   // Point springs, given ten times the iterations, are still creeping: a sideways reaction is left.
   const FkResult point = solve("point", 10 * plane.iterations, &top_point);
   EXPECT_EQ(point.status, FkStatus::IterationCap) << point.BriefReport();
   EXPECT_GT(std::abs(top_point.x()), 10 * std::abs(top_plane.x()));
-  std::printf("[ measured ] sliding contact: plane converged in %d iterations, x/z reaction %.2e; point after %d: "
-              "%.2e, residual ratio %.3g\n",
-              plane.iterations, top_plane.x() / top_plane.z(), point.iterations, top_point.x() / top_point.z(),
-              point.gradient_ratio);
+  std::printf(
+      "[ measured ] sliding contact: plane converged in %d iterations, x/z reaction %.2e; point "
+      "after %d: "
+      "%.2e, residual ratio %.3g\n",
+      plane.iterations, top_plane.x() / top_plane.z(), point.iterations,
+      top_point.x() / top_point.z(), point.gradient_ratio);
 }
 
 TEST(CollisionResponse, OptionsAreValidated) {
@@ -696,7 +706,8 @@ TEST(CollisionResponse, OptionsAreValidated) {
   o = CollisionOptions();
   o.self_target = "nearest";
   EXPECT_FALSE(o.IsValid(&why));
-  EXPECT_NE(why.find("collision.self_target: expected one of auto, walk; got 'nearest'"), std::string::npos);
+  EXPECT_NE(why.find("collision.self_target: expected one of auto, walk; got 'nearest'"),
+            std::string::npos);
   o = CollisionOptions();
   o.stiffness = -1;
   EXPECT_FALSE(o.IsValid(&why));

@@ -29,9 +29,10 @@ Scene CableBar(int body_cells) {
   const std::vector<Eigen::Vector3d> path = {{0, 1, 1}, {10, 1, 1}};
   std::map<int, Material> body;
   if (body_cells > 0) body[0] = Material{"rigid", 1.0, 1.0};
-  return test::VoxelScene({10, 2, 2}, 1.0,
-                          [body_cells](const Eigen::Vector3i& c) { return c.x() >= body_cells ? 1 : 0; },
-                          body, {Cable("tendon", {1}, path)}, "cable_bar");
+  return test::VoxelScene(
+      {10, 2, 2}, 1.0,
+      [body_cells](const Eigen::Vector3i& c) { return c.x() >= body_cells ? 1 : 0; }, body,
+      {Cable("tendon", {1}, path)}, "cable_bar");
 }
 
 /// An 6 x 6 one-layer prism sheet (edge 2, thickness 2), every prism a DEA element; one corner
@@ -274,8 +275,8 @@ TEST(RobotsCableFinger, ActuatorsMarkersAndRegions) {
   const Model m(s);
   for (int k = 0; k < 3; ++k) {
     EXPECT_NEAR(m.actuator_offset(k), 0.0, 0.02);
-    EXPECT_NEAR(m.actuator_rest_measure(k), (s.actuators[k].path[1] - s.actuators[k].path[0]).norm(),
-                0.02);
+    EXPECT_NEAR(m.actuator_rest_measure(k),
+                (s.actuators[k].path[1] - s.actuators[k].path[0]).norm(), 0.02);
   }
 }
 

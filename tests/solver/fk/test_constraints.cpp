@@ -165,7 +165,8 @@ PrismClassifier AllCells(int tag = 0) {
 
 double TriArea(const Mesh& m, int a, int b, int c) {
   const Eigen::Vector3d pa = m.vertices.row(a).transpose();
-  return 0.5 * (m.vertices.row(b).transpose() - pa).cross(m.vertices.row(c).transpose() - pa).norm();
+  return 0.5 *
+         (m.vertices.row(b).transpose() - pa).cross(m.vertices.row(c).transpose() - pa).norm();
 }
 
 TEST(PrismGrid, CountsOrientationVolumeAndCellCentres) {
@@ -214,7 +215,8 @@ TEST(PrismGrid, CountsOrientationVolumeAndCellCentres) {
     EXPECT_EQ(per_region[10 * l + 1], 14);
   }
   // Vertex (i, j, l) sits at origin + (i hx, j hy, z[l]) (z[l] added to origin.z()).
-  const Eigen::RowVector3d lo = m.vertices.colwise().minCoeff(), hi = m.vertices.colwise().maxCoeff();
+  const Eigen::RowVector3d lo = m.vertices.colwise().minCoeff(),
+                           hi = m.vertices.colwise().maxCoeff();
   EXPECT_NEAR(lo.x(), origin.x(), 1e-12);
   EXPECT_NEAR(hi.x(), origin.x() + cells.x() * hx, 1e-12);
   EXPECT_NEAR(hi.y(), origin.y() + cells.y() * hy, 1e-12);
@@ -233,8 +235,10 @@ TEST(PrismGrid, ConformingFacesAndBoundaryArea) {
   std::map<std::vector<int>, std::vector<std::vector<int>>> faces;  // sorted ids -> occurrences
   for (const auto& e : m.elements) {
     const auto& v = e.v;
-    const std::vector<std::vector<int>> fs = {{v[0], v[1], v[2]},       {v[3], v[4], v[5]},
-                                              {v[0], v[1], v[4], v[3]}, {v[1], v[2], v[5], v[4]},
+    const std::vector<std::vector<int>> fs = {{v[0], v[1], v[2]},
+                                              {v[3], v[4], v[5]},
+                                              {v[0], v[1], v[4], v[3]},
+                                              {v[1], v[2], v[5], v[4]},
                                               {v[2], v[0], v[3], v[5]}};
     for (const auto& f : fs) {
       std::vector<int> key = f;
@@ -283,7 +287,8 @@ TEST(PrismGrid, DiagonalsAlternateAndMeshIsMirrorSymmetric) {
     for (int j = 0; j < 6; ++j) c += m.vertices.row(e.v[j]) / 6.0;
     if (c.z() > 0.5) continue;  // first layer is enough
     // A triangle's centroid lies inside its cell.
-    const int ci = static_cast<int>(std::floor(c.x() / hx)), cj = static_cast<int>(std::floor(c.y() / hy));
+    const int ci = static_cast<int>(std::floor(c.x() / hx)),
+              cj = static_cast<int>(std::floor(c.y() / hy));
     tris[{ci, cj}].push_back({e.v[0], e.v[1], e.v[2]});
   }
   ASSERT_EQ(static_cast<int>(tris.size()), cells.x() * cells.y());
@@ -298,7 +303,7 @@ TEST(PrismGrid, DiagonalsAlternateAndMeshIsMirrorSymmetric) {
     ASSERT_EQ(shared.size(), 2u);
     const auto [i, j] = cell;
     std::vector<int> want = ((i + j) % 2 == 0) ? std::vector<int>{vid(i, j), vid(i + 1, j + 1)}
-                                                : std::vector<int>{vid(i + 1, j), vid(i, j + 1)};
+                                               : std::vector<int>{vid(i + 1, j), vid(i, j + 1)};
     std::sort(want.begin(), want.end());
     EXPECT_EQ(shared, want) << "cell " << i << ", " << j;
   }
@@ -319,7 +324,8 @@ TEST(PrismGrid, DiagonalsAlternateAndMeshIsMirrorSymmetric) {
   for (int d : {0, 1}) {
     const double centre = 0.5 * (d == 0 ? cells.x() * hx : cells.y() * hy);
     const std::vector<int> p = MirrorPartner(m, d, centre);
-    for (int v = 0; v < m.num_vertices(); ++v) ASSERT_GE(p[v], 0) << "axis " << d << " vertex " << v;
+    for (int v = 0; v < m.num_vertices(); ++v)
+      ASSERT_GE(p[v], 0) << "axis " << d << " vertex " << v;
     EXPECT_TRUE(element_set(p) == original) << "not symmetric about the centre line of axis " << d;
   }
 }
@@ -345,7 +351,8 @@ TEST(PrismGrid, EmptyCellsLeaveNoUnusedVertices) {
       for (int i = 0; i < cells.x(); ++i)
         if (keep(i, j, l)) {
           ++kept;
-          for (int c = 0; c < 8; ++c) used.insert({i + (c & 1), j + ((c >> 1) & 1), l + ((c >> 2) & 1)});
+          for (int c = 0; c < 8; ++c)
+            used.insert({i + (c & 1), j + ((c >> 1) & 1), l + ((c >> 2) & 1)});
         }
   EXPECT_EQ(m.num_elements(), 2 * kept);
   EXPECT_EQ(m.num_vertices(), static_cast<int>(used.size()));
@@ -495,8 +502,10 @@ TEST(Constraints, HeldZStaysAtRestWhileXAndYMove) {
     mean_dy += (r.positions(v, 1) - s.mesh.vertices(v, 1)) / tip.size();
   }
   for (int v : s.fixed) EXPECT_TRUE(r.positions.row(v) == s.mesh.vertices.row(v));
-  std::printf("  free tip drop %.4f mm; guided tip: min |dx| %.4f, min |dy| %.4f, mean dy %.4f, "
-              "%d iterations\n", drop, min_dx, min_dy, mean_dy, r.iterations);
+  std::printf(
+      "  free tip drop %.4f mm; guided tip: min |dx| %.4f, min |dy| %.4f, mean dy %.4f, "
+      "%d iterations\n",
+      drop, min_dx, min_dy, mean_dy, r.iterations);
   EXPECT_GT(drop, 0.5);
   // Every guided vertex moved in x and in y (by far more than the solver's tolerance).
   EXPECT_GT(min_dx, 1e-3);
@@ -664,10 +673,10 @@ TEST(Constraints, SymmetryPlaneHalfModelMatchesFullModel) {
     tip_drop = std::max(tip_drop, std::abs(rf.positions(w, 2) - full.mesh.vertices(w, 2)));
   }
   const double sym = MirrorDefect(rf.positions, MirrorPartner(full.mesh, 1, 4.0), 1, 4.0);
-  std::printf("  tip drop %.3f mm; |half - full| %.3g mm, full-model asymmetry %.3g mm "
-              "(%d / %d iterations); achieved ratio %.6f / %.6f\n",
-              tip_drop, worst, sym, rf.iterations, rh.iterations, rf.volume_ratios[0],
-              rh.volume_ratios[0]);
+  std::printf(
+      "  tip drop %.3f mm; |half - full| %.3g mm, full-model asymmetry %.3g mm "
+      "(%d / %d iterations); achieved ratio %.6f / %.6f\n",
+      tip_drop, worst, sym, rf.iterations, rh.iterations, rf.volume_ratios[0], rh.volume_ratios[0]);
   EXPECT_GT(tip_drop, 1.0);  // a real bend, not a trivial match
   // Both are solved to a per-iteration move of 1e-9 of the size (~28 mm) and a 1e10 drop of the
   // residual; the distance to the exact fixed point is about that move / (1 - contraction rate).
@@ -722,8 +731,8 @@ Scene MotionBar(const Eigen::Vector3i& cells, Actuator act, const std::map<int, 
 }
 
 TEST(Motion, DisplacementStretchesSymmetricallyAndLandsExactly) {
-  const Scene s = MotionBar({10, 4, 4}, Displacement("pull", {}, Eigen::Vector3d::UnitX()),
-                            {{0, Rigid()}});
+  const Scene s =
+      MotionBar({10, 4, 4}, Displacement("pull", {}, Eigen::Vector3d::UnitX()), {{0, Rigid()}});
   auto model = std::make_shared<const Model>(s);
   EXPECT_EQ(model->num_groups(), 0);  // motion actuators have no elements
   EXPECT_EQ(model->num_factors(), 1);
@@ -762,8 +771,10 @@ TEST(Motion, DisplacementStretchesSymmetricallyAndLandsExactly) {
     double mid = 0;
     for (int v : Plane(s.mesh, 0, 5.0))
       mid = std::max(mid, std::abs(r.positions(v, 0) - 5.0 - 0.5 * d));
-    std::printf("  d = %.1f: energy %.5g, asymmetry y %.2g z %.2g mm, mid-plane error %.2g mm, "
-                "%d iterations\n", d, r.energy, sy, sz, mid, r.iterations);
+    std::printf(
+        "  d = %.1f: energy %.5g, asymmetry y %.2g z %.2g mm, mid-plane error %.2g mm, "
+        "%d iterations\n",
+        d, r.energy, sy, sz, mid, r.iterations);
     // Bound: 1e-7 of the size, as in Constraints.SymmetryPlaneHalfModelMatchesFullModel.
     EXPECT_LT(sy, 1e-7 * model->size());
     EXPECT_LT(sz, 1e-7 * model->size());
@@ -773,8 +784,8 @@ TEST(Motion, DisplacementStretchesSymmetricallyAndLandsExactly) {
 
 TEST(Motion, DisplacementAxisIsNormalised) {
   // A shear: the end face moved along z; the axis need not be a unit vector.
-  const Scene s = MotionBar({6, 2, 2}, Displacement("shear", {}, Eigen::Vector3d(0, 0, 3.0)),
-                            {{0, Rigid()}});
+  const Scene s =
+      MotionBar({6, 2, 2}, Displacement("shear", {}, Eigen::Vector3d(0, 0, 3.0)), {{0, Rigid()}});
   auto model = std::make_shared<const Model>(s);
   const FkResult r = SolveTight(model, Vec1(-1.5));
   ASSERT_EQ(r.status, FkStatus::Converged) << r.BriefReport();
@@ -808,8 +819,8 @@ double SectionAngle(const Mesh& m, const Eigen::MatrixX3d& X, double x0) {
 
 TEST(Motion, TwistRotatesEndExactlyAndMidSectionByHalf) {
   const Eigen::Vector3d centre(0.0, 2.0, 2.0);
-  const Scene s = MotionBar({12, 4, 4}, Twist("twist", {}, Eigen::Vector3d::UnitX(), centre),
-                            {{0, Rigid()}});
+  const Scene s =
+      MotionBar({12, 4, 4}, Twist("twist", {}, Eigen::Vector3d::UnitX(), centre), {{0, Rigid()}});
   auto model = std::make_shared<const Model>(s);
   const double theta_deg = 60.0, theta = theta_deg * kPi / 180.0;
   const FkResult r = SolveTight(model, Vec1(theta_deg));
@@ -824,9 +835,10 @@ TEST(Motion, TwistRotatesEndExactlyAndMidSectionByHalf) {
   const double a_mid = SectionAngle(s.mesh, r.positions, 6.0);
   const double a_q1 = SectionAngle(s.mesh, r.positions, 3.0);
   const double a_q3 = SectionAngle(s.mesh, r.positions, 9.0);
-  std::printf("  twist %.0f deg: sections at x = 3, 6, 9 rotate %.4f, %.6f, %.4f deg; energy %.4g; "
-              "%d iterations\n", theta_deg, a_q1 * 180 / kPi, a_mid * 180 / kPi, a_q3 * 180 / kPi,
-              r.energy, r.iterations);
+  std::printf(
+      "  twist %.0f deg: sections at x = 3, 6, 9 rotate %.4f, %.6f, %.4f deg; energy %.4g; "
+      "%d iterations\n",
+      theta_deg, a_q1 * 180 / kPi, a_mid * 180 / kPi, a_q3 * 180 / kPi, r.energy, r.iterations);
   // Symmetry: x -> L - x, then y -> 4 - y, then rotation by theta about the axis maps the problem
   // onto itself (it swaps the clamped and twisted ends), and maps the mid-section's angle a to
   // theta - a. The answer is unique, so a = theta / 2 up to the solver's tolerance (1e-9 * size per
@@ -852,9 +864,9 @@ TEST(Motion, SofterHalfOfTwoMaterialBarStretchesMore) {
   // Cells 0..5 (x < 6): weight 1; cells 6..11: weight w. Both ARAP. Pulled by d along x. In 1D the
   // two halves carry the same force, w_soft e_soft = w_stiff e_stiff, so the strain ratio is w.
   auto strain_ratio = [](double w) {
-    const Scene s = MotionBar({12, 2, 2}, Displacement("pull", {}, Eigen::Vector3d::UnitX()),
-                              {{0, Rigid(1.0)}, {1, Rigid(w)}},
-                              [](int i) { return i < 6 ? 0 : 1; });
+    const Scene s =
+        MotionBar({12, 2, 2}, Displacement("pull", {}, Eigen::Vector3d::UnitX()),
+                  {{0, Rigid(1.0)}, {1, Rigid(w)}}, [](int i) { return i < 6 ? 0 : 1; });
     auto model = std::make_shared<const Model>(s);
     const double d = 1.2;
     const FkResult r = SolveTight(model, Vec1(d));
@@ -883,8 +895,8 @@ TEST(Motion, MotionsOfOneVertexComposeInActuatorOrder) {
   // order, each applied to the position left by the previous ones; a twist's axis is fixed in
   // space. A twist about x and a shift along y do not commute, so the order shows.
   const Eigen::Vector3d centre(0.0, 1.0, 1.0);
-  const Scene base = MotionBar({6, 2, 2}, Twist("twist", {}, Eigen::Vector3d::UnitX(), centre),
-                               {{0, Rigid()}});
+  const Scene base =
+      MotionBar({6, 2, 2}, Twist("twist", {}, Eigen::Vector3d::UnitX(), centre), {{0, Rigid()}});
   const std::vector<int> face = base.actuators[0].vertices;
   const Actuator shift = Displacement("shift", face, Eigen::Vector3d::UnitY());
   Scene twist_first = base, shift_first = base;
@@ -922,12 +934,12 @@ TEST(Motion, RestValueConvergesAtOnceUnderTightTolerance) {
   // At the rest actuation the rest shape is the exact answer (zero energy) and the residual is
   // round-off, so the solver should stop at once whatever the tolerances. With gradient_tolerance
   // 1e-10 it does not: the reference residual is floored at 1e-8 * sum(w Vol) * size
-  // (local_global.cpp), the round-off residual's ratio to it stays ~1e-8, and the solver runs to its
-  // iteration cap (20000 iterations, ~5-10 s on these bars) although the positions are exact.
+  // (local_global.cpp), the round-off residual's ratio to it stays ~1e-8, and the solver runs to
+  // its iteration cap (20000 iterations, ~5-10 s on these bars) although the positions are exact.
   // Same for signed (value 0) and plain pneumatic actuators (rest ratio 1). Capped at 50 iterations
   // here.
-  const Scene motion = MotionBar({10, 4, 4}, Displacement("pull", {}, Eigen::Vector3d::UnitX()),
-                                 {{0, Rigid()}});
+  const Scene motion =
+      MotionBar({10, 4, 4}, Displacement("pull", {}, Eigen::Vector3d::UnitX()), {{0, Rigid()}});
   const Scene chamber = QuadrantChamberBar();
   const Scene two_sided = TwoSidedBar();
   for (const Scene* s : {&motion, &two_sided, &chamber}) {
@@ -942,8 +954,8 @@ TEST(Motion, RestValueConvergesAtOnceUnderTightTolerance) {
 }
 
 TEST(Motion, ValidateRejectsBadMotionActuators) {
-  const Scene good = MotionBar({4, 2, 2}, Displacement("pull", {}, Eigen::Vector3d::UnitX()),
-                               {{0, Rigid()}});
+  const Scene good =
+      MotionBar({4, 2, 2}, Displacement("pull", {}, Eigen::Vector3d::UnitX()), {{0, Rigid()}});
   ASSERT_NO_THROW(good.validate());
   auto expect_reject = [](const Scene& s, const std::string& fragment) {
     try {
@@ -1091,10 +1103,11 @@ TEST(Signed, OppositeValuesGiveMirrorImages) {
     // Achieved value (from both sides' volume ratios) and each side's volume ratio, measured here.
     const double pos = RegionVolumeRatio(s.mesh, rp.positions, 1);
     const double neg = RegionVolumeRatio(s.mesh, rp.positions, 2);
-    std::printf("  v = +-%.1f: tip y %+.3f mm, mirror distance %.2g mm, achieved %+.5f / %+.5f, "
-                "driven side %.5f, passive side %.5f (%d / %d iterations)\n",
-                v, bend, dist, rp.volume_ratios[0], rn.volume_ratios[0], pos, neg, rp.iterations,
-                rn.iterations);
+    std::printf(
+        "  v = +-%.1f: tip y %+.3f mm, mirror distance %.2g mm, achieved %+.5f / %+.5f, "
+        "driven side %.5f, passive side %.5f (%d / %d iterations)\n",
+        v, bend, dist, rp.volume_ratios[0], rn.volume_ratios[0], pos, neg, rp.iterations,
+        rn.iterations);
     // Inflating the +y chamber bends the bar towards -y.
     EXPECT_LT(bend, -1.0);
     // v and -v are mirror images, to the solver's tolerance (1e-7 of the size: see
@@ -1138,9 +1151,10 @@ TEST(Signed, InactiveSideIsVentedLikeEmptySpace) {
     moved = std::max(moved, (rc.positions.row(q) - cut.mesh.vertices.row(q)).norm());
   }
   const double vented = RegionVolumeRatio(s.mesh, rs.positions, 2);
-  std::printf("  signed v = %.1f vs cut bar at %.1f: max distance %.3g mm (max displacement %.3f "
-              "mm); achieved %.6f vs %.6f; vented side's volume ratio %.4f\n",
-              v, 1.0 + gain * v, worst, moved, rs.volume_ratios[0], rc.volume_ratios[0], vented);
+  std::printf(
+      "  signed v = %.1f vs cut bar at %.1f: max distance %.3g mm (max displacement %.3f "
+      "mm); achieved %.6f vs %.6f; vented side's volume ratio %.4f\n",
+      v, 1.0 + gain * v, worst, moved, rs.volume_ratios[0], rc.volume_ratios[0], vented);
   EXPECT_GT(moved, 1.0);
   // Both solved to the tight tolerance: 1e-7 of the size as in
   // Constraints.SymmetryPlaneHalfModelMatchesFullModel (measured ~2e-9 of the size).

@@ -1,7 +1,7 @@
 // Tests of the FK energy (solver/fk/energy.hpp), the target shapes and local ratios
-// (solver/fk/targets.hpp) and the best-fit rotation (solver/fk/rotation.hpp). Every check is an identity
-// (zero at rest, rigid-motion invariance, finite differences, volume and congruence of targets),
-// not a stored number.
+// (solver/fk/targets.hpp) and the best-fit rotation (solver/fk/rotation.hpp). Every check is an
+// identity (zero at rest, rigid-motion invariance, finite differences, volume and congruence of
+// targets), not a stored number.
 #include "softkin/solver/fk/energy.hpp"
 #include "softkin/solver/fk/model.hpp"
 #include "softkin/solver/fk/rotation.hpp"
@@ -182,8 +182,8 @@ TEST(Rotation, ReflectionGivesBestProperRotation) {
   std::mt19937 rng(99);
   for (int t = 0; t < 20; ++t) {
     // A reflection-containing matrix with distinct singular values: Q1 diag(3, 2, -1) Q2.
-    const Eigen::Matrix3d M = RandomRotation(rng) * Eigen::Vector3d(3.0, 2.0, -1.0).asDiagonal() *
-                              RandomRotation(rng);
+    const Eigen::Matrix3d M =
+        RandomRotation(rng) * Eigen::Vector3d(3.0, 2.0, -1.0).asDiagonal() * RandomRotation(rng);
     ASSERT_LT(M.determinant(), 0.0);
     const Eigen::Matrix3d R = BestRotation(M);
     ExpectProperRotation(R, "reflection case");
@@ -225,11 +225,11 @@ TEST(Rotation, DegenerateAndScaledInputs) {
   for (int t = 0; t < 50; ++t) {
     const Eigen::Matrix3d Q1 = RandomRotation(rng), Q2 = RandomRotation(rng);
     const Eigen::Matrix3d cases[] = {
-        Q1 * Eigen::Vector3d(2.0, 1.0, 0.0).asDiagonal() * Q2,             // rank 2
-        Q1 * Eigen::Vector3d(1.0, 0.0, 0.0).asDiagonal() * Q2,             // rank 1
-        Q1 * Eigen::Vector3d(1.0, 1.0 + 1e-9, 0.3).asDiagonal() * Q2,      // near-repeated
-        Q1 * Eigen::Vector3d(1.0, 1.0, 1.0).asDiagonal() * Q2,             // a rotation
-        Q1 * Eigen::Vector3d(1.0, 1e-7, -1e-7).asDiagonal() * Q2,          // nearly rank 1, det<0
+        Q1 * Eigen::Vector3d(2.0, 1.0, 0.0).asDiagonal() * Q2,         // rank 2
+        Q1 * Eigen::Vector3d(1.0, 0.0, 0.0).asDiagonal() * Q2,         // rank 1
+        Q1 * Eigen::Vector3d(1.0, 1.0 + 1e-9, 0.3).asDiagonal() * Q2,  // near-repeated
+        Q1 * Eigen::Vector3d(1.0, 1.0, 1.0).asDiagonal() * Q2,         // a rotation
+        Q1 * Eigen::Vector3d(1.0, 1e-7, -1e-7).asDiagonal() * Q2,      // nearly rank 1, det<0
     };
     for (const auto& M : cases) {
       const Eigen::Matrix3d R = BestRotation(M);
@@ -262,9 +262,10 @@ TEST(Rotation, OrthonormalWithRepeatedSingularValues) {
     for (int t = 0; t < 200; ++t) {
       const Eigen::Matrix3d M = RandomRotation(rng) * sv.asDiagonal() * RandomRotation(rng);
       const Eigen::Matrix3d R = BestRotation(M), Rs = BestRotationSvd(M);
-      worst = std::max(worst, (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff());
-      worst_svd =
-          std::max(worst_svd, (Rs.transpose() * Rs - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff());
+      worst =
+          std::max(worst, (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff());
+      worst_svd = std::max(
+          worst_svd, (Rs.transpose() * Rs - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff());
     }
     std::printf("  singular values (%g, %g, %g): max |R^T R - I| = %.3g (SVD reference %.3g)\n",
                 sv(0), sv(1), sv(2), worst, worst_svd);
@@ -283,13 +284,27 @@ TEST(Rotation, BatchMatchesSingleBitForBit) {
   for (int t = 0; t < 203; ++t) {
     const Eigen::Matrix3d Q1 = RandomRotation(rng), Q2 = RandomRotation(rng);
     switch (t % 7) {
-      case 0: M.push_back(RandomMatrix(rng, 3, 3)); break;
-      case 1: M.push_back(Q1 * Eigen::Vector3d(40.0, 1.0, 0.02).asDiagonal() * Q2); break;
-      case 2: M.push_back(Q1 * Eigen::Vector3d(3.0, 2.0, -1.0).asDiagonal() * Q2); break;
-      case 3: M.push_back(Q1 * Eigen::Vector3d(2.0, 1.0, 0.0).asDiagonal() * Q2); break;
-      case 4: M.push_back(Q1); break;
-      case 5: M.push_back(1e-8 * Q1 * Eigen::Vector3d(1.0, 1.5, 1.2).asDiagonal()); break;
-      default: M.push_back(Q1 * Eigen::Vector3d(1.1, 0.9, 1.0).asDiagonal() * Q2); break;
+      case 0:
+        M.push_back(RandomMatrix(rng, 3, 3));
+        break;
+      case 1:
+        M.push_back(Q1 * Eigen::Vector3d(40.0, 1.0, 0.02).asDiagonal() * Q2);
+        break;
+      case 2:
+        M.push_back(Q1 * Eigen::Vector3d(3.0, 2.0, -1.0).asDiagonal() * Q2);
+        break;
+      case 3:
+        M.push_back(Q1 * Eigen::Vector3d(2.0, 1.0, 0.0).asDiagonal() * Q2);
+        break;
+      case 4:
+        M.push_back(Q1);
+        break;
+      case 5:
+        M.push_back(1e-8 * Q1 * Eigen::Vector3d(1.0, 1.5, 1.2).asDiagonal());
+        break;
+      default:
+        M.push_back(Q1 * Eigen::Vector3d(1.1, 0.9, 1.0).asDiagonal() * Q2);
+        break;
     }
   }
   M[17](1, 2) = std::numeric_limits<double>::quiet_NaN();
@@ -306,8 +321,10 @@ TEST(Rotation, BatchMatchesSingleBitForBit) {
           ExpectProperRotation(R[i], "NaN input");
         }
         ASSERT_EQ(std::memcmp(R[i].data(), Rs.data(), sizeof(double) * 9), 0)
-            << "n " << n << " first " << first << " lane " << i << "\nM =\n" << M[first + i]
-            << "\nbatch\n" << R[i] << "\nsingle\n" << Rs;
+            << "n " << n << " first " << first << " lane " << i << "\nM =\n"
+            << M[first + i] << "\nbatch\n"
+            << R[i] << "\nsingle\n"
+            << Rs;
         if (M[first + i].determinant() > 0.1) ++newton_lanes;
       }
     }
@@ -343,8 +360,8 @@ void ExpectZeroAtRest(const Scene& scene, const char* what) {
   const Eigen::MatrixX3d zero = Eigen::MatrixX3d::Zero(X.rows(), 3);
   EXPECT_TRUE(MatrixNear(g, zero, 1e-13 * gscale)) << what << " exact gradient";
   EXPECT_TRUE(MatrixNear(gf, zero, 1e-13 * gscale)) << what << " frozen-target gradient";
-  std::printf("  [%s] rest: E = %.3g (scale %.3g), |g| = %.3g, |g_frozen| = %.3g\n", what, E,
-              scale, g.cwiseAbs().maxCoeff(), gf.cwiseAbs().maxCoeff());
+  std::printf("  [%s] rest: E = %.3g (scale %.3g), |g| = %.3g, |g_frozen| = %.3g\n", what, E, scale,
+              g.cwiseAbs().maxCoeff(), gf.cwiseAbs().maxCoeff());
   // The same scene away from rest has clearly nonzero energy and gradient (the checks can fail).
   Eigen::VectorXd c2 = c;
   c2.setConstant(1.5);
@@ -403,9 +420,9 @@ TEST(Energy, GradientMatchesFiniteDifferencesRigidBodySinglePneumaticTet) {
 
 // (b) r_omega = 0.3 body everywhere (shape blending, Eq. 2.5) plus one r_omega 0 column.
 TEST(Energy, GradientMatchesFiniteDifferencesBlendedBody) {
-  const Scene s = test::VoxelScene(
-      {3, 2, 2}, 1.0, [](const Eigen::Vector3i& c) { return c.x() == 2 ? 1 : 0; },
-      {{0, Material{"soft", 0.3, 1.0}}, {1, Material{"softest", 0.0, 2.0}}}, {});
+  const Scene s =
+      test::VoxelScene({3, 2, 2}, 1.0, [](const Eigen::Vector3i& c) { return c.x() == 2 ? 1 : 0; },
+                       {{0, Material{"soft", 0.3, 1.0}}, {1, Material{"softest", 0.0, 2.0}}}, {});
   const Model m(s);
   CheckGradient(m, Perturbed(m, 0.06, 22), Eigen::VectorXd(0), "r=0.3/0 body");
 }
@@ -442,9 +459,9 @@ TEST(Energy, GradientMatchesFiniteDifferencesPrisms) {
 }
 
 TEST(Energy, FrozenTargetGradientEqualsExactForRigidBodiesWithoutActuators) {
-  const Scene s = test::VoxelScene(
-      {3, 2, 2}, 1.0, [](const Eigen::Vector3i& c) { return c.x() == 2 ? 1 : 0; },
-      {{0, Material{"a", 1.0, 1.0}}, {1, Material{"b", 1.0, 3.0}}}, {});
+  const Scene s =
+      test::VoxelScene({3, 2, 2}, 1.0, [](const Eigen::Vector3i& c) { return c.x() == 2 ? 1 : 0; },
+                       {{0, Material{"a", 1.0, 1.0}}, {1, Material{"b", 1.0, 3.0}}}, {});
   const Model m(s);
   const Eigen::VectorXd c(0);
   const Eigen::MatrixX3d X = Perturbed(m, 0.08, 31);
@@ -540,8 +557,7 @@ void CheckTargets(const Model& m, const char* what) {
     // Linear blending (Eq. 2.5): T(0.3) = 0.3 T(1) + 0.7 T(0).
     e.r_omega = 0.3;
     ElementTarget(e, D, 0.0, &T);
-    EXPECT_TRUE(MatrixNear(T.topRows(k), 0.3 * T1.topRows(k) + 0.7 * T0.topRows(k), 1e-13))
-        << what;
+    EXPECT_TRUE(MatrixNear(T.topRows(k), 0.3 * T1.topRows(k) + 0.7 * T0.topRows(k), 1e-13)) << what;
   }
   EXPECT_GT(seen_body, 0);
   EXPECT_GT(seen_pneu, 0);
@@ -577,7 +593,8 @@ TEST(Targets, SinglePneumaticTetScene) {
   const Eigen::Matrix3d R =
       (M.inverse() * me.rest.topRows(4).transpose() * T.topRows(4) / std::cbrt(alpha)).transpose();
   ExpectProperRotation(R, "pneumatic target rotation");
-  EXPECT_TRUE(MatrixNear(T.topRows(4), std::cbrt(alpha) * me.rest.topRows(4) * R.transpose(), 1e-13));
+  EXPECT_TRUE(
+      MatrixNear(T.topRows(4), std::cbrt(alpha) * me.rest.topRows(4) * R.transpose(), 1e-13));
   // With a single element the local ratio is the actuation itself, for any current shape.
   Eigen::MatrixX3d X = m.rest_positions();
   X.row(3) += Eigen::RowVector3d(0.1, -0.2, 0.3);

@@ -33,7 +33,7 @@ struct Solved {
 
 // Builds the model and a solver for `opts`, solves c (optionally warm-started).
 Solved SolveScene(const Scene& s, const Eigen::VectorXd& c, const FkOptions& opts,
-           const Eigen::MatrixX3d* warm = nullptr) {
+                  const Eigen::MatrixX3d* warm = nullptr) {
   auto model = std::make_shared<const Model>(s);
   auto solver = MakeFkSolver(model, opts);
   Solved out;
@@ -80,16 +80,16 @@ TEST(LocalGlobal, RestActuationReturnsRestShape) {
     if (c.z() == 1 && c.x() > 0) return 2;
     return c.x() == 5 ? 1 : 0;
   };
-  const Scene mixed = test::VoxelScene(
-      {6, 2, 2}, 1.0, region, {{0, Material{"a", 1.0, 1.0}}, {1, Material{"b", 0.3, 1.0}}},
-      {test::Pneumatic("p", {2})});
+  const Scene mixed = test::VoxelScene({6, 2, 2}, 1.0, region,
+                                       {{0, Material{"a", 1.0, 1.0}}, {1, Material{"b", 0.3, 1.0}}},
+                                       {test::Pneumatic("p", {2})});
   for (const Scene* s : {&ThreeChamber3(), &mixed})
     for (const char* name : {"lg", "lg-aa"}) {
       FkOptions o = Opts(name);
       o.max_iterations = 50;  // <= 2 are needed; the cap only bounds the runtime of a failure
       const Solved out = SolveScene(*s, s->rest_actuation(), o);
-      EXPECT_EQ(out.r.status, FkStatus::Converged) << s->name << " " << name << ": "
-                                                   << out.r.BriefReport();
+      EXPECT_EQ(out.r.status, FkStatus::Converged)
+          << s->name << " " << name << ": " << out.r.BriefReport();
       EXPECT_LE(out.r.iterations, 2) << s->name << " " << name;
       EXPECT_TRUE(MatrixNear(out.r.positions, s->mesh.vertices, 1e-12 * s->mesh.size()))
           << s->name << " " << name;
@@ -113,10 +113,10 @@ TEST(LocalGlobal, AchievedVolumeRatioIsSoftConstraint) {
   const double v50 = w50.r.volume_ratios[0];
   EXPECT_LE(v50, 1.5);
   EXPECT_LT(std::abs(v50 - 1.5), std::abs(v5 - 1.5));
-  std::printf("  c1 = 1.5: achieved %.5f (weight 5, %d it), %.5f (weight 50, %d it); "
-              "c2, c3 achieved %.5f, %.5f\n",
-              v5, w5.r.iterations, v50, w50.r.iterations, w5.r.volume_ratios[1],
-              w5.r.volume_ratios[2]);
+  std::printf(
+      "  c1 = 1.5: achieved %.5f (weight 5, %d it), %.5f (weight 50, %d it); "
+      "c2, c3 achieved %.5f, %.5f\n",
+      v5, w5.r.iterations, v50, w50.r.iterations, w5.r.volume_ratios[1], w5.r.volume_ratios[2]);
 }
 
 TEST(LocalGlobal, EqualInflationKeepsTipOnAxis) {
@@ -191,11 +191,12 @@ TEST(LocalGlobal, WarmStartEqualsColdStart) {
     EXPECT_EQ(w->status, FkStatus::Converged) << w->BriefReport();
     EXPECT_TRUE(MatrixNear(s.marker_positions(w->positions), mc, tol));
   }
-  std::printf("  cold %d it, warm(self) %d it, warm(nearby) %d it; |diff| %.3g / %.3g mm "
-              "(bound %.3g)\n",
-              cold.iterations, again.iterations, from_near.iterations,
-              (s.marker_positions(again.positions) - mc).cwiseAbs().maxCoeff(),
-              (s.marker_positions(from_near.positions) - mc).cwiseAbs().maxCoeff(), tol);
+  std::printf(
+      "  cold %d it, warm(self) %d it, warm(nearby) %d it; |diff| %.3g / %.3g mm "
+      "(bound %.3g)\n",
+      cold.iterations, again.iterations, from_near.iterations,
+      (s.marker_positions(again.positions) - mc).cwiseAbs().maxCoeff(),
+      (s.marker_positions(from_near.positions) - mc).cwiseAbs().maxCoeff(), tol);
   EXPECT_LE(again.iterations, 3);  // starting at the solution
   EXPECT_LT(from_near.iterations, cold.iterations);
 }
@@ -215,9 +216,8 @@ TEST(LocalGlobal, ScaleInvariance) {
     EXPECT_TRUE(MatrixNear(back, base.r.positions, 1e-4 * size)) << "scale " << k;
     EXPECT_LE(std::abs(out.r.iterations - base.r.iterations), 0.1 * base.r.iterations + 0.5)
         << "scale " << k;
-    std::printf("  scale %g: %d vs %d iterations, max |X/k - X| = %.3g mm\n", k,
-                out.r.iterations, base.r.iterations,
-                (back - base.r.positions).cwiseAbs().maxCoeff());
+    std::printf("  scale %g: %d vs %d iterations, max |X/k - X| = %.3g mm\n", k, out.r.iterations,
+                base.r.iterations, (back - base.r.positions).cwiseAbs().maxCoeff());
   }
 }
 
@@ -233,11 +233,12 @@ TEST(LocalGlobal, PlainAndAndersonAgree) {
   EXPECT_EQ(aa.r.status, FkStatus::Converged) << aa.r.BriefReport();
   EXPECT_TRUE(MatrixNear(lg.markers, aa.markers, 1e-3 * s.mesh.size()));
   EXPECT_LT(aa.r.iterations, lg.r.iterations);
-  std::printf("  lg: %d it (%.3f s), lg-aa: %d it (%.3f s, %d accepted, %d rejected); "
-              "max marker diff %.3g mm\n",
-              lg.r.iterations, std::chrono::duration<double>(t1 - t0).count(), aa.r.iterations,
-              std::chrono::duration<double>(t2 - t1).count(), aa.r.aa_accepted, aa.r.aa_rejected,
-              (lg.markers - aa.markers).cwiseAbs().maxCoeff());
+  std::printf(
+      "  lg: %d it (%.3f s), lg-aa: %d it (%.3f s, %d accepted, %d rejected); "
+      "max marker diff %.3g mm\n",
+      lg.r.iterations, std::chrono::duration<double>(t1 - t0).count(), aa.r.iterations,
+      std::chrono::duration<double>(t2 - t1).count(), aa.r.aa_accepted, aa.r.aa_rejected,
+      (lg.markers - aa.markers).cwiseAbs().maxCoeff());
 }
 
 TEST(LocalGlobal, StatusReporting) {
@@ -305,10 +306,9 @@ TEST(LocalGlobal, ContinuationMatchesSingleStep) {
 // (The 60 x 6 x 2 strip of the brief needs > 10^5 plain iterations for a reference: too slow for a
 // unit test; this one needs 20000, ~4 s.)
 Scene ThinStrip() {
-  return test::VoxelScene({20, 2, 2}, 1.0,
-                          [](const Eigen::Vector3i& c) { return c.z() == 1 ? 1 : 0; },
-                          {{0, Material{"layer", 1.0, 1.0}}}, {test::Pneumatic("top", {1})},
-                          "thin_strip");
+  return test::VoxelScene(
+      {20, 2, 2}, 1.0, [](const Eigen::Vector3i& c) { return c.z() == 1 ? 1 : 0; },
+      {{0, Material{"layer", 1.0, 1.0}}}, {test::Pneumatic("top", {1})}, "thin_strip");
 }
 
 TEST(LocalGlobal, ThinStripCurvatureMatchesTightReference) {
@@ -325,12 +325,12 @@ TEST(LocalGlobal, ThinStripCurvatureMatchesTightReference) {
   auto timed = [&](const FkOptions& o, const char* what) {
     const auto t0 = std::chrono::steady_clock::now();
     const FkResult r = MakeFkSolver(model, o)->Solve(c);
-    const double dt =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::printf("  %-34s %-13s %6d it, move %.3g, residual ratio %.3g, curvature %.7f 1/mm, "
-                "AA %d/%d, %.2f s\n",
-                what, FkStatusToString(r.status), r.iterations, r.max_move, r.gradient_ratio,
-                curvature(r.positions), r.aa_accepted, r.aa_rejected, dt);
+    const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf(
+        "  %-34s %-13s %6d it, move %.3g, residual ratio %.3g, curvature %.7f 1/mm, "
+        "AA %d/%d, %.2f s\n",
+        what, FkStatusToString(r.status), r.iterations, r.max_move, r.gradient_ratio,
+        curvature(r.positions), r.aa_accepted, r.aa_rejected, dt);
     return r;
   };
   FkOptions ref_o = Opts("lg");
@@ -355,11 +355,12 @@ TEST(LocalGlobal, ThinStripCurvatureMatchesTightReference) {
   const double k_ref = curvature(ref.positions);
   const double k_def = curvature(def.positions);
   const double k_trap = curvature(trap.positions);
-  std::printf("  curvature error vs reference: default %.3f %%, move-only %.3f %%; with cap 20000: "
-              "default rules (lg) %.3f %%, move-only %.3f %%\n",
-              100 * (k_def - k_ref) / k_ref, 100 * (k_trap - k_ref) / k_ref,
-              100 * (curvature(def_lg_r.positions) - k_ref) / k_ref,
-              100 * (curvature(trap_long.positions) - k_ref) / k_ref);
+  std::printf(
+      "  curvature error vs reference: default %.3f %%, move-only %.3f %%; with cap 20000: "
+      "default rules (lg) %.3f %%, move-only %.3f %%\n",
+      100 * (k_def - k_ref) / k_ref, 100 * (k_trap - k_ref) / k_ref,
+      100 * (curvature(def_lg_r.positions) - k_ref) / k_ref,
+      100 * (curvature(trap_long.positions) - k_ref) / k_ref);
   EXPECT_GT(k_ref, 0.01);  // it really bends (radius < 100 mm)
   EXPECT_EQ(def.status, FkStatus::Converged) << def.BriefReport();
   EXPECT_NEAR(k_def, k_ref, 0.01 * k_ref) << "default options vs reference";
@@ -388,9 +389,10 @@ TEST(LocalGlobal, IterationCapReturnsCheckedIterate) {
       const FkResult r = MakeFkSolver(model, o)->Solve(c);
       ASSERT_EQ(r.status, FkStatus::IterationCap);
       const double actual = free_residual(r.positions) / ref;
-      std::printf("  %-5s cap %d: reported residual ratio %.4g, at the returned positions %.4g, "
-                  "energy %.8g\n",
-                  name, n, r.gradient_ratio, actual, r.energy);
+      std::printf(
+          "  %-5s cap %d: reported residual ratio %.4g, at the returned positions %.4g, "
+          "energy %.8g\n",
+          name, n, r.gradient_ratio, actual, r.energy);
       // Plain lg returns the next iterate (one step after the checked one): within 10 %.
       EXPECT_LT(actual, 1.1 * r.gradient_ratio) << name << " cap " << n;
     }
@@ -458,8 +460,7 @@ TEST(Anderson, AcceleratesLinearContraction) {
   const int acc = IterateToTolerance(L, &aa, 1e-10, 5000);
   Anderson aa_full(10, 10);
   const int acc_full = IterateToTolerance(L, &aa_full, 1e-10, 5000);
-  std::printf("  plain %d iterations, Anderson(m=5) %d, Anderson(m=10) %d\n", plain, acc,
-              acc_full);
+  std::printf("  plain %d iterations, Anderson(m=5) %d, Anderson(m=10) %d\n", plain, acc, acc_full);
   EXPECT_GT(plain, 150);
   EXPECT_LT(acc, plain / 4);
   // With a window covering the whole space Anderson is GMRES-like: exact within ~n + 1 steps
@@ -481,7 +482,7 @@ TEST(Anderson, FirstStepAndReset) {
     g = L.A * x + L.b;
     out = aa.Compute(g, g - x);
   }
-  EXPECT_EQ(aa.history(), 4);  // capped at the window
+  EXPECT_EQ(aa.history(), 4);               // capped at the window
   EXPECT_FALSE(MatrixNear(out, g, 1e-12));  // an accelerated step differs from G(x)
   aa.Reset();
   EXPECT_EQ(aa.history(), 0);

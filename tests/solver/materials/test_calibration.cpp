@@ -1,5 +1,6 @@
-// R_omega calibration (solver/materials/calibration.hpp): Eq. 2.9, the elongation and twisting tests on
-// bimaterial_bar, monotonicity of R_m in R_omega, and the bisection recovering known parameters.
+// R_omega calibration (solver/materials/calibration.hpp): Eq. 2.9, the elongation and twisting
+// tests on bimaterial_bar, monotonicity of R_m in R_omega, and the bisection recovering known
+// parameters.
 #include "softkin/solver/materials/calibration.hpp"
 
 #include <gtest/gtest.h>
@@ -26,7 +27,8 @@ TEST(Calibration, Eq29) {
   EXPECT_DOUBLE_EQ(ElasticityRatio(80, 40, 8, 1), 7.0);
   // Unequal lengths: L1 = 20, L = 80, dL1 = 1, dL = 4: eps_A = 1/20, eps_B = 3/60.
   EXPECT_DOUBLE_EQ(ElasticityRatio(80, 20, 4, 1), 1.0);
-  for (auto bad : {std::array<double, 4>{80, 0, 8, 1}, {80, 80, 8, 1}, {80, 40, 8, 0}, {80, 40, 8, 8}})
+  for (auto bad :
+       {std::array<double, 4>{80, 0, 8, 1}, {80, 80, 8, 1}, {80, 40, 8, 0}, {80, 40, 8, 8}})
     EXPECT_THROW(ElasticityRatio(bad[0], bad[1], bad[2], bad[3]), std::invalid_argument);
 }
 
@@ -36,10 +38,10 @@ TEST(Calibration, EqualMaterialsGiveUnitRatioAndTwistSymmetrically) {
   std::printf("  equal materials: L = %.2f, L1 = %.2f, dL1 = %.4f of %.1f mm, R_m = %.5f\n", e.l_mm,
               e.l1_mm, e.dl1_mm, e.dl_mm, e.rm);
   EXPECT_NEAR(e.l1_mm, 0.5 * e.l_mm, 0.5 * 6.0);  // within half a 6 mm cell of mid-length
-  EXPECT_NEAR(e.rm, 1.0, 0.02);  // a homogeneous bar strains uniformly
+  EXPECT_NEAR(e.rm, 1.0, 0.02);                   // a homogeneous bar strains uniformly
   const TwistResult t = RunTwistTest(1.0, 1.0, o);
-  std::printf("  twist %.0f: A %.3f, B %.3f, a_mid %.3f, b_mid %.3f deg\n", t.twist_deg, t.angle_a_deg,
-              t.angle_b_deg, t.a_mid_deg, t.b_mid_deg);
+  std::printf("  twist %.0f: A %.3f, B %.3f, a_mid %.3f, b_mid %.3f deg\n", t.twist_deg,
+              t.angle_a_deg, t.angle_b_deg, t.a_mid_deg, t.b_mid_deg);
   // Equal materials twist in proportion to their lengths (the interface snaps to a cell face:
   // 42 of 78 mm at this resolution).
   EXPECT_NEAR(t.angle_a_deg, t.twist_deg * t.l1_mm / t.l_mm, 0.5);

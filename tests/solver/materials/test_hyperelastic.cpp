@@ -1,7 +1,7 @@
-// Hyperelastic body elements (solver/materials/hyperelastic.hpp, Eq. 3.6-3.7): the homogeneous uniaxial
-// response, the Mooney-Rivlin fit of R_omega(strain), the element's identities (zero energy at
-// rest, rigid-motion invariance, rest volume kept, gradient against differences) and a simulated
-// tension test against the analytic Mooney-Rivlin curve.
+// Hyperelastic body elements (solver/materials/hyperelastic.hpp, Eq. 3.6-3.7): the homogeneous
+// uniaxial response, the Mooney-Rivlin fit of R_omega(strain), the element's identities (zero
+// energy at rest, rigid-motion invariance, rest volume kept, gradient against differences) and a
+// simulated tension test against the analytic Mooney-Rivlin curve.
 #include "softkin/solver/materials/calibration.hpp"
 #include "softkin/solver/fk/energy.hpp"
 #include "softkin/solver/materials/hyperelastic.hpp"
@@ -28,7 +28,8 @@ TEST(Hyperelastic, UniaxialResponseLimitsAndSmallStrain) {
   EXPECT_NEAR(l, 1.0 / std::sqrt(1.5), 1e-9);
   for (double rho : {0.1, 0.4, 0.8}) {
     const double h = 1e-6;
-    const double slope = (BlendUniaxialStress(1 + h, rho) - BlendUniaxialStress(1 - h, rho)) / (2 * h);
+    const double slope =
+        (BlendUniaxialStress(1 + h, rho) - BlendUniaxialStress(1 - h, rho)) / (2 * h);
     EXPECT_NEAR(slope, 6 * rho / (2 + rho), 1e-6) << rho;
     BlendUniaxialStress(1 + h, rho, &l);
     EXPECT_NEAR(-(l - 1) / h, (1 - rho) / (2 + rho), 1e-4) << "Poisson ratio at rho " << rho;
@@ -47,7 +48,8 @@ TEST(Hyperelastic, EquivalentStrain) {
   EXPECT_NEAR(EquivalentStrain(Q), 0.0, 1e-7);
   EXPECT_NEAR(EquivalentStrain(2.0 * Q), 0.0, 1e-7);  // a pure volume change has no shear
   const double lam = 1.8;
-  const Eigen::Matrix3d U = Eigen::Vector3d(lam, 1 / std::sqrt(lam), 1 / std::sqrt(lam)).asDiagonal();
+  const Eigen::Matrix3d U =
+      Eigen::Vector3d(lam, 1 / std::sqrt(lam), 1 / std::sqrt(lam)).asDiagonal();
   EXPECT_NEAR(EquivalentStrain(U), std::log(lam), 1e-9);
   EXPECT_NEAR(EquivalentStrain(Q * U * test::RandomRotation(rng)), std::log(lam), 1e-7);
 }
@@ -75,7 +77,8 @@ TEST(Hyperelastic, NamedMaterialsAndFit) {
       double rho = 0;
       const double s = CurveUniaxialStress(c, lam, nullptr, &rho);
       EXPECT_LT(rho, rho0);
-      EXPECT_NEAR(s / (k * eco.NominalStress(lam)), 1.0, 0.01) << "rho0 " << rho0 << " lambda " << lam;
+      EXPECT_NEAR(s / (k * eco.NominalStress(lam)), 1.0, 0.01)
+          << "rho0 " << rho0 << " lambda " << lam;
     }
   }
   EXPECT_THROW(FitMooneyRivlinROmega(MooneyRivlin{0, 0}, 1.0), std::invalid_argument);
@@ -85,8 +88,9 @@ TEST(Hyperelastic, NamedMaterialsAndFit) {
 
 Scene HyperBar(double rho0 = 1.0) {
   Material m{"ecoflex-00-30", rho0, 1.0, "mooney-rivlin", 0.0418, 0.0106};
-  return test::VoxelScene(Eigen::Vector3i(4, 2, 2), 2.5,
-                          [](const Eigen::Vector3i&) { return 0; }, {{0, m}}, {}, "hyper_bar");
+  return test::VoxelScene(
+      Eigen::Vector3i(4, 2, 2), 2.5, [](const Eigen::Vector3i&) { return 0; }, {{0, m}}, {},
+      "hyper_bar");
 }
 
 TEST(Hyperelastic, ElementIdentities) {
@@ -159,7 +163,8 @@ TEST(Hyperelastic, InvertedAndFlatElementsGetBoundedRestVolumeTargets) {
     ElementTarget(e, D, 1.0, &T);
     ASSERT_TRUE(T.allFinite());
     EXPECT_NEAR(RowsVolume(T, 4), e.rest_volume, 1e-9 * e.rest_volume) << "trial " << trial;
-    EXPECT_LT(T.topRows(4).norm(), 2.0 * std::max(rest_size, D.topRows(4).norm())) << "trial " << trial;
+    EXPECT_LT(T.topRows(4).norm(), 2.0 * std::max(rest_size, D.topRows(4).norm()))
+        << "trial " << trial;
     // The weight actually moved where the plain blend is below the volume floor.
     ElemRows R = ElemRows::Zero();
     R.topRows(4) = P.topRows(4) * BestRotation(D.topRows(4).transpose() * P.topRows(4)).transpose();
@@ -199,8 +204,10 @@ TEST(Hyperelastic, SimulatedTensionFollowsMooneyRivlin) {
     return w;
   };
   const double h2 = worst(hyper, 2), h4 = worst(hyper, 4), b4 = worst(blend, 4);
-  std::printf("  worst deviation from Mooney-Rivlin up to stretch 2: law res 2 %.4f, res 4 %.4f; "
-              "constant R_omega res 4 %.4f\n", h2, h4, b4);
+  std::printf(
+      "  worst deviation from Mooney-Rivlin up to stretch 2: law res 2 %.4f, res 4 %.4f; "
+      "constant R_omega res 4 %.4f\n",
+      h2, h4, b4);
   // Linear tets make the nearly incompressible law a little stiff; the gap closes with refinement
   // (measured 10.4% at 5 mm cells, 6.8% at 2.5 mm).
   EXPECT_LT(h4, h2);

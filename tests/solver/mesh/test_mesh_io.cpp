@@ -1,6 +1,6 @@
-// Tests for solver/mesh/mesh.hpp and solver/mesh/io/mesh_io.hpp: the real finger mesh, round trips through every
-// format, error messages with file:line for corrupted inputs, orientation repair, warnings,
-// ParaView output (.vtu/.pvd), the boundary surface (.obj) and the strain measure.
+// Tests for solver/mesh/mesh.hpp and solver/mesh/io/mesh_io.hpp: the real finger mesh, round trips
+// through every format, error messages with file:line for corrupted inputs, orientation repair,
+// warnings, ParaView output (.vtu/.pvd), the boundary surface (.obj) and the strain measure.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -227,7 +227,8 @@ TEST(MeshBasics, CountsInvertedElements) {
   X.col(2) *= -1.0;
   EXPECT_EQ(CountInvertedElements(m, X), m.num_elements());
   X = m.vertices;
-  for (int j = 0; j < m.elements[0].k(); ++j) X(m.elements[0].v[j], 2) = 0.0;  // one element flattened
+  for (int j = 0; j < m.elements[0].k(); ++j)
+    X(m.elements[0].v[j], 2) = 0.0;  // one element flattened
   EXPECT_GE(CountInvertedElements(m, X), 1);
   EXPECT_LE(CountInvertedElements(m, X), m.num_elements());
   EXPECT_EQ(SignedVolume(m.elements[0], X), 0.0);

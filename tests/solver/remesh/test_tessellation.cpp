@@ -27,9 +27,10 @@ TessellationOptions BoxOptions() {
 }
 
 Mesh BoxMesh(TessellationReport* rep = nullptr) {
-  return Tessellate(MakeBoxSurface(Eigen::Vector3d::Constant(-kChamber), Eigen::Vector3d::Constant(kChamber)),
-                    MakeBoxSurface(Eigen::Vector3d::Constant(-kBody), Eigen::Vector3d::Constant(kBody)),
-                    BoxOptions(), rep);
+  return Tessellate(
+      MakeBoxSurface(Eigen::Vector3d::Constant(-kChamber), Eigen::Vector3d::Constant(kChamber)),
+      MakeBoxSurface(Eigen::Vector3d::Constant(-kBody), Eigen::Vector3d::Constant(kBody)),
+      BoxOptions(), rep);
 }
 
 /// Face -> the elements using it (sorted vertex ids).
@@ -67,7 +68,8 @@ TEST(Tessellation, BoxInBoxVolumesLabelsAndConformity) {
     ASSERT_GT(v, 0) << "tet " << i;
     (m.elements[i].region == 0 ? body : chamber) += v;
   }
-  const double body_exact = std::pow(2 * kBody, 3) - std::pow(2 * kChamber, 3), chamber_exact = std::pow(2 * kChamber, 3);
+  const double body_exact = std::pow(2 * kBody, 3) - std::pow(2 * kChamber, 3),
+               chamber_exact = std::pow(2 * kChamber, 3);
   EXPECT_NEAR(body, body_exact, 1e-3 * body_exact);
   EXPECT_NEAR(chamber, chamber_exact, 1e-3 * chamber_exact);
   EXPECT_NEAR(rep.body_volume, body, 1e-9 * body);
@@ -76,8 +78,10 @@ TEST(Tessellation, BoxInBoxVolumesLabelsAndConformity) {
   // Labels: chamber tets inside the inner box, body tets outside it.
   for (const auto& e : m.elements) {
     const double r = Centroid(m, e).cwiseAbs().maxCoeff();
-    if (e.region == 5) EXPECT_LT(r, kChamber + 1e-9);
-    else EXPECT_GT(r, kChamber - 1e-9);
+    if (e.region == 5)
+      EXPECT_LT(r, kChamber + 1e-9);
+    else
+      EXPECT_GT(r, kChamber - 1e-9);
   }
   // Conforming: every face is used by one tet (on the outer box) or two; a face between a body
   // and a chamber tet lies on the chamber box.
@@ -118,25 +122,29 @@ TEST(Tessellation, SameInputGivesTheSameMesh) {
   TessellationOptions fine = BoxOptions();
   fine.cell_size = 0.4;
   fine.facet_size = 0.4;
-  const Mesh f = Tessellate(MakeBoxSurface(Eigen::Vector3d::Constant(-kChamber), Eigen::Vector3d::Constant(kChamber)),
-                            MakeBoxSurface(Eigen::Vector3d::Constant(-kBody), Eigen::Vector3d::Constant(kBody)), fine);
+  const Mesh f = Tessellate(
+      MakeBoxSurface(Eigen::Vector3d::Constant(-kChamber), Eigen::Vector3d::Constant(kChamber)),
+      MakeBoxSurface(Eigen::Vector3d::Constant(-kBody), Eigen::Vector3d::Constant(kBody)), fine);
   EXPECT_GT(f.num_tets(), 2 * a.num_tets());
   // A smaller chamber cell size refines the chamber, not the body's interior.
   TessellationOptions ch = BoxOptions();
   ch.chamber_cell_size = 0.3;
   TessellationReport ra, rc;
   BoxMesh(&ra);
-  Tessellate(MakeBoxSurface(Eigen::Vector3d::Constant(-kChamber), Eigen::Vector3d::Constant(kChamber)),
-             MakeBoxSurface(Eigen::Vector3d::Constant(-kBody), Eigen::Vector3d::Constant(kBody)), ch, &rc);
+  Tessellate(
+      MakeBoxSurface(Eigen::Vector3d::Constant(-kChamber), Eigen::Vector3d::Constant(kChamber)),
+      MakeBoxSurface(Eigen::Vector3d::Constant(-kBody), Eigen::Vector3d::Constant(kBody)), ch, &rc);
   EXPECT_GT(rc.chamber_tets, 2 * ra.chamber_tets);
   EXPECT_LT(rc.body_tets, 2 * ra.body_tets);
 }
 
 TEST(Tessellation, EnclosedVolumeOfABox) {
-  EXPECT_NEAR(EnclosedVolume(MakeBoxSurface(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 2, 3))), 6.0, 1e-12);
+  EXPECT_NEAR(EnclosedVolume(MakeBoxSurface(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 2, 3))),
+              6.0, 1e-12);
 }
 
-std::string ErrorOf(TriangleSurface c, TriangleSurface b, const TessellationOptions& o = BoxOptions()) {
+std::string ErrorOf(TriangleSurface c, TriangleSurface b,
+                    const TessellationOptions& o = BoxOptions()) {
   try {
     Tessellate(c, b, o);
   } catch (const std::invalid_argument& e) {
@@ -146,8 +154,10 @@ std::string ErrorOf(TriangleSurface c, TriangleSurface b, const TessellationOpti
 }
 
 TEST(Tessellation, BadInputGivesClearErrors) {
-  const TriangleSurface body = MakeBoxSurface(Eigen::Vector3d::Constant(-kBody), Eigen::Vector3d::Constant(kBody));
-  TriangleSurface chamber = MakeBoxSurface(Eigen::Vector3d::Constant(-kChamber), Eigen::Vector3d::Constant(kChamber));
+  const TriangleSurface body =
+      MakeBoxSurface(Eigen::Vector3d::Constant(-kBody), Eigen::Vector3d::Constant(kBody));
+  TriangleSurface chamber =
+      MakeBoxSurface(Eigen::Vector3d::Constant(-kChamber), Eigen::Vector3d::Constant(kChamber));
   chamber.source = "chamber.obj";
 
   // Not closed: one triangle missing.
@@ -165,22 +175,26 @@ TEST(Tessellation, BadInputGivesClearErrors) {
   EXPECT_NE(msg.find("finite"), std::string::npos) << msg;
 
   // Chamber crossing the body surface.
-  TriangleSurface crossing = MakeBoxSurface(Eigen::Vector3d::Constant(-1), Eigen::Vector3d(1, 1, 4));
+  TriangleSurface crossing =
+      MakeBoxSurface(Eigen::Vector3d::Constant(-1), Eigen::Vector3d(1, 1, 4));
   crossing.source = "crossing.stl";
   msg = ErrorOf(crossing, body);
   EXPECT_NE(msg.find("crossing.stl"), std::string::npos) << msg;
   EXPECT_NE(msg.find("strictly inside"), std::string::npos) << msg;
 
   // Chamber entirely outside the body.
-  TriangleSurface outside = MakeBoxSurface(Eigen::Vector3d::Constant(10), Eigen::Vector3d::Constant(11));
+  TriangleSurface outside =
+      MakeBoxSurface(Eigen::Vector3d::Constant(10), Eigen::Vector3d::Constant(11));
   outside.source = "outside.obj";
   msg = ErrorOf(outside, body);
   EXPECT_NE(msg.find("outside.obj"), std::string::npos) << msg;
   EXPECT_NE(msg.find("not inside the body"), std::string::npos) << msg;
 
   // Self-intersecting body: two overlapping boxes in one surface.
-  TriangleSurface a = MakeBoxSurface(Eigen::Vector3d::Constant(-kBody), Eigen::Vector3d::Constant(kBody));
-  TriangleSurface b2 = MakeBoxSurface(Eigen::Vector3d::Constant(0), Eigen::Vector3d::Constant(2 * kBody));
+  TriangleSurface a =
+      MakeBoxSurface(Eigen::Vector3d::Constant(-kBody), Eigen::Vector3d::Constant(kBody));
+  TriangleSurface b2 =
+      MakeBoxSurface(Eigen::Vector3d::Constant(0), Eigen::Vector3d::Constant(2 * kBody));
   TriangleSurface two;
   two.source = "two_boxes.obj";
   two.vertices.resize(16, 3);
@@ -238,7 +252,8 @@ TEST(Tessellation, RemeshRegionInteriorKeepsEverythingElse) {
   EXPECT_EQ(k + r.region_tets_after, r.mesh.num_elements());
   // The chamber's boundary triangles are the ones it had (conforming to the body), its volume at X
   // is unchanged, every tet is positive, and faces are shared by at most two tets.
-  std::vector<std::array<int, 3>> before = RegionBoundaryFaces(m, 5), after = RegionBoundaryFaces(r.mesh, 5);
+  std::vector<std::array<int, 3>> before = RegionBoundaryFaces(m, 5),
+                                  after = RegionBoundaryFaces(r.mesh, 5);
   for (auto& f : after) {
     for (int& v : f) v = r.old_index[v];
     std::sort(f.begin(), f.end());

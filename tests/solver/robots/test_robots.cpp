@@ -1,6 +1,6 @@
 // Tests of the structured mesh generators (solver/mesh/mesh_gen.hpp) and the embedded robots
-// (solver/robots/robots.hpp). The mesh checks here are self-contained (own volume, face and component
-// code) so they test the generators independently of mesh.cpp.
+// (solver/robots/robots.hpp). The mesh checks here are self-contained (own volume, face and
+// component code) so they test the generators independently of mesh.cpp.
 #include "softkin/solver/mesh/mesh_gen.hpp"
 #include "softkin/solver/robots/robots.hpp"
 
@@ -169,8 +169,7 @@ std::vector<int> VertexMap(const Mesh& m, F f, double tol) {
                                        std::int64_t(std::floor(x[2] / q))};
   };
   std::map<std::array<std::int64_t, 3>, std::vector<int>> grid;
-  for (int v = 0; v < m.num_vertices(); ++v)
-    grid[cell(m.vertices.row(v).transpose())].push_back(v);
+  for (int v = 0; v < m.num_vertices(); ++v) grid[cell(m.vertices.row(v).transpose())].push_back(v);
   std::vector<int> out(m.num_vertices(), -1);
   for (int v = 0; v < m.num_vertices(); ++v) {
     const Eigen::Vector3d y = f(Eigen::Vector3d(m.vertices.row(v).transpose()));
@@ -209,8 +208,8 @@ std::array<int, 4> SortedTet(const Element& e, const std::vector<int>& map) {
 // onto a tet with region region_map(r).
 template <class RegionMap>
 void ExpectThreeFold(const Mesh& m, int a, int b, RegionMap region_map) {
-  const std::vector<int> map = VertexMap(m, [&](const Eigen::Vector3d& x) { return Rot120(x, a, b); },
-                                         1e-9);
+  const std::vector<int> map = VertexMap(
+      m, [&](const Eigen::Vector3d& x) { return Rot120(x, a, b); }, 1e-9);
   const int missing = static_cast<int>(std::count(map.begin(), map.end(), -1));
   ASSERT_EQ(missing, 0) << "vertices without a rotated image";
   std::vector<int> sorted = map;
@@ -279,8 +278,8 @@ TEST(MeshGenVoxel, ConformingCompactedAndCountsExposedFaces) {
   // A deterministic pattern of kept cells, kept connected through the full bottom layer.
   auto keep = [](const Eigen::Vector3i& c) {
     if (c[2] == 0) return true;
-    const unsigned hsh = unsigned(c[0] * 73856093) ^ unsigned(c[1] * 19349663) ^
-                         unsigned(c[2] * 83492791);
+    const unsigned hsh =
+        unsigned(c[0] * 73856093) ^ unsigned(c[1] * 19349663) ^ unsigned(c[2] * 83492791);
     return (hsh % 3) != 0 || c[0] == 0;
   };
   std::vector<char> kept(n.prod(), 0);
@@ -309,8 +308,8 @@ TEST(MeshGenVoxel, ConformingCompactedAndCountsExposedFaces) {
         const int nb[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k},
                               {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
         for (const auto& q : nb) {
-          const bool in = q[0] >= 0 && q[0] < n[0] && q[1] >= 0 && q[1] < n[1] && q[2] >= 0 &&
-                          q[2] < n[2];
+          const bool in =
+              q[0] >= 0 && q[0] < n[0] && q[1] >= 0 && q[1] < n[1] && q[2] >= 0 && q[2] < n[2];
           if (!in || !kept[idx(q[0], q[1], q[2])]) ++exposed;
         }
       }
@@ -450,10 +449,10 @@ TEST(MeshGenDisk, RejectsBadArguments) {
 
 TEST(Robots, ListsEveryRobotAndRejectsBadInput) {
   const std::vector<RobotInfo> list = ListRobots();
-  const std::vector<std::string> names = {"pneumatic_finger", "three_chamber", "cable_finger",
-                                          "finger_manipulator", "multi_segment_gripper",
-                                          "dea_crawler", "bimaterial_bar", "cable_gripper",
-                                          "selfcollision_finger", "membrane", "twisting_robot"};
+  const std::vector<std::string> names = {
+      "pneumatic_finger",      "three_chamber", "cable_finger",   "finger_manipulator",
+      "multi_segment_gripper", "dea_crawler",   "bimaterial_bar", "cable_gripper",
+      "selfcollision_finger",  "membrane",      "twisting_robot"};
   ASSERT_EQ(list.size(), names.size());
   for (size_t i = 0; i < names.size(); ++i) EXPECT_EQ(list[i].name, names[i]);
   for (const auto& r : list) {
@@ -465,16 +464,18 @@ TEST(Robots, ListsEveryRobotAndRejectsBadInput) {
     MakeRobot("x");
     FAIL() << "no exception";
   } catch (const std::invalid_argument& e) {
-    EXPECT_EQ(std::string(e.what()),
-              "unknown robot 'x'; known robots: pneumatic_finger, three_chamber, cable_finger, "
-              "finger_manipulator, multi_segment_gripper, dea_crawler, bimaterial_bar, cable_gripper, "
-              "selfcollision_finger, membrane, twisting_robot");
+    EXPECT_EQ(
+        std::string(e.what()),
+        "unknown robot 'x'; known robots: pneumatic_finger, three_chamber, cable_finger, "
+        "finger_manipulator, multi_segment_gripper, dea_crawler, bimaterial_bar, cable_gripper, "
+        "selfcollision_finger, membrane, twisting_robot");
   }
   try {
     MakeRobot("pneumatic_finger", 2);
     FAIL() << "no exception";
   } catch (const std::invalid_argument& e) {
-    EXPECT_EQ(std::string(e.what()), "pneumatic_finger: --res must be an integer in [5, 40], got 2");
+    EXPECT_EQ(std::string(e.what()),
+              "pneumatic_finger: --res must be an integer in [5, 40], got 2");
   }
   EXPECT_THROW(MakeRobot("pneumatic_finger", 41), std::invalid_argument);
   EXPECT_THROW(MakeRobot("three_chamber", 2), std::invalid_argument);
@@ -498,7 +499,8 @@ TEST(Robots, EveryRobotIsValidWellFormedAndDeterministic) {
     EXPECT_TRUE(SameMesh(a.mesh, b.mesh)) << "two builds differ";
     EXPECT_EQ(a.fixed, b.fixed);
     ASSERT_EQ(a.markers.size(), b.markers.size());
-    for (size_t i = 0; i < a.markers.size(); ++i) EXPECT_EQ(a.markers[i].vertices, b.markers[i].vertices);
+    for (size_t i = 0; i < a.markers.size(); ++i)
+      EXPECT_EQ(a.markers[i].vertices, b.markers[i].vertices);
     EXPECT_TRUE(std::is_sorted(a.fixed.begin(), a.fixed.end()));
     EXPECT_TRUE(std::adjacent_find(a.fixed.begin(), a.fixed.end()) == a.fixed.end());
     EXPECT_GE(a.marker_index("tip"), 0);
@@ -650,7 +652,8 @@ TEST(RobotsPneumaticFinger, FeaturesSurviveEveryResolution) {
       for (int j = 0; j < 4; ++j) ASSERT_GE(m.vertices(e.v[j], 2), 2 * h - 1e-9);
     }
     // Chambers: cavities ~5 mm long between ~1.5 mm walls along ~110 mm.
-    const int pitch = std::max(1, int(std::lround(5.0 / h))) + std::max(1, int(std::lround(1.5 / h)));
+    const int pitch =
+        std::max(1, int(std::lround(5.0 / h))) + std::max(1, int(std::lround(1.5 / h)));
     EXPECT_GE(chambers * pitch * h, 95.0);
     EXPECT_GE(chambers, 8);
     const Eigen::RowVector3d hi = m.vertices.colwise().maxCoeff();
@@ -660,7 +663,9 @@ TEST(RobotsPneumaticFinger, FeaturesSurviveEveryResolution) {
 }
 
 TEST(RobotsPneumaticFinger, CellCountScalesAsResCubed) {
-  auto tets = [](int res) { return double(MakeRobot("pneumatic_finger", res).mesh.num_elements()); };
+  auto tets = [](int res) {
+    return double(MakeRobot("pneumatic_finger", res).mesh.num_elements());
+  };
   const double n8 = tets(8), n12 = tets(12), n16 = tets(16), n24 = tets(24);
   EXPECT_NEAR(n16 / n8, 8.0, 8.0 * 0.2);
   EXPECT_NEAR(n24 / n12, 8.0, 8.0 * 0.2);
@@ -768,7 +773,8 @@ namespace {
 TEST(RobotsTwisting, StrainLimitingStripRegion) {
   const Scene plain = MakeRobot("twisting_robot", 1, {{"hyperelastic", 0.0}});
   EXPECT_EQ(plain.body.count(2), 0u);
-  const Scene s = MakeRobot("twisting_robot", 1, {{"hyperelastic", 0.0}, {"strip", 3.0}, {"strip_weight", 40.0}});
+  const Scene s = MakeRobot("twisting_robot", 1,
+                            {{"hyperelastic", 0.0}, {"strip", 3.0}, {"strip_weight", 40.0}});
   ASSERT_EQ(s.body.count(2), 1u);
   EXPECT_DOUBLE_EQ(s.body.at(2).weight, 40.0 * s.body.at(0).weight);
   EXPECT_EQ(s.mesh.num_elements(), plain.mesh.num_elements());
@@ -835,8 +841,10 @@ TEST(RobotsMembrane, ChambersStandChamberGapCellsApart) {
       if (cy > 125) continue;
       for (int j = 0; j < 4; ++j) {
         const double x = s.mesh.vertices(s.mesh.elements[e].v[j], 0);
-        if (cx < 125) left_max = std::max(left_max, x);
-        else right_min = std::min(right_min, x);
+        if (cx < 125)
+          left_max = std::max(left_max, x);
+        else
+          right_min = std::min(right_min, x);
       }
     }
     EXPECT_NEAR(right_min - left_max, gap * h, 1e-9) << "chamber_gap " << gap;
@@ -845,7 +853,8 @@ TEST(RobotsMembrane, ChambersStandChamberGapCellsApart) {
     MakeRobot("membrane", 24, {{"chamber_gap", 1.5}});
     FAIL() << "no exception";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("chamber_gap: expected an integer"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("chamber_gap: expected an integer"), std::string::npos)
+        << e.what();
   }
   try {
     MakeRobot("membrane", 10, {{"chamber_gap", 3}});

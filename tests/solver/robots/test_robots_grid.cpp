@@ -176,28 +176,29 @@ TEST(RobotGrid, DeaCrawlerSlidesOnTheGroundAndFlattens) {
   const Model model(s);
   const int front = s.marker_index("front_foot");
   double last_spacing = 0, last_apex = 1e9;
-  EXPECT_EQ(SolveGrid(s, {{0.7, 0.775, 0.85, 0.925, 1.0}},
-                      [&](const Eigen::VectorXd& c, const FkResult& r) {
-                        // The front foot stays on the ground exactly (held z), the rear is pinned.
-                        for (int v : s.markers[front].vertices)
-                          EXPECT_EQ(r.positions(v, 2), s.mesh.vertices(v, 2));
-                        for (int v : s.fixed)
-                          EXPECT_EQ(r.positions.row(v), s.mesh.vertices.row(v));
-                        const double spacing = (Marker(s, r.positions, "front_foot") -
-                                                Marker(s, r.positions, "rear_foot")).norm();
-                        const double apex = Marker(s, r.positions, "apex").z();
-                        // Relaxing the membrane spreads the legs and lowers the arch.
-                        EXPECT_GT(spacing, last_spacing) << c.transpose();
-                        EXPECT_LT(apex, last_apex) << c.transpose();
-                        last_spacing = spacing;
-                        last_apex = apex;
-                        if (c[0] == 1.0) {
-                          // lambda = 1 is the flat fabricated state: zero energy, rest positions.
-                          EXPECT_LT(r.energy, 1e-8);
-                          EXPECT_LT((r.positions - s.mesh.vertices).cwiseAbs().maxCoeff(), 1e-3);
-                        }
-                      }),
-            0);
+  EXPECT_EQ(
+      SolveGrid(
+          s, {{0.7, 0.775, 0.85, 0.925, 1.0}},
+          [&](const Eigen::VectorXd& c, const FkResult& r) {
+            // The front foot stays on the ground exactly (held z), the rear is pinned.
+            for (int v : s.markers[front].vertices)
+              EXPECT_EQ(r.positions(v, 2), s.mesh.vertices(v, 2));
+            for (int v : s.fixed) EXPECT_EQ(r.positions.row(v), s.mesh.vertices.row(v));
+            const double spacing =
+                (Marker(s, r.positions, "front_foot") - Marker(s, r.positions, "rear_foot")).norm();
+            const double apex = Marker(s, r.positions, "apex").z();
+            // Relaxing the membrane spreads the legs and lowers the arch.
+            EXPECT_GT(spacing, last_spacing) << c.transpose();
+            EXPECT_LT(apex, last_apex) << c.transpose();
+            last_spacing = spacing;
+            last_apex = apex;
+            if (c[0] == 1.0) {
+              // lambda = 1 is the flat fabricated state: zero energy, rest positions.
+              EXPECT_LT(r.energy, 1e-8);
+              EXPECT_LT((r.positions - s.mesh.vertices).cwiseAbs().maxCoeff(), 1e-3);
+            }
+          }),
+      0);
   // The released state arches well above the flat strip and pulls the feet together.
   const FkResult r = SolveFk(s, s.rest_actuation());
   ASSERT_EQ(r.status, FkStatus::Converged);
@@ -214,8 +215,10 @@ TEST(RobotGrid, BimaterialBarTwistAndStretch) {
                       [&](const Eigen::VectorXd& c, const FkResult& r) {
                         // The end face is where the motion puts it: its centre on the axis,
                         // moved by the stretch.
-                        const Eigen::Vector3d p = s.marker_positions(r.positions).row(tip).transpose();
-                        const Eigen::Vector3d p0 = s.marker_positions(s.mesh.vertices).row(tip).transpose();
+                        const Eigen::Vector3d p =
+                            s.marker_positions(r.positions).row(tip).transpose();
+                        const Eigen::Vector3d p0 =
+                            s.marker_positions(s.mesh.vertices).row(tip).transpose();
                         EXPECT_NEAR((p - p0 - Eigen::Vector3d(c[1], 0, 0)).norm(), 0.0, 1e-9);
                       }),
             0);
@@ -248,9 +251,8 @@ TEST(RobotBimaterialBar, InterfaceFollowsTheParameterAndTheSofterSideStretchesMo
 
 TEST(RobotGrid, CableGripperTwoMaterialDistributions) {
   std::map<std::string, Eigen::Vector3d> m3;
-  for (const auto& [label, params] :
-       std::vector<std::pair<std::string, RobotParams>>{{"uniform", {}},
-                                                        {"stiff_links", {{"link_weight", 8.0}}}}) {
+  for (const auto& [label, params] : std::vector<std::pair<std::string, RobotParams>>{
+           {"uniform", {}}, {"stiff_links", {{"link_weight", 8.0}}}}) {
     const Scene s = MakeRobot("cable_gripper", 4, params);
     const Eigen::Vector3d tip0 = Marker(s, s.mesh.vertices, "tip");
     Eigen::Vector3d last;
@@ -274,14 +276,16 @@ TEST(RobotParams, UnknownOrOutOfRangeParametersAreRejectedByName) {
     MakeRobot("bimaterial_bar", 3, {{"interfac", 0.3}});
     ADD_FAILURE() << "no throw";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("unknown parameter 'interfac'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("unknown parameter 'interfac'"), std::string::npos)
+        << e.what();
     EXPECT_NE(std::string(e.what()).find("interface"), std::string::npos) << e.what();
   }
   try {
     MakeRobot("dea_crawler", 4, {{"frame_thickness", -1}});
     ADD_FAILURE() << "no throw";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("'frame_thickness' must be in [0.2, 5]"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("'frame_thickness' must be in [0.2, 5]"),
+              std::string::npos)
         << e.what();
   }
   EXPECT_THROW(MakeRobot("three_chamber", 3, {{"gain", 1}}), std::invalid_argument);

@@ -1,5 +1,5 @@
-// Tests of the scene JSON reader (solver/scene/scene_json.hpp): the repository's real-mesh scene, every
-// selector on a tiny generated mesh, every error message, and the schema text.
+// Tests of the scene JSON reader (solver/scene/scene_json.hpp): the repository's real-mesh scene,
+// every selector on a tiny generated mesh, every error message, and the schema text.
 #include "softkin/solver/scene/scene_json.hpp"
 
 #include "softkin/solver/mesh/io/mesh_io.hpp"
@@ -43,9 +43,9 @@ class TempDir {
  public:
   TempDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() /
-            ("softkin_scene_json_" + std::string(info->test_suite_name()) + "_" + info->name() + "_" +
-             std::to_string(::getpid()));
+    path_ =
+        fs::temp_directory_path() / ("softkin_scene_json_" + std::string(info->test_suite_name()) +
+                                     "_" + info->name() + "_" + std::to_string(::getpid()));
     fs::remove_all(path_);
     fs::create_directories(path_);
   }
@@ -119,7 +119,8 @@ void ExpectError(const std::function<void()>& f, const std::vector<std::string>&
     ADD_FAILURE() << "expected std::invalid_argument containing '" << parts.front() << "'";
   } catch (const std::invalid_argument& e) {
     const std::string msg = e.what();
-    for (const auto& p : parts) EXPECT_NE(msg.find(p), std::string::npos) << "'" << p << "' not in: " << msg;
+    for (const auto& p : parts)
+      EXPECT_NE(msg.find(p), std::string::npos) << "'" << p << "' not in: " << msg;
   }
 }
 
@@ -302,7 +303,8 @@ TEST(SceneJsonTiny, CableAndDeaRolesAndDefaults) {
 TEST(SceneJsonTiny, OtherMeshFormats) {
   TempDir dir;
   WriteTinyMesh(dir.path());
-  const Mesh tiny = ReadTet((dir.path() / "tiny.tet").string(), (dir.path() / "tiny_labels.txt").string());
+  const Mesh tiny =
+      ReadTet((dir.path() / "tiny.tet").string(), (dir.path() / "tiny_labels.txt").string());
   WriteGmsh((dir.path() / "tiny.msh").string(), tiny);
   WriteTetGen((dir.path() / "tiny_tg").string(), tiny);
   // Legacy VTK by hand, with two integer cell arrays: the tags are in the second one.
@@ -333,14 +335,16 @@ TEST(SceneJsonTiny, OtherMeshFormats) {
   // Without tag_array the VTK reader takes the first integer array ("other": every cell 7).
   json j = TinyScene();
   j["mesh"] = {{"file", "tiny.vtk"}};
-  ExpectError([&] { LoadFrom(dir.path(), j); },
-              {"scene.json: regions[0].tag: no element of the mesh has region tag 0 (the mesh's tags: 7)"});
+  ExpectError(
+      [&] { LoadFrom(dir.path(), j); },
+      {"scene.json: regions[0].tag: no element of the mesh has region tag 0 (the mesh's tags: 7)"});
   j["mesh"] = {{"file", "tiny_tg.node"}, {"tag_array", "part"}};
-  ExpectError([&] { LoadFrom(dir.path(), j); },
-              {"scene.json: mesh.tag_array: only used by the vtk format (the mesh is read as tetgen)"});
+  ExpectError(
+      [&] { LoadFrom(dir.path(), j); },
+      {"scene.json: mesh.tag_array: only used by the vtk format (the mesh is read as tetgen)"});
   j["mesh"] = {{"file", "missing_tg.node"}};
-  ExpectError([&] { LoadFrom(dir.path(), j); },
-              {"scene.json: mesh.file: file not found: '" + (dir.path() / "missing_tg.node").string()});
+  ExpectError([&] { LoadFrom(dir.path(), j); }, {"scene.json: mesh.file: file not found: '" +
+                                                 (dir.path() / "missing_tg.node").string()});
 }
 
 TEST(SceneJsonTiny, ParseSceneJsonUsesBaseDirAndSource) {
@@ -371,7 +375,8 @@ TEST(SceneJsonErrors, WrongTypeAndRange) {
   ExpectSceneError(j, {"regions[0].tag: expected an integer", "got 18446744073709551615"});
   j = TinyScene();
   j["regions"][0]["role"] = "muscle";
-  ExpectSceneError(j, {"regions[0].role: expected one of: body, pneumatic, cable, dea", "\"muscle\""});
+  ExpectSceneError(j,
+                   {"regions[0].role: expected one of: body, pneumatic, cable, dea", "\"muscle\""});
   j = TinyScene();
   j["fixed"][1]["box"]["min"] = {1, 2};
   ExpectSceneError(j, {"fixed[1].box.min: expected an array of 3 numbers"});
@@ -393,7 +398,8 @@ TEST(SceneJsonTiny, MooneyRivlinMaterials) {
   TempDir dir;
   WriteTinyMesh(dir.path());
   json j = TinyScene();
-  j["regions"][0] = {{"tag", 0}, {"role", "body"}, {"material", "dragon-skin-20"}, {"law", "mooney-rivlin"}};
+  j["regions"][0] = {
+      {"tag", 0}, {"role", "body"}, {"material", "dragon-skin-20"}, {"law", "mooney-rivlin"}};
   Scene s = LoadFrom(dir.path(), j);
   EXPECT_TRUE(s.body.at(0).hyperelastic());
   EXPECT_DOUBLE_EQ(s.body.at(0).c1, 0.119);
@@ -402,15 +408,19 @@ TEST(SceneJsonTiny, MooneyRivlinMaterials) {
   s = LoadFrom(dir.path(), j);
   EXPECT_DOUBLE_EQ(s.body.at(0).c1, 0.119);
   EXPECT_DOUBLE_EQ(s.body.at(0).c2, 0.05);
-  j["regions"][0] = {{"tag", 0}, {"role", "body"}, {"law", "mooney-rivlin"}, {"c1", 0.2}, {"c2", 0}};
+  j["regions"][0] = {
+      {"tag", 0}, {"role", "body"}, {"law", "mooney-rivlin"}, {"c1", 0.2}, {"c2", 0}};
   s = LoadFrom(dir.path(), j);
   EXPECT_DOUBLE_EQ(s.body.at(0).c1, 0.2);
   // Errors: no constants, constants without the law, negative constants, unknown law.
-  j["regions"][0] = {{"tag", 0}, {"role", "body"}, {"material", "rubber"}, {"law", "mooney-rivlin"}};
-  ExpectSceneError(j, {"regions[0]: law mooney-rivlin needs c1 and c2", "ecoflex-00-30", "\"rubber\""});
+  j["regions"][0] = {
+      {"tag", 0}, {"role", "body"}, {"material", "rubber"}, {"law", "mooney-rivlin"}};
+  ExpectSceneError(
+      j, {"regions[0]: law mooney-rivlin needs c1 and c2", "ecoflex-00-30", "\"rubber\""});
   j["regions"][0] = {{"tag", 0}, {"role", "body"}, {"c1", 0.1}, {"c2", 0.1}};
   ExpectSceneError(j, {"regions[0]: c1 / c2 are given but law is \"blend\""});
-  j["regions"][0] = {{"tag", 0}, {"role", "body"}, {"law", "mooney-rivlin"}, {"c1", -0.1}, {"c2", 0.1}};
+  j["regions"][0] = {
+      {"tag", 0}, {"role", "body"}, {"law", "mooney-rivlin"}, {"c1", -0.1}, {"c2", 0.1}};
   ExpectSceneError(j, {"regions[0].c1: expected a number >= 0, got -0.1"});
   j["regions"][0] = {{"tag", 0}, {"role", "body"}, {"law", "ogden"}};
   ExpectSceneError(j, {"regions[0].law: expected one of: blend, mooney-rivlin", "\"ogden\""});
@@ -424,7 +434,10 @@ TEST(SceneJsonErrors, UnknownKeysAnywhere) {
   ExpectSceneError(j, {"fixed[0]: unknown key 'bx'", "did you mean 'box'?",
                        "expected one of: region, box, plane, file"});
 
-  struct Case { json::json_pointer where; std::string message; };
+  struct Case {
+    json::json_pointer where;
+    std::string message;
+  };
   const std::vector<Case> cases = {
       {json::json_pointer("/mesh_file"), "unknown key 'mesh_file'"},
       {json::json_pointer("/mesh/scal"), "mesh: unknown key 'scal'"},
@@ -457,7 +470,8 @@ TEST(SceneJsonErrors, KeyNotAllowedForRoleOrSelector) {
   ExpectSceneError(j, {"regions[0].min: not allowed for role 'body'", "pneumatic, cable, dea"});
   j = TinyScene();
   j["regions"][1]["r_omega"] = 1.0;
-  ExpectSceneError(j, {"regions[1].r_omega: not allowed for role 'pneumatic'", "only for role body"});
+  ExpectSceneError(j,
+                   {"regions[1].r_omega: not allowed for role 'pneumatic'", "only for role body"});
   j = TinyScene();
   j["fixed"][1]["base"] = 1;
   ExpectSceneError(j, {"fixed[1].base: only allowed together with 'file'"});
@@ -478,7 +492,8 @@ TEST(SceneJsonErrors, SelectorsNeedExactlyOne) {
 TEST(SceneJsonErrors, SelectionsThatSelectNothing) {
   json j = TinyScene();
   j["markers"][2]["box"] = json::parse(R"({"min": [10, 10, 10], "max": [11, 11, 11]})");
-  ExpectSceneError(j, {"markers[2].box selects no vertex", "the mesh spans [0, 0, 0] to [2, 2, 2]"});
+  ExpectSceneError(j,
+                   {"markers[2].box selects no vertex", "the mesh spans [0, 0, 0] to [2, 2, 2]"});
   j = TinyScene();
   j["fixed"][1]["box"] = json::parse(R"({"min": [10, 10, 10], "max": [11, 11, 11]})");
   ExpectSceneError(j, {"fixed[1].box selects no vertex"});
@@ -553,12 +568,12 @@ TEST(SceneJsonErrors, MissingFiles) {
   WriteTinyMesh(dir.path());
   json j = TinyScene();
   j["mesh"]["file"] = "nope.tet";
-  ExpectError([&] { LoadFrom(dir.path(), j); },
-              {"scene.json: mesh.file: file not found: '" + (dir.path() / "nope.tet").string() + "'"});
+  ExpectError([&] { LoadFrom(dir.path(), j); }, {"scene.json: mesh.file: file not found: '" +
+                                                 (dir.path() / "nope.tet").string() + "'"});
   j = TinyScene();
   j["mesh"]["labels"] = "sub/nope.txt";
-  ExpectError([&] { LoadFrom(dir.path(), j); },
-              {"scene.json: mesh.labels: file not found: '" + (dir.path() / "sub/nope.txt").string()});
+  ExpectError([&] { LoadFrom(dir.path(), j); }, {"scene.json: mesh.labels: file not found: '" +
+                                                 (dir.path() / "sub/nope.txt").string()});
   j = TinyScene();
   j["fixed"][2]["file"] = "none.txt";
   ExpectError([&] { LoadFrom(dir.path(), j); },
@@ -581,8 +596,9 @@ TEST(SceneJsonErrors, MeshFormatKeys) {
               {"scene.json: mesh.labels: only used by the tet format"});
   j = TinyScene();
   j["mesh"]["format"] = "stl";
-  ExpectError([&] { LoadFrom(dir.path(), j); },
-              {"scene.json: mesh.format: expected one of: auto, tet, tetgen, gmsh, vtk, got \"stl\""});
+  ExpectError(
+      [&] { LoadFrom(dir.path(), j); },
+      {"scene.json: mesh.format: expected one of: auto, tet, tetgen, gmsh, vtk, got \"stl\""});
 }
 
 TEST(SceneJsonErrors, IndexFileBadLineAndOutOfRange) {
@@ -590,14 +606,18 @@ TEST(SceneJsonErrors, IndexFileBadLineAndOutOfRange) {
   WriteTinyMesh(dir.path());
   WriteFile(dir.path() / "fixed.txt", "6\nseven\n");
   ExpectError([&] { LoadFrom(dir.path(), TinyScene()); },
-              {"scene.json: fixed[2].file: ", "fixed.txt:2: expected an integer vertex index, got 'seven'"});
+              {"scene.json: fixed[2].file: ",
+               "fixed.txt:2: expected an integer vertex index, got 'seven'"});
   WriteFile(dir.path() / "fixed.txt", "# base 1\n1 2\n7\n");
   ExpectError([&] { LoadFrom(dir.path(), TinyScene()); },
-              {"scene.json: fixed[2].file: ", "fixed.txt:3: vertex index 7 is out of range; expected 1 to 6"});
+              {"scene.json: fixed[2].file: ",
+               "fixed.txt:3: vertex index 7 is out of range; expected 1 to 6"});
   WriteFile(dir.path() / "fixed.txt", "0\n");
-  ExpectError([&] { LoadFrom(dir.path(), TinyScene()); }, {"fixed.txt:1: vertex index 0 is out of range"});
+  ExpectError([&] { LoadFrom(dir.path(), TinyScene()); },
+              {"fixed.txt:1: vertex index 0 is out of range"});
   WriteFile(dir.path() / "fixed.txt", "# nothing\n");
-  ExpectError([&] { LoadFrom(dir.path(), TinyScene()); }, {"fixed[2].file: ", "lists no vertex index"});
+  ExpectError([&] { LoadFrom(dir.path(), TinyScene()); },
+              {"fixed[2].file: ", "lists no vertex index"});
 }
 
 TEST(SceneJsonErrors, MarkerVertexOutOfRangeAndDuplicateNames) {
@@ -614,22 +634,26 @@ TEST(SceneJsonErrors, MarkerVertexOutOfRangeAndDuplicateNames) {
 TEST(SceneJsonErrors, ActuatorRegionsMustAgree) {
   json j = TinyScene();
   j["regions"][2]["max"] = 4;
-  ExpectSceneError(j, {"regions[2].max: actuator 'chamber' already has max 3 from regions[1].max, got 4"});
+  ExpectSceneError(
+      j, {"regions[2].max: actuator 'chamber' already has max 3 from regions[1].max, got 4"});
   j = TinyScene();
   j["regions"][2]["role"] = "cable";
   j["regions"][2]["path"] = json::parse("[[0, 0, 0], [1, 0, 0]]");
-  ExpectSceneError(j, {"regions[2].role: actuator 'chamber' is pneumatic in regions[1].role",
-                       "got \"cable\""});
+  ExpectSceneError(
+      j, {"regions[2].role: actuator 'chamber' is pneumatic in regions[1].role", "got \"cable\""});
   // A cable's path: at least two finite points, and the same path in every region of the cable.
   j = TinyScene();
-  j["regions"][1] = json::parse(R"({"tag": 1, "role": "cable", "name": "tendon", "path": [[0, 0, 0]]})");
+  j["regions"][1] =
+      json::parse(R"({"tag": 1, "role": "cable", "name": "tendon", "path": [[0, 0, 0]]})");
   ExpectSceneError(j, {"regions[1].path", "expected an array of >= 2 points [[x, y, z], ...]"});
   j = TinyScene();
   j["regions"][1] = json::parse(R"({"tag": 1, "role": "cable", "name": "tendon"})");
   ExpectSceneError(j, {"regions[1]", "path"});
   j = TinyScene();
-  j["regions"][1] = json::parse(R"({"tag": 1, "role": "cable", "name": "t", "path": [[0, 0, 0], [1, 0, 0]]})");
-  j["regions"][2] = json::parse(R"({"tag": 2, "role": "cable", "name": "t", "path": [[0, 0, 0], [2, 0, 0]]})");
+  j["regions"][1] =
+      json::parse(R"({"tag": 1, "role": "cable", "name": "t", "path": [[0, 0, 0], [1, 0, 0]]})");
+  j["regions"][2] =
+      json::parse(R"({"tag": 2, "role": "cable", "name": "t", "path": [[0, 0, 0], [2, 0, 0]]})");
   ExpectSceneError(j, {"regions[2].path: cable 't' already has a different path"});
   j = TinyScene();
   j["regions"][1]["path"] = json::parse("[[0, 0, 0], [1, 0, 0]]");
@@ -690,7 +714,8 @@ TEST(SceneJsonTiny, SignedActuatorAxesAndMotions) {
   EXPECT_EQ(s.actuators[2].centre, Eigen::Vector3d(1, 0, 1));
   EXPECT_DOUBLE_EQ(s.actuators[2].min, -90);
   // Vertex 3 (0,2,0) turned 90 degrees about the y line through (1,0,1): (0,2,2).
-  EXPECT_LT((s.actuators[2].Move(s.mesh.vertices.row(3).transpose(), 90) - Eigen::Vector3d(0, 2, 2)).norm(),
+  EXPECT_LT((s.actuators[2].Move(s.mesh.vertices.row(3).transpose(), 90) - Eigen::Vector3d(0, 2, 2))
+                .norm(),
             1e-12);
   EXPECT_EQ(s.rest_actuation(), Eigen::Vector3d(0, 0, 0));
   EXPECT_EQ(s.fixed, (std::vector<int>{0, 1, 2}));
@@ -702,7 +727,8 @@ TEST(SceneJsonTiny, SignedActuatorAxesAndMotions) {
   EXPECT_TRUE(s.is_constrained(4, 1));  // moved
   // A per-axis hold on a fully fixed vertex adds nothing.
   json j = SignedMotionScene();
-  j["fixed"][1] = json::parse(R"({"plane": {"point": [0, 0, 0], "normal": [0, 1, 0]}, "axes": "y"})");
+  j["fixed"][1] =
+      json::parse(R"({"plane": {"point": [0, 0, 0], "normal": [0, 1, 0]}, "axes": "y"})");
   const Scene t = LoadFrom(dir.path(), j);
   for (int d = 0; d < 3; ++d) EXPECT_TRUE(t.fixed_axis[d].empty());
 }
@@ -710,8 +736,9 @@ TEST(SceneJsonTiny, SignedActuatorAxesAndMotions) {
 TEST(SceneJsonErrors, SignedActuatorBadValues) {
   json j = SignedMotionScene();
   j["regions"][1].erase("min");
-  ExpectSceneError(j, {"regions[1]: signed actuator 's' (negative side from regions[2].side) needs 'min'",
-                       "expected min <= 0 <= max"});
+  ExpectSceneError(
+      j, {"regions[1]: signed actuator 's' (negative side from regions[2].side) needs 'min'",
+          "expected min <= 0 <= max"});
   j = SignedMotionScene();
   j["regions"][2]["rest"] = 1;
   ExpectSceneError(j, {"regions[2].rest: signed actuator 's': expected rest 0, got 1"});
@@ -732,7 +759,8 @@ TEST(SceneJsonErrors, SignedActuatorBadValues) {
   ExpectSceneError(j, {"regions[1].gain: expected a number > 0, got 0"});
   j = SignedMotionScene();
   j["regions"][2]["gain"] = 2;
-  ExpectSceneError(j, {"regions[2].gain: actuator 's' already has gain 1.5 from regions[1].gain, got 2"});
+  ExpectSceneError(
+      j, {"regions[2].gain: actuator 's' already has gain 1.5 from regions[1].gain, got 2"});
   j = SignedMotionScene();
   j["regions"][0]["side"] = "negative";
   ExpectSceneError(j, {"regions[0].side: not allowed for role 'body'"});
@@ -765,16 +793,19 @@ TEST(SceneJsonErrors, ObstaclesAndCollisionOptions) {
     j["obstacles"] = json::array({o});
     return j;
   };
-  ExpectSceneError(with_obstacle(json::parse(R"({"type": "box", "min": [0, 0, 0], "max": [0, 1, 1]})")),
-                   {"obstacles[0]: box obstacle: expected min < max on every axis"});
+  ExpectSceneError(
+      with_obstacle(json::parse(R"({"type": "box", "min": [0, 0, 0], "max": [0, 1, 1]})")),
+      {"obstacles[0]: box obstacle: expected min < max on every axis"});
   ExpectSceneError(with_obstacle(json::parse(R"({"type": "box", "min": [0, 0, 0]})")),
                    {"obstacles[0]: missing required key 'max'"});
-  ExpectSceneError(with_obstacle(json::parse(R"({"type": "cylinder", "min": [0, 0, 0], "base": [0, 0, 0],
+  ExpectSceneError(
+      with_obstacle(json::parse(R"({"type": "cylinder", "min": [0, 0, 0], "base": [0, 0, 0],
                                                  "axis": [0, 0, 1], "radius": 1, "height": 1})")),
-                   {"obstacles[0].min: not allowed for type 'cylinder'"});
-  ExpectSceneError(with_obstacle(json::parse(R"({"type": "cylinder", "base": [0, 0, 0], "axis": [0, 0, 1],
+      {"obstacles[0].min: not allowed for type 'cylinder'"});
+  ExpectSceneError(
+      with_obstacle(json::parse(R"({"type": "cylinder", "base": [0, 0, 0], "axis": [0, 0, 1],
                                                  "radius": -1, "height": 1})")),
-                   {"obstacles[0].radius: expected a number > 0"});
+      {"obstacles[0].radius: expected a number > 0"});
   ExpectSceneError(with_obstacle(json::parse(R"({"type": "file", "file": "no_such_surface.obj"})")),
                    {"obstacles[0].file: file not found", "no_such_surface.obj"});
   ExpectSceneError(with_obstacle(json::parse(R"({"type": "sphere"})")),
@@ -822,15 +853,19 @@ TEST(SceneJsonErrors, MotionBadValues) {
   ExpectSceneError(without("axis"), {"motions[1]: missing required key 'axis'"});
   ExpectSceneError(without("min"), {"motions[1]: missing required key 'min'"});
   ExpectSceneError(without("type"), {"motions[1]: missing required key 'type'"});
-  ExpectSceneError(without("box"), {"motions[1]: expected exactly one of: region, box, plane, file, got none"});
+  ExpectSceneError(without("box"),
+                   {"motions[1]: expected exactly one of: region, box, plane, file, got none"});
   ExpectSceneError(with("region", 0), {"motions[1]: expected exactly one of", "got both"});
   ExpectSceneError(with("type", "spin"), {"motions[1].type: expected one of: displacement, twist"});
-  ExpectSceneError(with("axis", json::parse("[0, 0, 0]")), {"motions[1].axis: expected a non-zero vector"});
+  ExpectSceneError(with("axis", json::parse("[0, 0, 0]")),
+                   {"motions[1].axis: expected a non-zero vector"});
   ExpectSceneError(with("axis", json::parse("[0, 1]")), {"motions[1].axis: expected"});
   ExpectSceneError(with("min", 5), {"motions[1].min: expected a number <= 0 (rest is 0), got 5"});
   ExpectSceneError(with("max", -5), {"motions[1].max: expected a number >= 0 (rest is 0), got -5"});
-  ExpectSceneError(with("name", "s"), {"motions[1].name: actuator 's' is already defined in regions"});
-  ExpectSceneError(with("name", "lift"), {"motions[1].name: actuator 'lift' is already defined by motions[0]"});
+  ExpectSceneError(with("name", "s"),
+                   {"motions[1].name: actuator 's' is already defined in regions"});
+  ExpectSceneError(with("name", "lift"),
+                   {"motions[1].name: actuator 'lift' is already defined by motions[0]"});
   ExpectSceneError(with("box", json::parse(R"({"min": [9, 9, 9], "max": [10, 10, 10]})")),
                    {"motions[1].box selects no vertex"});
   ExpectSceneError(with("box", json::parse(R"({"min": [-1, -1, -1], "max": [0.5, 0.5, 0.5]})")),
@@ -851,7 +886,8 @@ TEST(SceneJsonErrors, MotionBadValues) {
 TEST(SceneJsonErrors, RegionTags) {
   json j = TinyScene();
   j["regions"][2]["tag"] = 9;
-  ExpectSceneError(j, {"regions[2].tag: no element of the mesh has region tag 9 (the mesh's tags: 0, 1, 2)"});
+  ExpectSceneError(
+      j, {"regions[2].tag: no element of the mesh has region tag 9 (the mesh's tags: 0, 1, 2)"});
   j = TinyScene();
   j["regions"][2]["tag"] = 1;
   ExpectSceneError(j, {"regions[2].tag: region 1 is already described by regions[1]"});
@@ -866,7 +902,9 @@ TEST(SceneJsonErrors, ValidateMessagePassesThrough) {
 TEST(SceneJsonErrors, SolverOptions) {
   json j = TinyScene();
   j["solver"]["solver"] = "newton";
-  ExpectSceneError(j, {"solver.solver: expected one of: lg, lg-aa, ceres, ipopt-lbfgs, ipopt-newton, ipopt-hard, calculix-linear, calculix-nonlinear, got \"newton\""});
+  ExpectSceneError(j,
+                   {"solver.solver: expected one of: lg, lg-aa, ceres, ipopt-lbfgs, ipopt-newton, "
+                    "ipopt-hard, calculix-linear, calculix-nonlinear, got \"newton\""});
   j = TinyScene();
   j["solver"]["anderson_window"] = 0;
   ExpectSceneError(j, {"solver.anderson_window: expected an integer in [1, 50], got 0"});
@@ -898,39 +936,109 @@ TEST(SceneJsonErrors, MeshReaderErrorPassesThrough) {
 // ------------------------------------------------------------------------------------------------
 
 // Every key the scene JSON accepts. The schema must list exactly these.
-const std::vector<std::string> kAllKeys = {
-    "name", "mesh", "mesh.file", "mesh.format", "mesh.labels", "mesh.tag_array", "mesh.scale",
-    "regions", "regions[].tag", "regions[].role", "regions[].material", "regions[].law", "regions[].c1", "regions[].c2", "regions[].r_omega",
-    "regions[].weight", "regions[].name", "regions[].min", "regions[].max", "regions[].rest", "regions[].path",
-    "regions[].side", "regions[].gain", "fixed[].axes", "motions", "motions[].name", "motions[].type",
-    "motions[].region", "motions[].box", "motions[].box.min", "motions[].box.max", "motions[].plane",
-    "motions[].plane.point", "motions[].plane.normal", "motions[].plane.tolerance", "motions[].file",
-    "motions[].base", "motions[].axis", "motions[].centre", "motions[].min", "motions[].max",
-    "fixed", "fixed[].region", "fixed[].box", "fixed[].box.min", "fixed[].box.max",
-    "fixed[].plane", "fixed[].plane.point", "fixed[].plane.normal", "fixed[].plane.tolerance",
-    "fixed[].file", "fixed[].base", "markers", "markers[].name", "markers[].vertex",
-    "markers[].nearest", "markers[].box", "markers[].box.min", "markers[].box.max", "solver",
-    "solver.solver", "solver.max_iterations", "solver.tolerance", "solver.gradient_tolerance",
-    "solver.anderson_window", "solver.anderson_safeguard", "solver.continuation_steps", "solver.threads",
-    "solver.collision", "solver.collision.self", "solver.collision.obstacles", "solver.collision.epsilon",
-    "solver.collision.stiffness", "solver.collision.check_interval", "solver.collision.update",
-    "solver.collision.self_target",
-    "solver.collision.self_spring",
-    "solver.collision.obstacle_spring",
-    "obstacles", "obstacles[].type", "obstacles[].min", "obstacles[].max", "obstacles[].base",
-    "obstacles[].axis", "obstacles[].radius", "obstacles[].height", "obstacles[].segments",
-    "obstacles[].file"};
+const std::vector<std::string> kAllKeys = {"name",
+                                           "mesh",
+                                           "mesh.file",
+                                           "mesh.format",
+                                           "mesh.labels",
+                                           "mesh.tag_array",
+                                           "mesh.scale",
+                                           "regions",
+                                           "regions[].tag",
+                                           "regions[].role",
+                                           "regions[].material",
+                                           "regions[].law",
+                                           "regions[].c1",
+                                           "regions[].c2",
+                                           "regions[].r_omega",
+                                           "regions[].weight",
+                                           "regions[].name",
+                                           "regions[].min",
+                                           "regions[].max",
+                                           "regions[].rest",
+                                           "regions[].path",
+                                           "regions[].side",
+                                           "regions[].gain",
+                                           "fixed[].axes",
+                                           "motions",
+                                           "motions[].name",
+                                           "motions[].type",
+                                           "motions[].region",
+                                           "motions[].box",
+                                           "motions[].box.min",
+                                           "motions[].box.max",
+                                           "motions[].plane",
+                                           "motions[].plane.point",
+                                           "motions[].plane.normal",
+                                           "motions[].plane.tolerance",
+                                           "motions[].file",
+                                           "motions[].base",
+                                           "motions[].axis",
+                                           "motions[].centre",
+                                           "motions[].min",
+                                           "motions[].max",
+                                           "fixed",
+                                           "fixed[].region",
+                                           "fixed[].box",
+                                           "fixed[].box.min",
+                                           "fixed[].box.max",
+                                           "fixed[].plane",
+                                           "fixed[].plane.point",
+                                           "fixed[].plane.normal",
+                                           "fixed[].plane.tolerance",
+                                           "fixed[].file",
+                                           "fixed[].base",
+                                           "markers",
+                                           "markers[].name",
+                                           "markers[].vertex",
+                                           "markers[].nearest",
+                                           "markers[].box",
+                                           "markers[].box.min",
+                                           "markers[].box.max",
+                                           "solver",
+                                           "solver.solver",
+                                           "solver.max_iterations",
+                                           "solver.tolerance",
+                                           "solver.gradient_tolerance",
+                                           "solver.anderson_window",
+                                           "solver.anderson_safeguard",
+                                           "solver.continuation_steps",
+                                           "solver.threads",
+                                           "solver.collision",
+                                           "solver.collision.self",
+                                           "solver.collision.obstacles",
+                                           "solver.collision.epsilon",
+                                           "solver.collision.stiffness",
+                                           "solver.collision.check_interval",
+                                           "solver.collision.update",
+                                           "solver.collision.self_target",
+                                           "solver.collision.self_spring",
+                                           "solver.collision.obstacle_spring",
+                                           "obstacles",
+                                           "obstacles[].type",
+                                           "obstacles[].min",
+                                           "obstacles[].max",
+                                           "obstacles[].base",
+                                           "obstacles[].axis",
+                                           "obstacles[].radius",
+                                           "obstacles[].height",
+                                           "obstacles[].segments",
+                                           "obstacles[].file"};
 
 /// Key lines of the schema (after the "Keys:" line, not indented): path -> the rest of the line,
 /// plus the doc line that follows.
-std::multimap<std::string, std::pair<std::string, std::string>> SchemaLines(const std::string& schema) {
+std::multimap<std::string, std::pair<std::string, std::string>> SchemaLines(
+    const std::string& schema) {
   std::multimap<std::string, std::pair<std::string, std::string>> out;
   std::istringstream in(schema);
   std::string line;
   bool keys = false;
   std::string last;
   while (std::getline(in, line)) {
-    if (line == "Keys:") { keys = true; continue; }
+    if (line == "Keys:") {
+      keys = true;
+      continue;
+    }
     if (!keys || line.empty()) continue;
     if (line[0] != ' ') {
       const auto sp = line.find(' ');
@@ -951,7 +1059,8 @@ TEST(SceneJsonSchema, ListsExactlyEveryKeyWithTypeDefaultAndDoc) {
   for (const auto& [path, text] : lines) {
     listed.insert(path);
     const std::string& head = text.first;
-    EXPECT_TRUE(head.find("default ") != std::string::npos || head.find("required") != std::string::npos ||
+    EXPECT_TRUE(head.find("default ") != std::string::npos ||
+                head.find("required") != std::string::npos ||
                 head.find("selector") != std::string::npos)
         << head;
     EXPECT_GT(text.second.size(), 10u) << "no doc line for " << path;

@@ -1,7 +1,8 @@
 // Tests of the implicit differentiation of the local-global equilibrium
-// (solver/sensitivity/equilibrium_jacobian.hpp): the exact derivative of the global step's right-hand side
-// against central differences on every supported element kind, dX/dc against differences of
-// tightly converged forward solves, and the failure paths (unsupported law, GMRES budget).
+// (solver/sensitivity/equilibrium_jacobian.hpp): the exact derivative of the global step's
+// right-hand side against central differences on every supported element kind, dX/dc against
+// differences of tightly converged forward solves, and the failure paths (unsupported law, GMRES
+// budget).
 #include "softkin/solver/sensitivity/equilibrium_jacobian.hpp"
 #include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
