@@ -7,6 +7,7 @@
 #include "softkin/solver/mesh/io/mesh_io.hpp"
 #include "softkin/solver/robots/robots.hpp"
 #include "softkin/solver/scene/scene_json.hpp"
+#include "softkin/solver/scene/solver_options_json.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -40,6 +41,11 @@ CLI::App* AddFkCommand(CLI::App* app, FkCommandArgs* a) {
                  "Residual tolerance, relative to its reference value");
   fk->add_option("--aa-safeguard", a->safeguard,
                  "Anderson safeguard: hybrid (energy or residual), energy, or none");
+  fk->add_option("--set", a->set,
+                 "Any solver option KEY=VALUE, keys as in `softkin scene --schema` without the "
+                 "'solver.' prefix (e.g. --set time_limit_s=60 --set collision.self=true); "
+                 "repeatable")
+      ->type_name("KEY=VALUE");
   fk->add_option("--json", a->json_out, "Write the result as JSON to this file");
   fk->add_option("--vtu", a->vtu_out, "Write the deformed mesh as ParaView .vtu");
   fk->add_option("--obj", a->obj_out, "Write the deformed surface as .obj");
@@ -56,6 +62,28 @@ CLI::App* AddFkCommand(CLI::App* app, FkCommandArgs* a) {
 
 namespace {
 
+/// The --set KEY=VALUE options over `opt`, read by the scene JSON's reader. VALUE is JSON (a
+/// number, true, false) or, if it does not parse as JSON, a string.
+FkOptions ApplySetOptions(const std::vector<std::string>& sets, const FkOptions& opt) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const std::string& kv : sets) {
+    const auto eq = kv.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw std::invalid_argument("--set '" + kv + "': expected KEY=VALUE");
+    const std::string key = kv.substr(0, eq), text = kv.substr(eq + 1);
+    nlohmann::json v = nlohmann::json::parse(text, nullptr, false);
+    if (v.is_discarded()) v = text;
+    nlohmann::json* at = &j;
+    std::string rest = key;
+    for (auto dot = rest.find('.'); dot != std::string::npos; dot = rest.find('.')) {
+      at = &(*at)[rest.substr(0, dot)];
+      rest = rest.substr(dot + 1);
+    }
+    (*at)[rest] = v;
+  }
+  return sets.empty() ? opt : ReadSolverOptionsJson(j, "--set: solver", opt);
+}
+
 /// The scene's solver options with the command line's overrides, validated.
 FkOptions FkOptionsFromArgs(const FkCommandArgs& a, const Scene& scene) {
   FkOptions opt = scene.solver;
@@ -67,7 +95,7 @@ FkOptions FkOptionsFromArgs(const FkCommandArgs& a, const Scene& scene) {
   if (a.safeguard_given) opt.anderson_safeguard = a.safeguard;
   std::string why;
   if (!opt.IsValid(&why)) throw std::invalid_argument("option " + why);
-  return opt;
+  return ApplySetOptions(a.set, opt);
 }
 
 /// The result as `softkin fk --json` writes it.

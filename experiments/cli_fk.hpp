@@ -28,6 +28,9 @@ struct FkCommandArgs {
   bool tolerance_given = false;
   bool gradient_tolerance_given = false;
   bool safeguard_given = false;
+  /// --set KEY=VALUE: any solver option by its scene-schema key (solver.* without the prefix),
+  /// applied after the flags above.
+  std::vector<std::string> set;
   // Outputs.
   std::string json_out, vtu_out, obj_out;
 };

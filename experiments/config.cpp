@@ -1,5 +1,7 @@
 #include "softkin/experiments/config.hpp"
 
+#include "softkin/solver/scene/solver_options_json.hpp"
+
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -190,95 +192,7 @@ std::vector<std::string> Config::StringList(const std::string& key,
 }
 
 void ApplySolverJson(const nlohmann::json& j, const std::string& where, FkOptions* o) {
-  if (!j.is_object()) throw std::invalid_argument(where + ": expected an object of solver options");
-  for (auto it = j.begin(); it != j.end(); ++it) {
-    const std::string& k = it.key();
-    const auto& v = it.value();
-    auto need = [&](bool ok, const char* what) {
-      if (!ok)
-        throw std::invalid_argument(where + "." + k + ": expected " + what + ", got " + Dump(v));
-    };
-    if (k == "solver") {
-      need(v.is_string(), "a solver name (see softkin fk --help)");
-      o->solver = v.get<std::string>();
-    } else if (k == "max_iterations") {
-      need(v.is_number_integer(), "an integer");
-      o->max_iterations = v.get<int>();
-    } else if (k == "tolerance") {
-      need(v.is_number(), "a number");
-      o->tolerance = v.get<double>();
-    } else if (k == "gradient_tolerance") {
-      need(v.is_number(), "a number");
-      o->gradient_tolerance = v.get<double>();
-    } else if (k == "anderson_window") {
-      need(v.is_number_integer(), "an integer");
-      o->anderson_window = v.get<int>();
-    } else if (k == "anderson_safeguard") {
-      need(v.is_string(), "one of hybrid, energy, none");
-      o->anderson_safeguard = v.get<std::string>();
-    } else if (k == "continuation_steps") {
-      need(v.is_number_integer(), "an integer");
-      o->continuation_steps = v.get<int>();
-    } else if (k == "threads") {
-      need(v.is_number_integer(), "an integer");
-      o->threads = v.get<int>();
-    } else if (k == "time_limit_s") {
-      need(v.is_number(), "a number of seconds");
-      o->time_limit_s = v.get<double>();
-    } else if (k == "collision") {
-      need(v.is_object(), "an object of collision options");
-      for (auto c = v.begin(); c != v.end(); ++c) {
-        const std::string& ck = c.key();
-        const auto& cv = c.value();
-        auto cneed = [&](bool ok, const char* what) {
-          if (!ok)
-            throw std::invalid_argument(where + ".collision." + ck + ": expected " + what +
-                                        ", got " + Dump(cv));
-        };
-        CollisionOptions& co = o->collision;
-        if (ck == "self") {
-          cneed(cv.is_boolean(), "true or false");
-          co.self = cv.get<bool>();
-        } else if (ck == "obstacles") {
-          cneed(cv.is_boolean(), "true or false");
-          co.obstacles = cv.get<bool>();
-        } else if (ck == "epsilon") {
-          cneed(cv.is_number(), "a number (mm)");
-          co.epsilon = cv.get<double>();
-        } else if (ck == "stiffness") {
-          cneed(cv.is_number(), "a number");
-          co.stiffness = cv.get<double>();
-        } else if (ck == "check_interval") {
-          cneed(cv.is_number_integer(), "an integer");
-          co.check_interval = cv.get<int>();
-        } else if (ck == "update") {
-          cneed(cv.is_string(), "one of updown, refactor");
-          co.update = cv.get<std::string>();
-        } else if (ck == "self_target") {
-          cneed(cv.is_string(), "one of auto, walk");
-          co.self_target = cv.get<std::string>();
-        } else if (ck == "self_spring") {
-          cneed(cv.is_string(), "one of target, pair");
-          co.self_spring = cv.get<std::string>();
-        } else if (ck == "obstacle_spring") {
-          cneed(cv.is_string(), "one of point, plane");
-          co.obstacle_spring = cv.get<std::string>();
-        } else
-          throw std::invalid_argument(
-              where + ".collision." + ck +
-              ": unknown key (expected one of self, "
-              "obstacles, epsilon, stiffness, check_interval, update, self_target, self_spring, "
-              "obstacle_spring)");
-      }
-    } else
-      throw std::invalid_argument(where + "." + k +
-                                  ": unknown key (expected one of solver, "
-                                  "max_iterations, tolerance, gradient_tolerance, anderson_window, "
-                                  "anderson_safeguard, continuation_steps, threads, time_limit_s, "
-                                  "collision)");
-  }
-  std::string why;
-  if (!o->IsValid(&why)) throw std::invalid_argument(where + ": " + why);
+  *o = ReadSolverOptionsJson(j, where, *o);  // the scene JSON's reader and schema
 }
 
 FkOptions Config::Solver(const FkOptions& base) const {

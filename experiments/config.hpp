@@ -56,7 +56,8 @@ class Config {
   mutable std::set<std::string> used_;
 };
 
-/// Applies a JSON object of solver options (keys as in FkOptions) onto opts; `where` names it in
+/// Applies a JSON object of solver options onto opts with ReadSolverOptionsJson (the scene
+/// schema's solver.* keys; solver/scene/solver_options_json.hpp); `where` names it in
 /// errors (e.g. "config.json: solver"). Unknown keys and wrong types throw std::invalid_argument.
 void ApplySolverJson(const nlohmann::json& j, const std::string& where, FkOptions* opts);
 

@@ -451,15 +451,7 @@ nlohmann::json VariantJson(const CollisionSweepParams& p, const SweepVariant& va
     markers[scene.markers[q].name] = {P(q, 0), P(q, 1), P(q, 2)};
   jv["markers"] = markers;
   const CollisionCheck& ck = v.last_check;
-  jv["self_contacts_left"] = ck.self_contacts;
-  jv["obstacle_contacts_left"] = ck.obstacle_contacts;
-  jv["max_penetration_mm"] = ck.max_penetration;
-  jv["self_penetration_mm"] = ck.self_penetration;
-  jv["obstacle_penetration_mm"] = ck.obstacle_penetration;
-  jv["inverted_elements"] = ck.inverted_elements;
-  jv["inverted_body_elements"] = ck.inverted_body_elements;
-  jv["tangled_contacts"] = ck.tangled_contacts;
-  jv["collision_free"] = ck.collision_free();
+  jv.update(CollisionCheckJson(ck));  // the exact check of the last state, in its one JSON form
   jv["springs_at_end"] = v.last.springs;
   jv["iterations"] = v.iterations;
   jv["non_converged_steps"] = v.failed;

@@ -6,6 +6,7 @@
 
 #include "softkin/solver/scene/scene_keys.hpp"
 #include "softkin/solver/scene/scene_parser.hpp"
+#include "softkin/solver/scene/solver_options_json.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -213,28 +214,11 @@ void SceneParser::CheckObject(const json& obj, const std::string& pattern, const
 
 void SceneParser::ReadSolverOptions(const json& solver, FkOptions* o) const {
   CheckObject(solver, "solver", "solver");
-  o->solver = Get(solver, "solver", "solver").get<std::string>();
-  o->max_iterations = AsInt(Get(solver, "solver", "max_iterations"));
-  o->tolerance = Get(solver, "solver", "tolerance").get<double>();
-  o->gradient_tolerance = Get(solver, "solver", "gradient_tolerance").get<double>();
-  o->anderson_window = AsInt(Get(solver, "solver", "anderson_window"));
-  o->anderson_safeguard = Get(solver, "solver", "anderson_safeguard").get<std::string>();
-  o->continuation_steps = AsInt(Get(solver, "solver", "continuation_steps"));
-  o->threads = AsInt(Get(solver, "solver", "threads"));
-  const json col = Get(solver, "solver", "collision");
-  CheckObject(col, "solver.collision", "solver.collision");
-  CollisionOptions& c = o->collision;
-  c.self = Get(col, "solver.collision", "self").get<bool>();
-  c.obstacles = Get(col, "solver.collision", "obstacles").get<bool>();
-  c.epsilon = Get(col, "solver.collision", "epsilon").get<double>();
-  c.stiffness = Get(col, "solver.collision", "stiffness").get<double>();
-  c.check_interval = AsInt(Get(col, "solver.collision", "check_interval"));
-  c.update = Get(col, "solver.collision", "update").get<std::string>();
-  c.self_target = Get(col, "solver.collision", "self_target").get<std::string>();
-  c.self_spring = Get(col, "solver.collision", "self_spring").get<std::string>();
-  c.obstacle_spring = Get(col, "solver.collision", "obstacle_spring").get<std::string>();
-  std::string why;
-  if (!o->IsValid(&why)) Fail("solver." + why);
+  try {
+    *o = ReadSolverOptionsJson(solver, "solver", FkOptions());  // defaults as in the schema
+  } catch (const std::invalid_argument& e) {
+    Fail(e.what());
+  }
 }
 
 Scene SceneParser::Build(const json& root) {

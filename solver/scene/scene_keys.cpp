@@ -302,6 +302,11 @@ void AddSolverKeys(std::vector<KeySpec>* t) {
       Key("solver.threads", I, Opt, "OpenMP threads for the local step (0: library default).")
           .Def(fk.threads)
           .AtLeast(0));
+  t->push_back(Key("solver.time_limit_s", N, Opt,
+                   "Wall-clock limit of one solve in seconds (0: none); when it runs out the "
+                   "solve ends with status time_limit and its last checked state.")
+                   .Def(fk.time_limit_s)
+                   .AtLeast(0.0));
 }
 
 /// solver.collision: its CollisionOptions.

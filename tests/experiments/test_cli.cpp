@@ -111,6 +111,30 @@ TEST(Cli, FkJsonCarriesTheCollisionCheck) {
   EXPECT_FALSE(nlohmann::json::parse(g).contains("collision"));
 }
 
+// --set reaches every solver option through the scene JSON's reader, and names a bad one.
+TEST(Cli, FkSetsAnySolverOption) {
+  const std::string dir = TempDir("fk_set");
+  const CliRun capped =
+      Cli("fk --robot three_chamber --res 3 --actuation 1.3,1,1 --set max_iterations=3 "
+          "--set collision.stiffness=5 --json " +
+          dir + "/fk.json");
+  EXPECT_EQ(capped.code, 1) << capped.out;  // not converged in 3 iterations
+  std::ifstream f(dir + "/fk.json");
+  const nlohmann::json j = nlohmann::json::parse(f);
+  EXPECT_EQ(j["status"], "iteration_cap");
+  EXPECT_EQ(j["iterations"].get<int>(), 3);
+  const CliRun typo = Cli("fk --robot three_chamber --res 3 --actuation 1.3,1,1 --set tolerence=1");
+  EXPECT_NE(typo.code, 0);
+  EXPECT_NE(typo.out.find("--set: solver.tolerence: unknown key (expected one of solver, "),
+            std::string::npos)
+      << typo.out;
+  const CliRun bad = Cli("fk --robot three_chamber --res 3 --actuation 1.3,1,1 --set threads=x");
+  EXPECT_NE(bad.code, 0);
+  EXPECT_NE(bad.out.find("--set: solver.threads: expected an integer >= 0, got \"x\""),
+            std::string::npos)
+      << bad.out;
+}
+
 TEST(Cli, FkReportsEachContinuationStep) {
   const std::string dir = TempDir("fk_steps");
   const CliRun r =

@@ -1,6 +1,8 @@
 // Tests of the scene JSON reader (solver/scene/scene_json.hpp): the repository's real-mesh scene,
 // every selector on a tiny generated mesh, every error message, and the schema text.
 #include "softkin/solver/scene/scene_json.hpp"
+#include "softkin/solver/scene/scene_keys.hpp"
+#include "softkin/solver/scene/solver_options_json.hpp"
 
 #include "softkin/solver/mesh/io/mesh_io.hpp"
 
@@ -1093,6 +1095,113 @@ TEST(SceneJsonSchema, DocsContainTheCurrentSchema) {
   ASSERT_FALSE(doc.empty()) << "docs/scene.md missing";
   EXPECT_NE(doc.find(SceneSchema()), std::string::npos)
       << "docs/scene.md does not contain the current SceneSchema() text; regenerate it";
+}
+
+// ------------------------------------------------------------------------------------------------
+// Solver options: one reader for scenes, configs and `softkin fk --set`
+// ------------------------------------------------------------------------------------------------
+
+// Every solver.* leaf of the scene schema is an option the reader knows, and the other way round;
+// every schema default is FkOptions' default.
+TEST(SolverOptionsJson, EveryOptionHasASchemaEntryWithItsDefault) {
+  std::vector<std::string> schema;
+  const json defaults = SolverOptionsToJson(FkOptions());
+  for (const auto& k : scene_json_detail::KeyTable()) {
+    if (k.path.rfind("solver.", 0) != 0 || k.type == scene_json_detail::Type::Object) continue;
+    const std::string key = k.path.substr(7);
+    schema.push_back(key);
+    const auto dot = key.find('.');
+    const json& d = dot == std::string::npos
+                        ? defaults.at(key)
+                        : defaults.at(key.substr(0, dot)).at(key.substr(dot + 1));
+    EXPECT_EQ(k.def, d) << key;
+  }
+  EXPECT_EQ(schema, SolverOptionKeys());
+  EXPECT_GE(schema.size(), 18u);
+}
+
+TEST(SolverOptionsJson, RoundTripsEveryOption) {
+  FkOptions o;
+  o.solver = "lg";
+  o.max_iterations = 123;
+  o.tolerance = 2e-4;
+  o.gradient_tolerance = 3e-3;
+  o.anderson_window = 7;
+  o.anderson_safeguard = "energy";
+  o.continuation_steps = 4;
+  o.threads = 2;
+  o.time_limit_s = 12.5;
+  o.collision.self = true;
+  o.collision.obstacles = false;
+  o.collision.epsilon = 0.1;
+  o.collision.stiffness = 5;
+  o.collision.check_interval = 3;
+  o.collision.update = "refactor";
+  o.collision.self_target = "auto";
+  o.collision.self_spring = "pair";
+  o.collision.obstacle_spring = "point";
+  const json j = SolverOptionsToJson(o);
+  const FkOptions back = ReadSolverOptionsJson(j, "test", FkOptions());
+  EXPECT_EQ(SolverOptionsToJson(back), j);
+  EXPECT_NE(j, SolverOptionsToJson(FkOptions()));  // every value above differs from its default
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (it.key() == "collision") continue;
+    EXPECT_NE(it.value(), SolverOptionsToJson(FkOptions()).at(it.key())) << it.key();
+  }
+  // Keys left out keep the base's values.
+  const FkOptions partial = ReadSolverOptionsJson(json{{"tolerance", 1e-3}}, "test", o);
+  EXPECT_EQ(partial.max_iterations, 123);
+  EXPECT_EQ(partial.collision.update, "refactor");
+  EXPECT_DOUBLE_EQ(partial.tolerance, 1e-3);
+}
+
+TEST(SolverOptionsJson, BadValuesNameTheKeyAndWhatWasExpected) {
+  auto read = [](const json& j) {
+    (void)ReadSolverOptionsJson(j, "cfg.json: solver", FkOptions());
+  };
+  ExpectError(
+      [&] {
+        read(json{{"max_iterations", "many"}});
+      },
+      {"cfg.json: solver.max_iterations: expected an integer", "got \"many\""});
+  ExpectError(
+      [&] {
+        read(json{{"max_iterations", 0}});
+      },
+      {"cfg.json: solver.max_iterations: expected an integer >= 1"});
+  ExpectError(
+      [&] {
+        read(json{{"collision", {{"update", "magic"}}}});
+      },
+      {"cfg.json: solver.collision.update: expected", "updown", "refactor"});
+  ExpectError(
+      [&] {
+        read(json{{"tolerence", 1e-3}});
+      },
+      {"cfg.json: solver.tolerence: unknown key (expected one of solver, max_iterations"});
+  ExpectError(
+      [&] {
+        read(json{{"collision", {{"selff", true}}}});
+      },
+      {"cfg.json: solver.collision.selff: unknown key (expected one of self, obstacles"});
+  ExpectError(
+      [&] {
+        read(json{{"collision", true}});
+      },
+      {"cfg.json: solver.collision: expected an object"});
+  ExpectError([&] { read(json::array()); }, {"cfg.json: solver: expected an object"});
+}
+
+// time_limit_s is a scene key as it is a config key.
+TEST(SceneJsonTiny, SolverTimeLimitIsAKey) {
+  TempDir dir;
+  WriteTinyMesh(dir.path());
+  json j = TinyScene();
+  j["solver"] = {{"time_limit_s", 30}, {"collision", {{"stiffness", 4}}}};
+  const Scene s = ParseSceneJson(j.dump(), "inline.json", dir.path().string());
+  EXPECT_DOUBLE_EQ(s.solver.time_limit_s, 30.0);
+  EXPECT_DOUBLE_EQ(s.solver.collision.stiffness, 4.0);
+  EXPECT_EQ(s.solver.max_iterations, FkOptions().max_iterations);
 }
 
 }  // namespace
