@@ -44,6 +44,8 @@ if ((check)); then
   fi
   echo "[format] all ${#files[@]} C++ files are formatted ($(clang-format --version))"
 else
+  # Twice: clang-format 14 can need a second pass where it breaks a long string literal.
+  clang-format -i "${files[@]}"
   clang-format -i "${files[@]}"
   echo "[format] formatted ${#files[@]} C++ files"
 fi

@@ -84,15 +84,16 @@ std::string KnownKeys(const std::string& prefix) {
   return scene_json_detail::ListText(keys);
 }
 
-void ReadObject(const json& j, const std::string& where, const std::string& prefix,
-                FkOptions* o) {
+void ReadObject(const json& j, const std::string& where, const std::string& prefix, FkOptions* o) {
   for (auto it = j.begin(); it != j.end(); ++it) {
     const std::string key = prefix + it.key();
     const json& v = it.value();
     if (prefix.empty() && it.key() == "collision") {
       if (!v.is_object())
-        throw std::invalid_argument(where + ".collision: expected an object of collision "
-                                    "options, got " + scene_json_detail::Got(v));
+        throw std::invalid_argument(where +
+                                    ".collision: expected an object of collision "
+                                    "options, got " +
+                                    scene_json_detail::Got(v));
       ReadObject(v, where, "collision.", o);
       continue;
     }
