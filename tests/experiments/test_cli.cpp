@@ -469,8 +469,9 @@ TEST(Cli, CollisionCostsRejectsABadRemeshKeyBeforeRunningAny) {
                 "collision": {"stiffness": "soft"}}]})";
   const CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
   EXPECT_NE(r.code, 0);
-  EXPECT_NE(r.out.find(cfg + ": robots[1].collision.stiffness: expected a number, got \"soft\""),
-            std::string::npos)
+  EXPECT_NE(
+      r.out.find(cfg + ": robots[1].collision.stiffness: expected a number > 0, got \"soft\""),
+      std::string::npos)
       << r.out;
   EXPECT_EQ(r.out.find("[selfcollision_finger 1/1]"), std::string::npos) << r.out;
 }
@@ -487,8 +488,8 @@ TEST(Cli, CollisionSweepRejectsABadVariantBeforeRunningAny) {
   const CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
   EXPECT_NE(r.code, 0);
   EXPECT_NE(
-      r.out.find(cfg +
-                 ": variants[1]: collision.self_spring: expected one of target, pair; got 'glue'"),
+      r.out.find(
+          cfg + ": variants[1].collision.self_spring: expected one of: target, pair, got \"glue\""),
       std::string::npos)
       << r.out;
   EXPECT_EQ(r.out.find("[ok 1/1]"), std::string::npos) << r.out;  // variant 0 never ran
