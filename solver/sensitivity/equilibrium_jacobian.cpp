@@ -1,8 +1,12 @@
 /// \file equilibrium_jacobian.cpp
-/// The implicit Jacobian dX/dc (equilibrium_jacobian.hpp): the operator H on the free
-/// coordinates, the "local" preconditioner, the Krylov solvers (GMRES, BiCGSTAB) and
-/// ComputeEquilibriumJacobian. The linearization they apply is in equilibrium_linearization.cpp.
+/// The implicit Jacobian dX/dc (equilibrium_jacobian.hpp): the "local" preconditioner, the
+/// batched Krylov solves (GMRES columns of gmres.hpp, BiCGSTAB) on the operator of
+/// free_operator.hpp, and ComputeEquilibriumJacobian. The linearization they apply is in
+/// equilibrium_linearization.cpp.
 #include "softkin/solver/sensitivity/equilibrium_jacobian.hpp"
+
+#include "softkin/solver/sensitivity/free_operator.hpp"
+#include "softkin/solver/sensitivity/gmres.hpp"
 
 #include "softkin/solver/fk/actuation.hpp"
 #include "softkin/solver/fk/rotation.hpp"
@@ -65,79 +69,6 @@ Eigen::MatrixX3d PrescribedDerivative(const Model& model,
   // Free coordinates are zero in both (ApplyConstraints leaves them untouched).
   return dXc;
 }
-
-namespace {
-
-/// The operator of the linear solve on the free coordinates, applied to a block of vectors:
-/// Apply(Y) = H Y = A_ff Y - (K Y)_f (Y: #free x k, every other coordinate zero), and
-/// Precondition(V) = A_ff^-1 V with the model's CHOLMOD factors, all columns in one solve.
-class FreeOperator {
- public:
-  FreeOperator(const Model& model, EquilibriumLinearization* lin)
-      : model_(model), lin_(lin), zero_c_(Eigen::MatrixXd::Zero(model.num_actuators(), 1)) {}
-
-  /// Free coordinates x (#free) of the #V x 3 block X.
-  void Gather(const Eigen::Ref<const Eigen::MatrixXd>& X, Eigen::Ref<Eigen::VectorXd> x) const {
-    for (int d = 0; d < 3; ++d) {
-      const auto& fv = model_.free_vertices(d);
-      const int o = model_.free_offset(d);
-      for (size_t i = 0; i < fv.size(); ++i) x[o + static_cast<int>(i)] = X(fv[i], d);
-    }
-  }
-  /// Writes x (#free) into the free coordinates of the #V x 3 block X.
-  void Scatter(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::MatrixXd> X) const {
-    for (int d = 0; d < 3; ++d) {
-      const auto& fv = model_.free_vertices(d);
-      const int o = model_.free_offset(d);
-      for (size_t i = 0; i < fv.size(); ++i) X(fv[i], d) = x[o + static_cast<int>(i)];
-    }
-  }
-
-  Eigen::MatrixXd Apply(const Eigen::MatrixXd& Y) {
-    const int k = static_cast<int>(Y.cols()), nv = model_.num_vertices();
-    Yx_.setZero(nv, 3 * k);
-    for (int j = 0; j < k; ++j) Scatter(Y.col(j), Yx_.middleCols(3 * j, 3));
-    if (zero_c_.cols() != k) zero_c_.setZero(model_.num_actuators(), k);
-    lin_->ApplyRhsDerivativeBatch(Yx_, zero_c_, &dB_);
-    AY_.noalias() = model_.A() * Yx_;
-    AY_ -= dB_;
-    Eigen::MatrixXd out(Y.rows(), k);
-    for (int j = 0; j < k; ++j) Gather(AY_.middleCols(3 * j, 3), out.col(j));
-    return out;
-  }
-
-  /// Precondition with this factor of an approximation of H (free layout) instead of A_ff.
-  void SetPreconditioner(const LocalPreconditioner* p) { pre_ = p; }
-
-  Eigen::MatrixXd Precondition(const Eigen::MatrixXd& V) const {
-    const int k = static_cast<int>(V.cols());
-    if (pre_) return pre_->solve(V);
-    Eigen::MatrixXd out(V.rows(), k);
-    if (model_.factor_of_axis(0) == model_.factor_of_axis(1) &&
-        model_.factor_of_axis(1) == model_.factor_of_axis(2)) {
-      // One factor: every axis of every column is one right-hand side of one solve.
-      const int n0 = model_.free_offset(1);
-      Eigen::Map<const Eigen::MatrixXd> B(V.data(), n0, 3 * k);
-      Eigen::Map<Eigen::MatrixXd> Y(out.data(), n0, 3 * k);
-      Y = model_.factorization(model_.factor_of_axis(0)).solve(B);
-      return out;
-    }
-    for (int d = 0; d < 3; ++d) {
-      const int o = model_.free_offset(d), n = model_.free_offset(d + 1) - o;
-      out.middleRows(o, n) =
-          model_.factorization(model_.factor_of_axis(d)).solve(V.middleRows(o, n).eval());
-    }
-    return out;
-  }
-
- private:
-  const Model& model_;
-  EquilibriumLinearization* lin_;
-  const LocalPreconditioner* pre_ = nullptr;
-  Eigen::MatrixXd zero_c_, Yx_, dB_, AY_;
-};
-
-}  // namespace
 
 /// What the "local" preconditioner keeps between Jacobians of one model: the pattern of
 /// P = A_ff - sym(K_local)_ff in the free layout of FreeOperator (axis-major), where each of its
@@ -212,14 +143,13 @@ struct EquilibriumJacobianWorkspace::Impl {
 
 EquilibriumJacobianWorkspace::EquilibriumJacobianWorkspace() : impl_(std::make_unique<Impl>()) {}
 EquilibriumJacobianWorkspace::~EquilibriumJacobianWorkspace() = default;
-int EquilibriumJacobianWorkspace::factorizations() const { return impl_->factorizations; }
 
 namespace {
 
 /// Assembles P = A_ff - sym(K_local)_ff into the workspace's pattern and factors it (the symbolic
 /// analysis once per workspace and model). false if CHOLMOD finds P not positive definite.
 bool FactorLocalPreconditioner(const Model& model, const EquilibriumLinearization& lin, int threads,
-                               EquilibriumJacobianWorkspace::Impl* w) {
+                               EquilibriumJacobianWorkspace::Impl* w, bool project = false) {
   if (w->model != &model) w->Build(model);
   const size_t nnz = static_cast<size_t>(model.A().nonZeros());
   const int nt = threads > 0 ? threads : omp_get_max_threads();
@@ -260,7 +190,13 @@ bool FactorLocalPreconditioner(const Model& model, const EquilibriumLinearizatio
     double* Pv = w->P.valuePtr();
     for (Eigen::Index k = 0; k < w->P.nonZeros(); ++k) Pv[k] = B[w->p_src[k]];
     if (!w->analyzed) {
-      w->llt.cholmod().print = 0;  // silent: "not positive definite" is handled here
+      cholmod_common& cc = w->llt.cholmod();
+      cc.print = 0;  // silent: "not positive definite" is handled here
+      // CHOLMOD tries AMD and METIS (nested dissection) and keeps the ordering with less fill
+      // (three_chamber, the bilayer strip: METIS). The analysis is done once per workspace.
+      cc.nmethods = 2;
+      cc.method[0].ordering = CHOLMOD_AMD;
+      cc.method[1].ordering = CHOLMOD_METIS;
       w->llt.analyzePattern(w->P);
       w->analyzed = true;
     }
@@ -268,6 +204,7 @@ bool FactorLocalPreconditioner(const Model& model, const EquilibriumLinearizatio
     ++w->factorizations;
     return w->llt.info() == Eigen::Success;
   };
+  if (project) w->project = true;
   bool ok = !w->project && assemble(false);
   if (!ok) {
     w->project = true;  // remembered: later Jacobians of this workspace project at once
@@ -280,131 +217,22 @@ bool FactorLocalPreconditioner(const Model& model, const EquilibriumLinearizatio
   return ok;
 }
 
-/// GMRES state of one column (left-preconditioned, restarted, from a given start), advanced one
-/// operator product at a time so that several columns can share batched products. The basis is
-/// orthogonalised by classical Gram-Schmidt with one re-orthogonalisation (CGS2: as stable as
-/// modified Gram-Schmidt, with matrix-vector products).
-class GmresColumn {
- public:
-  /// b = prec(rhs) (#free), y0 the start (#free), restart/max_it/tol as the options.
-  GmresColumn(Eigen::VectorXd b, Eigen::VectorXd y0, int restart, int max_it, double tol)
-      : b_(std::move(b)),
-        y_(std::move(y0)),
-        m_(std::max(1, std::min(restart, max_it))),
-        max_it_(max_it),
-        tol_(tol) {
-    beta0_ = b_.norm();
-    if (!(beta0_ > 0.0)) {
-      done_ = true;  // rhs = 0: y = 0 exactly
-      y_.setZero();
-      rel_ = 0.0;
-      return;
-    }
-    if (y_.squaredNorm() > 0.0) {
-      want_residual_ = true;  // the start's residual costs a product
-    } else {
-      StartCycle(b_);
-    }
-  }
+}  // namespace
 
-  bool done() const { return done_; }
-  int products() const { return products_; }
-  double rel() const { return rel_; }
-  const Eigen::VectorXd& y() const { return y_; }
-  /// The vector the next product is applied to.
-  const Eigen::VectorXd& Request() {
-    if (want_residual_) return y_;
-    next_ = V_.col(j_);
-    return next_;
-  }
-  /// Feeds w = prec(op(Request())).
-  void Consume(const Eigen::VectorXd& w) {
-    ++products_;
-    if (want_residual_) {
-      want_residual_ = false;
-      StartCycle(b_ - w);
-      return;
-    }
-    const int j = j_;
-    // CGS2 against the j + 1 basis vectors.
-    Eigen::VectorXd v = w;
-    Eigen::VectorXd h = V_.leftCols(j + 1).transpose() * v;
-    v.noalias() -= V_.leftCols(j + 1) * h;
-    const Eigen::VectorXd h2 = V_.leftCols(j + 1).transpose() * v;
-    v.noalias() -= V_.leftCols(j + 1) * h2;
-    h += h2;
-    const double hn = v.norm();
-    Hh_.col(j).head(j + 1) = h;
-    Hh_(j + 1, j) = hn;
-    const bool breakdown = !(hn > 1e-14 * w.norm());
-    if (!breakdown) {
-      if (V_.cols() < j + 2) Grow(j + 2);
-      V_.col(j + 1) = v / hn;
-    }
-    for (int i = 0; i < j; ++i) {  // previous Givens rotations
-      const double t = cs_(i) * Hh_(i, j) + sn_(i) * Hh_(i + 1, j);
-      Hh_(i + 1, j) = -sn_(i) * Hh_(i, j) + cs_(i) * Hh_(i + 1, j);
-      Hh_(i, j) = t;
-    }
-    const double den = std::hypot(Hh_(j, j), Hh_(j + 1, j));
-    cs_(j) = den > 0.0 ? Hh_(j, j) / den : 1.0;
-    sn_(j) = den > 0.0 ? Hh_(j + 1, j) / den : 0.0;
-    Hh_(j, j) = den;
-    Hh_(j + 1, j) = 0.0;
-    g_(j + 1) = -sn_(j) * g_(j);
-    g_(j) = cs_(j) * g_(j);
-    j_ = j + 1;
-    const bool end = std::abs(g_(j + 1)) <= tol_ * beta0_ || breakdown || !(den > 0.0) ||
-                     j_ >= m_ || products_ >= max_it_;
-    if (!end) return;
-    const Eigen::VectorXd z =
-        Hh_.topLeftCorner(j_, j_).triangularView<Eigen::Upper>().solve(g_.head(j_));
-    y_.noalias() += V_.leftCols(j_) * z;
-    if (!y_.allFinite()) {
-      done_ = true;
-      rel_ = std::numeric_limits<double>::infinity();
-      return;
-    }
-    if (products_ >= max_it_) {
-      // No budget for the true residual: report the estimate of the cycle.
-      rel_ = std::abs(g_(j_)) / beta0_;
-      done_ = true;
-      return;
-    }
-    want_residual_ = true;  // recompute the residual from scratch (next product)
-  }
+int EquilibriumJacobianWorkspace::factorizations() const { return impl_->factorizations; }
 
- private:
-  void Grow(int cols) {
-    const int n = static_cast<int>(b_.size());
-    const int want = std::min(m_ + 1, std::max(cols, 2 * static_cast<int>(V_.cols())));
-    V_.conservativeResize(n, want);
-  }
-  void StartCycle(const Eigen::VectorXd& r) {
-    const double beta = r.norm();
-    rel_ = beta / beta0_;
-    if (rel_ <= tol_ || products_ >= max_it_ || !(beta > 0.0)) {
-      done_ = true;
-      return;
-    }
-    if (V_.cols() < 1) Grow(16);
-    V_.col(0) = r / beta;
-    Hh_.setZero(m_ + 1, m_);
-    g_.setZero(m_ + 1);
-    g_(0) = beta;
-    cs_.setZero(m_);
-    sn_.setZero(m_);
-    j_ = 0;
-  }
+bool EquilibriumJacobianWorkspace::Factor(const Model& model, const EquilibriumLinearization& lin,
+                                          int threads, bool project) {
+  return FactorLocalPreconditioner(model, lin, threads, impl_.get(), project);
+}
 
-  Eigen::VectorXd b_, y_, next_;
-  int m_, max_it_;
-  double tol_, beta0_ = 0.0, rel_ = 1.0;
-  Eigen::MatrixXd V_, Hh_;
-  Eigen::VectorXd g_, cs_, sn_;
-  int j_ = 0, products_ = 0;
-  bool done_ = false, want_residual_ = false;
-};
+const LocalPreconditioner* EquilibriumJacobianWorkspace::factor() const {
+  return impl_->has_factor ? &impl_->llt : nullptr;
+}
+
+bool EquilibriumJacobianWorkspace::projected() const { return impl_->project; }
+
+namespace {
 
 /// Runs the columns' GMRES solves, batching the products of every column still running (all of
 /// them together with lockstep, else one column after the other). Returns the number of batched

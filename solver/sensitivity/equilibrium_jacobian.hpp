@@ -49,6 +49,8 @@ using LocalPreconditioner = Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<doub
 /// One element's block of K_local (3k x 3k, k <= 6 vertices).
 using LocalBlock = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 18, 18>;
 
+class EquilibriumLinearization;
+
 /// What the "local" preconditioner keeps from one Jacobian to the next of the same model: the
 /// sparsity pattern of A_ff - sym(K_local) and CHOLMOD's symbolic analysis (ordering, supernodes),
 /// so later Jacobians only assemble and factor numerically. Not thread-safe; one per caller.
@@ -60,6 +62,18 @@ class EquilibriumJacobianWorkspace {
   EquilibriumJacobianWorkspace& operator=(const EquilibriumJacobianWorkspace&) = delete;
   /// Numeric factorisations done with this workspace.
   int factorizations() const;
+  /// Assembles P = A_ff - sym(K_local)_ff at lin's state (the per-element blocks of
+  /// EquilibriumLinearization::ForEachLocalBlock) and factors it; the pattern and the symbolic
+  /// analysis are kept for later calls on the same model. `project`: replace each element's block
+  /// by V |Lambda| V^T (the absolute values of its eigenvalues) from now on, which keeps P
+  /// positive definite; without it that happens only once P was found indefinite. Returns false
+  /// if P is not positive definite (factor() is then null).
+  bool Factor(const Model& model, const EquilibriumLinearization& lin, int threads, bool project);
+  /// The factor of the last successful factorisation (by Factor or by a Jacobian's "local"
+  /// preconditioner), or null.
+  const LocalPreconditioner* factor() const;
+  /// Whether the element blocks are projected (asked for, or found indefinite once).
+  bool projected() const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
