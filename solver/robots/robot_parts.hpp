@@ -38,6 +38,7 @@ RobotEntry CableGripperEntry();         // cable_gripper.cpp
 RobotEntry SelfCollisionFingerEntry();  // selfcollision_finger.cpp
 RobotEntry MembraneEntry();             // membrane.cpp
 RobotEntry TwistingRobotEntry();        // robot_twisting.cpp
+RobotEntry BilayerStripEntry();         // bilayer_strip.cpp
 
 // ---- The PneuNet finger's nominal dimensions (mm): pneumatic_finger, selfcollision_finger ----
 

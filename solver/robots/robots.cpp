@@ -25,7 +25,7 @@ const std::vector<RobotEntry>& Registry() {
       robots_detail::MultiSegmentGripperEntry(), robots_detail::DeaCrawlerEntry(),
       robots_detail::BimaterialBarEntry(),       robots_detail::CableGripperEntry(),
       robots_detail::SelfCollisionFingerEntry(), robots_detail::MembraneEntry(),
-      robots_detail::TwistingRobotEntry(),
+      robots_detail::TwistingRobotEntry(),       robots_detail::BilayerStripEntry(),
   };
   return kRobots;
 }

@@ -452,7 +452,7 @@ TEST(Robots, ListsEveryRobotAndRejectsBadInput) {
   const std::vector<std::string> names = {
       "pneumatic_finger",      "three_chamber", "cable_finger",   "finger_manipulator",
       "multi_segment_gripper", "dea_crawler",   "bimaterial_bar", "cable_gripper",
-      "selfcollision_finger",  "membrane",      "twisting_robot"};
+      "selfcollision_finger",  "membrane",      "twisting_robot", "bilayer_strip"};
   ASSERT_EQ(list.size(), names.size());
   for (size_t i = 0; i < names.size(); ++i) EXPECT_EQ(list[i].name, names[i]);
   for (const auto& r : list) {
@@ -468,7 +468,7 @@ TEST(Robots, ListsEveryRobotAndRejectsBadInput) {
         std::string(e.what()),
         "unknown robot 'x'; known robots: pneumatic_finger, three_chamber, cable_finger, "
         "finger_manipulator, multi_segment_gripper, dea_crawler, bimaterial_bar, cable_gripper, "
-        "selfcollision_finger, membrane, twisting_robot");
+        "selfcollision_finger, membrane, twisting_robot, bilayer_strip");
   }
   try {
     MakeRobot("pneumatic_finger", 2);
@@ -553,6 +553,7 @@ TEST(Robots, DefaultResolutionScenesHaveTheirSizes) {
       {"selfcollision_finger", 13824, 3447, 63, 1, 3},
       {"membrane", 7008, 2178, 484, 4, 5},
       {"twisting_robot", 6200, -1, -1, 1, 2},  // Mesh_3: elements approximately, the rest unpinned
+      {"bilayer_strip", 24000, 5555, 55, 1, 3},
   };
   const std::vector<RobotInfo> list = ListRobots();
   ASSERT_EQ(list.size(), sizes.size());

@@ -1,0 +1,75 @@
+/// \file bilayer_strip.cpp
+/// bilayer_strip: a thin clamped two-layer strip whose top layer is one pneumatic actuator. The
+/// hard case of the FK benchmarks: long, thin and bending-dominated.
+#include "softkin/solver/robots/robot_parts.hpp"
+
+#include "softkin/solver/mesh/mesh_gen.hpp"
+
+#include <Eigen/Core>
+
+#include <cmath>
+#include <vector>
+
+namespace softkin {
+namespace robots_detail {
+namespace {
+
+// ================================================================================================
+// bilayer_strip: a strip of length L (x, default 100 mm), width W (y, default 10 mm) and two
+// layers of thickness t each (z, default 2 mm). The bottom layer z in [0, t] is the body (region
+// 0, R_omega 1, weight 1); the top layer z in [t, 2t] is the pneumatic actuation elements of the
+// single actuator "top" (region 1, weight 1, volume ratio alpha in [1, 2]). The face x = 0 is
+// clamped. Inflating the top layer lengthens it, so the strip curls towards -z. Both layers are
+// solid: the strip is a bending beam whose curvature grows with alpha (a bimetal).
+// Resolution: cells across one layer (cell size t / res); res 1 gives 6 * 50 * 5 * 2 = 3,000
+// tets at the defaults, res 2 24,000, res 3 81,000 and res 4 192,000. Markers: tip (the x = L
+// face), tip_top / tip_bottom (its top and bottom quarters in z).
+// ================================================================================================
+
+constexpr int kStripMinRes = 1, kStripMaxRes = 8, kStripDefaultRes = 2;
+
+Scene MakeBilayerStrip(int res, const RobotParams& P) {
+  const double t = P.at("layer"), h = t / res;
+  const int nx = Cells(P.at("length"), h), ny = Cells(P.at("width"), h), nz = 2 * res;
+  Scene s;
+  s.name = "bilayer_strip";
+  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz),
+                        [res](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
+                          return c[2] < res ? 0 : 1;
+                        });
+  s.body[0] = Material{"body", 1.0, 1.0};
+  Actuator a;
+  a.name = "top";
+  a.type = ActuatorType::Pneumatic;
+  a.regions = {1};
+  a.rest = 1.0;
+  a.min = 1.0;
+  a.max = 2.0;
+  s.actuators.push_back(a);
+  const double eps = 1e-6 * h;
+  s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
+  AddDistalFaceMarkers(nx * h, nz * h, eps, &s);
+  s.validate();
+  return s;
+}
+
+}  // namespace
+
+RobotEntry BilayerStripEntry() {
+  const RobotInfo info = {
+      "bilayer_strip",
+      "Thin clamped two-layer strip (the hard case of the FK benchmarks): x = length [0, 100] "
+      "mm (x = 0 clamped), y = width [0, 10], z = two 2 mm layers; the bottom layer is the body "
+      "(region 0, R_omega 1), the top layer the pneumatic actuator 'top' (region 1, alpha in "
+      "[1, 2]), so inflation curls the strip towards -z. Markers: tip, tip_top, tip_bottom.",
+      kStripDefaultRes,
+      "cells across one layer (cell size layer/res mm), integer in [1, 8]; res 1: 3,000 tets, "
+      "res 2: 24,000",
+      {{"length", 100.0, 10.0, 500.0, "strip length, mm"},
+       {"width", 10.0, 1.0, 100.0, "strip width, mm"},
+       {"layer", 2.0, 0.25, 20.0, "thickness of each layer, mm"}}};
+  return {info, kStripMinRes, kStripMaxRes, &MakeBilayerStrip};
+}
+
+}  // namespace robots_detail
+}  // namespace softkin
