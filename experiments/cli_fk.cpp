@@ -109,6 +109,10 @@ nlohmann::json FkResultJson(const Scene& scene, const Eigen::VectorXd& c, const 
   j["time_s"] = r.time_s;
   j["local_time_s"] = r.local_time_s;
   j["global_time_s"] = r.global_time_s;
+  if (r.load_steps > 0) {  // newton
+    j["linear_iterations"] = r.linear_iterations;
+    j["load_steps"] = r.load_steps;
+  }
   j["n_vertices"] = scene.mesh.num_vertices();
   j["n_elements"] = scene.mesh.num_elements();
   j["actuation"] = std::vector<double>(c.data(), c.data() + c.size());

@@ -4,6 +4,7 @@
 #include "softkin/solver/baselines/nlp_solvers.hpp"
 #include "softkin/solver/collision/collision_response.hpp"
 #include "softkin/solver/fk/local_global.hpp"
+#include "softkin/solver/newton/newton_solver.hpp"
 
 #include <stdexcept>
 
@@ -19,8 +20,9 @@ std::unique_ptr<ContactTerm> SpringResponse(const Model& model, const CollisionO
 }  // namespace
 
 std::vector<std::string> FkSolverNames() {
-  return {"lg",           "lg-aa",      "ceres",           "ipopt-lbfgs",
-          "ipopt-newton", "ipopt-hard", "calculix-linear", "calculix-nonlinear"};
+  return {"lg",         "lg-aa",           "newton",
+          "ceres",      "ipopt-lbfgs",     "ipopt-newton",
+          "ipopt-hard", "calculix-linear", "calculix-nonlinear"};
 }
 
 std::unique_ptr<FkSolver> MakeFkSolver(std::shared_ptr<const Model> model,
@@ -29,6 +31,8 @@ std::unique_ptr<FkSolver> MakeFkSolver(std::shared_ptr<const Model> model,
   if (!options.IsValid(&why)) throw std::invalid_argument("solver options: " + why);
   if (options.solver == "lg" || options.solver == "lg-aa")
     return std::make_unique<LocalGlobalSolver>(std::move(model), options, SpringResponse);
+  if (options.solver == "newton")
+    return std::make_unique<NewtonSolver>(std::move(model), options, SpringResponse);
   if (options.solver == "ceres" || options.solver == "ipopt-lbfgs" ||
       options.solver == "ipopt-newton" || options.solver == "ipopt-hard")
     return MakeNlpSolver(std::move(model), options);

@@ -31,11 +31,11 @@ bool FkOptions::IsValid(std::string* why) const {
     if (why) *why = m;
     return false;
   };
-  if (solver != "lg" && solver != "lg-aa" && solver != "ceres" && solver != "ipopt-lbfgs" &&
-      solver != "ipopt-newton" && solver != "ipopt-hard" && solver != "calculix-linear" &&
-      solver != "calculix-nonlinear")
+  if (solver != "lg" && solver != "lg-aa" && solver != "newton" && solver != "ceres" &&
+      solver != "ipopt-lbfgs" && solver != "ipopt-newton" && solver != "ipopt-hard" &&
+      solver != "calculix-linear" && solver != "calculix-nonlinear")
     return bad(
-        "solver: expected one of lg, lg-aa, ceres, ipopt-lbfgs, ipopt-newton, ipopt-hard, "
+        "solver: expected one of lg, lg-aa, newton, ceres, ipopt-lbfgs, ipopt-newton, ipopt-hard, "
         "calculix-linear, calculix-nonlinear; got '" +
         solver + "'");
   if (max_iterations < 1) return bad("max_iterations: expected an integer >= 1");

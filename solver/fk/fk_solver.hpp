@@ -25,12 +25,15 @@ struct FkResult {
   std::string solver;
   Eigen::VectorXd actuation;   ///< the actuation solved for
   Eigen::MatrixX3d positions;  ///< #V x 3, mm; never NaN (the last finite iterate on divergence)
-  int iterations = 0;          ///< local-global iterations (summed over continuation steps)
-  double energy = 0;           ///< E at `positions` (Eq. 2.10)
-  double gradient_ratio = 0;   ///< ||local-global residual|| / its reference value at the start
-  double max_move = 0;         ///< last per-iteration vertex move / model size
+  int iterations = 0;  ///< local-global iterations (summed over continuation steps); newton: its
+                       ///< iterations (plus those of an lg-aa fallback)
+  double energy = 0;   ///< E at `positions` (Eq. 2.10)
+  double gradient_ratio = 0;  ///< ||local-global residual|| / its reference value at the start
+  double max_move = 0;        ///< last per-iteration vertex move / model size
   double time_s = 0, local_time_s = 0, global_time_s = 0;
   int aa_accepted = 0, aa_rejected = 0;
+  int linear_iterations = 0;          ///< newton: Krylov operator products
+  int load_steps = 0;                 ///< newton: converged load steps
   std::vector<double> volume_ratios;  ///< achieved volume ratio per actuator
   /// Collision handling (lg / lg-aa when FkOptions::collision is active for the scene): whether
   /// it ran, the exact check of the final positions, the springs still active at the end, and

@@ -266,13 +266,14 @@ void AddSolverKeys(std::vector<KeySpec>* t) {
                    .Def(json::object()));
   t->push_back(Key("solver.solver", S, Opt,
                    "lg: plain local-global (Algorithm 1); lg-aa: Anderson-accelerated "
-                   "local-global; ceres, ipopt-lbfgs, ipopt-newton: the same energy minimised by "
+                   "local-global; newton: Newton-Krylov on the same equilibrium, with load "
+                   "stepping; ceres, ipopt-lbfgs, ipopt-newton: the same energy minimised by "
                    "Ceres or Ipopt; ipopt-hard: body energy with hard actuation constraints; "
                    "calculix-linear, calculix-nonlinear: FEM baselines by CalculiX "
                    "(docs/solvers.md).")
                    .Def(fk.solver)
-                   .Choices({"lg", "lg-aa", "ceres", "ipopt-lbfgs", "ipopt-newton", "ipopt-hard",
-                             "calculix-linear", "calculix-nonlinear"}));
+                   .Choices({"lg", "lg-aa", "newton", "ceres", "ipopt-lbfgs", "ipopt-newton",
+                             "ipopt-hard", "calculix-linear", "calculix-nonlinear"}));
   t->push_back(Key("solver.max_iterations", I, Opt, "Iteration limit (per continuation step).")
                    .Def(fk.max_iterations)
                    .AtLeast(1));

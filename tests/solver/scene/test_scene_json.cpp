@@ -903,10 +903,10 @@ TEST(SceneJsonErrors, ValidateMessagePassesThrough) {
 
 TEST(SceneJsonErrors, SolverOptions) {
   json j = TinyScene();
-  j["solver"]["solver"] = "newton";
-  ExpectSceneError(j,
-                   {"solver.solver: expected one of: lg, lg-aa, ceres, ipopt-lbfgs, ipopt-newton, "
-                    "ipopt-hard, calculix-linear, calculix-nonlinear, got \"newton\""});
+  j["solver"]["solver"] = "newtonian";
+  ExpectSceneError(j, {"solver.solver: expected one of: lg, lg-aa, newton, ceres, ipopt-lbfgs, "
+                       "ipopt-newton, ipopt-hard, calculix-linear, calculix-nonlinear, got "
+                       "\"newtonian\""});
   j = TinyScene();
   j["solver"]["anderson_window"] = 0;
   ExpectSceneError(j, {"solver.anderson_window: expected an integer in [1, 50], got 0"});

@@ -1,0 +1,388 @@
+/// \file newton_solver.cpp
+/// NewtonSolver (newton_solver.hpp): the residual, the Newton direction by preconditioned GMRES,
+/// the line search, adaptive load stepping and the lg-aa fallback.
+#include "softkin/solver/newton/newton_solver.hpp"
+
+#include "softkin/solver/fk/energy.hpp"
+#include "softkin/solver/fk/local_global.hpp"
+#include "softkin/solver/fk/targets.hpp"
+#include "softkin/solver/sensitivity/free_operator.hpp"
+#include "softkin/solver/sensitivity/gmres.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace softkin {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double Seconds(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+
+/// Krylov products allowed per Newton step (no restart below this).
+constexpr int kMaxKrylov = 300;
+/// The largest Eisenstat-Walker forcing term (and the first one).
+constexpr double kMaxForcing = 0.1;
+/// An intermediate load step ends when |g| has dropped by this factor.
+constexpr double kStepReduction = 1e-3;
+/// Armijo constant and the halvings of the line search.
+constexpr double kArmijo = 1e-4;
+constexpr int kMaxHalvings = 12;
+}  // namespace
+
+NewtonSolver::NewtonSolver(std::shared_ptr<const Model> model, const FkOptions& options,
+                           ContactTermFactory contacts)
+    : FkSolver(std::move(model)), options_(options), contacts_(std::move(contacts)) {
+  std::string why;
+  if (!options_.IsValid(&why)) throw std::invalid_argument("solver options: " + why);
+  for (const auto& e : model_->elements()) total_weight_ += e.wv;
+}
+
+bool NewtonSolver::TimeUp() const { return deadline_ && Clock::now() > *deadline_; }
+
+void NewtonSolver::Evaluate(const Eigen::VectorXd& c, State* s) {
+  const auto t0 = Clock::now();
+  const Model& m = *model_;
+  const int nt = options_.threads;
+  ComputeLocalRatios(m, s->X, c, &s->ratios);
+  s->energy = LocalStep(m, s->X, s->ratios, &weighted_, nt);
+  AssembleRhs(m, weighted_, &B_, nt);
+  m.GatherFree(B_, &s->Bf);
+  m.GatherFree(s->X, &s->x);
+  m.GatherFree(m.A() * s->X, &s->g);  // A_ff x + A_fc x_c
+  s->g -= s->Bf;
+  s->residual = 2.0 * s->g.norm();
+  local_time_s_ += Seconds(t0, Clock::now());
+}
+
+double NewtonSolver::ReferenceResidual(const Eigen::VectorXd& c) {
+  if (ref_c_.size() != c.size() || ref_c_ != c) {
+    State s;
+    s.X = model_->rest_positions();
+    model_->ApplyConstraints(c, &s.X);
+    Evaluate(c, &s);
+    ref_value_ = s.residual;
+    ref_c_ = c;
+  }
+  return ref_value_;
+}
+
+bool NewtonSolver::Direction(const Eigen::VectorXd& c, const State& s, double eta,
+                             Eigen::VectorXd* d, FkResult* r, std::string* why) {
+  const auto t0 = Clock::now();
+  struct AddTime {
+    Clock::time_point t0;
+    double* to;
+    ~AddTime() { *to += Seconds(t0, Clock::now()); }
+  } add_time{t0, &r->global_time_s};
+  const Model& m = *model_;
+  if (!lin_.Setup(m, s.X, c, why, options_.threads)) return false;
+  FreeOperator op(m, &lin_);
+  // GMRES with the factor of P: the one of an earlier iterate while it keeps working (its cost
+  // per digit of residual reduction stays within twice that right after it was factored), else
+  // factored at this state.
+  auto solve = [&](int budget) {
+    op.SetPreconditioner(workspace_.factor());
+    // Right-preconditioned: GMRES on H P^-1 u = -g bounds the true residual |H d + g| <= eta |g|
+    // with d = P^-1 u. (Left preconditioning bounds |P^-1 (H d + g)|, which on bilayer_strip
+    // was up to 50 times smaller than the true residual: the steps were not Newton steps.)
+    GmresColumn gm(-s.g, Eigen::VectorXd::Zero(s.g.size()), budget, budget, eta);
+    while (!gm.done()) gm.Consume(op.Apply(op.Precondition(gm.Request())).col(0));
+    r->linear_iterations += gm.products();
+    *d = op.Precondition(gm.y()).col(0);
+    const double digits = std::max(0.5, -std::log10(std::max(gm.rel(), 1e-16)));
+    const bool ok = d->allFinite() && gm.rel() <= eta;
+    return std::make_pair(ok, gm.products() / digits);
+  };
+  auto factor = [&]() {
+    ++factorizations_;
+    if (!workspace_.Factor(m, lin_, options_.threads, /*project=*/true)) {
+      *why = "the projected Hessian is not positive definite (is every body held?)";
+      return false;
+    }
+    return true;
+  };
+  if (workspace_.factor() && fresh_rate_ > 0.0) {
+    const int budget = std::min(kMaxKrylov, static_cast<int>(std::ceil(
+                                                4.0 * fresh_rate_ * std::max(1.0, -std::log10(eta)))) + 10);
+    const auto [ok, rate] = solve(budget);
+    if (ok && rate <= 2.0 * fresh_rate_ + 1.0) return true;
+    if (ok) {
+      fresh_rate_ = -1.0;  // worked, but slowly: factor at the next iteration
+      return true;
+    }
+  }
+  if (!factor()) return false;
+  const auto [ok, rate] = solve(kMaxKrylov);
+  fresh_rate_ = rate;
+  (void)ok;  // a direction short of eta is still used: the line search guards it
+  if (!d->allFinite()) {
+    *why = "the Krylov solve of the Newton step produced non-finite values";
+    return false;
+  }
+  return true;
+}
+
+NewtonSolver::StepEnd NewtonSolver::NewtonStep(const Eigen::VectorXd& c, bool final,
+                                               Eigen::MatrixX3d* Xp, FkResult* r,
+                                               std::string* why) {
+  const Model& m = *model_;
+  State s, trial;
+  s.X = *Xp;
+  m.ApplyConstraints(c, &s.X);
+  Evaluate(c, &s);
+  if (!std::isfinite(s.residual)) {
+    *why = "non-finite residual at the start of a load step";
+    return StepEnd::Failed;
+  }
+  // The stopping reference of the local-global solver, and the round-off floor.
+  const double floor = 1e-8 * total_weight_ * m.size();
+  const double ref = final ? std::max({ReferenceResidual(c), s.residual, floor})
+                           : std::max(s.residual, floor);
+  const bool roundoff_ok = final;
+  Eigen::MatrixX3d Mv(m.num_vertices(), 3), D(m.num_vertices(), 3);
+  Eigen::VectorXd d;
+  double eta = kMaxForcing, previous = s.residual;
+  history_.clear();
+  for (int it = 0;; ++it) {
+    history_.push_back(s.residual);
+    // Convergence: the local-global test at s (its step, and the residual ratio).
+    if (final) {
+      const Eigen::VectorXd step = -m.SolveFree(s.g);
+      Mv.setZero();
+      m.ScatterFree(step, &Mv);
+      const double move = Mv.rowwise().norm().maxCoeff() / m.size();
+      r->gradient_ratio = s.residual / ref;
+      r->max_move = move;
+      const bool roundoff = roundoff_ok && s.residual <= 1e-12 * total_weight_ * m.size();
+      if (move < options_.tolerance && (r->gradient_ratio < options_.gradient_tolerance || roundoff)) {
+        m.ScatterFree(s.x + step, &s.X);  // the local-global step, as lg-aa ends
+        *Xp = s.X;
+        return StepEnd::Converged;
+      }
+    } else if (s.residual <= kStepReduction * ref) {
+      *Xp = s.X;
+      return StepEnd::Converged;
+    }
+    if (TimeUp()) {
+      *Xp = s.X;
+      return StepEnd::TimeLimit;
+    }
+    if (r->iterations >= options_.max_iterations) {
+      *Xp = s.X;
+      return StepEnd::IterationCap;
+    }
+    if (it >= limits_.step_iterations) {
+      *why = std::to_string(limits_.step_iterations) + " Newton iterations without convergence";
+      return StepEnd::Failed;
+    }
+    // Eisenstat-Walker forcing term (choice 2), with its safeguards.
+    if (it > 0) {
+      const double ratio = s.residual / previous;
+      const double next = 0.9 * ratio * ratio, kept = 0.9 * eta * eta;
+      eta = kept > 0.1 ? std::max(next, kept) : next;
+      // No oversolving near the end: the target residual is gradient_tolerance * ref.
+      eta = std::max(eta, 0.5 * options_.gradient_tolerance * ref / s.residual);
+      eta = std::clamp(eta, 1e-10, kMaxForcing);
+    }
+    previous = s.residual;
+    if (!Direction(c, s, eta, &d, r, why)) return StepEnd::Failed;
+    // A descent direction of the energy with the ratios frozen at x (whose gradient is 2 g for
+    // rigid bodies): the Newton direction if it is one, else the projected-Newton one -P^-1 g.
+    double slope = 2.0 * s.g.dot(d);
+    if (!(slope < 0.0)) {
+      d = -Eigen::VectorXd(workspace_.factor()->solve(s.g));
+      slope = 2.0 * s.g.dot(d);
+    }
+    D.setZero();
+    m.ScatterFree(d, &D);
+    // Backtracking (halving) until the step lowers the frozen-ratio energy (Armijo) or the
+    // residual |g| (the hybrid rule of lg-aa's safeguard: with volume-coupled ratios or blended
+    // bodies the equilibrium is not a minimum of the energy, and near it the residual decides).
+    double t = 1.0;
+    bool accepted = false;
+    for (int h = 0; h <= kMaxHalvings && !accepted; ++h, t *= 0.5) {
+      trial.X = s.X + t * D;
+      const double frozen = LocalStep(m, trial.X, s.ratios, &scratch_, options_.threads);
+      Evaluate(c, &trial);
+      if (!std::isfinite(trial.residual) || !trial.X.allFinite() || !std::isfinite(frozen))
+        continue;
+      accepted = frozen <= s.energy + kArmijo * t * slope ||
+                 trial.residual <= (1.0 - kArmijo * t) * s.residual;
+    }
+    ++r->iterations;
+    if (!accepted) {
+      *why = "the line search found no decrease of the residual along the Newton direction";
+      *Xp = s.X;
+      return StepEnd::Failed;
+    }
+    std::swap(s, trial);
+  }
+}
+
+bool NewtonSolver::Tangent(const Eigen::VectorXd& c, const Eigen::MatrixX3d& X,
+                           const Eigen::VectorXd& dc, Eigen::MatrixX3d* dX, FkResult* r) {
+  const auto t0 = Clock::now();
+  const Model& m = *model_;
+  std::string why;
+  if (!lin_.Setup(m, X, c, &why, options_.threads)) return false;
+  // H dx_f = dB/dc dc + (K_fc - A_fc) dx_c with dx_c the prescribed coordinates' motion
+  // (equilibrium_jacobian.hpp), along the one direction dc.
+  Eigen::MatrixX3d dXc = Eigen::MatrixX3d::Zero(m.num_vertices(), 3), dB;
+  for (int a = 0; a < m.num_actuators(); ++a)
+    if (dc[a] != 0.0) dXc += dc[a] * PrescribedDerivative(m, c, a);
+  lin_.ApplyRhsDerivative(dXc, dc, &dB);
+  dB -= m.A() * dXc;
+  Eigen::VectorXd rhs;
+  m.GatherFree(dB, &rhs);
+  if (!workspace_.factor()) {
+    ++factorizations_;
+    if (!workspace_.Factor(m, lin_, options_.threads, /*project=*/true)) return false;
+  }
+  FreeOperator op(m, &lin_);
+  op.SetPreconditioner(workspace_.factor());
+  GmresColumn gm(rhs, Eigen::VectorXd::Zero(rhs.size()), kMaxKrylov, kMaxKrylov, 1e-3);
+  while (!gm.done()) gm.Consume(op.Apply(op.Precondition(gm.Request())).col(0));
+  r->linear_iterations += gm.products();
+  const Eigen::VectorXd y = op.Precondition(gm.y()).col(0);
+  r->global_time_s += Seconds(t0, Clock::now());
+  if (!y.allFinite()) return false;
+  *dX = dXc;
+  m.ScatterFree(y, dX);
+  return true;
+}
+
+NewtonSolver::StepEnd NewtonSolver::LoadSteps(const Eigen::VectorXd& c0,
+                                              const Eigen::VectorXd& c, Eigen::MatrixX3d* X,
+                                              FkResult* r, std::string* why) {
+  double lambda = 0.0, delta = 1.0 / std::max(1, options_.continuation_steps);
+  Eigen::MatrixX3d converged = *X, tangent;
+  bool have_tangent = false;
+  const auto t0 = Clock::now();
+  while (lambda < 1.0) {
+    const double dl = std::min(delta, 1.0 - lambda);
+    const double target = (1.0 - lambda - dl) < 1e-12 ? 1.0 : lambda + dl;
+    const bool final = target == 1.0;
+    const Eigen::VectorXd cl = lambda == 0.0 ? c0 : Eigen::VectorXd(c0 + (c - c0) * lambda);
+    const Eigen::VectorXd cs = final ? c : Eigen::VectorXd(c0 + (c - c0) * target);
+    // Predictor: the tangent of the equilibrium path at the last converged state.
+    if (!have_tangent) have_tangent = Tangent(cl, converged, c - c0, &tangent, r);
+    Eigen::MatrixX3d trial = converged;
+    if (have_tangent) trial += (target - lambda) * tangent;
+    std::string step_why;
+    const int before = r->iterations;
+    const StepEnd end = NewtonStep(cs, final, &trial, r, &step_why);
+    if (end == StepEnd::Converged) {
+      converged = trial;
+      const int used = r->iterations - before;
+      lambda = target;
+      have_tangent = false;
+      ++r->load_steps;
+      // Aim at a few Newton iterations per load step.
+      delta = used <= 4 ? 2.0 * dl : used <= 10 ? dl : 0.5 * dl;
+      if (options_.on_step)
+        options_.on_step(r->load_steps, 0, final ? "converged" : "load_step", r->iterations,
+                         Seconds(t0, Clock::now()));
+      continue;
+    }
+    if (end == StepEnd::TimeLimit || end == StepEnd::IterationCap) {
+      *X = final ? trial : converged;
+      return end;
+    }
+    delta = 0.5 * dl;
+    if (delta < limits_.min_load_step) {
+      *X = converged;
+      std::ostringstream os;
+      os << step_why << " (load step cut below " << limits_.min_load_step << " at "
+         << lambda << " of the actuation)";
+      *why = os.str();
+      return StepEnd::Failed;
+    }
+  }
+  *X = converged;
+  return StepEnd::Converged;
+}
+
+FkResult NewtonSolver::Fallback(const Eigen::VectorXd& c, const Eigen::MatrixX3d* start,
+                                const std::string& reason, const FkResult& so_far,
+                                Clock::time_point t0) {
+  FkOptions o = options_;
+  o.solver = "lg-aa";
+  if (deadline_) o.time_limit_s = std::max(1e-3, Seconds(Clock::now(), *deadline_));
+  LocalGlobalSolver lg(model_, o, contacts_);
+  FkResult f = lg.Solve(c, start);
+  f.solver = name();
+  f.message = "newton: " + reason + "; continued with lg-aa from " +
+              (start ? "the best Newton state" : "the rest shape") +
+              (f.message.empty() ? "" : ": " + f.message);
+  f.iterations += so_far.iterations;
+  f.linear_iterations = so_far.linear_iterations;
+  f.load_steps = so_far.load_steps;
+  f.time_s = Seconds(t0, Clock::now());
+  return f;
+}
+
+FkResult NewtonSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c_in,
+                             const Eigen::MatrixX3d* warm_start) {
+  const Model& m = *model_;
+  const auto t0 = Clock::now();
+  FkResult r;
+  if (!StartResult(c_in, warm_start, &r)) {
+    r.time_s = Seconds(t0, Clock::now());
+    return r;
+  }
+  const Eigen::VectorXd c = c_in;
+  local_time_s_ = 0.0;
+  deadline_.reset();
+  if (options_.time_limit_s > 0)
+    deadline_ = t0 + std::chrono::duration_cast<Clock::duration>(
+                         std::chrono::duration<double>(options_.time_limit_s));
+  const std::string unsupported = EquilibriumJacobianUnsupported(m);
+  if (!unsupported.empty())  // the reason, without the implicit Jacobian's advice
+    return Fallback(c, warm_start, "not used (" + unsupported.substr(0, unsupported.find(';')) + ")",
+                    r, t0);
+  if (ContactHandlingActive(m.scene(), options_.collision))
+    return Fallback(c, warm_start, "not used (collision response is on)", r, t0);
+
+  Eigen::MatrixX3d X = r.positions;
+  std::string why;
+  StepEnd end = StepEnd::Failed;
+  if (warm_start) {
+    // A warm start is usually close: try the full actuation from it first.
+    end = NewtonStep(c, true, &X, &r, &why);
+    if (end == StepEnd::Converged) r.load_steps = 1;
+  }
+  if (end == StepEnd::Failed) {
+    X = m.rest_positions();
+    const Eigen::VectorXd rest = m.scene().rest_actuation();
+    m.ApplyConstraints(rest, &X);
+    end = LoadSteps(rest, c, &X, &r, &why);
+  }
+  deadline_.reset();
+  if (end == StepEnd::Failed) {
+    if (options_.time_limit_s > 0)
+      deadline_ = t0 + std::chrono::duration_cast<Clock::duration>(
+                           std::chrono::duration<double>(options_.time_limit_s));
+    FkResult f = Fallback(c, &X, why, r, t0);
+    deadline_.reset();
+    return f;
+  }
+  r.positions = X;
+  r.local_time_s = local_time_s_;
+  r.status = end == StepEnd::Converged   ? FkStatus::Converged
+             : end == StepEnd::TimeLimit ? FkStatus::TimeLimit
+                                         : FkStatus::IterationCap;
+  if (end == StepEnd::TimeLimit)
+    r.message = "time limit of " + std::to_string(options_.time_limit_s) + " s reached";
+  if (end == StepEnd::IterationCap)
+    r.message = "iteration cap of " + std::to_string(options_.max_iterations) + " reached";
+  ComputeLocalRatios(m, r.positions, c, &ratios_, &r.volume_ratios);
+  r.energy = LocalStep(m, r.positions, ratios_, &weighted_, options_.threads);
+  r.time_s = Seconds(t0, Clock::now());
+  return r;
+}
+
+}  // namespace softkin

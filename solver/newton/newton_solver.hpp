@@ -1,0 +1,134 @@
+#pragma once
+/// \file newton_solver.hpp
+/// The second-order FK solver ("newton"): inexact Newton-Krylov on the equilibrium that the
+/// local-global iteration of Algorithm 1 converges to, so both solvers stop at the same state by
+/// the same test.
+///
+/// The problem. The free coordinates x solve g(x) = A_ff x + A_fc x_c - B_f(X) = 0 (half the
+/// local-global residual; B gathers the element targets, targets.hpp). Its Jacobian is
+/// H = A_ff - K_ff with K = dB/dX applied exactly by EquilibriumLinearization (rotations, blend
+/// scales, and the actuation ratios' coupling within each group). H is not symmetric in general,
+/// and g is not the gradient of one energy when bodies blend (R_omega < 1) or chambers share a
+/// volume constraint, so the method works on g itself:
+///  - Newton step: H d = -g solved by GMRES (gmres.hpp) to a relative tolerance eta_k, the
+///    Eisenstat-Walker forcing term (choice 2: eta_k = 0.9 (|g_k| / |g_k-1|)^2, safeguarded),
+///    preconditioned by a CHOLMOD factor of P = sum_e |A_e - sym(K_e)|, the per-element blocks
+///    with their eigenvalues made positive (the projected-Newton Hessian of the rotation-free
+///    energy; EquilibriumJacobianWorkspace::Factor). P drops only the groups' rank-one coupling
+///    and the skew part of K, so GMRES needs few products;
+///  - globalisation: a backtracking line search on the merit |g| (Armijo, halving), so no accepted
+///    step raises the residual; an intermediate load step ends at |g| <= 1e-3 of its start, the
+///    last one by the local-global test (FkOptions::tolerance and gradient_tolerance: the
+///    local-global step's largest vertex move and the residual ratio against the same reference);
+///    the final state takes that local-global step, as lg-aa's does;
+///  - adaptive load stepping: from the rest shape the actuation is applied in one step first;
+///    a load step whose Newton iteration fails (no decrease along the Newton direction, a
+///    degenerate element, or 30 iterations) is halved; the next step doubles after one that took
+///    at most 4 iterations and halves after one that took more than 10. Each step starts from the
+///    tangent predictor x + dlambda dx/dlambda (the equilibrium's derivative along the actuation,
+///    solved with the same operator and factor). A warm start is tried at the full actuation
+///    first, then from the rest shape;
+///  - fallback: when the step falls below 1/1024 of the range, the remaining actuation is left to
+///    lg-aa from the last converged state, and the message says so. Scenes Newton does not cover
+///    (Mooney-Rivlin bodies, active collision response: EquilibriumJacobianUnsupported and
+///    ContactHandlingActive) are solved by lg-aa outright, with a message.
+/// FkResult::iterations counts Newton iterations (plus the fallback's local-global ones),
+/// linear_iterations the Krylov products and load_steps the converged load steps; local_time_s is
+/// the time of the residual evaluations, global_time_s that of the Newton directions (the
+/// linearisation, the factorisation of P and GMRES).
+#include "softkin/solver/fk/contact_term.hpp"
+#include "softkin/solver/fk/fk_solver.hpp"
+#include "softkin/solver/sensitivity/equilibrium_jacobian.hpp"
+
+#include <chrono>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace softkin {
+
+class NewtonSolver : public FkSolver {
+ public:
+  /// `contacts` is passed on to the lg-aa fallback for scenes with collision response
+  /// (MakeFkSolver passes the spring response of solver/collision/).
+  NewtonSolver(std::shared_ptr<const Model> model, const FkOptions& options,
+               ContactTermFactory contacts = {});
+  std::string name() const override { return "newton"; }
+  FkResult Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
+                 const Eigen::MatrixX3d* warm_start = nullptr) override;
+  const FkOptions& options() const { return options_; }
+
+  /// The load stepping's limits (the defaults are what FkOptions selects by name).
+  struct Limits {
+    /// Newton iterations allowed per load step before it counts as failed.
+    int step_iterations = 30;
+    /// The smallest load step, as a fraction of the actuation range of one call.
+    double min_load_step = 1.0 / 1024.0;
+  };
+  void set_limits(const Limits& limits) { limits_ = limits; }
+
+  /// The residual 2 |g| before each Newton iteration of the last load step of the last Solve(),
+  /// and at its end (for convergence studies).
+  const std::vector<double>& residual_history() const { return history_; }
+
+ private:
+  /// One evaluated iterate: positions, free coordinates, the residual g (free layout) and the
+  /// local-global right-hand side's free part.
+  struct State {
+    Eigen::MatrixX3d X;
+    Eigen::VectorXd x, g, Bf;
+    std::vector<double> ratios;  ///< the actuation ratios at X (ComputeLocalRatios)
+    double energy = 0.0;
+    double residual = 0.0;  ///< 2 |g|: the local-global residual of FkResult::gradient_ratio
+  };
+  enum class StepEnd { Converged, Failed, TimeLimit, IterationCap };
+
+  /// Evaluates s at positions s->X for actuation c (local step, right-hand side, residual).
+  void Evaluate(const Eigen::VectorXd& c, State* s);
+  /// Newton iterations at actuation c from *X. `final`: stop by the local-global test; else at
+  /// |g| <= 1e-3 of its start. *X receives the last accepted iterate; *why the reason of a failure.
+  StepEnd NewtonStep(const Eigen::VectorXd& c, bool final, Eigen::MatrixX3d* X, FkResult* r,
+                     std::string* why);
+  /// The Newton direction at s: H d = -g by preconditioned GMRES to relative tolerance eta.
+  /// false with *why if the linearisation or the preconditioner cannot be set up.
+  bool Direction(const Eigen::VectorXd& c, const State& s, double eta, Eigen::VectorXd* d,
+                 FkResult* r, std::string* why);
+  /// Adaptive load stepping from x0 (an equilibrium at c0) to c. Returns the status; *X the last
+  /// converged state.
+  StepEnd LoadSteps(const Eigen::VectorXd& c0, const Eigen::VectorXd& c, Eigen::MatrixX3d* X,
+                    FkResult* r, std::string* why);
+  /// dX/dlambda along the actuation direction dc at the equilibrium X for c (the predictor of a
+  /// load step); false if it cannot be computed.
+  bool Tangent(const Eigen::VectorXd& c, const Eigen::MatrixX3d& X, const Eigen::VectorXd& dc,
+               Eigen::MatrixX3d* dX, FkResult* r);
+  /// lg-aa from `start` (null: the rest shape) for c; its result under this solver's name, with
+  /// `reason` in the message and this solve's Newton counts added.
+  FkResult Fallback(const Eigen::VectorXd& c, const Eigen::MatrixX3d* start,
+                    const std::string& reason, const FkResult& so_far,
+                    std::chrono::steady_clock::time_point t0);
+  /// ||2 (A X_rest - B(X_rest; c))||, as the local-global solver's reference (cached per c).
+  double ReferenceResidual(const Eigen::VectorXd& c);
+  bool TimeUp() const;
+
+  FkOptions options_;
+  Limits limits_;
+  ContactTermFactory contacts_;
+  std::vector<double> history_;
+  EquilibriumLinearization lin_;
+  EquilibriumJacobianWorkspace workspace_;
+  std::vector<ElemRows> weighted_, scratch_;
+  std::vector<double> ratios_;
+  Eigen::MatrixX3d B_;
+  double total_weight_ = 0.0;
+  double local_time_s_ = 0.0;  ///< in Evaluate during one Solve
+  /// GMRES products per digit of residual reduction right after the last factorisation of P
+  /// (-1: refactor at the next Newton step).
+  double fresh_rate_ = -1.0;
+  int factorizations_ = 0;
+  std::optional<std::chrono::steady_clock::time_point> deadline_;
+  Eigen::VectorXd ref_c_;
+  double ref_value_ = 0.0;
+};
+
+}  // namespace softkin

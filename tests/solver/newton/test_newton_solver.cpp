@@ -1,0 +1,209 @@
+/// \file test_newton_solver.cpp
+/// The Newton-Krylov FK solver (solver/newton/newton_solver.hpp): its linearisation against
+/// differences of the residual, the same equilibrium as lg-aa on every embedded robot, superlinear
+/// convergence near the solution, and the lg-aa fallback.
+#include "softkin/solver/factory/fk_factory.hpp"
+#include "softkin/solver/fk/targets.hpp"
+#include "softkin/solver/newton/newton_solver.hpp"
+#include "softkin/solver/robots/robots.hpp"
+#include "softkin/solver/sensitivity/free_operator.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace softkin {
+namespace {
+
+/// g(X) = A_ff x + A_fc x_c - B_f(X): the residual Newton drives to zero (free layout).
+Eigen::VectorXd Residual(const Model& m, const Eigen::MatrixX3d& X, const Eigen::VectorXd& c) {
+  std::vector<double> ratios;
+  std::vector<ElemRows> weighted;
+  ComputeLocalRatios(m, X, c, &ratios);
+  LocalStep(m, X, ratios, &weighted, 1);
+  Eigen::MatrixX3d B;
+  AssembleRhs(m, weighted, &B, 1);
+  Eigen::VectorXd g;
+  m.GatherFree(m.A() * X - B, &g);
+  return g;
+}
+
+FkOptions Options(const std::string& solver, double tol, double gtol) {
+  FkOptions o;
+  o.solver = solver;
+  o.threads = 1;
+  o.tolerance = tol;
+  o.gradient_tolerance = gtol;
+  o.max_iterations = 200000;
+  return o;
+}
+
+/// Mid-range actuation of every actuator (between its rest value and its maximum).
+Eigen::VectorXd MidActuation(const Scene& s) {
+  Eigen::VectorXd c = s.rest_actuation();
+  for (int a = 0; a < s.num_actuators(); ++a) {
+    const Actuator& act = s.actuators[a];
+    const double hi = std::isfinite(act.max) ? act.max : act.rest + 1.0;
+    c[a] = act.rest + (0.3 + 0.1 * a) * (hi - act.rest);
+  }
+  return c;
+}
+
+// The operator the solver applies, H = A_ff - K_ff, equals central differences of the residual
+// along random directions at states away from the equilibrium.
+TEST(NewtonSolver, JacobianOfTheResidualMatchesDifferences) {
+  struct Case {
+    std::string robot;
+    int res;
+    double value;
+  };
+  std::mt19937 rng(11);
+  std::normal_distribution<double> nd;
+  int checked = 0;
+  for (const Case& k : std::vector<Case>{{"bilayer_strip", 1, 1.3}, {"three_chamber", 3, 1.6}}) {
+    SCOPED_TRACE(k.robot);
+    const Scene s = MakeRobot(k.robot, k.res);
+    auto model = std::make_shared<const Model>(s);
+    Eigen::VectorXd c = s.rest_actuation();
+    c[0] = k.value;
+    const FkResult r = MakeFkSolver(model, Options("lg-aa", 1e-3, 1e-2))->Solve(c);
+    Eigen::MatrixX3d X = r.positions;
+    for (int v = 0; v < X.rows(); ++v)
+      for (int d = 0; d < 3; ++d) X(v, d) += 1e-3 * model->size() * nd(rng);
+    model->ApplyConstraints(c, &X);
+    EquilibriumLinearization lin;
+    std::string why;
+    ASSERT_TRUE(lin.Setup(*model, X, c, &why, 1)) << why;
+    FreeOperator op(*model, &lin);
+    for (int trial = 0; trial < 2; ++trial) {
+      Eigen::VectorXd v(model->num_free_dofs());
+      for (int i = 0; i < v.size(); ++i) v[i] = nd(rng);
+      Eigen::MatrixX3d V = Eigen::MatrixX3d::Zero(X.rows(), 3);
+      model->ScatterFree(v, &V);
+      const double h = 1e-6 * model->size() / V.rowwise().norm().maxCoeff();
+      const Eigen::VectorXd fd =
+          (Residual(*model, X + h * V, c) - Residual(*model, X - h * V, c)) / (2.0 * h);
+      const Eigen::VectorXd Hv = op.Apply(v).col(0);
+      EXPECT_LT((Hv - fd).norm(), 1e-6 * fd.norm()) << "trial " << trial;
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 4);
+}
+
+// newton's answer is lg-aa's fixed point on every embedded robot at a small resolution: lg-aa
+// started from it stays there, and lg-aa from rest ends within its own tolerance of it. (Scenes
+// Newton does not cover are solved by lg-aa, and say so.)
+TEST(NewtonSolver, SameStateAsLgAaOnEveryEmbeddedRobot) {
+  int compared = 0, newton_solved = 0;
+  for (const RobotInfo& info : ListRobots()) {
+    SCOPED_TRACE(info.name);
+    int res = info.default_resolution;
+    // The smallest resolution each robot accepts (MakeRobot throws below it).
+    for (int trial = 1; trial < info.default_resolution; ++trial) {
+      try {
+        MakeRobot(info.name, trial);
+        res = trial;
+        break;
+      } catch (const std::invalid_argument&) {
+      }
+    }
+    const Scene s = MakeRobot(info.name, res);
+    if (s.mesh.num_elements() > 20000) continue;
+    auto model = std::make_shared<const Model>(s);
+    // Left to lg-aa (MooneyRivlinBodiesAreLeftToLgAaWithAReason covers that path).
+    if (!EquilibriumJacobianUnsupported(*model).empty() ||
+        ContactHandlingActive(s, s.solver.collision))
+      continue;
+    const Eigen::VectorXd c = MidActuation(s);
+    const FkResult nw = MakeFkSolver(model, Options("newton", 1e-8, 1e-8))->Solve(c);
+    ASSERT_EQ(nw.status, FkStatus::Converged) << nw.BriefReport();
+    EXPECT_EQ(nw.solver, "newton");
+    EXPECT_EQ(nw.message.find("lg-aa"), std::string::npos) << nw.message;
+    ++newton_solved;
+    // A fixed point of lg-aa: one more solve from it hardly moves.
+    const FkResult again = MakeFkSolver(model, Options("lg-aa", 1e-8, 1e-8))->Solve(c, &nw.positions);
+    EXPECT_LT((again.positions - nw.positions).rowwise().norm().maxCoeff(), 1e-5 * model->size())
+        << again.BriefReport();
+    // lg-aa from rest, at its usual tolerance, ends near it (its error is its creep).
+    const FkResult ref = MakeFkSolver(model, Options("lg-aa", 1e-6, 1e-7))->Solve(c);
+    if (ref.status != FkStatus::Converged) continue;
+    EXPECT_LT((ref.positions - nw.positions).rowwise().norm().maxCoeff(), 1e-3 * model->size())
+        << nw.BriefReport() << " vs " << ref.BriefReport();
+    ++compared;
+  }
+  EXPECT_GE(newton_solved, 7);
+  EXPECT_GE(compared, 6);
+}
+
+// Near the solution each Newton iteration divides the residual by more than the one before.
+TEST(NewtonSolver, ResidualFallsSuperlinearlyNearTheSolution) {
+  const Scene s = MakeRobot("three_chamber", 3);
+  auto model = std::make_shared<const Model>(s);
+  NewtonSolver solver(model, Options("newton", 1e-10, 1e-11));
+  Eigen::VectorXd c = s.rest_actuation();
+  c[0] = 1.8;
+  const FkResult r = solver.Solve(c);
+  ASSERT_EQ(r.status, FkStatus::Converged) << r.BriefReport();
+  const std::vector<double>& h = solver.residual_history();
+  ASSERT_GE(h.size(), 4u);
+  // Some three consecutive iterations with contraction factors below 0.3 that shrink.
+  bool superlinear = false;
+  for (size_t k = 0; k + 2 < h.size(); ++k) {
+    const double q1 = h[k + 1] / h[k], q2 = h[k + 2] / h[k + 1];
+    if (q1 < 0.3 && q2 < 0.5 * q1) superlinear = true;
+  }
+  std::string trace;
+  for (double v : h) trace += std::to_string(v) + " ";
+  EXPECT_TRUE(superlinear) << trace;
+  EXPECT_LE(r.iterations, 12) << trace;
+}
+
+// A Newton solve that fails (here: at most one iteration per load step, and no step below a half)
+// continues with lg-aa from its best state, says so, and converges to lg-aa's answer.
+TEST(NewtonSolver, FailureContinuesWithLgAaAndSaysSo) {
+  const Scene s = MakeRobot("bilayer_strip", 1);
+  auto model = std::make_shared<const Model>(s);
+  Eigen::VectorXd c(1);
+  c << 1.1;
+  NewtonSolver solver(model, Options("newton", 1e-5, 1e-6));
+  solver.set_limits({1, 0.5});
+  const FkResult r = solver.Solve(c);
+  EXPECT_EQ(r.status, FkStatus::Converged) << r.BriefReport();
+  EXPECT_NE(r.message.find("continued with lg-aa"), std::string::npos) << r.message;
+  EXPECT_EQ(r.solver, "newton");
+  EXPECT_GT(r.iterations, 100);  // the fallback's local-global iterations are counted
+  const FkResult ref = MakeFkSolver(model, Options("lg-aa", 1e-5, 1e-6))->Solve(c);
+  EXPECT_LT((r.positions - ref.positions).rowwise().norm().maxCoeff(), 1e-3 * model->size());
+}
+
+// Scenes outside Newton's reach are solved by lg-aa, with the reason in the message.
+TEST(NewtonSolver, MooneyRivlinBodiesAreLeftToLgAaWithAReason) {
+  Scene s = MakeRobot("three_chamber", 3);
+  s.body[0].law = "mooney-rivlin";
+  s.body[0].c1 = 0.0418;
+  s.body[0].c2 = 0.0106;
+  FkOptions o = Options("newton", 1e-6, 1e-6);
+  auto model = std::make_shared<const Model>(s);
+  const FkResult nw = MakeFkSolver(model, o)->Solve(Eigen::Vector3d(1.4, 1.0, 1.0));
+  EXPECT_EQ(nw.status, FkStatus::Converged) << nw.BriefReport();
+  EXPECT_NE(nw.message.find("not used"), std::string::npos) << nw.message;
+  EXPECT_NE(nw.message.find("lg-aa"), std::string::npos) << nw.message;
+}
+
+TEST(NewtonSolver, UnknownSolverNameListsNewton) {
+  FkOptions o;
+  o.solver = "newtn";
+  std::string why;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("solver"), std::string::npos) << why;
+  EXPECT_NE(why.find("newton"), std::string::npos) << why;
+  EXPECT_NE(why.find("newtn"), std::string::npos) << why;
+}
+
+}  // namespace
+}  // namespace softkin
