@@ -1,0 +1,92 @@
+// Google Benchmark suite for the Newton-Krylov FK solver against lg-aa (docs/newton.md).
+//
+// Each benchmark solves one actuation from the rest shape with one solver, to the same stopping
+// test (tolerance 1e-5, gradient_tolerance 1e-6; lg-aa gets an iteration cap of 10^6 so that it
+// converges), and reports the counters
+//   tets, vertices      mesh size
+//   iterations          Newton iterations (newton) or local-global iterations (lg-aa)
+//   krylov              GMRES products (newton)
+//   load_steps          converged load steps (newton)
+//   residual_ratio      the final residual ratio (both must be below 1e-6)
+//   per_vertex          wall time per vertex
+// Compare solvers as the ratio of their times within one run (the machine is shared):
+//   build/bin/bench_newton --benchmark_filter='Strip'
+// Cases: bilayer_strip res 1 and 2 (3k and 24k tets) at alpha 1.1 and 1.5; pneumatic_finger
+// res 8 at alpha 5; three_chamber res 5 at (1.5, 1, 1).
+#include "softkin/solver/factory/fk_factory.hpp"
+#include "softkin/solver/robots/robots.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace softkin {
+namespace {
+
+/// One model per (robot, res), built once.
+std::shared_ptr<const Model> CachedModel(const std::string& robot, int res) {
+  static std::map<std::pair<std::string, int>, std::shared_ptr<const Model>> cache;
+  auto& m = cache[{robot, res}];
+  if (!m) m = std::make_shared<const Model>(MakeRobot(robot, res));
+  return m;
+}
+
+void Solve(benchmark::State& state, const std::string& robot, int res, const std::string& solver,
+           const Eigen::VectorXd& c) {
+  auto model = CachedModel(robot, res);
+  FkOptions o;
+  o.solver = solver;
+  o.max_iterations = 1000000;
+  FkResult r;
+  for (auto _ : state) {
+    auto s = MakeFkSolver(model, o);  // a fresh solver: no factor or reference kept between runs
+    r = s->Solve(c);
+    if (r.status != FkStatus::Converged) state.SkipWithError(r.BriefReport().c_str());
+  }
+  state.counters["tets"] = model->mesh().num_elements();
+  state.counters["vertices"] = model->num_vertices();
+  state.counters["iterations"] = r.iterations;
+  state.counters["krylov"] = r.linear_iterations;
+  state.counters["load_steps"] = r.load_steps;
+  state.counters["residual_ratio"] = r.gradient_ratio;
+  state.counters["per_vertex"] = benchmark::Counter(
+      model->num_vertices(), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
+Eigen::VectorXd One(double v) { return Eigen::VectorXd::Constant(1, v); }
+
+void BM_Strip(benchmark::State& state, int res, double alpha, const char* solver) {
+  Solve(state, "bilayer_strip", res, solver, One(alpha));
+}
+void BM_Finger(benchmark::State& state, const char* solver) {
+  Solve(state, "pneumatic_finger", 8, solver, One(5.0));
+}
+void BM_ThreeChamber(benchmark::State& state, const char* solver) {
+  Solve(state, "three_chamber", 5, solver, Eigen::Vector3d(1.5, 1.0, 1.0));
+}
+
+void BM_Strip_r1_a1_1(benchmark::State& s, const char* solver) { BM_Strip(s, 1, 1.1, solver); }
+void BM_Strip_r1_a1_5(benchmark::State& s, const char* solver) { BM_Strip(s, 1, 1.5, solver); }
+void BM_Strip_r2_a1_1(benchmark::State& s, const char* solver) { BM_Strip(s, 2, 1.1, solver); }
+void BM_Strip_r2_a1_5(benchmark::State& s, const char* solver) { BM_Strip(s, 2, 1.5, solver); }
+
+BENCHMARK_CAPTURE(BM_Strip_r1_a1_1, newton, "newton")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip_r1_a1_1, lg_aa, "lg-aa")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip_r1_a1_5, newton, "newton")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip_r1_a1_5, lg_aa, "lg-aa")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip_r2_a1_1, newton, "newton")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip_r2_a1_1, lg_aa, "lg-aa")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip_r2_a1_5, newton, "newton")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip_r2_a1_5, lg_aa, "lg-aa")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_CAPTURE(BM_Finger, newton, "newton")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_CAPTURE(BM_Finger, lg_aa, "lg-aa")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_CAPTURE(BM_ThreeChamber, newton, "newton")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_CAPTURE(BM_ThreeChamber, lg_aa, "lg-aa")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+
+}  // namespace
+}  // namespace softkin
+
+BENCHMARK_MAIN();
