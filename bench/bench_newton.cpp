@@ -52,8 +52,9 @@ void Solve(benchmark::State& state, const std::string& robot, int res, const std
   state.counters["krylov"] = r.linear_iterations;
   state.counters["load_steps"] = r.load_steps;
   state.counters["residual_ratio"] = r.gradient_ratio;
-  state.counters["per_vertex"] = benchmark::Counter(
-      model->num_vertices(), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["per_vertex"] =
+      benchmark::Counter(model->num_vertices(), benchmark::Counter::kIsIterationInvariantRate |
+                                                    benchmark::Counter::kInvert);
 }
 
 Eigen::VectorXd One(double v) { return Eigen::VectorXd::Constant(1, v); }
@@ -73,18 +74,54 @@ void BM_Strip_r1_a1_5(benchmark::State& s, const char* solver) { BM_Strip(s, 1, 
 void BM_Strip_r2_a1_1(benchmark::State& s, const char* solver) { BM_Strip(s, 2, 1.1, solver); }
 void BM_Strip_r2_a1_5(benchmark::State& s, const char* solver) { BM_Strip(s, 2, 1.5, solver); }
 
-BENCHMARK_CAPTURE(BM_Strip_r1_a1_1, newton, "newton")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
-BENCHMARK_CAPTURE(BM_Strip_r1_a1_1, lg_aa, "lg-aa")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
-BENCHMARK_CAPTURE(BM_Strip_r1_a1_5, newton, "newton")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
-BENCHMARK_CAPTURE(BM_Strip_r1_a1_5, lg_aa, "lg-aa")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
-BENCHMARK_CAPTURE(BM_Strip_r2_a1_1, newton, "newton")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
-BENCHMARK_CAPTURE(BM_Strip_r2_a1_1, lg_aa, "lg-aa")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
-BENCHMARK_CAPTURE(BM_Strip_r2_a1_5, newton, "newton")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
-BENCHMARK_CAPTURE(BM_Strip_r2_a1_5, lg_aa, "lg-aa")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
-BENCHMARK_CAPTURE(BM_Finger, newton, "newton")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
-BENCHMARK_CAPTURE(BM_Finger, lg_aa, "lg-aa")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
-BENCHMARK_CAPTURE(BM_ThreeChamber, newton, "newton")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
-BENCHMARK_CAPTURE(BM_ThreeChamber, lg_aa, "lg-aa")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip_r1_a1_1, newton, "newton")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip_r1_a1_1, lg_aa, "lg-aa")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip_r1_a1_5, newton, "newton")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip_r1_a1_5, lg_aa, "lg-aa")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip_r2_a1_1, newton, "newton")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip_r2_a1_1, lg_aa, "lg-aa")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip_r2_a1_5, newton, "newton")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip_r2_a1_5, lg_aa, "lg-aa")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_Finger, newton, "newton")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_Finger, lg_aa, "lg-aa")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_ThreeChamber, newton, "newton")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_ThreeChamber, lg_aa, "lg-aa")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
 
 }  // namespace
 }  // namespace softkin

@@ -106,8 +106,9 @@ bool NewtonSolver::Direction(const Eigen::VectorXd& c, const State& s, double et
     return true;
   };
   if (workspace_.factor() && fresh_rate_ > 0.0) {
-    const int budget = std::min(kMaxKrylov, static_cast<int>(std::ceil(
-                                                4.0 * fresh_rate_ * std::max(1.0, -std::log10(eta)))) + 10);
+    const int budget = std::min(
+        kMaxKrylov,
+        static_cast<int>(std::ceil(4.0 * fresh_rate_ * std::max(1.0, -std::log10(eta)))) + 10);
     const auto [ok, rate] = solve(budget);
     if (ok && rate <= 2.0 * fresh_rate_ + 1.0) return true;
     if (ok) {
@@ -140,8 +141,8 @@ NewtonSolver::StepEnd NewtonSolver::NewtonStep(const Eigen::VectorXd& c, bool fi
   }
   // The stopping reference of the local-global solver, and the round-off floor.
   const double floor = 1e-8 * total_weight_ * m.size();
-  const double ref = final ? std::max({ReferenceResidual(c), s.residual, floor})
-                           : std::max(s.residual, floor);
+  const double ref =
+      final ? std::max({ReferenceResidual(c), s.residual, floor}) : std::max(s.residual, floor);
   const bool roundoff_ok = final;
   Eigen::MatrixX3d Mv(m.num_vertices(), 3), D(m.num_vertices(), 3);
   Eigen::VectorXd d;
@@ -158,7 +159,8 @@ NewtonSolver::StepEnd NewtonSolver::NewtonStep(const Eigen::VectorXd& c, bool fi
       r->gradient_ratio = s.residual / ref;
       r->max_move = move;
       const bool roundoff = roundoff_ok && s.residual <= 1e-12 * total_weight_ * m.size();
-      if (move < options_.tolerance && (r->gradient_ratio < options_.gradient_tolerance || roundoff)) {
+      if (move < options_.tolerance &&
+          (r->gradient_ratio < options_.gradient_tolerance || roundoff)) {
         m.ScatterFree(s.x + step, &s.X);  // the local-global step, as lg-aa ends
         *Xp = s.X;
         return StepEnd::Converged;
@@ -255,9 +257,8 @@ bool NewtonSolver::Tangent(const Eigen::VectorXd& c, const Eigen::MatrixX3d& X,
   return true;
 }
 
-NewtonSolver::StepEnd NewtonSolver::LoadSteps(const Eigen::VectorXd& c0,
-                                              const Eigen::VectorXd& c, Eigen::MatrixX3d* X,
-                                              FkResult* r, std::string* why) {
+NewtonSolver::StepEnd NewtonSolver::LoadSteps(const Eigen::VectorXd& c0, const Eigen::VectorXd& c,
+                                              Eigen::MatrixX3d* X, FkResult* r, std::string* why) {
   double lambda = 0.0, delta = 1.0 / std::max(1, options_.continuation_steps);
   Eigen::MatrixX3d converged = *X, tangent;
   bool have_tangent = false;
@@ -296,8 +297,8 @@ NewtonSolver::StepEnd NewtonSolver::LoadSteps(const Eigen::VectorXd& c0,
     if (delta < limits_.min_load_step) {
       *X = converged;
       std::ostringstream os;
-      os << step_why << " (load step cut below " << limits_.min_load_step << " at "
-         << lambda << " of the actuation)";
+      os << step_why << " (load step cut below " << limits_.min_load_step << " at " << lambda
+         << " of the actuation)";
       *why = os.str();
       return StepEnd::Failed;
     }
@@ -342,8 +343,8 @@ FkResult NewtonSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c_in,
                          std::chrono::duration<double>(options_.time_limit_s));
   const std::string unsupported = EquilibriumJacobianUnsupported(m);
   if (!unsupported.empty())  // the reason, without the implicit Jacobian's advice
-    return Fallback(c, warm_start, "not used (" + unsupported.substr(0, unsupported.find(';')) + ")",
-                    r, t0);
+    return Fallback(c, warm_start,
+                    "not used (" + unsupported.substr(0, unsupported.find(';')) + ")", r, t0);
   if (ContactHandlingActive(m.scene(), options_.collision))
     return Fallback(c, warm_start, "not used (collision response is on)", r, t0);
 

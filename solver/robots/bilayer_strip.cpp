@@ -33,10 +33,9 @@ Scene MakeBilayerStrip(int res, const RobotParams& P) {
   const int nx = Cells(P.at("length"), h), ny = Cells(P.at("width"), h), nz = 2 * res;
   Scene s;
   s.name = "bilayer_strip";
-  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz),
-                        [res](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
-                          return c[2] < res ? 0 : 1;
-                        });
+  s.mesh = VoxelTetMesh(
+      Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz),
+      [res](const Eigen::Vector3d&, const Eigen::Vector3i& c) { return c[2] < res ? 0 : 1; });
   s.body[0] = Material{"body", 1.0, 1.0};
   Actuator a;
   a.name = "top";

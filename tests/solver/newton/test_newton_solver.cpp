@@ -126,7 +126,8 @@ TEST(NewtonSolver, SameStateAsLgAaOnEveryEmbeddedRobot) {
     EXPECT_EQ(nw.message.find("lg-aa"), std::string::npos) << nw.message;
     ++newton_solved;
     // A fixed point of lg-aa: one more solve from it hardly moves.
-    const FkResult again = MakeFkSolver(model, Options("lg-aa", 1e-8, 1e-8))->Solve(c, &nw.positions);
+    const FkResult again =
+        MakeFkSolver(model, Options("lg-aa", 1e-8, 1e-8))->Solve(c, &nw.positions);
     EXPECT_LT((again.positions - nw.positions).rowwise().norm().maxCoeff(), 1e-5 * model->size())
         << again.BriefReport();
     // lg-aa from rest, at its usual tolerance, ends near it (its error is its creep).
