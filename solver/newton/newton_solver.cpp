@@ -362,15 +362,12 @@ FkResult NewtonSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c_in,
     m.ApplyConstraints(rest, &X);
     end = LoadSteps(rest, c, &X, &r, &why);
   }
-  deadline_.reset();
   if (end == StepEnd::Failed) {
-    if (options_.time_limit_s > 0)
-      deadline_ = t0 + std::chrono::duration_cast<Clock::duration>(
-                           std::chrono::duration<double>(options_.time_limit_s));
-    FkResult f = Fallback(c, &X, why, r, t0);
+    FkResult f = Fallback(c, &X, why, r, t0);  // within what is left of the time limit
     deadline_.reset();
     return f;
   }
+  deadline_.reset();
   r.positions = X;
   r.local_time_s = local_time_s_;
   r.status = end == StepEnd::Converged   ? FkStatus::Converged
