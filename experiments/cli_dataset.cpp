@@ -157,7 +157,7 @@ DatasetSource RobotSource(const DatasetCommandArgs& a, SimulatorKinematicsOption
               {"robot", a.robot},
               {"res", a.res > 0 ? a.res : DefaultResolution(a.robot)},
               {"params", pj},
-              {"fk_solver", fk.solver},
+              {"fk_solver", ToString(fk.solver)},
               {"gradient_tolerance", fk.gradient_tolerance},
               {"jacobian_mode", with_j ? a.jacobian : "none"}};
   out.kin = std::move(sim);

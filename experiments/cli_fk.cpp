@@ -87,12 +87,20 @@ FkOptions ApplySetOptions(const std::vector<std::string>& sets, const FkOptions&
 /// The scene's solver options with the command line's overrides, validated.
 FkOptions FkOptionsFromArgs(const FkCommandArgs& a, const Scene& scene) {
   FkOptions opt = scene.solver;
-  if (!a.solver.empty()) opt.solver = a.solver;
+  try {
+    if (!a.solver.empty()) opt.solver = FkSolverTypeFromString(a.solver);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("--solver: ") + e.what());
+  }
+  try {
+    if (a.safeguard_given) opt.anderson_safeguard = AndersonSafeguardFromString(a.safeguard);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("--aa-safeguard: ") + e.what());
+  }
   if (a.continuation_given) opt.continuation_steps = a.continuation;
   if (a.max_iterations_given) opt.max_iterations = a.max_iterations;
   if (a.tolerance_given) opt.tolerance = a.tolerance;
   if (a.gradient_tolerance_given) opt.gradient_tolerance = a.gradient_tolerance;
-  if (a.safeguard_given) opt.anderson_safeguard = a.safeguard;
   std::string why;
   if (!opt.IsValid(&why)) throw std::invalid_argument("option " + why);
   return ApplySetOptions(a.set, opt);
@@ -153,8 +161,8 @@ int RunFkCommand(const FkCommandArgs& a) {
     // Bad values are the actuation's; anything else (a scene a solver cannot express, a missing
     // ccx) is the solver's.
     const bool actuation = r.message.rfind("actuation", 0) == 0;
-    throw std::invalid_argument((actuation ? "--actuation: " : "--solver " + opt.solver + ": ") +
-                                r.message);
+    throw std::invalid_argument(
+        (actuation ? "--actuation: " : "--solver " + ToString(opt.solver) + ": ") + r.message);
   }
   std::cerr << r.BriefReport() << "\n";
   const nlohmann::json j = FkResultJson(scene, c, r);

@@ -264,7 +264,7 @@ TrajectoryOptions SimulatorTrajectoryOptions(const IkCommandArgs& a, const Simul
   else
     key << "robot=" << a.robot << " res=" << a.res;
   for (const auto& p : a.params) key << " " << p;
-  key << " fk=" << kin.fk_options().solver;
+  key << " fk=" << ToString(kin.fk_options().solver);
   to.sampling.cache_key = key.str();
   if (a.samples == 0) to.warm_start = kin.rest();
   return to;

@@ -47,7 +47,7 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
   Eigen::MatrixX3d& X = *Xp;
   const int nf = m.num_free_dofs();
   const int nt = options_.threads;
-  const bool aa_on = options_.solver == "lg-aa";
+  const bool aa_on = options_.solver == FkSolverType::kLgAa;
   const double tol = options_.tolerance;
   const double gtol = options_.gradient_tolerance;
 
@@ -98,7 +98,7 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     for (const auto& e : m.elements()) total_weight_ += e.wv;
   Anderson aa(nf, options_.anderson_window);
   Eigen::MatrixX3d X_good = X;
-  const std::string& guard = options_.anderson_safeguard;
+  const AndersonSafeguard guard = options_.anderson_safeguard;
   // Merits of the iterate an accelerated step was extrapolated from.
   double base_E = 0.0, base_f = 0.0;
   bool accelerated = false;  // X is an Anderson (extrapolated) iterate, not yet checked
@@ -124,7 +124,7 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     local(&E);
     const double grad = residual();
     const bool finite = std::isfinite(E) && X.allFinite() && std::isfinite(grad);
-    if (accelerated && (!finite || (guard == "energy" && !(E <= base_E)))) {
+    if (accelerated && (!finite || (guard == AndersonSafeguard::kEnergy && !(E <= base_E)))) {
       reject();
       ++r->iterations;
       continue;
@@ -153,7 +153,7 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     step = Gf - xf;
     const double fnorm = step.norm();  // fixed-point residual ||G(x) - x||
     if (accelerated) {
-      if (guard == "hybrid" && !(E <= base_E || fnorm <= base_f)) {
+      if (guard == AndersonSafeguard::kHybrid && !(E <= base_E || fnorm <= base_f)) {
         reject();
         continue;
       }

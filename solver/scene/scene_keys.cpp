@@ -88,8 +88,8 @@ void AddRegionKeys(std::vector<KeySpec>* t) {
                    "Body material law: blend (Ch. 2 shape blending, Eq. 2.5, constant r_omega) or "
                    "mooney-rivlin (hyperelastic target, Eq. 3.6-3.7: R_omega a function of strain "
                    "fitted to c1, c2, with r_omega its zero-strain value; docs/materials.md).")
-                   .Def(mat.law)
-                   .Choices({"blend", "mooney-rivlin"})
+                   .Def(ToString(mat.law))
+                   .Choices(MaterialLawNames())
                    .Roles({"body"}));
   t->push_back(Key("regions[].c1", N, Opt,
                    "mooney-rivlin: c1, MPa (>= 0). Needed unless 'material' names a known "
@@ -270,9 +270,8 @@ void AddSolverKeys(std::vector<KeySpec>* t) {
                    "Ceres or Ipopt; ipopt-hard: body energy with hard actuation constraints; "
                    "calculix-linear, calculix-nonlinear: FEM baselines by CalculiX "
                    "(docs/solvers.md).")
-                   .Def(fk.solver)
-                   .Choices({"lg", "lg-aa", "ceres", "ipopt-lbfgs", "ipopt-newton", "ipopt-hard",
-                             "calculix-linear", "calculix-nonlinear"}));
+                   .Def(ToString(fk.solver))
+                   .Choices(FkSolverTypeNames()));
   t->push_back(Key("solver.max_iterations", I, Opt, "Iteration limit (per continuation step).")
                    .Def(fk.max_iterations)
                    .AtLeast(1));
@@ -292,8 +291,8 @@ void AddSolverKeys(std::vector<KeySpec>* t) {
   t->push_back(Key("solver.anderson_safeguard", S, Opt,
                    "Keep an Anderson step if it lowers the energy or the fixed-point residual "
                    "(hybrid), only if it does not raise the energy (energy), or always (none).")
-                   .Def(fk.anderson_safeguard)
-                   .Choices({"hybrid", "energy", "none"}));
+                   .Def(ToString(fk.anderson_safeguard))
+                   .Choices(AndersonSafeguardNames()));
   t->push_back(Key("solver.continuation_steps", I, Opt,
                    "Apply the actuation in this many equal steps, warm-starting each.")
                    .Def(fk.continuation_steps)
@@ -339,28 +338,28 @@ void AddCollisionKeys(std::vector<KeySpec>* t) {
   t->push_back(Key("solver.collision.update", S, Opt,
                    "How the factor follows the spring set: CHOLMOD update/downdate, or a numeric "
                    "refactorisation.")
-                   .Def(co.update)
-                   .Choices({"updown", "refactor"}));
+                   .Def(ToString(co.update))
+                   .Choices(SpringUpdateNames()));
   t->push_back(Key("solver.collision.self_target", S, Opt,
                    "Where a self-collided vertex is sent: 'walk' along -n(v) through the collided "
                    "region (the thesis's rule) for every contact, or 'auto': the same within one "
                    "body, the closest facing point of the other body's surface between separate "
                    "bodies.")
-                   .Def(co.self_target)
-                   .Choices({"auto", "walk"}));
+                   .Def(ToString(co.self_target))
+                   .Choices(SelfTargetNames()));
   t->push_back(Key("solver.collision.self_spring", S, Opt,
                    "What a self-collision spring pulls its vertex to: a fixed 'target' half way "
                    "to the exit point (Eq. 3.5), or 'pair': the exit point as a point of the "
                    "exit face, which moves with the face and loads both sides equally.")
-                   .Def(co.self_spring)
-                   .Choices({"target", "pair"}));
+                   .Def(ToString(co.self_spring))
+                   .Choices(SelfSpringNames()));
   t->push_back(Key("solver.collision.obstacle_spring", S, Opt,
                    "What an obstacle spring resists: 'plane', only the normal part of the offset "
                    "to the closest point plus eps, against the obstacle's tangent plane "
                    "(frictionless), or 'point', the whole offset (Eq. 3.5 as written; it holds "
                    "the vertex tangentially between checks, so sliding contacts creep).")
-                   .Def(co.obstacle_spring)
-                   .Choices({"plane", "point"}));
+                   .Def(ToString(co.obstacle_spring))
+                   .Choices(ObstacleSpringNames()));
 }
 
 std::string RangeText(const KeySpec& k) {

@@ -177,7 +177,7 @@ TEST(SceneJsonRealMesh, FingerChamber1Loads) {
 
   std::string why;
   EXPECT_TRUE(s.solver.IsValid(&why)) << why;
-  EXPECT_EQ(s.solver.solver, "lg-aa");
+  EXPECT_EQ(s.solver.solver, FkSolverType::kLgAa);
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -226,7 +226,7 @@ TEST(SceneJsonTiny, EverySelectorScaleAndMergedActuator) {
   EXPECT_NEAR(P(2, 1), 2.0, 1e-12);
   EXPECT_NEAR(P(2, 2), 2.0 / 3.0, 1e-12);
 
-  EXPECT_EQ(s.solver.solver, "lg");
+  EXPECT_EQ(s.solver.solver, FkSolverType::kLg);
   EXPECT_EQ(s.solver.max_iterations, 50);
   EXPECT_DOUBLE_EQ(s.solver.tolerance, 1e-4);
   EXPECT_DOUBLE_EQ(s.solver.gradient_tolerance, 0.01);
@@ -838,7 +838,7 @@ TEST(SceneJsonErrors, ObstaclesAndCollisionOptions) {
   EXPECT_EQ(s.solver.collision.epsilon, 0.1);
   EXPECT_EQ(s.solver.collision.stiffness, 5.0);
   EXPECT_EQ(s.solver.collision.check_interval, 3);
-  EXPECT_EQ(s.solver.collision.update, "refactor");
+  EXPECT_EQ(s.solver.collision.update, SpringUpdate::kRefactor);
 }
 
 TEST(SceneJsonErrors, MotionBadValues) {
@@ -1080,7 +1080,8 @@ TEST(SceneJsonSchema, DefaultsComeFromTheStructs) {
     return it == lines.end() ? std::string() : it->second.first;
   };
   const FkOptions fk;
-  EXPECT_NE(head("solver.solver").find("default \"" + fk.solver + "\""), std::string::npos);
+  EXPECT_NE(head("solver.solver").find("default \"" + ToString(fk.solver) + "\""),
+            std::string::npos);
   EXPECT_NE(head("solver.max_iterations").find("default " + std::to_string(fk.max_iterations)),
             std::string::npos);
   EXPECT_NE(head("solver.anderson_window").find("integer in [1, 50]"), std::string::npos);
@@ -1123,12 +1124,12 @@ TEST(SolverOptionsJson, EveryOptionHasASchemaEntryWithItsDefault) {
 
 TEST(SolverOptionsJson, RoundTripsEveryOption) {
   FkOptions o;
-  o.solver = "lg";
+  o.solver = FkSolverType::kLg;
   o.max_iterations = 123;
   o.tolerance = 2e-4;
   o.gradient_tolerance = 3e-3;
   o.anderson_window = 7;
-  o.anderson_safeguard = "energy";
+  o.anderson_safeguard = AndersonSafeguard::kEnergy;
   o.continuation_steps = 4;
   o.threads = 2;
   o.time_limit_s = 12.5;
@@ -1137,10 +1138,10 @@ TEST(SolverOptionsJson, RoundTripsEveryOption) {
   o.collision.epsilon = 0.1;
   o.collision.stiffness = 5;
   o.collision.check_interval = 3;
-  o.collision.update = "refactor";
-  o.collision.self_target = "auto";
-  o.collision.self_spring = "pair";
-  o.collision.obstacle_spring = "point";
+  o.collision.update = SpringUpdate::kRefactor;
+  o.collision.self_target = SelfTarget::kAuto;
+  o.collision.self_spring = SelfSpring::kPair;
+  o.collision.obstacle_spring = ObstacleSpring::kPoint;
   const json j = SolverOptionsToJson(o);
   const FkOptions back = ReadSolverOptionsJson(j, "test", FkOptions());
   EXPECT_EQ(SolverOptionsToJson(back), j);
@@ -1152,7 +1153,7 @@ TEST(SolverOptionsJson, RoundTripsEveryOption) {
   // Keys left out keep the base's values.
   const FkOptions partial = ReadSolverOptionsJson(json{{"tolerance", 1e-3}}, "test", o);
   EXPECT_EQ(partial.max_iterations, 123);
-  EXPECT_EQ(partial.collision.update, "refactor");
+  EXPECT_EQ(partial.collision.update, SpringUpdate::kRefactor);
   EXPECT_DOUBLE_EQ(partial.tolerance, 1e-3);
 }
 
