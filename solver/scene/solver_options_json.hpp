@@ -5,10 +5,10 @@
 /// range or allowed values (an enum's names), default (a default-constructed FkOptions') and how to
 /// read and write it. From that table come
 ///  - the scene schema's `solver.*` entries (softkin scene --schema; scene_keys.hpp),
-///  - the reader of the scene JSON's `solver` object (scene_json.hpp), of experiment configs
-///    (experiments/config.hpp) and of `softkin fk --set`, which checks each value against its
-///    entry,
-///  - the writer SolverOptionsToJson and the help texts' view of the options (SolverOptionDocs).
+///  - the reader of the scene JSON's `solver` object (scene_json.hpp) and of experiment configs
+///    (experiments/config.hpp), which checks each value against its entry,
+///  - the command-line flags of `softkin fk` and the FK flags of other commands
+///    (experiments/cli_args.hpp), whose values go through the same reader.
 #include "softkin/solver/fk/fk_options.hpp"
 
 #include <nlohmann/json.hpp>
