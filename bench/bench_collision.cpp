@@ -62,7 +62,7 @@ const Fixture& GetFixture(int res) {
   Eigen::VectorXd c = f->model->scene().rest_actuation();
   c[0] = kAlpha;
   FkOptions opts = f->model->scene().solver;
-  opts.solver = "lg-aa";
+  opts.solver = FkSolverType::kLgAa;
   opts.max_iterations = kSetupIterations;
   opts.continuation_steps = 1;
   const FkResult r = MakeFkSolver(f->model, opts)->Solve(c);

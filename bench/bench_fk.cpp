@@ -75,7 +75,7 @@ const Fixture& GetFixture(int res) {
   f->c = m.scene().rest_actuation();
   f->c[0] = kAlpha;
   FkOptions opts = m.scene().solver;
-  opts.solver = "lg-aa";
+  opts.solver = FkSolverType::kLgAa;
   opts.max_iterations = kSetupIterations;
   opts.continuation_steps = 1;
   auto solver = MakeFkSolver(f->model, opts);
@@ -214,7 +214,7 @@ void BaselineCounters(benchmark::State& state, const Baseline& b) {
 
 FkOptions OneIterationOptions(const Model& m, int max_iterations) {
   FkOptions o = m.scene().solver;
-  o.solver = "lg-aa";
+  o.solver = FkSolverType::kLgAa;
   o.max_iterations = max_iterations;
   o.tolerance = 1e-300;  // never converge: every call runs exactly max_iterations iterations
   o.gradient_tolerance = 1e-300;
@@ -278,7 +278,7 @@ void BM_LocalStepLaw(benchmark::State& state) {
   if (!hm) {
     Scene s = f.model->scene();
     for (auto& [tag, mat] : s.body)
-      mat = Material{"ecoflex-00-30", 1.0, mat.weight, "mooney-rivlin", 0.0418, 0.0106};
+      mat = Material{"ecoflex-00-30", 1.0, mat.weight, MaterialLaw::kMooneyRivlin, 0.0418, 0.0106};
     hm = std::make_shared<const Model>(s);
   }
   static std::map<int, double> blend_time;
@@ -566,7 +566,7 @@ void BM_FullBend(benchmark::State& state) {
   const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
   const Model& m = *f.model;
   FkOptions opts = m.scene().solver;
-  opts.solver = "lg-aa";
+  opts.solver = FkSolverType::kLgAa;
   opts.anderson_window = static_cast<int>(state.range(1));
   auto solver = MakeFkSolver(f.model, opts);
   const Actuator& act = m.scene().actuators[0];
@@ -633,7 +633,7 @@ void BM_RobotSolve(benchmark::State& state) {
     c[a] = std::abs(act.max - neutral) >= std::abs(act.min - neutral) ? act.max : act.min;
   }
   FkOptions opts = sc.solver;
-  opts.solver = "lg-aa";
+  opts.solver = FkSolverType::kLgAa;
   FkResult r;
   for (auto _ : state) {
     auto solver = MakeFkSolver(model, opts);
@@ -685,7 +685,7 @@ void BM_SolverCompare(benchmark::State& state) {
   Eigen::VectorXd c = model->scene().rest_actuation();
   c[0] = which == 0 ? 2.0 : 2.5;
   FkOptions opts = model->scene().solver;
-  opts.solver = name;
+  opts.solver = FkSolverTypeFromString(name);
   opts.time_limit_s = 120;
   opts.max_iterations = 100000;
   FkResult r;

@@ -207,7 +207,8 @@ void BM_ImplicitSolve(benchmark::State& state) {
   EquilibriumJacobianOptions o;
   o.lockstep = state.range(1) == 1;
   const bool guess = state.range(2) == 1;
-  o.preconditioner = state.range(3) >= 1 ? "local" : "A_ff";
+  o.preconditioner =
+      state.range(3) >= 1 ? JacobianPreconditioner::kLocal : JacobianPreconditioner::kAff;
   o.reuse_preconditioner = state.range(3) == 2;
   if (f.dXdc0.size() == 0) {
     state.SkipWithError("implicit Jacobian at c0 failed");
@@ -217,7 +218,7 @@ void BM_ImplicitSolve(benchmark::State& state) {
   // SimulatorKinematics keeps them along a path); a first call at c0, untimed, sets them up and
   // leaves c0's factor, which range(3) = 2 reuses at c.
   auto ws = std::make_unique<EquilibriumJacobianWorkspace>();
-  if (o.preconditioner == "local")
+  if (o.preconditioner == JacobianPreconditioner::kLocal)
     ComputeEquilibriumJacobian(*f.model, f.X0, f.c0, {}, o, nullptr, ws.get());
   EquilibriumJacobianResult r;
   int products = 0;
@@ -244,7 +245,7 @@ void BM_ImplicitTolerance(benchmark::State& state) {
   static std::map<int, Eigen::MatrixXd> reference;
   if (!reference.count(static_cast<int>(state.range(0)))) {
     EquilibriumJacobianOptions tight;
-    tight.preconditioner = "A_ff";
+    tight.preconditioner = JacobianPreconditioner::kAff;
     tight.tolerance = 1e-12;
     tight.max_iterations = 3000;
     const EquilibriumJacobianResult ref =
@@ -258,7 +259,8 @@ void BM_ImplicitTolerance(benchmark::State& state) {
   const Eigen::MatrixXd& J_ref = reference[static_cast<int>(state.range(0))];
   EquilibriumJacobianOptions o;
   o.tolerance = std::pow(10.0, -static_cast<double>(state.range(1)));
-  o.preconditioner = state.range(2) == 1 ? "local" : "A_ff";
+  o.preconditioner =
+      state.range(2) == 1 ? JacobianPreconditioner::kLocal : JacobianPreconditioner::kAff;
   EquilibriumJacobianResult r;
   int products = 0;
   if (!TimeImplicit(state, f, o, nullptr, nullptr, &r, &products)) return;

@@ -38,7 +38,7 @@ void Solve(benchmark::State& state, const std::string& robot, int res, const std
            const Eigen::VectorXd& c) {
   auto model = CachedModel(robot, res);
   FkOptions o;
-  o.solver = solver;
+  o.solver = FkSolverTypeFromString(solver);
   o.max_iterations = 1000000;
   FkResult r;
   for (auto _ : state) {

@@ -118,7 +118,7 @@ void BM_CollisionResponseUpdate(benchmark::State& state) {
   Scene s = MakeRobot("pneumatic_finger", res);
   s.obstacles.push_back(
       MakeBoxSurface(Eigen::Vector3d(100, -10, -10), Eigen::Vector3d(140, 30, 2)));
-  s.solver.collision.obstacle_spring = plane ? "plane" : "point";
+  s.solver.collision.obstacle_spring = plane ? ObstacleSpring::kPlane : ObstacleSpring::kPoint;
   const Model model(s);
   CollisionResponse resp(model, s.solver.collision);
   // The tip end of the finger moved 2 mm down into the box's top (z <= 2).
@@ -159,7 +159,7 @@ void BM_SelfTargetRule(benchmark::State& state) {
   const int res = static_cast<int>(state.range(0));
   const bool body_rule = state.range(1) != 0;
   Scene s = MakeRobot("membrane", res);
-  s.solver.collision.self_target = body_rule ? "auto" : "walk";
+  s.solver.collision.self_target = body_rule ? SelfTarget::kAuto : SelfTarget::kWalk;
   const Model model(s);
   CollisionResponse resp(model, s.solver.collision);
   // The membrane (every vertex above the roofs' 2 mm air gap; its top is one cell above the roofs)

@@ -1,5 +1,10 @@
 #include "softkin/experiments/cli_args.hpp"
 
+#include "softkin/solver/scene/solver_options_json.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
@@ -47,6 +52,66 @@ RobotParams ParseRobotParams(const std::vector<std::string>& items) {
     params[text.substr(0, eq)] = v;
   }
   return params;
+}
+
+namespace {
+
+/// A flag's value placeholder in help texts, by the option's type.
+std::string ValueName(const nlohmann::json& default_value) {
+  if (default_value.is_boolean()) return "BOOL";
+  if (default_value.is_number_integer()) return "INT";
+  if (default_value.is_number()) return "NUMBER";
+  return "NAME";
+}
+
+}  // namespace
+
+nlohmann::json CommandLineValue(const std::string& text) {
+  nlohmann::json v = nlohmann::json::parse(text, nullptr, false);
+  if (v.is_discarded()) v = text;
+  return v;
+}
+
+std::string FkOptionFlagName(const std::string& key) {
+  std::string name = "--" + key;
+  std::replace(name.begin(), name.end(), '_', '-');
+  std::replace(name.begin(), name.end(), '.', '-');
+  return name;
+}
+
+std::vector<CLI::Option*> AddFkOptionFlags(CLI::App* cmd, FkOptionFlags* flags,
+                                           const std::vector<std::string>& keys,
+                                           const std::map<std::string, std::string>& aliases) {
+  std::vector<CLI::Option*> added;
+  for (const SolverOptionDoc& o : SolverOptionDocs()) {
+    if (!keys.empty() && std::find(keys.begin(), keys.end(), o.key) == keys.end()) continue;
+    std::string names = FkOptionFlagName(o.key);
+    if (aliases.count(o.key)) names += "," + aliases.at(o.key);
+    const std::string key = o.key;
+    const std::string help = o.doc + " [" + o.value + "; default: the scene's solver." + key + "]";
+    CLI::Option* flag = cmd->add_option_function<std::string>(
+        names, [flags, key](const std::string& v) { flags->given[key] = v; }, help);
+    flag->type_name(ValueName(o.default_value));
+    added.push_back(flag);
+  }
+  return added;
+}
+
+FkOptions ApplyFkOptionFlags(const FkOptionFlags& flags, const FkOptions& base) {
+  FkOptions o = base;
+  for (const std::string& key : SolverOptionKeys()) {
+    const auto it = flags.given.find(key);
+    if (it == flags.given.end()) continue;
+    // {"max_iterations": 5} or {"collision": {"self": true}}: the reader's layout.
+    nlohmann::json j;
+    const auto dot = key.find('.');
+    if (dot == std::string::npos)
+      j[key] = CommandLineValue(it->second);
+    else
+      j[key.substr(0, dot)][key.substr(dot + 1)] = CommandLineValue(it->second);
+    o = ReadSolverOptionsJson(j, FkOptionFlagName(key) + ": solver", o);
+  }
+  return o;
 }
 
 }  // namespace softkin

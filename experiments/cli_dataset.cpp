@@ -58,9 +58,7 @@ CLI::App* AddDatasetCommand(CLI::App* app, DatasetCommandArgs* a) {
   ds->add_option("--shard", a->shard,
                  "Compute shard k of n (k = 0..n-1): a contiguous slice of "
                  "the serpentine order, into its own --out file");
-  ds->add_option("--gradient-tolerance", a->gradient_tolerance,
-                 "Forward solves stop when the energy gradient falls below this fraction of its "
-                 "starting value (default: the scene's)");
+  AddFkOptionFlags(ds, &a->fk_options, {"gradient_tolerance"});
   ds->add_option("--merge", a->merge, "Merge these complete shard files (all n of them) into --out")
       ->expected(1, -1);
   ds->add_option("--out", a->out, "Output CSV (its sidecar is FILE.json)")->required();
@@ -137,10 +135,7 @@ DatasetSource RobotSource(const DatasetCommandArgs& a, SimulatorKinematicsOption
   const bool with_j = a.jacobian != "none";
   const RobotParams params = ParseRobotParams(a.params);
   const Scene scene = MakeRobot(a.robot, a.res, params);
-  FkOptions fk = scene.solver;
-  if (a.gradient_tolerance > 0) fk.gradient_tolerance = a.gradient_tolerance;
-  std::string why;
-  if (!fk.IsValid(&why)) throw std::invalid_argument("--gradient-tolerance: " + why);
+  FkOptions fk = ApplyFkOptionFlags(a.fk_options, scene.solver);
   ko.points = points;
   std::unique_ptr<SimulatorKinematics> sim;
   try {
@@ -157,7 +152,7 @@ DatasetSource RobotSource(const DatasetCommandArgs& a, SimulatorKinematicsOption
               {"robot", a.robot},
               {"res", a.res > 0 ? a.res : DefaultResolution(a.robot)},
               {"params", pj},
-              {"fk_solver", fk.solver},
+              {"fk_solver", ToString(fk.solver)},
               {"gradient_tolerance", fk.gradient_tolerance},
               {"jacobian_mode", with_j ? a.jacobian : "none"}};
   out.kin = std::move(sim);
@@ -176,7 +171,9 @@ DatasetSource TwinSource(const DatasetCommandArgs& a, const std::vector<std::str
   TwinOptions to;
   to.res = a.res;
   to.points = points;
-  to.gradient_tolerance = a.gradient_tolerance;
+  // --gradient-tolerance, checked by the option reader; 0 (not given): the robot's own.
+  if (a.fk_options.given.count("gradient_tolerance"))
+    to.gradient_tolerance = ApplyFkOptionFlags(a.fk_options, FkOptions()).gradient_tolerance;
   std::unique_ptr<TwinKinematics> twin;
   try {
     twin = std::make_unique<TwinKinematics>(spec, to);
@@ -226,8 +223,6 @@ int RunDatasetCommand(const DatasetCommandArgs& a) {
     throw std::invalid_argument(
         "--jacobian: a twin gives positions only (hardware has no "
         "Jacobian); use --jacobian none with --twin");
-  if (a.gradient_tolerance < 0 || !std::isfinite(a.gradient_tolerance))
-    throw std::invalid_argument("--gradient-tolerance: expected a fraction > 0");
   DatasetRunOptions run;
   run.out = a.out;
   run.jacobian = with_j;

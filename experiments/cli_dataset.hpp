@@ -3,6 +3,8 @@
 /// `softkin dataset`: generate a learning dataset (thesis Sec. 5.3.2) from an embedded robot's
 /// simulator or from a "hardware" twin (learn/twin.hpp), resumable and shardable, or merge shard
 /// files (learn/dataset.hpp, docs/datasets.md).
+#include "softkin/experiments/cli_args.hpp"
+
 #include <CLI/CLI.hpp>
 
 #include <string>
@@ -21,8 +23,8 @@ struct DatasetCommandArgs {
   int block = 64;
   std::string points = "tip";
   std::string jacobian = "none";
-  std::string shard;              ///< "k/n", empty: the whole dataset
-  double gradient_tolerance = 0;  ///< 0: the scene's FK setting
+  std::string shard;         ///< "k/n", empty: the whole dataset
+  FkOptionFlags fk_options;  ///< --gradient-tolerance: over the robot's FK options (cli_args.hpp)
   std::vector<std::string> merge;
   std::string out;
   bool quiet = false;

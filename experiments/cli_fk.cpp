@@ -29,18 +29,11 @@ CLI::App* AddFkCommand(CLI::App* app, FkCommandArgs* a) {
       ->needs(o_robot);
   fk->add_option("--actuation", a->actuation, "Actuation values v1,v2,... in actuator order")
       ->required();
-  fk->add_option(
-      "--solver", a->solver,
-      "FK solver: lg (plain local-global), lg-aa (Anderson), ceres, ipopt-lbfgs, "
-      "ipopt-newton, ipopt-hard, calculix-linear or calculix-nonlinear (docs/solvers.md)");
-  fk->add_option("--continuation", a->continuation, "Apply the actuation in this many steps");
-  fk->add_option("--max-iterations", a->max_iterations, "Iteration cap");
-  fk->add_option("--tolerance", a->tolerance,
-                 "Per-iteration vertex move tolerance, relative to model size");
-  fk->add_option("--gradient-tolerance", a->gradient_tolerance,
-                 "Residual tolerance, relative to its reference value");
-  fk->add_option("--aa-safeguard", a->safeguard,
-                 "Anderson safeguard: hybrid (energy or residual), energy, or none");
+  // One flag per solver option of the table; --continuation and --aa-safeguard are the short
+  // names older command lines use.
+  AddFkOptionFlags(
+      fk, &a->options, {},
+      {{"continuation_steps", "--continuation"}, {"anderson_safeguard", "--aa-safeguard"}});
   fk->add_option("--set", a->set,
                  "Any solver option KEY=VALUE, keys as in `softkin scene --schema` without the "
                  "'solver.' prefix (e.g. --set time_limit_s=60 --set collision.self=true); "
@@ -49,30 +42,21 @@ CLI::App* AddFkCommand(CLI::App* app, FkCommandArgs* a) {
   fk->add_option("--json", a->json_out, "Write the result as JSON to this file");
   fk->add_option("--vtu", a->vtu_out, "Write the deformed mesh as ParaView .vtu");
   fk->add_option("--obj", a->obj_out, "Write the deformed surface as .obj");
-  // Which overriding options were given, once the command line is parsed.
-  fk->callback([a, fk] {
-    a->continuation_given = fk->count("--continuation") > 0;
-    a->max_iterations_given = fk->count("--max-iterations") > 0;
-    a->tolerance_given = fk->count("--tolerance") > 0;
-    a->gradient_tolerance_given = fk->count("--gradient-tolerance") > 0;
-    a->safeguard_given = fk->count("--aa-safeguard") > 0;
-  });
   return fk;
 }
 
 namespace {
 
 /// The --set KEY=VALUE options over `opt`, read by the scene JSON's reader. VALUE is JSON (a
-/// number, true, false) or, if it does not parse as JSON, a string.
+/// number, true, false) or, if it does not parse as JSON, a string (CommandLineValue).
 FkOptions ApplySetOptions(const std::vector<std::string>& sets, const FkOptions& opt) {
   nlohmann::json j = nlohmann::json::object();
   for (const std::string& kv : sets) {
     const auto eq = kv.find('=');
     if (eq == std::string::npos || eq == 0)
       throw std::invalid_argument("--set '" + kv + "': expected KEY=VALUE");
-    const std::string key = kv.substr(0, eq), text = kv.substr(eq + 1);
-    nlohmann::json v = nlohmann::json::parse(text, nullptr, false);
-    if (v.is_discarded()) v = text;
+    const std::string key = kv.substr(0, eq);
+    const nlohmann::json v = CommandLineValue(kv.substr(eq + 1));
     nlohmann::json* at = &j;
     std::string rest = key;
     for (auto dot = rest.find('.'); dot != std::string::npos; dot = rest.find('.')) {
@@ -82,20 +66,6 @@ FkOptions ApplySetOptions(const std::vector<std::string>& sets, const FkOptions&
     (*at)[rest] = v;
   }
   return sets.empty() ? opt : ReadSolverOptionsJson(j, "--set: solver", opt);
-}
-
-/// The scene's solver options with the command line's overrides, validated.
-FkOptions FkOptionsFromArgs(const FkCommandArgs& a, const Scene& scene) {
-  FkOptions opt = scene.solver;
-  if (!a.solver.empty()) opt.solver = a.solver;
-  if (a.continuation_given) opt.continuation_steps = a.continuation;
-  if (a.max_iterations_given) opt.max_iterations = a.max_iterations;
-  if (a.tolerance_given) opt.tolerance = a.tolerance;
-  if (a.gradient_tolerance_given) opt.gradient_tolerance = a.gradient_tolerance;
-  if (a.safeguard_given) opt.anderson_safeguard = a.safeguard;
-  std::string why;
-  if (!opt.IsValid(&why)) throw std::invalid_argument("option " + why);
-  return ApplySetOptions(a.set, opt);
 }
 
 /// The result as `softkin fk --json` writes it.
@@ -138,13 +108,17 @@ nlohmann::json FkResultJson(const Scene& scene, const Eigen::VectorXd& c, const 
 
 }  // namespace
 
+FkOptions FkOptionsFromArgs(const FkCommandArgs& a, const FkOptions& base) {
+  return ApplySetOptions(a.set, ApplyFkOptionFlags(a.options, base));
+}
+
 int RunFkCommand(const FkCommandArgs& a) {
   if (a.robot.empty() == a.scene.empty())
     throw std::invalid_argument("fk: give exactly one of --robot NAME or --scene FILE");
   if (a.res < 0) throw std::invalid_argument("--res: expected a positive integer");
   const RobotParams params = ParseRobotParams(a.params);
   Scene scene = a.robot.empty() ? LoadSceneJson(a.scene) : MakeRobot(a.robot, a.res, params);
-  FkOptions opt = FkOptionsFromArgs(a, scene);
+  FkOptions opt = FkOptionsFromArgs(a, scene.solver);
   const Eigen::VectorXd c = ParseNumberList(a.actuation, "--actuation");
   if (opt.continuation_steps > 1)
     opt.on_step = [](int step, int steps, const std::string& status, int iterations, double sec) {
@@ -157,8 +131,8 @@ int RunFkCommand(const FkCommandArgs& a) {
     // Bad values are the actuation's; anything else (a scene a solver cannot express, a missing
     // ccx) is the solver's.
     const bool actuation = r.message.rfind("actuation", 0) == 0;
-    throw std::invalid_argument((actuation ? "--actuation: " : "--solver " + opt.solver + ": ") +
-                                r.message);
+    throw std::invalid_argument(
+        (actuation ? "--actuation: " : "--solver " + ToString(opt.solver) + ": ") + r.message);
   }
   std::cerr << r.BriefReport() << "\n";
   const nlohmann::json j = FkResultJson(scene, c, r);

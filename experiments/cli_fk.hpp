@@ -3,6 +3,9 @@
 /// `softkin fk`: forward kinematics of an embedded robot or a scene file for one actuation; the
 /// result (status, energy, markers, the final collision check) as JSON, the deformed mesh as .vtu
 /// or .obj.
+#include "softkin/experiments/cli_args.hpp"
+#include "softkin/solver/fk/fk_options.hpp"
+
 #include <CLI/CLI.hpp>
 
 #include <string>
@@ -16,18 +19,9 @@ struct FkCommandArgs {
   int res = 0;
   std::vector<std::string> params;
   std::string actuation;
-  std::string solver;  ///< empty: the scene's
-  // Solver settings that override the scene's when given (a given 0 is validated, not ignored).
-  int continuation = 0;
-  int max_iterations = 0;
-  double tolerance = 0;
-  double gradient_tolerance = 0;
-  std::string safeguard;
-  bool continuation_given = false;
-  bool max_iterations_given = false;
-  bool tolerance_given = false;
-  bool gradient_tolerance_given = false;
-  bool safeguard_given = false;
+  /// One flag per solver option (--solver, --max-iterations, --collision-self, ...; cli_args.hpp),
+  /// overriding the scene's options when given.
+  FkOptionFlags options;
   /// --set KEY=VALUE: any solver option by its scene-schema key (solver.* without the prefix),
   /// applied after the flags above.
   std::vector<std::string> set;
@@ -37,6 +31,10 @@ struct FkCommandArgs {
 
 /// Adds the `fk` subcommand to `app`, bound to *args; returns it.
 CLI::App* AddFkCommand(CLI::App* app, FkCommandArgs* args);
+
+/// The solver options of `softkin fk`: `base` (the scene's) with the option flags, then --set,
+/// applied and validated. Throws std::invalid_argument naming the flag and what was expected.
+FkOptions FkOptionsFromArgs(const FkCommandArgs& args, const FkOptions& base);
 
 /// Runs `softkin fk`. Throws std::invalid_argument for bad input (naming the option) and
 /// std::runtime_error when a file cannot be written; returns the exit code (0: converged, 1: not).

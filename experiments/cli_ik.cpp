@@ -70,13 +70,12 @@ CLI::App* AddIkCommand(CLI::App* app, IkCommandArgs* a) {
   ik->add_option("--max-evaluations", a->max_evaluations,
                  "Kinematics evaluations per waypoint, every method (default 300)");
   ik->add_option("--max-time", a->max_time_s, "Wall-time limit per waypoint, s (default 600)");
-  ik->add_option(
-      "--gradient-tolerance", a->gradient_tolerance,
-      "Forward solves stop when the energy gradient falls below this fraction of its "
-      "starting value (default: the scene's, 1e-6). 1e-4 saves about half the iterations "
-      "but its error depends on the robot: micrometres on cable_finger, ~0.1 mm on "
-      "three_chamber, up to 4 mm on finger_manipulator (a soft lateral mode); check "
-      "yours against a tight solve first");
+  CLI::Option* gtol = AddFkOptionFlags(ik, &a->fk_options, {"gradient_tolerance"}).front();
+  gtol->description(gtol->get_description() +
+                    " 1e-4 saves about half the iterations but its error depends on the robot: "
+                    "micrometres on cable_finger, ~0.1 mm on three_chamber, up to 4 mm on "
+                    "finger_manipulator (a soft lateral mode); check yours against a tight solve "
+                    "first.");
   ik->add_option("--samples", a->samples,
                  "Configuration-space samples per actuator for the first waypoint's initial guess "
                  "(default 5: 5^3 = 125 for three actuators); 0 starts from the rest actuation");
@@ -238,10 +237,7 @@ std::unique_ptr<SimulatorKinematics> MakeSimulatorKinematics(const IkCommandArgs
                                 " (its markers: " + names + ")");
   }
   ko.points = {a.point};
-  FkOptions fk = scene.solver;
-  if (a.gradient_tolerance > 0) fk.gradient_tolerance = a.gradient_tolerance;
-  std::string why;
-  if (!fk.IsValid(&why)) throw std::invalid_argument("--gradient-tolerance: " + why);
+  FkOptions fk = ApplyFkOptionFlags(a.fk_options, scene.solver);
   try {
     return std::make_unique<SimulatorKinematics>(scene, ko, &fk);
   } catch (const std::invalid_argument& e) {
@@ -264,7 +260,7 @@ TrajectoryOptions SimulatorTrajectoryOptions(const IkCommandArgs& a, const Simul
   else
     key << "robot=" << a.robot << " res=" << a.res;
   for (const auto& p : a.params) key << " " << p;
-  key << " fk=" << kin.fk_options().solver;
+  key << " fk=" << ToString(kin.fk_options().solver);
   to.sampling.cache_key = key.str();
   if (a.samples == 0) to.warm_start = kin.rest();
   return to;
@@ -343,9 +339,6 @@ int RunSimulatorIk(const IkCommandArgs& a) {
   if (a.point.find("[*]") != std::string::npos)
     throw std::invalid_argument(
         "--point: expected one point (a marker or 'marker[i]'), got the group '" + a.point + "'");
-  if (a.gradient_tolerance < 0 || !std::isfinite(a.gradient_tolerance))
-    throw std::invalid_argument("--gradient-tolerance: expected a fraction > 0, got " +
-                                std::to_string(a.gradient_tolerance));
   std::string source;
   const Eigen::MatrixX3d waypoints = ReadTargets(a, &source);
   const Scene scene = a.robot.empty() ? LoadSceneJson(a.scene)

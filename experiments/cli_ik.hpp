@@ -3,6 +3,8 @@
 /// `softkin ik`: simulation-in-the-loop inverse kinematics of an embedded robot or a scene file for
 /// one target point or a waypoint file (thesis Algorithm 4), one CSV row per waypoint as it
 /// finishes, resumable (docs/ik.md, "The softkin ik command").
+#include "softkin/experiments/cli_args.hpp"
+
 #include <CLI/CLI.hpp>
 
 #include <string>
@@ -25,7 +27,7 @@ struct IkCommandArgs {
   int samples = 5;
   int first_starts = 3;
   double max_time_s = 600;
-  double gradient_tolerance = 0;  ///< 0: the scene's FK setting
+  FkOptionFlags fk_options;  ///< --gradient-tolerance: over the scene's FK options (cli_args.hpp)
   std::string cache;
   std::string out;
   bool resume = false;

@@ -1,6 +1,7 @@
 // Ablation: plain local-global against Anderson-accelerated, at mid and full actuation.
 #include "softkin/experiments/results.hpp"
 #include "softkin/experiments/runner.hpp"
+#include "softkin/solver/common/enum_names.hpp"
 #include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/robots/robots.hpp"
@@ -8,6 +9,7 @@
 #include <cstdio>
 #include <iostream>
 #include <map>
+#include <stdexcept>
 
 namespace softkin {
 
@@ -40,18 +42,20 @@ AaAblationParams ReadAaAblationParams(const Config& cfg) {
   if (windows.empty()) cfg.Fail("windows", "a non-empty array of Anderson windows");
   if (guards.empty()) cfg.Fail("safeguards", "a non-empty array of safeguard names");
   p.variants = {{"lg", base}};
-  p.variants[0].opts.solver = "lg";
+  p.variants[0].opts.solver = FkSolverType::kLg;
   for (int m : windows)
     for (const auto& g : guards) {
       Variant v{"lg-aa m=" + std::to_string(m) + " " + g, base};
-      v.opts.solver = "lg-aa";
+      v.opts.solver = FkSolverType::kLgAa;
       v.opts.anderson_window = m;
-      v.opts.anderson_safeguard = g;
-      std::string why;
-      if (!v.opts.IsValid(&why)) {
-        if (m < 1 || m > 50) cfg.Fail("windows", "Anderson windows, integers in [1, 50]");
-        cfg.Fail("safeguards", "safeguard names, each one of hybrid, energy, none");
+      try {
+        v.opts.anderson_safeguard = AndersonSafeguardFromString(g);
+      } catch (const std::invalid_argument&) {
+        cfg.Fail("safeguards",
+                 "safeguard names, each one of " + NameList(AndersonSafeguardNames()));
       }
+      std::string why;
+      if (!v.opts.IsValid(&why)) cfg.Fail("windows", "Anderson windows, integers in [1, 50]");
       p.variants.push_back(v);
     }
   if (!p.res.empty() && p.res.size() != p.robots.size())
@@ -76,7 +80,7 @@ nlohmann::json RunCase(const AaAblationParams& p, const std::string& robot, cons
   bool lg_capped = false;
   for (const Variant& v : p.variants) {
     FkResult r = MakeFkSolver(model, v.opts)->Solve(c);
-    const bool plain = v.opts.solver == "lg";
+    const bool plain = v.opts.solver == FkSolverType::kLg;
     if (plain) {
       lg_iters = r.iterations;
       lg_time = r.time_s;

@@ -210,7 +210,7 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
   j["model_build_s"] = build_s;
   j["factor_s"] = model->factor_time_s();
   j["non_converged_steps"] = b.failures;
-  j["solver"] = p.opts.solver;
+  j["solver"] = ToString(p.opts.solver);
   j["anderson_window"] = p.opts.anderson_window;
   j["predictor"] = p.predictor;
   j["spacing"] = p.spacing;

@@ -62,8 +62,8 @@ nlohmann::json FitMaterial(const Config& cfg, const HyperelasticParams& p, const
   const ROmegaCurve curve = FitMooneyRivlinROmega(mr, rho0, p.lambda_max, p.knots);
   for (size_t i = 0; i < curve.eps().size(); ++i)
     curve_csv->RowStrings({name, std::to_string(curve.eps()[i]), std::to_string(curve.rho()[i])});
-  const Material hyper{name, rho0, 1.0, "mooney-rivlin", mr.c1, mr.c2};
-  const Material constant{name + " (constant R_omega)", rho0, 1.0, "blend", 0, 0};
+  const Material hyper{name, rho0, 1.0, MaterialLaw::kMooneyRivlin, mr.c1, mr.c2};
+  const Material constant{name + " (constant R_omega)", rho0, 1.0, MaterialLaw::kBlend, 0, 0};
   const auto h = SimulateUniaxialTension(hyper, p.stretches, p.res, p.solver);
   const auto b = SimulateUniaxialTension(constant, p.stretches, p.res, p.solver);
   const double Eh = h[0].stress / (h[0].mid_stretch - 1), Eb = b[0].stress / (b[0].mid_stretch - 1);

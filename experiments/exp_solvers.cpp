@@ -6,6 +6,7 @@
 #include "softkin/experiments/results.hpp"
 #include "softkin/experiments/runner.hpp"
 #include "softkin/solver/baselines/calculix.hpp"
+#include "softkin/solver/common/enum_names.hpp"
 #include "softkin/solver/fk/energy.hpp"
 #include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
@@ -18,6 +19,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <stdexcept>
 
 namespace softkin {
 namespace {
@@ -63,12 +65,16 @@ SolverComparisonParams ReadSolverComparisonParams(const Config& cfg) {
   if (!(p.budget > 0)) cfg.Fail("time_limit_s", "a number of seconds > 0");
   if (p.methods.empty() || p.methods[0] != "lg-aa")
     cfg.Fail("methods", "a list of FK solver names starting with lg-aa (the reference shape)");
-  const auto names = FkSolverNames();
-  for (const auto& m : p.methods)
-    if (std::find(names.begin(), names.end(), m) == names.end() && !kNotRun.count(m))
-      cfg.Fail("methods",
-               "FK solver names (lg, lg-aa, ceres, ipopt-lbfgs, ipopt-newton, "
-               "ipopt-hard, calculix-linear, calculix-nonlinear, sofa)");
+  for (const auto& m : p.methods) {
+    if (kNotRun.count(m)) continue;
+    try {
+      (void)FkSolverTypeFromString(m);
+    } catch (const std::invalid_argument&) {
+      std::vector<std::string> names = FkSolverTypeNames();
+      for (const auto& [n, why] : kNotRun) names.push_back(n);
+      cfg.Fail("methods", "FK solver names (" + NameList(names) + ")");
+    }
+  }
   const Actuator& act = p.scene.actuators.at(0);
   p.vmax = end_value_cfg > 0 ? end_value_cfg : act.FarEnd();
   if (p.vmax > act.max || p.vmax < act.min || p.vmax == act.rest)
@@ -221,10 +227,10 @@ void RunMethod(const SolverComparisonParams& p, const std::shared_ptr<const Mode
     return;
   }
   FkOptions o = p.base;
-  o.solver = name;
+  o.solver = FkSolverTypeFromString(name);
   o.continuation_steps = 1;
   MethodSweep m(p, name, csv, &t->bends[name], verbose);
-  if (name.rfind("calculix", 0) == 0)
+  if (o.solver == FkSolverType::kCalculixLinear || o.solver == FkSolverType::kCalculixNonlinear)
     SweepCalculix(model, o, &m);
   else
     SweepIterative(model, o, &m);

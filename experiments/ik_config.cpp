@@ -210,7 +210,7 @@ nlohmann::json IkExperimentSetup::Json() const {
           {"max_evaluations", ik.max_evaluations},
           {"samples_per_axis", samples_per_axis},
           {"first_waypoint_starts", first_waypoint_starts},
-          {"fk_solver", fk.solver}};
+          {"fk_solver", ToString(fk.solver)}};
 }
 
 SimulatorKinematicsOptions IkExperimentSetup::KinematicsFor(

@@ -80,11 +80,12 @@ void SimulatorKinematics::Init(const SimulatorKinematicsOptions& options, const 
   const Scene& scene = model_->scene();
   fk_ = fk ? *fk : scene.solver;
   if (!fk_.IsValid(&why)) throw std::invalid_argument("solver options: " + why);
-  if (options_.jacobian == JacobianMode::kImplicit && fk_.solver != "lg" && fk_.solver != "lg-aa")
+  if (options_.jacobian == JacobianMode::kImplicit && fk_.solver != FkSolverType::kLg &&
+      fk_.solver != FkSolverType::kLgAa)
     throw std::invalid_argument(
         "jacobian 'implicit' differentiates the local-global equilibrium; it needs solver lg or "
         "lg-aa, got '" +
-        fk_.solver + "' (use fd or fd-warm with other solvers)");
+        ToString(fk_.solver) + "' (use fd or fd-warm with other solvers)");
   solver_ = MakeFkSolver(model_, fk_);
   warm_solver_.reset();
   if (options_.warm_max_iterations > 0 && options_.warm_max_iterations < fk_.max_iterations) {

@@ -252,7 +252,7 @@ std::string FindCcx() {
 
 CalculixSolver::CalculixSolver(std::shared_ptr<const Model> model, const FkOptions& fk,
                                CalculixOptions options)
-    : FkSolver(std::move(model)), name_(fk.solver), options_(std::move(options)) {
+    : FkSolver(std::move(model)), name_(ToString(fk.solver)), options_(std::move(options)) {
   if (fk.time_limit_s > 0 && options_.time_limit_s <= 0) options_.time_limit_s = fk.time_limit_s;
   if (fk.continuation_steps > 1) options_.increments = fk.continuation_steps;
 }

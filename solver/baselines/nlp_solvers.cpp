@@ -44,7 +44,7 @@ class RatioUpdateSolver : public FkSolver {
       : FkSolver(std::move(model)), options_(options) {
     for (const auto& e : model_->elements()) total_weight_ += e.wv;
   }
-  std::string name() const override { return options_.solver; }
+  std::string name() const override { return ToString(options_.solver); }
 
   FkResult Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
                  const Eigen::MatrixX3d* warm_start) override {
@@ -651,7 +651,7 @@ class IpoptHardSolver : public FkSolver {
  public:
   IpoptHardSolver(std::shared_ptr<const Model> model, const FkOptions& options)
       : FkSolver(std::move(model)), options_(options) {}
-  std::string name() const override { return options_.solver; }
+  std::string name() const override { return ToString(options_.solver); }
 
   FkResult Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
                  const Eigen::MatrixX3d* warm_start) override {
@@ -759,14 +759,16 @@ bool HasIpoptSolver() { return true; }
 
 std::unique_ptr<FkSolver> MakeNlpSolver(std::shared_ptr<const Model> model,
                                         const FkOptions& options) {
-  if (options.solver == "ceres") return std::make_unique<CeresFkSolver>(std::move(model), options);
-  if (options.solver == "ipopt-lbfgs")
+  if (options.solver == FkSolverType::kCeres)
+    return std::make_unique<CeresFkSolver>(std::move(model), options);
+  if (options.solver == FkSolverType::kIpoptLbfgs)
     return std::make_unique<IpoptFkSolver>(std::move(model), options, false);
-  if (options.solver == "ipopt-newton")
+  if (options.solver == FkSolverType::kIpoptNewton)
     return std::make_unique<IpoptFkSolver>(std::move(model), options, true);
-  if (options.solver == "ipopt-hard")
+  if (options.solver == FkSolverType::kIpoptHard)
     return std::make_unique<IpoptHardSolver>(std::move(model), options);
-  throw std::invalid_argument("MakeNlpSolver: unknown solver '" + options.solver + "'");
+  throw std::invalid_argument("MakeNlpSolver: not a general-purpose optimiser: '" +
+                              ToString(options.solver) + "'");
 }
 
 }  // namespace softkin

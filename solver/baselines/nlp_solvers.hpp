@@ -53,7 +53,7 @@ bool HasCeresSolver();
 bool HasIpoptSolver();
 
 /// Builds "ceres", "ipopt-lbfgs", "ipopt-newton" or "ipopt-hard" (options.solver). Throws
-/// std::invalid_argument for any other name.
+/// std::invalid_argument for any other solver.
 std::unique_ptr<FkSolver> MakeNlpSolver(std::shared_ptr<const Model> model,
                                         const FkOptions& options);
 

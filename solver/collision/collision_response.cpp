@@ -27,7 +27,8 @@ bool AllTets(const Mesh& m) {
 }
 
 SpringSystem::Method UpdateMethod(const CollisionOptions& o) {
-  return o.update == "refactor" ? SpringSystem::Method::kRefactor : SpringSystem::Method::kUpdown;
+  return o.update == SpringUpdate::kRefactor ? SpringSystem::Method::kRefactor
+                                             : SpringSystem::Method::kUpdown;
 }
 }  // namespace
 
@@ -298,7 +299,7 @@ void CollisionResponse::SetSelfTarget(const Eigen::Ref<const Eigen::MatrixX3d>& 
   const Eigen::Vector3d p = X.row(s->vertex);
   const Eigen::Vector3d off = options_.epsilon * s->normal;
   s->face = {-1, -1, -1};
-  if (options_.self_spring == "pair") {
+  if (options_.self_spring == SelfSpring::kPair) {
     // Barycentric coordinates of the exit point in the face (clamped into it: the walk's exit
     // lies on the face up to round-off, the closest point on it exactly).
     const Eigen::Vector3d a = X.row(face[0]), b = X.row(face[1]), c = X.row(face[2]);
@@ -518,7 +519,7 @@ bool CollisionResponse::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) {
     CollisionSpring s;
     const int b = body_[model_.mesh().elements[c.tet].v[0]];
     bool ok;
-    if (options_.self_target == "auto" && !body_faces_.empty() && b != body_[c.vertex]) {
+    if (options_.self_target == SelfTarget::kAuto && !body_faces_.empty() && b != body_[c.vertex]) {
       // Between two bodies: the closest point of the other body's surface.
       if (body_surface_.empty()) body_surface_ = MakeBodySurfaces();
       if (!fresh[b]) {

@@ -158,7 +158,8 @@ class CollisionResponse : public ContactTerm {
   std::vector<MovingSurface> MakeBodySurfaces() const;
   /// Whether spring s is a plane (normal-only) obstacle spring.
   bool IsPlane(const CollisionSpring& s) const {
-    return s.kind == CollisionSpring::Kind::Obstacle && options_.obstacle_spring == "plane";
+    return s.kind == CollisionSpring::Kind::Obstacle &&
+           options_.obstacle_spring == ObstacleSpring::kPlane;
   }
   /// Rebuilds the Woodbury terms of the plane springs from springs_ (after any change of the
   /// springs, their normals, k or the factored system; `system_changed`: the factored system

@@ -19,29 +19,30 @@ std::unique_ptr<ContactTerm> SpringResponse(const Model& model, const CollisionO
 
 }  // namespace
 
-std::vector<std::string> FkSolverNames() {
-  return {"lg",         "lg-aa",           "newton",
-          "ceres",      "ipopt-lbfgs",     "ipopt-newton",
-          "ipopt-hard", "calculix-linear", "calculix-nonlinear"};
-}
-
 std::unique_ptr<FkSolver> MakeFkSolver(std::shared_ptr<const Model> model,
                                        const FkOptions& options) {
   std::string why;
   if (!options.IsValid(&why)) throw std::invalid_argument("solver options: " + why);
-  if (options.solver == "lg" || options.solver == "lg-aa")
-    return std::make_unique<LocalGlobalSolver>(std::move(model), options, SpringResponse);
-  if (options.solver == "newton")
-    return std::make_unique<NewtonSolver>(std::move(model), options, SpringResponse);
-  if (options.solver == "ceres" || options.solver == "ipopt-lbfgs" ||
-      options.solver == "ipopt-newton" || options.solver == "ipopt-hard")
-    return MakeNlpSolver(std::move(model), options);
-  if (options.solver == "calculix-linear" || options.solver == "calculix-nonlinear") {
-    CalculixOptions co;
-    co.law = options.solver == "calculix-linear" ? "linear" : "neo-hooke";
-    return std::make_unique<CalculixSolver>(std::move(model), options, co);
+  switch (options.solver) {
+    case FkSolverType::kLg:
+    case FkSolverType::kLgAa:
+      return std::make_unique<LocalGlobalSolver>(std::move(model), options, SpringResponse);
+    case FkSolverType::kNewton:
+      return std::make_unique<NewtonSolver>(std::move(model), options, SpringResponse);
+    case FkSolverType::kCeres:
+    case FkSolverType::kIpoptLbfgs:
+    case FkSolverType::kIpoptNewton:
+    case FkSolverType::kIpoptHard:
+      return MakeNlpSolver(std::move(model), options);
+    case FkSolverType::kCalculixLinear:
+    case FkSolverType::kCalculixNonlinear: {
+      CalculixOptions co;
+      co.law = options.solver == FkSolverType::kCalculixLinear ? "linear" : "neo-hooke";
+      return std::make_unique<CalculixSolver>(std::move(model), options, co);
+    }
   }
-  throw std::invalid_argument("unknown FK solver '" + options.solver + "'");
+  throw std::invalid_argument("unknown FK solver " +
+                              std::to_string(static_cast<int>(options.solver)));
 }
 
 FkResult SolveFk(const Scene& scene, const Eigen::Ref<const Eigen::VectorXd>& c,

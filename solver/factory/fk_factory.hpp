@@ -1,13 +1,13 @@
 #pragma once
 /// \file fk_factory.hpp
-/// Forward-kinematics solvers by name, with everything wired in: the two-tier API of SoftKin.
-///  - MakeFkSolver(model, options): the stateful solver named options.solver, which reuses the
+/// Forward-kinematics solvers by type, with everything wired in: the two-tier API of SoftKin.
+///  - MakeFkSolver(model, options): the stateful solver options.solver, which reuses the
 ///    model's factorisation across calls (sweeps, IK, datasets);
 ///  - SolveFk(scene, c): one shot, building the model first.
-/// Names: "lg" and "lg-aa" (local-global, solver/fk/, with the spring response of
-/// solver/collision/ when the scene has collision handling on), "ceres", "ipopt-lbfgs",
-/// "ipopt-newton", "ipopt-hard" (solver/baselines/nlp_solvers.hpp), "calculix-linear" and
-/// "calculix-nonlinear" (solver/baselines/calculix.hpp).
+/// Solvers (FkSolverType; FkSolverTypeNames() lists their names): "lg" and "lg-aa" (local-global,
+/// solver/fk/, with the spring response of solver/collision/ when the scene has collision handling
+/// on), "ceres", "ipopt-lbfgs", "ipopt-newton", "ipopt-hard" (solver/baselines/nlp_solvers.hpp),
+/// "calculix-linear" and "calculix-nonlinear" (solver/baselines/calculix.hpp).
 #include "softkin/solver/fk/fk_solver.hpp"
 
 #include <memory>
@@ -16,10 +16,8 @@
 
 namespace softkin {
 
-/// Names accepted by MakeFkSolver.
-std::vector<std::string> FkSolverNames();
-/// Builds the solver named options.solver; throws std::invalid_argument for an unknown name or
-/// invalid options (message from FkOptions::IsValid).
+/// Builds the solver options.solver; throws std::invalid_argument for invalid options (message
+/// from FkOptions::IsValid).
 std::unique_ptr<FkSolver> MakeFkSolver(std::shared_ptr<const Model> model,
                                        const FkOptions& options);
 

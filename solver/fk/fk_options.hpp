@@ -1,10 +1,64 @@
 #pragma once
 /// \file fk_options.hpp
 /// Options shared by the forward-kinematics solvers (Ceres-style: IsValid(&why)).
+#include <nlohmann/json_fwd.hpp>
+
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace softkin {
+
+// Every string-valued option is an enum with one list of names: ToString gives a value's name,
+// <Enum>FromString the value of a name (std::invalid_argument naming the string and listing the
+// names for any other), <Enum>Names every name in list order (the schema's and the help texts'
+// choices; solver/scene/solver_options_json.hpp reads and writes the options by these names). As
+// JSON (nlohmann's to_json / from_json, found by argument-dependent lookup) a value is its name,
+// never its number.
+
+/// How the factor follows the spring set (CollisionOptions::update).
+enum class SpringUpdate {
+  kUpdown,    ///< "updown": CHOLMOD update/downdate
+  kRefactor,  ///< "refactor": a numeric refactorisation
+};
+std::string ToString(SpringUpdate u);
+SpringUpdate SpringUpdateFromString(const std::string& s);
+std::vector<std::string> SpringUpdateNames();
+void to_json(nlohmann::json& j, SpringUpdate v);
+void from_json(const nlohmann::json& j, SpringUpdate& v);
+
+/// Where a self-collided vertex is sent (CollisionOptions::self_target).
+enum class SelfTarget {
+  kAuto,  ///< "auto"
+  kWalk,  ///< "walk"
+};
+std::string ToString(SelfTarget t);
+SelfTarget SelfTargetFromString(const std::string& s);
+std::vector<std::string> SelfTargetNames();
+void to_json(nlohmann::json& j, SelfTarget v);
+void from_json(const nlohmann::json& j, SelfTarget& v);
+
+/// What a self-collision spring pulls a vertex to (CollisionOptions::self_spring).
+enum class SelfSpring {
+  kTarget,  ///< "target"
+  kPair,    ///< "pair"
+};
+std::string ToString(SelfSpring s);
+SelfSpring SelfSpringFromString(const std::string& s);
+std::vector<std::string> SelfSpringNames();
+void to_json(nlohmann::json& j, SelfSpring v);
+void from_json(const nlohmann::json& j, SelfSpring& v);
+
+/// What an obstacle spring resists (CollisionOptions::obstacle_spring).
+enum class ObstacleSpring {
+  kPlane,  ///< "plane"
+  kPoint,  ///< "point"
+};
+std::string ToString(ObstacleSpring s);
+ObstacleSpring ObstacleSpringFromString(const std::string& s);
+std::vector<std::string> ObstacleSpringNames();
+void to_json(nlohmann::json& j, ObstacleSpring v);
+void from_json(const nlohmann::json& j, ObstacleSpring& v);
 
 /// Collision response (thesis Sec. 3.2.3, Eq. 3.5, 3.8, 3.9; collision_response.hpp). It is
 /// active in the local-global solvers when `self` is on or the scene has obstacles (and
@@ -22,7 +76,7 @@ struct CollisionOptions {
   /// before the solver is allowed to stop.
   int check_interval = 1;
   /// How the factor follows the spring set: "updown" (CHOLMOD update/downdate) or "refactor".
-  std::string update = "updown";
+  SpringUpdate update = SpringUpdate::kUpdown;
   /// Where a self-collided vertex is sent. "walk" (the default): along -n(v) through the
   /// collided region to its boundary (the thesis's rule, Sec. 3.2.3) for every contact. "auto":
   /// the same within one body, but a vertex inside another body of the mesh (a separate
@@ -30,14 +84,14 @@ struct CollisionOptions {
   /// body's surface facing it, never further than the shortest way out. Not the default: on the
   /// measured cases it converges no better, and it unbalances the pressed blocks' contact forces
   /// more (docs/collision_response.md).
-  std::string self_target = "walk";
+  SelfTarget self_target = SelfTarget::kWalk;
   /// What a self-collision spring pulls a vertex v to. "target" (the default, Eq. 3.5): a fixed
   /// point v_c, half way to the exit point plus eps (both sides of a contact get springs), set at
   /// each check. "pair": the exit point as a point of the exit face, sum_i w_i x_fi, plus eps:
   /// the energy k ||v - sum_i w_i x_fi - delta||^2 moves with the face and loads both sides
   /// equally and oppositely (action and reaction), so it couples v with the face's vertices in
   /// the global matrix (SpringSystem).
-  std::string self_spring = "target";
+  SelfSpring self_spring = SelfSpring::kTarget;
   /// What an obstacle spring resists. "plane" (the default): only the normal part of the offset
   /// to v_c (the closest point plus eps), k (n . (v - v_c))^2, against the obstacle's tangent
   /// plane at v_c: a frictionless contact. Its n n^T term couples a vertex's x, y and z, so the
@@ -45,14 +99,45 @@ struct CollisionOptions {
   /// "point" (Eq. 3.5 as written): k ||v - v_c||^2, refreshed at each check; it has the same
   /// fixed point, but between checks it also holds the vertex tangentially, so a sliding contact
   /// creeps by the tangential force / k per check (docs/collision_response.md).
-  std::string obstacle_spring = "plane";
+  ObstacleSpring obstacle_spring = ObstacleSpring::kPlane;
   bool IsValid(std::string* why) const;
 };
 
+/// The forward-kinematics solvers (solver/factory/fk_factory.hpp builds them).
+enum class FkSolverType {
+  kLg,                 ///< "lg": plain local-global (Algorithm 1)
+  kLgAa,               ///< "lg-aa": Anderson-accelerated local-global
+  kNewton,             ///< "newton": Newton-Krylov on the same equilibrium (solver/newton/)
+  kCeres,              ///< "ceres": the energy by Ceres (solver/baselines/nlp_solvers.hpp)
+  kIpoptLbfgs,         ///< "ipopt-lbfgs": the energy by Ipopt with L-BFGS
+  kIpoptNewton,        ///< "ipopt-newton": the energy by Ipopt with the exact Hessian
+  kIpoptHard,          ///< "ipopt-hard": body energy, hard actuation constraints, by Ipopt
+  kCalculixLinear,     ///< "calculix-linear": FEM baseline (solver/baselines/calculix.hpp)
+  kCalculixNonlinear,  ///< "calculix-nonlinear": FEM baseline, neo-Hookean
+};
+std::string ToString(FkSolverType t);
+FkSolverType FkSolverTypeFromString(const std::string& s);
+/// Every solver name, in enum order: the one list of solvers.
+std::vector<std::string> FkSolverTypeNames();
+void to_json(nlohmann::json& j, FkSolverType v);
+void from_json(const nlohmann::json& j, FkSolverType& v);
+
+/// Which Anderson steps are kept (FkOptions::anderson_safeguard).
+enum class AndersonSafeguard {
+  kHybrid,  ///< "hybrid"
+  kEnergy,  ///< "energy"
+  kNone,    ///< "none"
+};
+std::string ToString(AndersonSafeguard g);
+AndersonSafeguard AndersonSafeguardFromString(const std::string& s);
+std::vector<std::string> AndersonSafeguardNames();
+void to_json(nlohmann::json& j, AndersonSafeguard v);
+void from_json(const nlohmann::json& j, AndersonSafeguard& v);
+
 struct FkOptions {
-  /// Solver name: "lg" (plain local-global, Algorithm 1), "lg-aa" (Anderson-accelerated), or one
-  /// of the general-purpose optimisers of nlp_solvers.hpp: "ceres", "ipopt-lbfgs", "ipopt-newton".
-  std::string solver = "lg-aa";
+  /// The solver: lg (plain local-global, Algorithm 1), lg-aa (Anderson-accelerated), or one of the
+  /// general-purpose optimisers and FEM baselines (FkSolverType).
+  FkSolverType solver = FkSolverType::kLgAa;
   int max_iterations = 10000;
   /// Stop when every vertex moves less than tolerance * model size in one iteration ...
   double tolerance = 1e-5;
@@ -67,7 +152,7 @@ struct FkOptions {
   /// local_global.hpp): "hybrid" keeps it if it lowers the energy OR the fixed-point residual
   /// ||G(x) - x|| relative to the point it extrapolates from; "energy" keeps it only if it does not
   /// raise the energy (Peng et al. 2018); "none" keeps every finite step.
-  std::string anderson_safeguard = "hybrid";
+  AndersonSafeguard anderson_safeguard = AndersonSafeguard::kHybrid;
   /// Apply the actuation in this many equal steps (continuation), warm-starting each.
   int continuation_steps = 1;
   /// OpenMP threads for the local step (0 = library default).

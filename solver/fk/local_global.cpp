@@ -33,6 +33,73 @@ double MaxRelativeMove(const Model& m, const Eigen::VectorXd& step, Eigen::Matri
   m.ScatterFree(step, Mv);
   return Mv->rowwise().norm().maxCoeff() / m.size();
 }
+
+/// What one continuation stage evaluates at the current positions X (the caller's): the local
+/// step with its energy and right-hand side B_f (and the contact term's part), the free
+/// coordinates x_f and the residual. Holds B, B_f, x_f and scratch; the per-element targets and
+/// the local step's time are the solver's.
+struct StageEvaluation {
+  StageEvaluation(const Model& model, const Eigen::VectorXd& actuation, Eigen::MatrixX3d* positions,
+                  ContactTerm* contacts, std::vector<double>* element_ratios,
+                  std::vector<ElemRows>* element_rows, int num_threads, double* local_seconds)
+      : m(model),
+        c(actuation),
+        X(*positions),
+        resp(contacts),
+        ratios(*element_ratios),
+        weighted(*element_rows),
+        nt(num_threads),
+        local_time_s(local_seconds),
+        B(model.num_vertices(), 3),
+        Bf(model.num_free_dofs()),
+        xf(model.num_free_dofs()),
+        AX(model.num_free_dofs()) {}
+
+  /// The local step at X: the targets, the energy *E and B_f.
+  void Local(double* E) {
+    const auto t0 = Clock::now();
+    ComputeLocalRatios(m, X, c, &ratios);
+    *E = LocalStep(m, X, ratios, &weighted, nt);
+    AssembleRhs(m, weighted, &B, nt);
+    m.GatherFree(B, &Bf);
+    if (resp) {
+      *E += resp->Energy(X);
+      resp->AddToRhs(X, &Bf);
+    }
+    *local_time_s += Seconds(t0, Clock::now());
+  }
+  void StoreFree(const Eigen::VectorXd& y) { m.ScatterFree(y, &X); }
+  /// ||A_ff x_f + A_fc x_c - B_f||: the energy gradient over the free coordinates (up to 2).
+  /// Loads x_f from X as well.
+  double Residual() {
+    m.GatherFree(X, &xf);
+    m.GatherFree(m.A() * X, &AX);
+    if (resp) resp->AddSpringProduct(xf, &AX);
+    return 2.0 * (AX - Bf).norm();
+  }
+  /// The residual at the rest shape for this actuation (X is restored afterwards).
+  double RestResidual() {
+    const Eigen::MatrixX3d keep = X;
+    X = m.rest_positions();
+    m.ApplyConstraints(c, &X);
+    double E0;
+    Local(&E0);
+    const double ref = Residual();
+    X = keep;
+    return ref;
+  }
+
+  const Model& m;
+  const Eigen::VectorXd& c;
+  Eigen::MatrixX3d& X;
+  ContactTerm* resp;
+  std::vector<double>& ratios;
+  std::vector<ElemRows>& weighted;
+  int nt;
+  double* local_time_s;
+  Eigen::MatrixX3d B;
+  Eigen::VectorXd Bf, xf, AX;
+};
 }  // namespace
 
 LocalGlobalSolver::LocalGlobalSolver(std::shared_ptr<const Model> model, const FkOptions& options,
@@ -47,50 +114,25 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
   Eigen::MatrixX3d& X = *Xp;
   const int nf = m.num_free_dofs();
   const int nt = options_.threads;
-  const bool aa_on = options_.solver == "lg-aa";
+  const bool aa_on = options_.solver == FkSolverType::kLgAa;
   const double tol = options_.tolerance;
   const double gtol = options_.gradient_tolerance;
 
   m.ApplyConstraints(c, &X);  // the prescribed coordinates for this actuation
   const Eigen::VectorXd Cfix = PrescribedRhs(m, c);
 
-  Eigen::MatrixX3d B(m.num_vertices(), 3), Mv(m.num_vertices(), 3);
-  Eigen::VectorXd Bf(nf), xf(nf), Gf(nf), Gprev(nf), step(nf), AX(nf);
+  Eigen::MatrixX3d Mv(m.num_vertices(), 3);
+  Eigen::VectorXd Gf(nf), Gprev(nf), step(nf);
   ContactTerm* resp = response_.get();
-  auto local = [&](double* E) {
-    const auto t0 = Clock::now();
-    ComputeLocalRatios(m, X, c, &ratios_);
-    *E = LocalStep(m, X, ratios_, &weighted_, nt);
-    AssembleRhs(m, weighted_, &B, nt);
-    m.GatherFree(B, &Bf);
-    if (resp) {
-      *E += resp->Energy(X);
-      resp->AddToRhs(X, &Bf);
-    }
-    r->local_time_s += Seconds(t0, Clock::now());
-  };
-  auto load_free = [&]() { m.GatherFree(X, &xf); };
-  auto store_free = [&](const Eigen::VectorXd& y) { m.ScatterFree(y, &X); };
-  // ||A_ff x_f + A_fc x_c - B_f||: the energy gradient over the free coordinates (up to 2).
-  // Loads x_f from X as well.
-  auto residual = [&]() {
-    load_free();
-    m.GatherFree(m.A() * X, &AX);
-    if (resp) resp->AddSpringProduct(xf, &AX);
-    return 2.0 * (AX - Bf).norm();
-  };
+  StageEvaluation ev(m, c, &X, resp, &ratios_, &weighted_, nt, &r->local_time_s);
+  const Eigen::VectorXd& Bf = ev.Bf;
+  const Eigen::VectorXd& xf = ev.xf;
 
   // Reference residual: the residual at the rest shape for this actuation. It depends on c only,
   // so it is cached across calls (sweeps and finite differences re-solve the same c often).
   if (ref_c_.size() != c.size() || ref_c_ != c) {
-    const Eigen::MatrixX3d keep = X;
-    X = m.rest_positions();
-    m.ApplyConstraints(c, &X);
-    double E0;
-    local(&E0);
-    ref_value_ = residual();
+    ref_value_ = ev.RestResidual();
     ref_c_ = c;
-    X = keep;
   }
   double ref = ref_value_;
 
@@ -98,12 +140,12 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     for (const auto& e : m.elements()) total_weight_ += e.wv;
   Anderson aa(nf, options_.anderson_window);
   Eigen::MatrixX3d X_good = X;
-  const std::string& guard = options_.anderson_safeguard;
+  const AndersonSafeguard guard = options_.anderson_safeguard;
   // Merits of the iterate an accelerated step was extrapolated from.
   double base_E = 0.0, base_f = 0.0;
   bool accelerated = false;  // X is an Anderson (extrapolated) iterate, not yet checked
   auto reject = [&]() {      // fall back to the plain step G(x_k); the history is kept
-    store_free(Gprev);
+    ev.StoreFree(Gprev);
     ++r->aa_rejected;
     accelerated = false;
   };
@@ -121,10 +163,10 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
       accelerated = false;
     }
     double E;
-    local(&E);
-    const double grad = residual();
+    ev.Local(&E);
+    const double grad = ev.Residual();
     const bool finite = std::isfinite(E) && X.allFinite() && std::isfinite(grad);
-    if (accelerated && (!finite || (guard == "energy" && !(E <= base_E)))) {
+    if (accelerated && (!finite || (guard == AndersonSafeguard::kEnergy && !(E <= base_E)))) {
       reject();
       ++r->iterations;
       continue;
@@ -153,7 +195,7 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     step = Gf - xf;
     const double fnorm = step.norm();  // fixed-point residual ||G(x) - x||
     if (accelerated) {
-      if (guard == "hybrid" && !(E <= base_E || fnorm <= base_f)) {
+      if (guard == AndersonSafeguard::kHybrid && !(E <= base_E || fnorm <= base_f)) {
         reject();
         continue;
       }
@@ -173,7 +215,7 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
     // round-off) counts as converged whatever the ratio.
     const bool roundoff = grad <= 1e-12 * total_weight_ * m.size();
     if (move < tol && (r->gradient_ratio < gtol || roundoff)) {
-      store_free(Gf);
+      ev.StoreFree(Gf);
       // With collisions, stop only if a check at this state leaves the spring set as it is.
       if (resp &&
           (resp->Update(X) || (resp->HasHandledContacts(resp->Check(X)) && resp->Stiffen()))) {
@@ -190,9 +232,9 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
       base_E = E;
       base_f = fnorm;
       accelerated = aa.history() > 0;
-      store_free(xn);
+      ev.StoreFree(xn);
     } else {
-      store_free(Gf);
+      ev.StoreFree(Gf);
     }
   }
   X = X_good;  // never return an unchecked (extrapolated) iterate

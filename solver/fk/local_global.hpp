@@ -39,7 +39,7 @@ class LocalGlobalSolver : public FkSolver {
   /// MakeFkSolver (solver/factory/fk_factory.hpp) passes the spring response of solver/collision/.
   LocalGlobalSolver(std::shared_ptr<const Model> model, const FkOptions& options,
                     ContactTermFactory contacts = {});
-  std::string name() const override { return options_.solver; }
+  std::string name() const override { return ToString(options_.solver); }
   FkResult Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
                  const Eigen::MatrixX3d* warm_start = nullptr) override;
   const FkOptions& options() const { return options_; }

@@ -311,7 +311,7 @@ FkResult NewtonSolver::Fallback(const Eigen::VectorXd& c, const Eigen::MatrixX3d
                                 const std::string& reason, const FkResult& so_far,
                                 Clock::time_point t0) {
   FkOptions o = options_;
-  o.solver = "lg-aa";
+  o.solver = FkSolverType::kLgAa;
   if (deadline_) o.time_limit_s = std::max(1e-3, Seconds(Clock::now(), *deadline_));
   LocalGlobalSolver lg(model_, o, contacts_);
   FkResult f = lg.Solve(c, start);

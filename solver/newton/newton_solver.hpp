@@ -54,7 +54,7 @@ class NewtonSolver : public FkSolver {
   /// (MakeFkSolver passes the spring response of solver/collision/).
   NewtonSolver(std::shared_ptr<const Model> model, const FkOptions& options,
                ContactTermFactory contacts = {});
-  std::string name() const override { return "newton"; }
+  std::string name() const override { return ToString(FkSolverType::kNewton); }
   FkResult Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
                  const Eigen::MatrixX3d* warm_start = nullptr) override;
   const FkOptions& options() const { return options_; }

@@ -45,7 +45,7 @@ Material MooneyRivlinMaterial(const std::string& name, const std::string& named,
   if (!NamedMooneyRivlin(named, &mr))
     throw std::logic_error("unknown built-in material '" + named + "'");
   Material m{name, 1.0, weight};
-  m.law = "mooney-rivlin";
+  m.law = MaterialLaw::kMooneyRivlin;
   m.c1 = mr.c1;
   m.c2 = mr.c2;
   return m;

@@ -159,7 +159,7 @@ Scene MakeTwistingRobot(int res, const RobotParams& P) {
   if (Param(P, "hyperelastic", 1.0) >= 0.5) {
     MooneyRivlin eco;
     NamedMooneyRivlin("ecoflex-00-30", &eco);
-    s.body[0] = Material{"ecoflex-00-30", 1.0, 1.0, "mooney-rivlin", eco.c1, eco.c2};
+    s.body[0] = Material{"ecoflex-00-30", 1.0, 1.0, MaterialLaw::kMooneyRivlin, eco.c1, eco.c2};
   } else {
     s.body[0] = Material{"as-rigid-as-possible", 1.0, 1.0};  // Ch. 2 shape blending, R_omega = 1
   }

@@ -1,5 +1,7 @@
 #include "softkin/solver/scene/scene.hpp"
 
+#include "softkin/solver/common/enum_names.hpp"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -9,6 +11,19 @@
 #include <stdexcept>
 
 namespace softkin {
+
+namespace {
+constexpr EnumName<MaterialLaw> kLawNames[] = {
+    {MaterialLaw::kBlend, "blend"},
+    {MaterialLaw::kMooneyRivlin, "mooney-rivlin"},
+};
+}  // namespace
+
+std::string ToString(MaterialLaw law) { return EnumToString(kLawNames, law); }
+MaterialLaw MaterialLawFromString(const std::string& s) {
+  return EnumFromString(kLawNames, s, "material law");
+}
+std::vector<std::string> MaterialLawNames() { return EnumNames(kLawNames); }
 
 const char* ActuatorTypeToString(ActuatorType t) {
   switch (t) {
@@ -111,9 +126,6 @@ std::string BodyMaterialError(int tag, const Material& mat) {
     return "body region " + std::to_string(tag) + ": r_omega must be in [0, 1], got " +
            std::to_string(mat.r_omega);
   if (!(mat.weight > 0.0)) return "body region " + std::to_string(tag) + ": weight must be > 0";
-  if (mat.law != "blend" && mat.law != "mooney-rivlin")
-    return "body region " + std::to_string(tag) +
-           ": law must be \"blend\" or \"mooney-rivlin\", got \"" + mat.law + "\"";
   if (mat.hyperelastic() && !(mat.c1 >= 0 && mat.c2 >= 0 && mat.c1 + mat.c2 > 0 && mat.r_omega > 0))
     return "body region " + std::to_string(tag) +
            ": a mooney-rivlin material needs c1, c2 >= 0 "

@@ -21,13 +21,23 @@ namespace softkin {
 /// law "mooney-rivlin": the hyperelastic target of Eq. 3.6-3.7 with R_omega a function of strain,
 /// fitted to the Mooney-Rivlin constants c1, c2 (MPa) with r_omega as its zero-strain value
 /// (solver/materials/hyperelastic.hpp).
+/// A body material's law (Material::law). Names as for the FK options (fk_options.hpp): ToString,
+/// MaterialLawFromString, MaterialLawNames.
+enum class MaterialLaw {
+  kBlend,         ///< "blend"
+  kMooneyRivlin,  ///< "mooney-rivlin"
+};
+std::string ToString(MaterialLaw law);
+MaterialLaw MaterialLawFromString(const std::string& s);
+std::vector<std::string> MaterialLawNames();
+
 struct Material {
   std::string name = "default";
   double r_omega = 1.0;
   double weight = 1.0;
-  std::string law = "blend";
+  MaterialLaw law = MaterialLaw::kBlend;
   double c1 = 0.0, c2 = 0.0;
-  bool hyperelastic() const { return law == "mooney-rivlin"; }
+  bool hyperelastic() const { return law == MaterialLaw::kMooneyRivlin; }
 };
 
 /// Element actuators (pneumatic, cable, DEA) drive actuation elements. Motion actuators

@@ -62,10 +62,10 @@ Material SceneParser::ReadBodyMaterial(const json& r, const std::string& path,
   mat.name = Get(r, "regions[]", "material", role).get<std::string>();
   mat.r_omega = Get(r, "regions[]", "r_omega", role).get<double>();
   mat.weight = Get(r, "regions[]", "weight", role).get<double>();
-  mat.law = Get(r, "regions[]", "law", role).get<std::string>();
+  mat.law = MaterialLawFromString(Get(r, "regions[]", "law", role).get<std::string>());
   const bool has_c = r.contains("c1") || r.contains("c2");
   if (has_c && !mat.hyperelastic())
-    Fail(path + ": c1 / c2 are given but law is \"" + mat.law +
+    Fail(path + ": c1 / c2 are given but law is \"" + ToString(mat.law) +
          "\"; expected law \"mooney-rivlin\" with them");
   if (mat.hyperelastic()) {
     MooneyRivlin mr;

@@ -3,7 +3,6 @@
 /// it, and the schema printed from it (SceneSchema, scene_json.hpp).
 #include "softkin/solver/scene/scene_keys.hpp"
 
-#include "softkin/solver/fk/fk_options.hpp"
 #include "softkin/solver/scene/scene.hpp"
 #include "softkin/solver/scene/scene_json.hpp"
 
@@ -88,8 +87,8 @@ void AddRegionKeys(std::vector<KeySpec>* t) {
                    "Body material law: blend (Ch. 2 shape blending, Eq. 2.5, constant r_omega) or "
                    "mooney-rivlin (hyperelastic target, Eq. 3.6-3.7: R_omega a function of strain "
                    "fitted to c1, c2, with r_omega its zero-strain value; docs/materials.md).")
-                   .Def(mat.law)
-                   .Choices({"blend", "mooney-rivlin"})
+                   .Def(ToString(mat.law))
+                   .Choices(MaterialLawNames())
                    .Roles({"body"}));
   t->push_back(Key("regions[].c1", N, Opt,
                    "mooney-rivlin: c1, MPa (>= 0). Needed unless 'material' names a known "
@@ -259,111 +258,6 @@ void AddObstacleKeys(std::vector<KeySpec>* t) {
           .Roles({"file"}));
 }
 
-/// solver: the scene's default FkOptions.
-void AddSolverKeys(std::vector<KeySpec>* t) {
-  const FkOptions fk;
-  t->push_back(Key("solver", O, Opt, "Default forward-kinematics solver options of this scene.")
-                   .Def(json::object()));
-  t->push_back(Key("solver.solver", S, Opt,
-                   "lg: plain local-global (Algorithm 1); lg-aa: Anderson-accelerated "
-                   "local-global; newton: Newton-Krylov on the same equilibrium, with load "
-                   "stepping; ceres, ipopt-lbfgs, ipopt-newton: the same energy minimised by "
-                   "Ceres or Ipopt; ipopt-hard: body energy with hard actuation constraints; "
-                   "calculix-linear, calculix-nonlinear: FEM baselines by CalculiX "
-                   "(docs/solvers.md).")
-                   .Def(fk.solver)
-                   .Choices({"lg", "lg-aa", "newton", "ceres", "ipopt-lbfgs", "ipopt-newton",
-                             "ipopt-hard", "calculix-linear", "calculix-nonlinear"}));
-  t->push_back(Key("solver.max_iterations", I, Opt, "Iteration limit (per continuation step).")
-                   .Def(fk.max_iterations)
-                   .AtLeast(1));
-  t->push_back(Key("solver.tolerance", N, Opt,
-                   "Converged when every vertex moves less than tolerance x model size in one "
-                   "iteration ...")
-                   .Def(fk.tolerance)
-                   .Above(0.0));
-  t->push_back(Key("solver.gradient_tolerance", N, Opt,
-                   "... and the energy gradient norm is below this fraction of its first value.")
-                   .Def(fk.gradient_tolerance)
-                   .Above(0.0));
-  t->push_back(
-      Key("solver.anderson_window", I, Opt, "History length of Anderson acceleration (lg-aa).")
-          .Def(fk.anderson_window)
-          .In(1, 50));
-  t->push_back(Key("solver.anderson_safeguard", S, Opt,
-                   "Keep an Anderson step if it lowers the energy or the fixed-point residual "
-                   "(hybrid), only if it does not raise the energy (energy), or always (none).")
-                   .Def(fk.anderson_safeguard)
-                   .Choices({"hybrid", "energy", "none"}));
-  t->push_back(Key("solver.continuation_steps", I, Opt,
-                   "Apply the actuation in this many equal steps, warm-starting each.")
-                   .Def(fk.continuation_steps)
-                   .AtLeast(1));
-  t->push_back(
-      Key("solver.threads", I, Opt, "OpenMP threads for the local step (0: library default).")
-          .Def(fk.threads)
-          .AtLeast(0));
-  t->push_back(Key("solver.time_limit_s", N, Opt,
-                   "Wall-clock limit of one solve in seconds (0: none); when it runs out the "
-                   "solve ends with status time_limit and its last checked state.")
-                   .Def(fk.time_limit_s)
-                   .AtLeast(0.0));
-}
-
-/// solver.collision: its CollisionOptions.
-void AddCollisionKeys(std::vector<KeySpec>* t) {
-  const CollisionOptions co;
-  t->push_back(Key("solver.collision", O, Opt,
-                   "Collision response by springs (Sec. 3.2.3, Eq. 3.5, 3.8, 3.9; lg and lg-aa).")
-                   .Def(json::object()));
-  t->push_back(Key("solver.collision.self", Type::Bool, Opt,
-                   "Respond to self-collision: boundary vertices inside tets not incident to them "
-                   "(tet meshes only).")
-                   .Def(co.self));
-  t->push_back(
-      Key("solver.collision.obstacles", Type::Bool, Opt, "Respond to the scene's obstacles.")
-          .Def(co.obstacles));
-  t->push_back(Key("solver.collision.epsilon", N, Opt,
-                   "Offset of the contact boundary (mm): springs pull vertices this far beyond it "
-                   "and release them once they are this far beyond their target (Eq. 3.8).")
-                   .Def(co.epsilon)
-                   .AtLeast(0.0));
-  t->push_back(Key("solver.collision.stiffness", N, Opt,
-                   "Spring stiffness k (Eq. 3.5) relative to the median diagonal entry of the "
-                   "global matrix over the boundary vertices.")
-                   .Def(co.stiffness)
-                   .Above(0.0));
-  t->push_back(Key("solver.collision.check_interval", I, Opt,
-                   "Run collision detection every this many iterations (and before stopping).")
-                   .Def(co.check_interval)
-                   .AtLeast(1));
-  t->push_back(Key("solver.collision.update", S, Opt,
-                   "How the factor follows the spring set: CHOLMOD update/downdate, or a numeric "
-                   "refactorisation.")
-                   .Def(co.update)
-                   .Choices({"updown", "refactor"}));
-  t->push_back(Key("solver.collision.self_target", S, Opt,
-                   "Where a self-collided vertex is sent: 'walk' along -n(v) through the collided "
-                   "region (the thesis's rule) for every contact, or 'auto': the same within one "
-                   "body, the closest facing point of the other body's surface between separate "
-                   "bodies.")
-                   .Def(co.self_target)
-                   .Choices({"auto", "walk"}));
-  t->push_back(Key("solver.collision.self_spring", S, Opt,
-                   "What a self-collision spring pulls its vertex to: a fixed 'target' half way "
-                   "to the exit point (Eq. 3.5), or 'pair': the exit point as a point of the "
-                   "exit face, which moves with the face and loads both sides equally.")
-                   .Def(co.self_spring)
-                   .Choices({"target", "pair"}));
-  t->push_back(Key("solver.collision.obstacle_spring", S, Opt,
-                   "What an obstacle spring resists: 'plane', only the normal part of the offset "
-                   "to the closest point plus eps, against the obstacle's tangent plane "
-                   "(frictionless), or 'point', the whole offset (Eq. 3.5 as written; it holds "
-                   "the vertex tangentially between checks, so sliding contacts creep).")
-                   .Def(co.obstacle_spring)
-                   .Choices({"plane", "point"}));
-}
-
 std::string RangeText(const KeySpec& k) {
   const bool has_lo = std::isfinite(k.lo), has_hi = std::isfinite(k.hi);
   if (has_lo && has_hi)
@@ -389,8 +283,8 @@ const std::vector<KeySpec>& KeyTable() {
     AddFixedAndMotionKeys(&t);
     AddMarkerKeys(&t);
     AddObstacleKeys(&t);
-    AddSolverKeys(&t);
-    AddCollisionKeys(&t);
+    const std::vector<KeySpec> solver = SolverKeySpecs();  // from the FK option table
+    t.insert(t.end(), solver.begin(), solver.end());
     return t;
   }();
   return table;

@@ -3,8 +3,9 @@
 /// The scene JSON's key table, private to solver/scene (not public API; scene_json.hpp is). One
 /// table (KeyTable()) drives both the validator (scene_parser.hpp) and SceneSchema(): every key
 /// path, its type, range or allowed values, default, role condition and doc line live there, and
-/// the parser takes its defaults from it, so the documentation cannot drift from the code. Also
-/// the value checks against a key's spec and the text helpers of the reader's messages.
+/// the parser takes its defaults from it, so the documentation cannot drift from the code. The
+/// `solver` object's entries are generated from the FK option table (solver_options_json.hpp).
+/// Also the value checks against a key's spec and the text helpers of the reader's messages.
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
@@ -82,6 +83,9 @@ struct KeySpec {
 
 /// Every key of the scene JSON, in schema order (parents before their children).
 const std::vector<KeySpec>& KeyTable();
+
+/// The `solver` object's keys: generated from the FK option table (solver_options_json.cpp).
+std::vector<KeySpec> SolverKeySpecs();
 
 /// "a.b.c" -> "a.b"; "a" -> "".
 std::string ParentOf(const std::string& path);

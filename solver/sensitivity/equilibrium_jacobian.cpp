@@ -5,6 +5,7 @@
 /// equilibrium_linearization.cpp.
 #include "softkin/solver/sensitivity/equilibrium_jacobian.hpp"
 
+#include "softkin/solver/common/enum_names.hpp"
 #include "softkin/solver/sensitivity/free_operator.hpp"
 #include "softkin/solver/sensitivity/gmres.hpp"
 
@@ -24,6 +25,29 @@
 
 namespace softkin {
 
+namespace {
+constexpr EnumName<KrylovMethod> kKrylovNames[] = {
+    {KrylovMethod::kGmres, "gmres"},
+    {KrylovMethod::kBicgstab, "bicgstab"},
+};
+constexpr EnumName<JacobianPreconditioner> kPreconditionerNames[] = {
+    {JacobianPreconditioner::kAff, "A_ff"},
+    {JacobianPreconditioner::kLocal, "local"},
+};
+}  // namespace
+
+std::string ToString(KrylovMethod k) { return EnumToString(kKrylovNames, k); }
+KrylovMethod KrylovMethodFromString(const std::string& s) {
+  return EnumFromString(kKrylovNames, s, "Krylov method");
+}
+std::vector<std::string> KrylovMethodNames() { return EnumNames(kKrylovNames); }
+
+std::string ToString(JacobianPreconditioner p) { return EnumToString(kPreconditionerNames, p); }
+JacobianPreconditioner JacobianPreconditionerFromString(const std::string& s) {
+  return EnumFromString(kPreconditionerNames, s, "preconditioner");
+}
+std::vector<std::string> JacobianPreconditionerNames() { return EnumNames(kPreconditionerNames); }
+
 bool EquilibriumJacobianOptions::IsValid(std::string* why) const {
   auto bad = [&](const std::string& m) {
     if (why) *why = m;
@@ -35,11 +59,6 @@ bool EquilibriumJacobianOptions::IsValid(std::string* why) const {
   if (restart < 1 || restart > 1000)
     return bad("implicit.restart: expected an integer in [1, 1000]");
   if (threads < 0) return bad("implicit.threads: expected an integer >= 0");
-  if (krylov != "gmres" && krylov != "bicgstab")
-    return bad("implicit.krylov: expected one of gmres, bicgstab; got '" + krylov + "'");
-  if (preconditioner != "A_ff" && preconditioner != "local")
-    return bad("implicit.preconditioner: expected one of A_ff, local; got '" + preconditioner +
-               "'");
   return true;
 }
 
@@ -433,10 +452,10 @@ bool AssembleDxdc(const Model& model, const FreeOperator& op, const std::vector<
     const int a = columns[j];
     if (!Yf.col(j).allFinite() || !(rels[j] <= options.tolerance)) {
       std::ostringstream s;
-      s << "implicit Jacobian: " << (options.krylov == "bicgstab" ? "BiCGSTAB" : "GMRES")
-        << " for actuator '" << model.scene().actuators[a].name << "' stopped at relative residual "
-        << rels[j] << " after " << res->iterations[j] << " iterations (tolerance "
-        << options.tolerance << ")";
+      s << "implicit Jacobian: "
+        << (options.krylov == KrylovMethod::kBicgstab ? "BiCGSTAB" : "GMRES") << " for actuator '"
+        << model.scene().actuators[a].name << "' stopped at relative residual " << rels[j]
+        << " after " << res->iterations[j] << " iterations (tolerance " << options.tolerance << ")";
       res->message = s.str();
       res->dXdc.resize(0, 0);
       return false;
@@ -486,7 +505,7 @@ EquilibriumJacobianResult ComputeEquilibriumJacobian(const Model& model,
   res.preconditioner = "A_ff";
   bool reused = false;
   // The local preconditioner: factored now, or the workspace's factor of an earlier state.
-  if (options.preconditioner == "local") {
+  if (options.preconditioner == JacobianPreconditioner::kLocal) {
     if (options.reuse_preconditioner && ws->model == &model && ws->not_positive_definite)
       res.preconditioner = "A_ff (the local preconditioner was not positive definite earlier)";
     else
@@ -500,7 +519,7 @@ EquilibriumJacobianResult ComputeEquilibriumJacobian(const Model& model,
   Eigen::MatrixXd Yf(nf, nc);
   std::vector<double> rels(nc, 0.0);
   res.iterations.assign(nc, 0);
-  if (options.krylov == "bicgstab") {
+  if (options.krylov == KrylovMethod::kBicgstab) {
     for (int j = 0; j < nc; ++j) {
       Eigen::VectorXd y = Y0.col(j);
       res.iterations[j] =
@@ -510,7 +529,8 @@ EquilibriumJacobianResult ComputeEquilibriumJacobian(const Model& model,
     }
   } else {
     auto [converged, rounds] = SolveGmresColumns(&op, rhs, Y0, options, &Yf, &rels, &res);
-    if (options.preconditioner == "local" && res.preconditioner.rfind("local (reused)", 0) == 0) {
+    if (options.preconditioner == JacobianPreconditioner::kLocal &&
+        res.preconditioner.rfind("local (reused)", 0) == 0) {
       // A factor of an earlier state that no longer helps: factor now, and retry if it failed.
       const int limit = std::max(2 * ws->fresh_rounds, ws->fresh_rounds + 10);
       if (!converged || rounds > limit) ws->stale = true;

@@ -78,9 +78,28 @@ class EquilibriumJacobianWorkspace {
   std::unique_ptr<Impl> impl_;
 };
 
+/// The Krylov method of the implicit solve (EquilibriumJacobianOptions::krylov). Names as for the
+/// FK options (fk_options.hpp): ToString, KrylovMethodFromString, KrylovMethodNames.
+enum class KrylovMethod {
+  kGmres,     ///< "gmres": restarted GMRES
+  kBicgstab,  ///< "bicgstab": BiCGSTAB, no stored basis
+};
+std::string ToString(KrylovMethod k);
+KrylovMethod KrylovMethodFromString(const std::string& s);
+std::vector<std::string> KrylovMethodNames();
+
+/// The preconditioner of the implicit solve (EquilibriumJacobianOptions::preconditioner).
+enum class JacobianPreconditioner {
+  kAff,    ///< "A_ff": the global step's prefactored matrix
+  kLocal,  ///< "local": A_ff - sym(K_local), factored
+};
+std::string ToString(JacobianPreconditioner p);
+JacobianPreconditioner JacobianPreconditionerFromString(const std::string& s);
+std::vector<std::string> JacobianPreconditionerNames();
+
 struct EquilibriumJacobianOptions {
   /// Krylov method: "gmres" (restarted, see restart) or "bicgstab" (no stored basis).
-  std::string krylov = "gmres";
+  KrylovMethod krylov = KrylovMethod::kGmres;
   /// Stop GMRES when the preconditioned residual has dropped by this factor (relative to the
   /// preconditioned right-hand side, whatever the starting guess).
   double tolerance = 1e-8;
@@ -104,7 +123,7 @@ struct EquilibriumJacobianOptions {
   /// ARAP Hessian; only the groups' rank-one coupling and the skew part are left to GMRES) but a
   /// factorisation of 3 #V unknowns; falls back to A_ff if it is not positive definite
   /// (docs/kinematics.md).
-  std::string preconditioner = "local";
+  JacobianPreconditioner preconditioner = JacobianPreconditioner::kLocal;
   /// "local" with a workspace: use the workspace's factor of an earlier state instead of
   /// factoring again, while it still works (GMRES converges within max(2 n, n + 10) rounds, n the
   /// rounds right after it was factored; past that it is refactored at the next Jacobian, and at

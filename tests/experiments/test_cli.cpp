@@ -1,4 +1,10 @@
 // Tests of the `softkin` command line: the contract later issues and users rely on.
+#include "softkin/experiments/cli_args.hpp"
+#include "softkin/experiments/cli_dataset.hpp"
+#include "softkin/experiments/cli_fk.hpp"
+#include "softkin/experiments/cli_ik.hpp"
+#include "softkin/solver/scene/solver_options_json.hpp"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -133,6 +139,91 @@ TEST(Cli, FkSetsAnySolverOption) {
   EXPECT_NE(bad.out.find("--set: solver.threads: expected an integer >= 0, got \"x\""),
             std::string::npos)
       << bad.out;
+}
+
+// Every option of the FK option table has a `softkin fk` flag, and each flag's value reaches
+// FkOptions through the option reader (in process: the flags CLI11 parses, then
+// FkOptionsFromArgs).
+TEST(Cli, FkHasAFlagForEveryOptionThatReachesFkOptions) {
+  using namespace softkin;
+  // A value other than the default for every option.
+  FkOptions want;
+  want.solver = FkSolverType::kLg;
+  want.max_iterations = 5;
+  want.tolerance = 2e-4;
+  want.gradient_tolerance = 3e-3;
+  want.anderson_window = 7;
+  want.anderson_safeguard = AndersonSafeguard::kEnergy;
+  want.continuation_steps = 4;
+  want.threads = 2;
+  want.time_limit_s = 12.5;
+  want.collision.self = true;
+  want.collision.obstacles = false;
+  want.collision.epsilon = 0.1;
+  want.collision.stiffness = 5;
+  want.collision.check_interval = 3;
+  want.collision.update = SpringUpdate::kRefactor;
+  want.collision.self_target = SelfTarget::kAuto;
+  want.collision.self_spring = SelfSpring::kPair;
+  want.collision.obstacle_spring = ObstacleSpring::kPoint;
+  const nlohmann::json wj = SolverOptionsToJson(want), dj = SolverOptionsToJson(FkOptions());
+
+  CLI::App app;
+  FkCommandArgs args;
+  CLI::App* fk = AddFkCommand(&app, &args);
+  std::string line = "fk --robot three_chamber --actuation 1";
+  for (const std::string& key : SolverOptionKeys()) {
+    const std::string flag = FkOptionFlagName(key);
+    EXPECT_NE(fk->get_option_no_throw(flag), nullptr) << key << ": no flag " << flag;
+    const auto dot = key.find('.');
+    const nlohmann::json& v =
+        dot == std::string::npos ? wj.at(key) : wj.at(key.substr(0, dot)).at(key.substr(dot + 1));
+    const nlohmann::json& d =
+        dot == std::string::npos ? dj.at(key) : dj.at(key.substr(0, dot)).at(key.substr(dot + 1));
+    EXPECT_NE(v, d) << key << ": the test value is the default";
+    line += " " + flag + " " + (v.is_string() ? v.get<std::string>() : v.dump());
+  }
+  app.parse(line, false);
+  EXPECT_EQ(SolverOptionsToJson(FkOptionsFromArgs(args, FkOptions())), wj) << line;
+
+  // --max-iterations 5 alone; the short names of older command lines; --set after the flags.
+  CLI::App app2;
+  FkCommandArgs args2;
+  AddFkCommand(&app2, &args2);
+  app2.parse(
+      "fk --robot three_chamber --actuation 1 --max-iterations 5 --continuation 3 "
+      "--aa-safeguard none --set tolerance=1e-3",
+      false);
+  const FkOptions o = FkOptionsFromArgs(args2, FkOptions());
+  EXPECT_EQ(o.max_iterations, 5);
+  EXPECT_EQ(o.continuation_steps, 3);
+  EXPECT_EQ(o.anderson_safeguard, AndersonSafeguard::kNone);
+  EXPECT_DOUBLE_EQ(o.tolerance, 1e-3);
+  EXPECT_EQ(o.solver, FkOptions().solver);  // not given: the base's
+
+  // A bad value names the flag, the option and what was expected.
+  CLI::App app3;
+  FkCommandArgs args3;
+  AddFkCommand(&app3, &args3);
+  app3.parse("fk --robot three_chamber --actuation 1 --max-iterations 0", false);
+  try {
+    (void)FkOptionsFromArgs(args3, FkOptions());
+    ADD_FAILURE() << "no exception for --max-iterations 0";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--max-iterations: solver.max_iterations: expected an "
+                                         "integer >= 1, got 0"),
+              std::string::npos)
+        << e.what();
+  }
+
+  // ik and dataset take the FK option they use by the same generated flag.
+  CLI::App app4;
+  IkCommandArgs ik;
+  DatasetCommandArgs ds;
+  EXPECT_NE(AddIkCommand(&app4, &ik)->get_option_no_throw("--gradient-tolerance"), nullptr);
+  EXPECT_NE(AddDatasetCommand(&app4, &ds)->get_option_no_throw("--gradient-tolerance"), nullptr);
+  app4.parse("ik --robot cable_finger --target 1,2,3 --gradient-tolerance 1e-4", false);
+  EXPECT_DOUBLE_EQ(ApplyFkOptionFlags(ik.fk_options, FkOptions()).gradient_tolerance, 1e-4);
 }
 
 TEST(Cli, FkReportsEachContinuationStep) {

@@ -23,7 +23,7 @@ Eigen::VectorXd Vec(std::initializer_list<double> v) {
 
 FkOptions Fk(double tol, double gtol) {
   FkOptions o;
-  o.solver = "lg-aa";
+  o.solver = FkSolverType::kLgAa;
   o.threads = 1;
   o.tolerance = tol;
   o.gradient_tolerance = gtol;
@@ -459,7 +459,7 @@ TEST(Kinematics, FailedForwardSolvesAndUnsupportedScenesGiveReasons) {
   EXPECT_FALSE(en.message.empty());
 
   FkOptions nlp = Fk(1e-5, 1e-6);
-  nlp.solver = "ceres";
+  nlp.solver = FkSolverType::kCeres;
   EXPECT_THROW(SimulatorKinematics(model, Mode(JacobianMode::kImplicit), &nlp),
                std::invalid_argument);
   SimulatorKinematicsOptions badstep = Mode(JacobianMode::kFd, 0.5);

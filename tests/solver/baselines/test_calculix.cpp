@@ -205,7 +205,7 @@ TEST(Calculix, TinyRunBendsTheWayLgAaDoes) {
     GTEST_SKIP() << "ccx is not installed (scripts/setup.sh installs calculix-ccx)";
   for (const char* name : {"calculix-linear", "calculix-nonlinear"}) {
     FkOptions o = s.solver;
-    o.solver = name;
+    o.solver = FkSolverTypeFromString(name);
     o.time_limit_s = 120;
     const FkResult r = SolveFk(s, c, &o);
     ASSERT_EQ(r.status, FkStatus::Converged) << r.BriefReport();

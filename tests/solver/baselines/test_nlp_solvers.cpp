@@ -38,7 +38,7 @@ Scene ChamberBar(double r_omega = 1.0) {
 FkResult SolveWith(const Scene& s, const Eigen::VectorXd& c, const std::string& solver, double gtol,
                    int max_iterations = 20000) {
   FkOptions o = s.solver;
-  o.solver = solver;
+  o.solver = FkSolverTypeFromString(solver);
   o.gradient_tolerance = gtol;
   o.tolerance = 1e-7;
   o.max_iterations = max_iterations;
@@ -207,7 +207,7 @@ TEST(NlpSolvers, BadInputGivesInvalidInputNotAThrow) {
   auto model = std::make_shared<const Model>(s);
   for (const auto& name : kAllNlpSolvers) {
     FkOptions o;
-    o.solver = name;
+    o.solver = FkSolverTypeFromString(name);
     auto solver = MakeFkSolver(model, o);
     EXPECT_EQ(solver->name(), name);
     const FkResult r = solver->Solve(Eigen::VectorXd::Constant(1, 9.0));
@@ -218,11 +218,15 @@ TEST(NlpSolvers, BadInputGivesInvalidInputNotAThrow) {
     EXPECT_EQ(solver->Solve(Eigen::VectorXd::Constant(1, 1.5), &bad).status,
               FkStatus::InvalidInput);
   }
-  FkOptions o;
-  o.solver = "ipopt";
-  std::string why;
-  EXPECT_FALSE(o.IsValid(&why));
-  EXPECT_NE(why.find("ceres, ipopt-lbfgs, ipopt-newton, ipopt-hard"), std::string::npos) << why;
+  // An unknown name is refused where it is read, with the name and the list of solvers.
+  try {
+    (void)FkSolverTypeFromString("ipopt");
+    ADD_FAILURE() << "no exception for 'ipopt'";
+  } catch (const std::invalid_argument& e) {
+    const std::string why = e.what();
+    EXPECT_NE(why.find("'ipopt'"), std::string::npos) << why;
+    EXPECT_NE(why.find("ceres, ipopt-lbfgs, ipopt-newton, ipopt-hard"), std::string::npos) << why;
+  }
 }
 
 }  // namespace

@@ -169,7 +169,7 @@ TEST(CollisionResponse, SpringEnergyGradientMatchesFiniteDifferences) {
     const bool pair = std::string(kind) == "pair";
     Scene scene = TwoBlocks();
     scene.solver.collision.self = true;
-    scene.solver.collision.self_spring = kind;
+    scene.solver.collision.self_spring = SelfSpringFromString(kind);
     const Model model(scene);
     CollisionResponse resp(model, scene.solver.collision);
     // Push the upper block 3 mm down rigidly: its bottom layer enters the lower block.
@@ -354,7 +354,7 @@ TEST(CollisionResponse, BetweenBodiesTheTargetIsTheClosestSurfacePoint) {
   ASSERT_GE(corner, 0);
   for (const char* rule : {"auto", "walk"}) {
     CollisionOptions o = scene.solver.collision;
-    o.self_target = rule;
+    o.self_target = SelfTargetFromString(rule);
     CollisionResponse resp(model, o);
     EXPECT_EQ(resp.num_bodies(), 2);
     EXPECT_NE(resp.body(corner), resp.body(0));
@@ -421,11 +421,11 @@ TEST(CollisionResponse, PressedBlocksAreCollisionFreeOnlyWithResponse) {
     const std::string v = variant;
     const bool between = v == "auto" || v == "pair-auto";
     const bool pair = v == "pair" || v == "pair-auto";
-    scene.solver.collision.self_target = between ? "auto" : "walk";
-    scene.solver.collision.self_spring = pair ? "pair" : "target";
+    scene.solver.collision.self_target = between ? SelfTarget::kAuto : SelfTarget::kWalk;
+    scene.solver.collision.self_spring = pair ? SelfSpring::kPair : SelfSpring::kTarget;
     const char* update = (between || pair) ? "updown" : variant;
     scene.solver.continuation_steps = 4;  // progressive, as Algorithm 2: 1 mm per step
-    scene.solver.collision.update = update;
+    scene.solver.collision.update = SpringUpdateFromString(update);
     auto model = std::make_shared<const Model>(scene);
     auto solver = MakeFkSolver(model, scene.solver);
     const FkResult r = solver->Solve(c);
@@ -573,7 +573,7 @@ TEST(CollisionResponse, PlaneObstacleSpringsSolveTheCoupledSystem) {
   // plane spring's k n n^T couples a vertex's coordinates. The Woodbury solve must match a direct
   // solve of the assembled system, and the energy's gradient finite differences.
   Scene scene = BlockOverObstacle(-Eigen::Vector3d::UnitZ(), true);
-  scene.solver.collision.obstacle_spring = "plane";
+  scene.solver.collision.obstacle_spring = ObstacleSpring::kPlane;
   const Model model(scene);
   CollisionResponse resp(model, scene.solver.collision);
   Eigen::VectorXd c(1);
@@ -665,7 +665,7 @@ TEST(CollisionResponse, PlaneObstacleSpringsLetTheContactSlide) {
   c << 3.0 * std::sqrt(2.0);
   auto solve = [&](const char* kind, int cap, Eigen::Vector3d* top) {
     Scene t = scene;
-    t.solver.collision.obstacle_spring = kind;
+    t.solver.collision.obstacle_spring = ObstacleSpringFromString(kind);
     t.solver.max_iterations = cap;
     auto model = std::make_shared<const Model>(t);
     const FkResult r = MakeFkSolver(model, t.solver)->Solve(c);
@@ -700,15 +700,19 @@ TEST(CollisionResponse, OptionsAreValidated) {
   CollisionOptions o;
   std::string why;
   EXPECT_TRUE(o.IsValid(&why));
-  o.update = "magic";
-  EXPECT_FALSE(o.IsValid(&why));
-  EXPECT_NE(why.find("collision.update"), std::string::npos);
-  o = CollisionOptions();
-  o.self_target = "nearest";
-  EXPECT_FALSE(o.IsValid(&why));
-  EXPECT_NE(why.find("collision.self_target: expected one of auto, walk; got 'nearest'"),
-            std::string::npos);
-  o = CollisionOptions();
+  // Names of the enum options are checked where they are read, naming the value and the names.
+  EXPECT_THROW(SpringUpdateFromString("magic"), std::invalid_argument);
+  try {
+    (void)SelfTargetFromString("nearest");
+    ADD_FAILURE() << "no exception for 'nearest'";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'nearest'; expected one of: auto, walk"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(SelfSpringFromString("glue"), std::invalid_argument);
+  EXPECT_THROW(ObstacleSpringFromString("line"), std::invalid_argument);
+  EXPECT_EQ(ToString(SelfTargetFromString("walk")), "walk");
   o.stiffness = -1;
   EXPECT_FALSE(o.IsValid(&why));
   o = CollisionOptions();

@@ -53,7 +53,7 @@ Eigen::VectorXd Vec(std::initializer_list<double> v) {
 // count; it keeps timings stable on a loaded machine).
 FkOptions Opts(const std::string& solver = "lg-aa") {
   FkOptions o;
-  o.solver = solver;
+  o.solver = FkSolverTypeFromString(solver);
   o.threads = 1;
   return o;
 }

@@ -87,7 +87,7 @@ TEST(Hyperelastic, NamedMaterialsAndFit) {
 }
 
 Scene HyperBar(double rho0 = 1.0) {
-  Material m{"ecoflex-00-30", rho0, 1.0, "mooney-rivlin", 0.0418, 0.0106};
+  Material m{"ecoflex-00-30", rho0, 1.0, MaterialLaw::kMooneyRivlin, 0.0418, 0.0106};
   return test::VoxelScene(
       Eigen::Vector3i(4, 2, 2), 2.5, [](const Eigen::Vector3i&) { return 0; }, {{0, m}}, {},
       "hyper_bar");
@@ -187,8 +187,8 @@ TEST(Hyperelastic, InvertedAndFlatElementsGetBoundedRestVolumeTargets) {
 TEST(Hyperelastic, SimulatedTensionFollowsMooneyRivlin) {
   MooneyRivlin eco;
   NamedMooneyRivlin("ecoflex-00-30", &eco);
-  const Material hyper{"ecoflex-00-30", 1.0, 1.0, "mooney-rivlin", eco.c1, eco.c2};
-  const Material blend{"linear", 1.0, 1.0, "blend", 0, 0};
+  const Material hyper{"ecoflex-00-30", 1.0, 1.0, MaterialLaw::kMooneyRivlin, eco.c1, eco.c2};
+  const Material blend{"linear", 1.0, 1.0, MaterialLaw::kBlend, 0, 0};
   const std::vector<double> stretches = {1.01, 1.2, 1.4, 1.6, 1.8, 2.0};
   // Largest relative deviation of the normalised stress (by the small-strain modulus measured at
   // the first point) from the normalised Mooney-Rivlin curve, at the measured mid stretch.
@@ -199,7 +199,7 @@ TEST(Hyperelastic, SimulatedTensionFollowsMooneyRivlin) {
     for (size_t i = 1; i < p.size(); ++i) {
       const double mr = eco.NominalStress(p[i].mid_stretch) / eco.Modulus();
       w = std::max(w, std::abs(p[i].stress / E / mr - 1));
-      EXPECT_LT(p[i].lateral_stretch, 1.0) << m.law;  // it narrows
+      EXPECT_LT(p[i].lateral_stretch, 1.0) << ToString(m.law);  // it narrows
     }
     return w;
   };

@@ -34,7 +34,7 @@ Eigen::VectorXd Residual(const Model& m, const Eigen::MatrixX3d& X, const Eigen:
 
 FkOptions Options(const std::string& solver, double tol, double gtol) {
   FkOptions o;
-  o.solver = solver;
+  o.solver = FkSolverTypeFromString(solver);
   o.threads = 1;
   o.tolerance = tol;
   o.gradient_tolerance = gtol;
@@ -185,7 +185,7 @@ TEST(NewtonSolver, FailureContinuesWithLgAaAndSaysSo) {
 // Scenes outside Newton's reach are solved by lg-aa, with the reason in the message.
 TEST(NewtonSolver, MooneyRivlinBodiesAreLeftToLgAaWithAReason) {
   Scene s = MakeRobot("three_chamber", 3);
-  s.body[0].law = "mooney-rivlin";
+  s.body[0].law = MaterialLaw::kMooneyRivlin;
   s.body[0].c1 = 0.0418;
   s.body[0].c2 = 0.0106;
   FkOptions o = Options("newton", 1e-6, 1e-6);
@@ -197,11 +197,13 @@ TEST(NewtonSolver, MooneyRivlinBodiesAreLeftToLgAaWithAReason) {
 }
 
 TEST(NewtonSolver, UnknownSolverNameListsNewton) {
-  FkOptions o;
-  o.solver = "newtn";
   std::string why;
-  EXPECT_FALSE(o.IsValid(&why));
-  EXPECT_NE(why.find("solver"), std::string::npos) << why;
+  try {
+    (void)FkSolverTypeFromString("newtn");
+  } catch (const std::invalid_argument& e) {
+    why = e.what();
+  }
+  EXPECT_NE(why.find("FK solver"), std::string::npos) << why;
   EXPECT_NE(why.find("newton"), std::string::npos) << why;
   EXPECT_NE(why.find("newtn"), std::string::npos) << why;
 }

@@ -1,139 +1,21 @@
 // Tests of the scene JSON reader (solver/scene/scene_json.hpp): the repository's real-mesh scene,
-// every selector on a tiny generated mesh, every error message, and the schema text.
+// every selector on a tiny generated mesh, and every error message. The schema text and the FK
+// option table are tested in test_scene_schema.cpp.
 #include "softkin/solver/scene/scene_json.hpp"
-#include "softkin/solver/scene/scene_keys.hpp"
-#include "softkin/solver/scene/solver_options_json.hpp"
 
 #include "softkin/solver/mesh/io/mesh_io.hpp"
+#include "tests/solver/scene/scene_json_test_util.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include <algorithm>
-#include <filesystem>
-#include <fstream>
-#include <functional>
-#include <map>
-#include <set>
-#include <sstream>
 #include <string>
 #include <vector>
-
-#include <unistd.h>
 
 namespace softkin {
 namespace {
 
-using json = nlohmann::json;
-namespace fs = std::filesystem;
-
-void WriteFile(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary);
-  ASSERT_TRUE(out) << p;
-  out << text;
-}
-
-std::string ReadFile(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-/// A fresh directory per test, removed afterwards.
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ =
-        fs::temp_directory_path() / ("softkin_scene_json_" + std::string(info->test_suite_name()) +
-                                     "_" + info->name() + "_" + std::to_string(::getpid()));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
-
-// A triangular prism y in [0, 1] split into three positively oriented tets, one region each
-// (tags 0, 1, 2).
-// Vertices: 0 (0,0,0) 1 (1,0,0) 2 (0,0,1) at y = 0; 3 (0,1,0) 4 (1,1,0) 5 (0,1,1) at y = 1.
-const char* kTinyTet =
-    "6 vertices\n"
-    "3 tets\n"
-    "0 0 0\n"
-    "1 0 0\n"
-    "0 0 1\n"
-    "0 1 0\n"
-    "1 1 0\n"
-    "0 1 1\n"
-    "4 0 2 1 3\n"
-    "4 1 3 2 4\n"
-    "4 2 4 3 5\n";
-
-void WriteTinyMesh(const fs::path& dir) {
-  WriteFile(dir / "tiny.tet", kTinyTet);
-  WriteFile(dir / "tiny_labels.txt", "0\n1\n2\n");
-  WriteFile(dir / "fixed.txt", "# one-based vertex indices\n6\n\n");
-}
-
-/// A scene over the tiny mesh using every selector, scale 2 and an actuator split over two regions.
-/// After scaling: 0 (0,0,0) 1 (2,0,0) 2 (0,0,2) 3 (0,2,0) 4 (2,2,0) 5 (0,2,2).
-json TinyScene() {
-  return json::parse(R"({
-    "name": "tiny",
-    "mesh": {"file": "tiny.tet", "labels": "tiny_labels.txt", "scale": 2},
-    "regions": [
-      {"tag": 0, "role": "body", "material": "soft", "r_omega": 0.5, "weight": 2},
-      {"tag": 1, "role": "pneumatic", "name": "chamber", "min": 1, "max": 3},
-      {"tag": 2, "role": "pneumatic", "name": "chamber", "max": 3, "weight": 4}
-    ],
-    "fixed": [
-      {"plane": {"point": [0, 0, 0], "normal": [0, 2, 0]}},
-      {"box": {"min": [1.5, -1, -1], "max": [3, 3, 0.5]}},
-      {"file": "fixed.txt", "base": 1}
-    ],
-    "markers": [
-      {"name": "a", "vertex": 3},
-      {"name": "b", "nearest": [2.1, 2.1, 0.1]},
-      {"name": "tip", "box": {"min": [-1, 1.9, -1], "max": [3, 2.1, 3]}}
-    ],
-    "solver": {"solver": "lg", "max_iterations": 50, "tolerance": 1e-4, "gradient_tolerance": 0.01,
-               "anderson_window": 3, "continuation_steps": 2, "threads": 1}
-  })");
-}
-
-Scene LoadFrom(const fs::path& dir, const json& scene) {
-  WriteFile(dir / "scene.json", scene.dump(2));
-  return LoadSceneJson((dir / "scene.json").string());
-}
-
-/// Expects `f` to throw std::invalid_argument whose message contains every string in `parts`.
-void ExpectError(const std::function<void()>& f, const std::vector<std::string>& parts) {
-  try {
-    f();
-    ADD_FAILURE() << "expected std::invalid_argument containing '" << parts.front() << "'";
-  } catch (const std::invalid_argument& e) {
-    const std::string msg = e.what();
-    for (const auto& p : parts)
-      EXPECT_NE(msg.find(p), std::string::npos) << "'" << p << "' not in: " << msg;
-  }
-}
-
-/// Loads `scene` (written as scene.json into a directory with the tiny mesh) expecting an error.
-void ExpectSceneError(const json& scene, const std::vector<std::string>& parts) {
-  TempDir dir;
-  WriteTinyMesh(dir.path());
-  std::vector<std::string> all = {"scene.json: "};
-  all.insert(all.end(), parts.begin(), parts.end());
-  ExpectError([&] { LoadFrom(dir.path(), scene); }, all);
-}
+using namespace scene_test;
 
 // ------------------------------------------------------------------------------------------------
 // The repository's scene on the real finger mesh
@@ -177,7 +59,7 @@ TEST(SceneJsonRealMesh, FingerChamber1Loads) {
 
   std::string why;
   EXPECT_TRUE(s.solver.IsValid(&why)) << why;
-  EXPECT_EQ(s.solver.solver, "lg-aa");
+  EXPECT_EQ(s.solver.solver, FkSolverType::kLgAa);
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -226,7 +108,7 @@ TEST(SceneJsonTiny, EverySelectorScaleAndMergedActuator) {
   EXPECT_NEAR(P(2, 1), 2.0, 1e-12);
   EXPECT_NEAR(P(2, 2), 2.0 / 3.0, 1e-12);
 
-  EXPECT_EQ(s.solver.solver, "lg");
+  EXPECT_EQ(s.solver.solver, FkSolverType::kLg);
   EXPECT_EQ(s.solver.max_iterations, 50);
   EXPECT_DOUBLE_EQ(s.solver.tolerance, 1e-4);
   EXPECT_DOUBLE_EQ(s.solver.gradient_tolerance, 0.01);
@@ -666,29 +548,6 @@ TEST(SceneJsonErrors, ActuatorRegionsMustAgree) {
                        "rest 3.5 (regions[1].rest)", "max 3 (regions[1].max)"});
 }
 
-/// The tiny scene with a signed chamber pair, a per-axis hold and two motion actuators.
-/// After scaling: 0 (0,0,0) 1 (2,0,0) 2 (0,0,2) 3 (0,2,0) 4 (2,2,0) 5 (0,2,2).
-json SignedMotionScene() {
-  return json::parse(R"({
-    "mesh": {"file": "tiny.tet", "labels": "tiny_labels.txt", "scale": 2},
-    "regions": [
-      {"tag": 0, "role": "body"},
-      {"tag": 1, "role": "pneumatic", "name": "s", "min": -2, "max": 3, "gain": 1.5},
-      {"tag": 2, "role": "pneumatic", "name": "s", "side": "negative"}
-    ],
-    "fixed": [
-      {"plane": {"point": [0, 0, 0], "normal": [0, 1, 0]}},
-      {"file": "fixed.txt", "base": 1, "axes": "zx"}
-    ],
-    "motions": [
-      {"name": "lift", "type": "displacement", "box": {"min": [1.5, 1.9, -1], "max": [3, 2.1, 1]},
-       "axis": [0, 0, 2], "min": -1, "max": 1},
-      {"name": "turn", "type": "twist", "box": {"min": [-1, 1.9, -1], "max": [0.5, 2.1, 0.5]},
-       "axis": [0, 1, 0], "centre": [1, 0, 1], "min": -90, "max": 90}
-    ]
-  })");
-}
-
 TEST(SceneJsonTiny, SignedActuatorAxesAndMotions) {
   TempDir dir;
   WriteTinyMesh(dir.path());
@@ -838,7 +697,7 @@ TEST(SceneJsonErrors, ObstaclesAndCollisionOptions) {
   EXPECT_EQ(s.solver.collision.epsilon, 0.1);
   EXPECT_EQ(s.solver.collision.stiffness, 5.0);
   EXPECT_EQ(s.solver.collision.check_interval, 3);
-  EXPECT_EQ(s.solver.collision.update, "refactor");
+  EXPECT_EQ(s.solver.collision.update, SpringUpdate::kRefactor);
 }
 
 TEST(SceneJsonErrors, MotionBadValues) {
@@ -931,266 +790,6 @@ TEST(SceneJsonErrors, MeshReaderErrorPassesThrough) {
   j["mesh"]["labels"] = "short_labels.txt";
   ExpectError([&] { LoadFrom(dir.path(), j); },
               {"scene.json: mesh.labels: cannot read the tet mesh: ", "short_labels.txt:"});
-}
-
-// ------------------------------------------------------------------------------------------------
-// Schema text
-// ------------------------------------------------------------------------------------------------
-
-// Every key the scene JSON accepts. The schema must list exactly these.
-const std::vector<std::string> kAllKeys = {"name",
-                                           "mesh",
-                                           "mesh.file",
-                                           "mesh.format",
-                                           "mesh.labels",
-                                           "mesh.tag_array",
-                                           "mesh.scale",
-                                           "regions",
-                                           "regions[].tag",
-                                           "regions[].role",
-                                           "regions[].material",
-                                           "regions[].law",
-                                           "regions[].c1",
-                                           "regions[].c2",
-                                           "regions[].r_omega",
-                                           "regions[].weight",
-                                           "regions[].name",
-                                           "regions[].min",
-                                           "regions[].max",
-                                           "regions[].rest",
-                                           "regions[].path",
-                                           "regions[].side",
-                                           "regions[].gain",
-                                           "fixed[].axes",
-                                           "motions",
-                                           "motions[].name",
-                                           "motions[].type",
-                                           "motions[].region",
-                                           "motions[].box",
-                                           "motions[].box.min",
-                                           "motions[].box.max",
-                                           "motions[].plane",
-                                           "motions[].plane.point",
-                                           "motions[].plane.normal",
-                                           "motions[].plane.tolerance",
-                                           "motions[].file",
-                                           "motions[].base",
-                                           "motions[].axis",
-                                           "motions[].centre",
-                                           "motions[].min",
-                                           "motions[].max",
-                                           "fixed",
-                                           "fixed[].region",
-                                           "fixed[].box",
-                                           "fixed[].box.min",
-                                           "fixed[].box.max",
-                                           "fixed[].plane",
-                                           "fixed[].plane.point",
-                                           "fixed[].plane.normal",
-                                           "fixed[].plane.tolerance",
-                                           "fixed[].file",
-                                           "fixed[].base",
-                                           "markers",
-                                           "markers[].name",
-                                           "markers[].vertex",
-                                           "markers[].nearest",
-                                           "markers[].box",
-                                           "markers[].box.min",
-                                           "markers[].box.max",
-                                           "solver",
-                                           "solver.solver",
-                                           "solver.max_iterations",
-                                           "solver.tolerance",
-                                           "solver.gradient_tolerance",
-                                           "solver.anderson_window",
-                                           "solver.anderson_safeguard",
-                                           "solver.continuation_steps",
-                                           "solver.threads",
-                                           "solver.time_limit_s",
-                                           "solver.collision",
-                                           "solver.collision.self",
-                                           "solver.collision.obstacles",
-                                           "solver.collision.epsilon",
-                                           "solver.collision.stiffness",
-                                           "solver.collision.check_interval",
-                                           "solver.collision.update",
-                                           "solver.collision.self_target",
-                                           "solver.collision.self_spring",
-                                           "solver.collision.obstacle_spring",
-                                           "obstacles",
-                                           "obstacles[].type",
-                                           "obstacles[].min",
-                                           "obstacles[].max",
-                                           "obstacles[].base",
-                                           "obstacles[].axis",
-                                           "obstacles[].radius",
-                                           "obstacles[].height",
-                                           "obstacles[].segments",
-                                           "obstacles[].file"};
-
-/// Key lines of the schema (after the "Keys:" line, not indented): path -> the rest of the line,
-/// plus the doc line that follows.
-std::multimap<std::string, std::pair<std::string, std::string>> SchemaLines(
-    const std::string& schema) {
-  std::multimap<std::string, std::pair<std::string, std::string>> out;
-  std::istringstream in(schema);
-  std::string line;
-  bool keys = false;
-  std::string last;
-  while (std::getline(in, line)) {
-    if (line == "Keys:") {
-      keys = true;
-      continue;
-    }
-    if (!keys || line.empty()) continue;
-    if (line[0] != ' ') {
-      const auto sp = line.find(' ');
-      last = line.substr(0, sp);
-      out.emplace(last, std::make_pair(line, std::string()));
-    } else if (!last.empty()) {
-      auto it = out.equal_range(last).second;
-      (--it)->second.second = line;
-    }
-  }
-  return out;
-}
-
-TEST(SceneJsonSchema, ListsExactlyEveryKeyWithTypeDefaultAndDoc) {
-  const std::string schema = SceneSchema();
-  const auto lines = SchemaLines(schema);
-  std::set<std::string> listed;
-  for (const auto& [path, text] : lines) {
-    listed.insert(path);
-    const std::string& head = text.first;
-    EXPECT_TRUE(head.find("default ") != std::string::npos ||
-                head.find("required") != std::string::npos ||
-                head.find("selector") != std::string::npos)
-        << head;
-    EXPECT_GT(text.second.size(), 10u) << "no doc line for " << path;
-  }
-  EXPECT_EQ(listed, std::set<std::string>(kAllKeys.begin(), kAllKeys.end()));
-  // regions[].weight has a default per role: 1 for body, 5 for actuators.
-  EXPECT_EQ(lines.count("regions[].weight"), 2u);
-}
-
-TEST(SceneJsonSchema, DefaultsComeFromTheStructs) {
-  const auto lines = SchemaLines(SceneSchema());
-  auto head = [&](const std::string& key) {
-    auto it = lines.find(key);
-    return it == lines.end() ? std::string() : it->second.first;
-  };
-  const FkOptions fk;
-  EXPECT_NE(head("solver.solver").find("default \"" + fk.solver + "\""), std::string::npos);
-  EXPECT_NE(head("solver.max_iterations").find("default " + std::to_string(fk.max_iterations)),
-            std::string::npos);
-  EXPECT_NE(head("solver.anderson_window").find("integer in [1, 50]"), std::string::npos);
-  EXPECT_NE(head("regions[].r_omega").find("number in [0, 1]"), std::string::npos);
-  EXPECT_NE(head("regions[].r_omega").find("[role body]"), std::string::npos);
-  EXPECT_NE(head("mesh.file").find("required"), std::string::npos);
-  EXPECT_NE(head("fixed[].box").find("selector"), std::string::npos);
-  EXPECT_NE(head("mesh.format").find("one of: auto, tet, tetgen, gmsh, vtk"), std::string::npos);
-}
-
-TEST(SceneJsonSchema, DocsContainTheCurrentSchema) {
-  const std::string doc = ReadFile(fs::path(SOFTKIN_SOURCE_DIR) / "docs" / "scene.md");
-  ASSERT_FALSE(doc.empty()) << "docs/scene.md missing";
-  EXPECT_NE(doc.find(SceneSchema()), std::string::npos)
-      << "docs/scene.md does not contain the current SceneSchema() text; regenerate it";
-}
-
-// ------------------------------------------------------------------------------------------------
-// Solver options: one reader for scenes, configs and `softkin fk --set`
-// ------------------------------------------------------------------------------------------------
-
-// Every solver.* leaf of the scene schema is an option the reader knows, and the other way round;
-// every schema default is FkOptions' default.
-TEST(SolverOptionsJson, EveryOptionHasASchemaEntryWithItsDefault) {
-  std::vector<std::string> schema;
-  const json defaults = SolverOptionsToJson(FkOptions());
-  for (const auto& k : scene_json_detail::KeyTable()) {
-    if (k.path.rfind("solver.", 0) != 0 || k.type == scene_json_detail::Type::Object) continue;
-    const std::string key = k.path.substr(7);
-    schema.push_back(key);
-    const auto dot = key.find('.');
-    const json& d = dot == std::string::npos
-                        ? defaults.at(key)
-                        : defaults.at(key.substr(0, dot)).at(key.substr(dot + 1));
-    EXPECT_EQ(k.def, d) << key;
-  }
-  EXPECT_EQ(schema, SolverOptionKeys());
-  EXPECT_GE(schema.size(), 18u);
-}
-
-TEST(SolverOptionsJson, RoundTripsEveryOption) {
-  FkOptions o;
-  o.solver = "lg";
-  o.max_iterations = 123;
-  o.tolerance = 2e-4;
-  o.gradient_tolerance = 3e-3;
-  o.anderson_window = 7;
-  o.anderson_safeguard = "energy";
-  o.continuation_steps = 4;
-  o.threads = 2;
-  o.time_limit_s = 12.5;
-  o.collision.self = true;
-  o.collision.obstacles = false;
-  o.collision.epsilon = 0.1;
-  o.collision.stiffness = 5;
-  o.collision.check_interval = 3;
-  o.collision.update = "refactor";
-  o.collision.self_target = "auto";
-  o.collision.self_spring = "pair";
-  o.collision.obstacle_spring = "point";
-  const json j = SolverOptionsToJson(o);
-  const FkOptions back = ReadSolverOptionsJson(j, "test", FkOptions());
-  EXPECT_EQ(SolverOptionsToJson(back), j);
-  EXPECT_NE(j, SolverOptionsToJson(FkOptions()));  // every value above differs from its default
-  for (auto it = j.begin(); it != j.end(); ++it) {
-    if (it.key() == "collision") continue;
-    EXPECT_NE(it.value(), SolverOptionsToJson(FkOptions()).at(it.key())) << it.key();
-  }
-  // Keys left out keep the base's values.
-  const FkOptions partial = ReadSolverOptionsJson(json{{"tolerance", 1e-3}}, "test", o);
-  EXPECT_EQ(partial.max_iterations, 123);
-  EXPECT_EQ(partial.collision.update, "refactor");
-  EXPECT_DOUBLE_EQ(partial.tolerance, 1e-3);
-}
-
-TEST(SolverOptionsJson, BadValuesNameTheKeyAndWhatWasExpected) {
-  auto read = [](const json& j) {
-    (void)ReadSolverOptionsJson(j, "cfg.json: solver", FkOptions());
-  };
-  ExpectError(
-      [&] {
-        read(json{{"max_iterations", "many"}});
-      },
-      {"cfg.json: solver.max_iterations: expected an integer", "got \"many\""});
-  ExpectError(
-      [&] {
-        read(json{{"max_iterations", 0}});
-      },
-      {"cfg.json: solver.max_iterations: expected an integer >= 1"});
-  ExpectError(
-      [&] {
-        read(json{{"collision", {{"update", "magic"}}}});
-      },
-      {"cfg.json: solver.collision.update: expected", "updown", "refactor"});
-  ExpectError(
-      [&] {
-        read(json{{"tolerence", 1e-3}});
-      },
-      {"cfg.json: solver.tolerence: unknown key (expected one of solver, max_iterations"});
-  ExpectError(
-      [&] {
-        read(json{{"collision", {{"selff", true}}}});
-      },
-      {"cfg.json: solver.collision.selff: unknown key (expected one of self, obstacles"});
-  ExpectError(
-      [&] {
-        read(json{{"collision", true}});
-      },
-      {"cfg.json: solver.collision: expected an object"});
-  ExpectError([&] { read(json::array()); }, {"cfg.json: solver: expected an object"});
 }
 
 // time_limit_s is a scene key as it is a config key.

@@ -39,7 +39,7 @@ Eigen::MatrixX3d Rhs(const Model& m, const Eigen::MatrixX3d& X, const Eigen::Vec
 
 FkOptions Opts(double tol = 1e-6, double gtol = 1e-7) {
   FkOptions o;
-  o.solver = "lg-aa";
+  o.solver = FkSolverType::kLgAa;
   o.threads = 1;
   o.tolerance = tol;
   o.gradient_tolerance = gtol;
@@ -158,7 +158,7 @@ TEST(EquilibriumJacobian, LockstepEqualsColumnByColumn) {
   const auto a = ComputeEquilibriumJacobian(*model, r.positions, c, {}, o);
   o.lockstep = false;
   const auto b = ComputeEquilibriumJacobian(*model, r.positions, c, {}, o);
-  o.krylov = "bicgstab";
+  o.krylov = KrylovMethod::kBicgstab;
   const auto k = ComputeEquilibriumJacobian(*model, r.positions, c, {}, o);
   ASSERT_TRUE(a.ok) << a.message;
   ASSERT_TRUE(b.ok) << b.message;
@@ -285,8 +285,8 @@ TEST(EquilibriumJacobian, LocalPreconditionerSameAnswerFewerProducts) {
     ASSERT_EQ(r0.status, FkStatus::Converged) << r0.message;
     EquilibriumJacobianOptions a, l;
     a.threads = l.threads = 1;
-    a.preconditioner = "A_ff";
-    l.preconditioner = "local";
+    a.preconditioner = JacobianPreconditioner::kAff;
+    l.preconditioner = JacobianPreconditioner::kLocal;
     const auto ja = ComputeEquilibriumJacobian(*model, r0.positions, k.c, {}, a);
     EquilibriumJacobianWorkspace ws;
     const auto jl = ComputeEquilibriumJacobian(*model, r0.positions, k.c, {}, l, nullptr, &ws);
@@ -318,16 +318,22 @@ TEST(EquilibriumJacobian, LocalPreconditionerSameAnswerFewerProducts) {
     EXPECT_EQ(ws.factorizations(), factored);
     EXPECT_LT((jr.dXdc - jr_ref.dXdc).norm(), 1e-4 * jr_ref.dXdc.norm());
   }
-  EquilibriumJacobianOptions bad;
-  bad.preconditioner = "ilu";
-  std::string why;
-  EXPECT_FALSE(bad.IsValid(&why));
-  EXPECT_NE(why.find("preconditioner"), std::string::npos) << why;
+  // Names are checked where they are read.
+  try {
+    (void)JacobianPreconditionerFromString("ilu");
+    ADD_FAILURE() << "no exception for 'ilu'";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'ilu'; expected one of: A_ff, local"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(JacobianPreconditionerFromString("local"), JacobianPreconditioner::kLocal);
+  EXPECT_EQ(ToString(KrylovMethodFromString("bicgstab")), "bicgstab");
+  EXPECT_THROW(KrylovMethodFromString("cg"), std::invalid_argument);
 }
 
 TEST(EquilibriumJacobian, HyperelasticBodyIsRefusedWithAReason) {
   Scene s = MakeRobot("three_chamber", 3);
-  s.body[0].law = "mooney-rivlin";
+  s.body[0].law = MaterialLaw::kMooneyRivlin;
   s.body[0].c1 = 0.0418;
   s.body[0].c2 = 0.0106;
   const Model model(s);
