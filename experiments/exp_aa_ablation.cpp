@@ -1,4 +1,5 @@
-// Ablation: plain local-global against Anderson-accelerated, at mid and full actuation.
+// Solver ablation: plain local-global against Anderson-accelerated variants and whole other
+// solvers (newton), at mid and full actuation.
 #include "softkin/experiments/results.hpp"
 #include "softkin/experiments/runner.hpp"
 #include "softkin/solver/common/enum_names.hpp"
@@ -6,6 +7,7 @@
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/robots/robots.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <map>
@@ -15,7 +17,8 @@ namespace softkin {
 
 namespace {
 
-/// A solver variant: plain local-global or Anderson with a window and a safeguard.
+/// A solver variant: plain local-global, Anderson with a window and a safeguard, or another
+/// solver by name.
 struct Variant {
   std::string label;
   FkOptions opts;
@@ -24,9 +27,10 @@ struct Variant {
 /// The keys of an aa_ablation config.
 struct AaAblationParams {
   std::vector<std::string> robots;
-  std::vector<int> res;           ///< per robot (empty: the defaults)
-  std::vector<double> levels;     ///< fractions of the way from rest to the far end of each range
-  std::vector<Variant> variants;  ///< lg first, then every (window, safeguard) pair
+  std::vector<int> res;        ///< per robot (empty: the defaults)
+  std::vector<double> levels;  ///< fractions of the way from rest to the far end of each range
+  /// lg first, then every (window, safeguard) pair, then the other solvers of "solvers"
+  std::vector<Variant> variants;
 };
 
 AaAblationParams ReadAaAblationParams(const Config& cfg) {
@@ -37,6 +41,7 @@ AaAblationParams ReadAaAblationParams(const Config& cfg) {
   // Anderson variants: every (window, safeguard) pair, each against plain local-global.
   const std::vector<int> windows = cfg.IntList("windows", {6});
   const std::vector<std::string> guards = cfg.StringList("safeguards", {"hybrid"});
+  const std::vector<std::string> solvers = cfg.StringList("solvers", {});
   FkOptions base = cfg.Solver(FkOptions{});
   cfg.CheckNoUnknownKeys();
   if (windows.empty()) cfg.Fail("windows", "a non-empty array of Anderson windows");
@@ -58,16 +63,30 @@ AaAblationParams ReadAaAblationParams(const Config& cfg) {
       if (!v.opts.IsValid(&why)) cfg.Fail("windows", "Anderson windows, integers in [1, 50]");
       p.variants.push_back(v);
     }
+  // Whole other solvers with the same options (their iterations count in their own units).
+  for (const auto& name : solvers) {
+    Variant v{name, base};
+    try {
+      v.opts.solver = FkSolverTypeFromString(name);
+    } catch (const std::invalid_argument&) {
+      cfg.Fail("solvers", "FK solver names, each one of " + NameList(FkSolverTypeNames()));
+    }
+    if (v.opts.solver == FkSolverType::kLg || v.opts.solver == FkSolverType::kLgAa)
+      cfg.Fail("solvers", "solvers other than lg and lg-aa (those are the other keys' variants)");
+    p.variants.push_back(v);
+  }
   if (!p.res.empty() && p.res.size() != p.robots.size())
     cfg.Fail("resolutions", "one resolution per robot (or none for the defaults)");
   return p;
 }
 
 /// Every variant on one robot at one actuation level: rows of aa_ablation.csv and the case's
-/// entry; the Anderson variants' iteration ratios at full actuation go into *min_ratio.
+/// entry; the Anderson variants' iteration ratios at full actuation go into *min_ratio, the other
+/// solvers' time ratios (lg / solver) at full actuation into *time_ratios.
 nlohmann::json RunCase(const AaAblationParams& p, const std::string& robot, const Scene& scene,
                        const std::shared_ptr<const Model>& model, double level, CsvWriter* csv,
-                       std::map<std::string, double>* min_ratio, bool verbose) {
+                       std::map<std::string, double>* min_ratio,
+                       std::map<std::string, std::vector<double>>* time_ratios, bool verbose) {
   // All actuators driven the same fraction of the way from rest to the far end of their range
   // (the max volume ratio of a chamber, the min length ratio of a cable).
   Eigen::VectorXd c = scene.rest_actuation();
@@ -96,17 +115,25 @@ nlohmann::json RunCase(const AaAblationParams& p, const std::string& robot, cons
                       {"time_s", r.time_s},
                       {"energy", r.energy},
                       {"status", FkStatusToString(r.status)}};
+    const bool anderson = v.opts.solver == FkSolverType::kLgAa;
     if (!plain) {
-      rj["aa_accepted"] = r.aa_accepted;
-      rj["aa_rejected"] = r.aa_rejected;
+      if (anderson) {
+        rj["aa_accepted"] = r.aa_accepted;
+        rj["aa_rejected"] = r.aa_rejected;
+      }
+      if (v.opts.solver == FkSolverType::kNewton) {
+        rj["linear_iterations"] = r.linear_iterations;
+        rj["load_steps"] = r.load_steps;
+      }
       rj["iteration_ratio"] = it_ratio;
       rj["time_ratio"] = t_ratio;
       // Plain lg stopped at the cap: its true count is higher, the ratio a lower bound.
       rj["ratio_is_lower_bound"] = lg_capped;
-      if (level == 1.0) {
+      if (level == 1.0 && anderson) {
         auto it = min_ratio->find(v.label);
         (*min_ratio)[v.label] = it == min_ratio->end() ? it_ratio : std::min(it->second, it_ratio);
       }
+      if (level == 1.0 && !anderson) (*time_ratios)[v.label].push_back(t_ratio);
     }
     row[v.label] = rj;
     if (verbose)
@@ -125,11 +152,13 @@ nlohmann::json RunAaAblation(const Config& cfg, const std::string& dir, bool ver
                  "aa_accepted", "aa_rejected", "iteration_ratio", "time_ratio"});
   nlohmann::json cases = nlohmann::json::array();
   std::map<std::string, double> min_ratio;  // per Anderson variant, at full actuation
+  std::map<std::string, std::vector<double>> time_ratios;  // per other solver, at full actuation
   for (size_t ri = 0; ri < p.robots.size(); ++ri) {
     Scene scene = MakeRobot(p.robots[ri], p.res.empty() ? 0 : p.res[ri]);
     auto model = std::make_shared<const Model>(scene);
     for (double level : p.levels)
-      cases.push_back(RunCase(p, p.robots[ri], scene, model, level, &csv, &min_ratio, verbose));
+      cases.push_back(
+          RunCase(p, p.robots[ri], scene, model, level, &csv, &min_ratio, &time_ratios, verbose));
   }
   nlohmann::json j;
   j["cases"] = cases;
@@ -139,6 +168,12 @@ nlohmann::json RunAaAblation(const Config& cfg, const std::string& dir, bool ver
   j["min_iteration_ratio_full_actuation"] =
       min_ratio.count(head) ? nlohmann::json(min_ratio[head]) : nlohmann::json(nullptr);
   j["min_iteration_ratio_full_actuation_by_variant"] = min_ratio;
+  // Other solvers: the range of lg's time over theirs at full actuation (> 1: faster than lg).
+  nlohmann::json by_solver = nlohmann::json::object();
+  for (const auto& [label, ratios] : time_ratios)
+    by_solver[label] = {{"min", *std::min_element(ratios.begin(), ratios.end())},
+                        {"max", *std::max_element(ratios.begin(), ratios.end())}};
+  j["time_ratio_full_actuation_by_solver"] = by_solver;
   return j;
 }
 

@@ -28,6 +28,14 @@ constexpr int kMaxKrylov = 300;
 constexpr double kMaxForcing = 0.1;
 /// An intermediate load step ends when |g| has dropped by this factor.
 constexpr double kStepReduction = 1e-3;
+/// GMRES is stopped as stalled when its relative residual is still above kStall after
+/// kStallProducts products (no progress: on multi_segment_gripper at its full range it stays at
+/// 1.0; where the factor works it falls below 0.1 within 2-35 products on the embedded robots,
+/// and below 0.5 within 50 on bilayer_strip). kMaxStalls stalls with a fresh factor end Newton
+/// for one Solve.
+constexpr int kStallProducts = 50;
+constexpr double kStall = 0.9;
+constexpr int kMaxStalls = 2;
 /// Armijo constant and the halvings of the line search.
 constexpr double kArmijo = 1e-4;
 constexpr int kMaxHalvings = 12;
@@ -84,17 +92,20 @@ bool NewtonSolver::Direction(const Eigen::VectorXd& c, const State& s, double et
   // GMRES with the factor of P: the one of an earlier iterate while it keeps working (its cost
   // per digit of residual reduction stays within twice that right after it was factored), else
   // factored at this state.
+  bool stalled = false;
   auto solve = [&](int budget) {
     op.SetPreconditioner(workspace_.factor());
     // Right-preconditioned: GMRES on H P^-1 u = -g bounds the true residual |H d + g| <= eta |g|
     // with d = P^-1 u. (Left preconditioning bounds |P^-1 (H d + g)|, which on bilayer_strip
     // was up to 50 times smaller than the true residual: the steps were not Newton steps.)
     GmresColumn gm(-s.g, Eigen::VectorXd::Zero(s.g.size()), budget, budget, eta);
-    while (!gm.done()) gm.Consume(op.Apply(op.Precondition(gm.Request())).col(0));
+    while (!gm.done() && !(gm.products() >= kStallProducts && gm.rel() > kStall))
+      gm.Consume(op.Apply(op.Precondition(gm.Request())).col(0));
     r->linear_iterations += gm.products();
     *d = op.Precondition(gm.y()).col(0);
     const double digits = std::max(0.5, -std::log10(std::max(gm.rel(), 1e-16)));
     const bool ok = d->allFinite() && gm.rel() <= eta;
+    stalled = gm.rel() > kStall;
     return std::make_pair(ok, gm.products() / digits);
   };
   auto factor = [&]() {
@@ -119,7 +130,16 @@ bool NewtonSolver::Direction(const Eigen::VectorXd& c, const State& s, double et
   if (!factor()) return false;
   const auto [ok, rate] = solve(kMaxKrylov);
   fresh_rate_ = rate;
-  (void)ok;  // a direction short of eta is still used: the line search guards it
+  // A direction short of eta is still used (the line search guards it), but GMRES that stalls
+  // with a fresh factor means P is far from H here (H strongly indefinite or non-normal): after
+  // kMaxStalls of those Newton gives up and lg-aa takes over (LoadSteps, Solve). (Failing only
+  // the load step instead, and halving it, took 5.7 s on multi_segment_gripper at its full range
+  // against 2.1 s, and still ended in lg-aa on bilayer_strip res 2 at 1.5.)
+  if (!ok && stalled && ++stalls_ >= kMaxStalls) {
+    *why = "GMRES with a fresh preconditioner stalled " + std::to_string(stalls_) +
+           " times (the Newton systems are far from their projected Hessian here)";
+    return false;
+  }
   if (!d->allFinite()) {
     *why = "the Krylov solve of the Newton step produced non-finite values";
     return false;
@@ -294,6 +314,11 @@ NewtonSolver::StepEnd NewtonSolver::LoadSteps(const Eigen::VectorXd& c0, const E
       return end;
     }
     delta = 0.5 * dl;
+    if (stalls_ >= kMaxStalls) {  // smaller load steps do not make the linear systems easier
+      *X = converged;
+      *why = step_why;
+      return StepEnd::Failed;
+    }
     if (delta < limits_.min_load_step) {
       *X = converged;
       std::ostringstream os;
@@ -317,7 +342,7 @@ FkResult NewtonSolver::Fallback(const Eigen::VectorXd& c, const Eigen::MatrixX3d
   FkResult f = lg.Solve(c, start);
   f.solver = name();
   f.message = "newton: " + reason + "; continued with lg-aa from " +
-              (start ? "the best Newton state" : "the rest shape") +
+              (start ? "the last converged load step" : "the rest shape") +
               (f.message.empty() ? "" : ": " + f.message);
   f.iterations += so_far.iterations;
   f.linear_iterations = so_far.linear_iterations;
@@ -337,6 +362,7 @@ FkResult NewtonSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c_in,
   }
   const Eigen::VectorXd c = c_in;
   local_time_s_ = 0.0;
+  stalls_ = 0;
   deadline_.reset();
   if (options_.time_limit_s > 0)
     deadline_ = t0 + std::chrono::duration_cast<Clock::duration>(
@@ -363,7 +389,9 @@ FkResult NewtonSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c_in,
     end = LoadSteps(rest, c, &X, &r, &why);
   }
   if (end == StepEnd::Failed) {
-    FkResult f = Fallback(c, &X, why, r, t0);  // within what is left of the time limit
+    // From the last converged load step (none: the rest shape), within what is left of the
+    // time limit.
+    FkResult f = Fallback(c, r.load_steps > 0 ? &X : nullptr, why, r, t0);
     deadline_.reset();
     return f;
   }

@@ -28,8 +28,10 @@
 ///    tangent predictor x + dlambda dx/dlambda (the equilibrium's derivative along the actuation,
 ///    solved with the same operator and factor). A warm start is tried at the full actuation
 ///    first, then from the rest shape;
-///  - fallback: when the step falls below 1/1024 of the range, the remaining actuation is left to
-///    lg-aa from the last converged state, and the message says so. Scenes Newton does not cover
+///  - fallback: when the step falls below 1/1024 of the range, or GMRES stalls twice with a
+///    fresh factor of P (P far from H: strongly indefinite or non-normal systems, as on
+///    multi_segment_gripper near its full range), the remaining actuation is left to lg-aa from
+///    the last converged state, and the message says so. Scenes Newton does not cover
 ///    (Mooney-Rivlin bodies, active collision response: EquilibriumJacobianUnsupported and
 ///    ContactHandlingActive) are solved by lg-aa outright, with a message.
 /// FkResult::iterations counts Newton iterations (plus the fallback's local-global ones),
@@ -126,6 +128,7 @@ class NewtonSolver : public FkSolver {
   /// (-1: refactor at the next Newton step).
   double fresh_rate_ = -1.0;
   int factorizations_ = 0;
+  int stalls_ = 0;  ///< GMRES solves with a fresh factor that stalled, in this Solve()
   std::optional<std::chrono::steady_clock::time_point> deadline_;
   Eigen::VectorXd ref_c_;
   double ref_value_ = 0.0;

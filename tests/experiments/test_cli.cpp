@@ -326,12 +326,21 @@ TEST(Cli, RunWritesSummaryWithConfigCommitAndMachine) {
   }
 
   std::ofstream(cfg) << R"({"name": "tiny_aa", "experiment": "aa_ablation", "seed": 3,
-    "robots": ["three_chamber"], "resolutions": [3], "levels": [0.5]})";
+    "robots": ["three_chamber"], "resolutions": [3], "levels": [0.5, 1.0], "solvers": ["newton"]})";
   r = Cli("run " + cfg + " --no-plot --results " + dir);
   ASSERT_EQ(r.code, 0) << r.out;
   std::ifstream f(dir + "/tiny_aa/summary.json");
   const auto j = nlohmann::json::parse(f);
   EXPECT_EQ(j["seed"], 3);
+  // The whole other solver runs beside the Anderson variants, compared by time.
+  const auto& full = j["cases"][1];
+  EXPECT_EQ(full["newton"]["status"], "converged");
+  EXPECT_GT(full["newton"]["linear_iterations"].get<int>(), 0);
+  EXPECT_FALSE(full["newton"].contains("aa_accepted"));
+  EXPECT_NEAR(full["newton"]["energy"].get<double>(),
+              full["lg-aa m=6 hybrid"]["energy"].get<double>(),
+              1e-4 * full["lg-aa m=6 hybrid"]["energy"].get<double>());
+  EXPECT_GT(j["time_ratio_full_actuation_by_solver"]["newton"]["min"].get<double>(), 0.0);
   EXPECT_TRUE(j.contains("git_commit"));
   EXPECT_TRUE(j["machine"].contains("hardware_threads"));
   EXPECT_EQ(j["config"]["robots"][0], "three_chamber");
@@ -342,6 +351,14 @@ TEST(Cli, RunWritesSummaryWithConfigCommitAndMachine) {
   r = Cli("run " + cfg + " --no-plot --results " + dir);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.out.find("robts"), std::string::npos) << r.out;
+  for (const char* bad : {R"(["lg-aa"])", R"(["newtn"])"}) {
+    std::ofstream(cfg) << R"({"name": "tiny_aa", "experiment": "aa_ablation", "seed": 3,
+      "solvers": )" << bad
+                       << "}";
+    r = Cli("run " + cfg + " --no-plot --results " + dir);
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_NE(r.out.find("solvers"), std::string::npos) << r.out;
+  }
   std::ofstream(cfg) << R"({"name": "x", "experiment": "aa_ablation"})";
   r = Cli("run " + cfg + " --no-plot --results " + dir);
   EXPECT_EQ(r.code, 2);

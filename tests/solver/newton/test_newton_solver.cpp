@@ -196,6 +196,22 @@ TEST(NewtonSolver, MooneyRivlinBodiesAreLeftToLgAaWithAReason) {
   EXPECT_NE(nw.message.find("lg-aa"), std::string::npos) << nw.message;
 }
 
+// Where the projected Hessian is no preconditioner for H (multi_segment_gripper with every chamber
+// at volume ratio 8, where GMRES makes no progress), Newton gives up early and lg-aa reaches the
+// same state as lg-aa alone, with the reason in the message.
+TEST(NewtonSolver, StalledKrylovSolvesHandOverToLgAa) {
+  auto model = std::make_shared<const Model>(MakeRobot("multi_segment_gripper", 6));
+  const Eigen::VectorXd c = Eigen::Vector3d(8.0, 8.0, 8.0);
+  const FkResult nw = MakeFkSolver(model, Options("newton", 1e-5, 1e-6))->Solve(c);
+  const FkResult lg = MakeFkSolver(model, Options("lg-aa", 1e-5, 1e-6))->Solve(c);
+  ASSERT_EQ(lg.status, FkStatus::Converged) << lg.BriefReport();
+  EXPECT_EQ(nw.status, FkStatus::Converged) << nw.BriefReport();
+  EXPECT_NE(nw.message.find("stalled"), std::string::npos) << nw.message;
+  EXPECT_NE(nw.message.find("continued with lg-aa"), std::string::npos) << nw.message;
+  EXPECT_LT((nw.positions - lg.positions).rowwise().norm().maxCoeff(), 1e-3 * model->size());
+  EXPECT_NEAR(nw.energy, lg.energy, 1e-6 * lg.energy);
+}
+
 TEST(NewtonSolver, UnknownSolverNameListsNewton) {
   std::string why;
   try {
