@@ -8,6 +8,8 @@
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -112,6 +114,34 @@ FkOptions ApplyFkOptionFlags(const FkOptionFlags& flags, const FkOptions& base) 
     o = ReadSolverOptionsJson(j, FkOptionFlagName(key) + ": solver", o);
   }
   return o;
+}
+
+std::vector<NamedPath> SceneInputs(const std::string& scene, const std::string& option) {
+  std::vector<NamedPath> in;
+  if (scene.empty()) return in;
+  in.push_back({option, scene});
+  std::ifstream f(scene, std::ios::binary);
+  const nlohmann::json j = nlohmann::json::parse(f, nullptr, /*allow_exceptions=*/false);
+  if (!j.is_object()) return in;
+  const std::filesystem::path dir = std::filesystem::path(scene).parent_path();
+  auto add = [&](const nlohmann::json& v, const std::string& key) {
+    if (v.is_string()) in.push_back({option + " " + key, (dir / v.get<std::string>()).string()});
+  };
+  if (j.contains("mesh") && j["mesh"].is_object()) {
+    if (j["mesh"].contains("file")) add(j["mesh"]["file"], "mesh.file");
+    if (j["mesh"].contains("labels")) add(j["mesh"]["labels"], "mesh.labels");
+  }
+  if (j.contains("obstacles") && j["obstacles"].is_array())
+    for (const auto& o : j["obstacles"])
+      if (o.is_object() && o.contains("file")) add(o["file"], "obstacles[].file");
+  return in;
+}
+
+void CheckCommandPaths(const std::vector<NamedPath>& inputs,
+                       const std::vector<NamedPath>& outputs) {
+  CheckDistinctPaths(inputs, outputs);
+  for (const NamedPath& o : outputs)
+    if (!o.path.empty()) CheckOutputPath(o);
 }
 
 }  // namespace softkin

@@ -2,6 +2,7 @@
 /// \file cli_args.hpp
 /// Parsing of `softkin` option values shared by several commands. Every error is a
 /// std::invalid_argument that names the option and says what was expected.
+#include "softkin/solver/common/output_file.hpp"
 #include "softkin/solver/fk/fk_options.hpp"
 #include "softkin/solver/robots/robots.hpp"
 
@@ -52,5 +53,14 @@ std::vector<CLI::Option*> AddFkOptionFlags(CLI::App* cmd, FkOptionFlags* flags,
 /// error names the flag, the option and what was expected, e.g. "--max-iterations:
 /// solver.max_iterations: expected an integer >= 1, got 0".
 FkOptions ApplyFkOptionFlags(const FkOptionFlags& flags, const FkOptions& base);
+
+/// The files a scene JSON reads: the scene itself (as `option`), its mesh.file and mesh.labels
+/// and its obstacles' files, resolved as the scene reader resolves them. Empty `scene`: none. An
+/// unreadable or malformed scene gives just the scene (its reader reports the error later).
+std::vector<NamedPath> SceneInputs(const std::string& scene, const std::string& option = "--scene");
+
+/// Before any work: refuses an output that is an input or another output, and an output that
+/// cannot be written (CheckDistinctPaths, CheckOutputPath; empty paths are skipped).
+void CheckCommandPaths(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs);
 
 }  // namespace softkin

@@ -1,5 +1,6 @@
 #include "softkin/experiments/cli_calibrate.hpp"
 
+#include "softkin/experiments/cli_args.hpp"
 #include "softkin/experiments/results.hpp"
 
 #include <nlohmann/json.hpp>
@@ -27,6 +28,7 @@ CLI::App* AddCalibrateCommand(CLI::App* app, CalibrateCommandArgs* a) {
 }
 
 int RunCalibrateCommand(const CalibrateCommandArgs& a) {
+  CheckCommandPaths({}, {{"--json", a.json_out}});  // before the calibration's solves
   const BarTestOptions& bar = a.bar;
   const CalibrationResult c = CalibrateROmega(a.rm, bar);
   nlohmann::json j = {

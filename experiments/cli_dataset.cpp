@@ -58,7 +58,7 @@ CLI::App* AddDatasetCommand(CLI::App* app, DatasetCommandArgs* a) {
   ds->add_option("--shard", a->shard,
                  "Compute shard k of n (k = 0..n-1): a contiguous slice of "
                  "the serpentine order, into its own --out file");
-  AddFkOptionFlags(ds, &a->fk_options, {"gradient_tolerance"});
+  AddFkOptionFlags(ds, &a->fk_options, {"solver", "gradient_tolerance"});
   ds->add_option("--merge", a->merge, "Merge these complete shard files (all n of them) into --out")
       ->expected(1, -1);
   ds->add_option("--out", a->out, "Output CSV (its sidecar is FILE.json)")->required();
@@ -209,6 +209,13 @@ void ReportSummary(const DatasetRunSummary& s) {
 }  // namespace
 
 int RunDatasetCommand(const DatasetCommandArgs& a) {
+  // Before any work: --out and its sidecar are not inputs (shards) and can be written.
+  std::vector<NamedPath> shards;
+  for (const std::string& m : a.merge) {
+    shards.push_back({"--merge", m});
+    shards.push_back({"--merge sidecar", m + ".json"});
+  }
+  CheckCommandPaths(shards, {{"--out", a.out}, {"--out's sidecar", a.out + ".json"}});
   if (!a.merge.empty()) return MergeCommand(a);
   if (a.robot.empty() == a.twin.empty())
     throw std::invalid_argument("dataset: give exactly one of --robot NAME or --twin NAME");

@@ -116,6 +116,9 @@ int RunFkCommand(const FkCommandArgs& a) {
   if (a.robot.empty() == a.scene.empty())
     throw std::invalid_argument("fk: give exactly one of --robot NAME or --scene FILE");
   if (a.res < 0) throw std::invalid_argument("--res: expected a positive integer");
+  // Before any work: no output overwrites an input or another output, and each can be written.
+  CheckCommandPaths(SceneInputs(a.scene),
+                    {{"--json", a.json_out}, {"--vtu", a.vtu_out}, {"--obj", a.obj_out}});
   const RobotParams params = ParseRobotParams(a.params);
   Scene scene = a.robot.empty() ? LoadSceneJson(a.scene) : MakeRobot(a.robot, a.res, params);
   FkOptions opt = FkOptionsFromArgs(a, scene.solver);

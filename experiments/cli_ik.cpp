@@ -70,7 +70,8 @@ CLI::App* AddIkCommand(CLI::App* app, IkCommandArgs* a) {
   ik->add_option("--max-evaluations", a->max_evaluations,
                  "Kinematics evaluations per waypoint, every method (default 300)");
   ik->add_option("--max-time", a->max_time_s, "Wall-time limit per waypoint, s (default 600)");
-  CLI::Option* gtol = AddFkOptionFlags(ik, &a->fk_options, {"gradient_tolerance"}).front();
+  // --solver and --gradient-tolerance, in the option table's order.
+  CLI::Option* gtol = AddFkOptionFlags(ik, &a->fk_options, {"solver", "gradient_tolerance"}).back();
   gtol->description(gtol->get_description() +
                     " 1e-4 saves about half the iterations but its error depends on the robot: "
                     "micrometres on cable_finger, ~0.1 mm on three_chamber, up to 4 mm on "
@@ -563,6 +564,10 @@ int RunLearnedIk(const IkCommandArgs& a) {
 }  // namespace
 
 int RunIkCommand(const IkCommandArgs& a) {
+  // Before any work: no output overwrites an input or another output, and each can be written.
+  std::vector<NamedPath> inputs = SceneInputs(a.scene);
+  inputs.push_back({"--trajectory", a.trajectory});
+  CheckCommandPaths(inputs, {{"--out", a.out}, {"--cache", a.cache}});
   if (!a.nets.empty() || a.method == "learned" || a.method == "direct") return RunLearnedIk(a);
   return RunSimulatorIk(a);
 }

@@ -1,5 +1,6 @@
 #include "softkin/experiments/cli_tessellate.hpp"
 
+#include "softkin/experiments/cli_args.hpp"
 #include "softkin/experiments/results.hpp"
 #include "softkin/solver/mesh/io/mesh_io.hpp"
 
@@ -87,6 +88,8 @@ int RunTessellateCommand(const TessellateCommandArgs& a) {
   CheckOption("--feature-angle", o.feature_angle >= 0 && o.feature_angle < 180,
               "an angle in [0, 180) degrees", o.feature_angle);
   const std::string ext = OutputExtension(a.out);
+  CheckCommandPaths({{"--body", a.body}, {"--chamber", a.chamber}},
+                    {{"--out", a.out}, {"--json", a.json_out}});
   const TriangleSurface body = ReadSurfaceMesh(a.body);
   const TriangleSurface chamber = ReadSurfaceMesh(a.chamber);
   TessellationReport rep;

@@ -1,5 +1,7 @@
 #include "softkin/experiments/cli_train.hpp"
 
+#include "softkin/solver/fk/fk_options.hpp"
+
 #include "softkin/experiments/cli_args.hpp"
 #include "softkin/experiments/results.hpp"
 #include "softkin/learn/dataset.hpp"
@@ -102,7 +104,10 @@ LmOptions LmFromArgs(const TrainCommandArgs& a) {
   if (a.epochs < 0) throw std::invalid_argument("--epochs: expected an integer >= 0");
   if (!(a.max_time_s >= 0) || !std::isfinite(a.max_time_s))
     throw std::invalid_argument("--max-time: expected a time >= 0 s");
-  if (a.threads < 0) throw std::invalid_argument("--threads: expected an integer >= 0");
+  if (a.threads < 0 || a.threads > kMaxThreads)
+    throw std::invalid_argument("--threads: expected an integer in [0, " +
+                                std::to_string(kMaxThreads) + "], got " +
+                                std::to_string(a.threads));
   if (!(a.eta > 0) || !std::isfinite(a.eta))
     throw std::invalid_argument("--eta: expected a number > 0");
   LmOptions lm;

@@ -1,5 +1,7 @@
 #include "softkin/experiments/results.hpp"
 
+#include "softkin/solver/common/output_file.hpp"
+
 #include "softkin/solver/collision/collision_response.hpp"
 
 #include <cstdio>
@@ -70,10 +72,9 @@ nlohmann::json MachineInfo() {
 }
 
 void WriteJson(const std::string& path, const nlohmann::json& j) {
-  std::ofstream f(path);
-  if (!f) throw std::runtime_error("cannot write " + path);
-  f << std::setw(2) << j << "\n";
-  if (!f) throw std::runtime_error("error while writing " + path);
+  OutputFile f(path);  // atomic: a failed write leaves the old file
+  f.stream() << std::setw(2) << j << "\n";
+  f.Commit();
 }
 
 CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& header)

@@ -2,6 +2,8 @@
 // reader.
 #include "softkin/learn/fnn.hpp"
 
+#include "softkin/solver/common/output_file.hpp"
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -139,11 +141,9 @@ void Fnn::Write(std::ostream& out) const {
 
 void Fnn::Save(const std::string& path) const {
   if (num_layers() == 0) throw std::runtime_error("Fnn::Save(" + path + "): the network is empty");
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  if (!f) throw std::runtime_error("Fnn::Save: cannot open '" + path + "' for writing");
-  Write(f);
-  f.flush();
-  if (!f) throw std::runtime_error("Fnn::Save: writing '" + path + "' failed");
+  OutputFile f(path, std::ios::binary);  // atomic: a failed write leaves the old network
+  Write(f.stream());
+  f.Commit();
 }
 
 Fnn Fnn::Read(std::istream& in, const std::string& source) {

@@ -1,6 +1,7 @@
 #include "softkin/learn/lm_trainer.hpp"
 
 #include "softkin/learn/tiled_cholesky.hpp"
+#include "softkin/solver/fk/fk_options.hpp"
 
 #include <omp.h>
 
@@ -117,7 +118,9 @@ bool LmOptions::IsValid(std::string* why) const {
   if (!(goal >= 0.0)) return fail("goal must be >= 0");
   if (!(max_time_s >= 0.0)) return fail("max_time_s must be >= 0 (0: no limit)");
   if (block_size < 0) return fail("block_size must be >= 0 (0: automatic)");
-  if (num_threads < 0) return fail("num_threads must be >= 0 (0: OpenMP default)");
+  if (num_threads < 0 || num_threads > kMaxThreads)
+    return fail("num_threads must be in [0, " + std::to_string(kMaxThreads) +
+                "] (0: OpenMP default)");
   if (progress_every < 1) return fail("progress_every must be >= 1");
   return true;
 }

@@ -131,7 +131,8 @@ bool FkOptions::IsValid(std::string* why) const {
   if (anderson_window < 1 || anderson_window > 50)
     return bad("anderson_window: expected an integer in [1, 50]");
   if (continuation_steps < 1) return bad("continuation_steps: expected an integer >= 1");
-  if (threads < 0) return bad("threads: expected an integer >= 0");
+  if (threads < 0 || threads > kMaxThreads)
+    return bad("threads: expected an integer in [0, " + std::to_string(kMaxThreads) + "]");
   if (!(time_limit_s >= 0.0) || !std::isfinite(time_limit_s))
     return bad("time_limit_s: expected a number >= 0 (0: no limit)");
   if (!collision.IsValid(why)) return false;

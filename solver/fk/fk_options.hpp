@@ -134,6 +134,9 @@ std::vector<std::string> AndersonSafeguardNames();
 void to_json(nlohmann::json& j, AndersonSafeguard v);
 void from_json(const nlohmann::json& j, AndersonSafeguard& v);
 
+/// The most OpenMP threads any option accepts (a larger count crashed libgomp: 100000 threads).
+constexpr int kMaxThreads = 256;
+
 struct FkOptions {
   /// The solver: lg (plain local-global, Algorithm 1), lg-aa (Anderson-accelerated), or one of the
   /// general-purpose optimisers and FEM baselines (FkSolverType).

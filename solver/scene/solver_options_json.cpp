@@ -130,7 +130,7 @@ const std::vector<Row>& Rows() {
              "Apply the actuation in this many equal steps, warm-starting each.")
           .AtLeast(1),
       Option("threads", &F::threads, "OpenMP threads for the local step (0: library default).")
-          .AtLeast(0),
+          .In(0, kMaxThreads),
       Option("time_limit_s", &F::time_limit_s,
              "Wall-clock limit of one solve in seconds (0: none); when it runs out the solve "
              "ends with status time_limit and its last checked state.")

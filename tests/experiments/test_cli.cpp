@@ -40,6 +40,58 @@ std::string TempDir(const std::string& name) {
   return d.string();
 }
 
+std::string ReadAll(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::ostringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// An output that is also an input (or another output), or that cannot be written, is refused
+// before any solve, and the input is left as it was; a failed write is an error, not exit 0.
+TEST(Cli, BadOutputsAndThreadCountsAreRefusedBeforeAnyWork) {
+  const std::string dir = TempDir("outputs");
+  const std::string scene = dir + "/s.json", path = dir + "/p.txt";
+  {
+    std::ofstream(scene) << R"({"robot": {"name": "three_chamber", "res": 3}})";
+    std::ofstream(path) << "0 0 50\n";
+  }
+  const std::string scene_text = ReadAll(scene), path_text = ReadAll(path);
+  struct Case {
+    std::string args, expect;
+  };
+  const std::string fk = "fk --robot three_chamber --res 3 --actuation 1.2,1,1 ";
+  for (const Case& c : std::vector<Case>{
+           {"fk --scene " + scene + " --actuation 1.2,1,1 --json " + scene,
+            "same file as the input --scene"},
+           {fk + "--json " + dir + "/o --vtu " + dir + "/./o", "same file as the output --json"},
+           {fk + "--vtu " + dir + "/nodir/o.vtu", "does not exist"},
+           {fk + "--json " + dir, "is a folder"},
+           {"ik --robot three_chamber --res 3 --trajectory " + path + " --out " + path,
+            "same file as the input --trajectory"},
+           {"ik --robot three_chamber --res 3 --trajectory " + path + " --out " + dir +
+                "/x.csv --cache " + dir + "/x.csv",
+            "--cache"},
+           {"dataset --robot three_chamber --res 3 --grid 2 --out " + dir + "/nodir/d.csv",
+            "does not exist"},
+           // Thread counts beyond the cap (100000 crashed libgomp).
+           {fk + "--threads 100000", "solver.threads: expected an integer in [0, 256]"},
+           {"train --dataset " + dir + "/d.csv --out " + dir + "/nets --threads 100000",
+            "--threads: expected an integer in [0, 256]"}}) {
+    const CliRun r = Cli(c.args);
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.out;
+    EXPECT_NE(r.out.find(c.expect), std::string::npos) << c.args << "\n" << r.out;
+    EXPECT_EQ(r.out.find("converged"), std::string::npos) << "solved before the check: " << r.out;
+  }
+  EXPECT_EQ(ReadAll(scene), scene_text);
+  EXPECT_EQ(ReadAll(path), path_text);
+  if (std::filesystem::exists("/dev/full")) {
+    const CliRun r = Cli(fk + "--json /dev/full");
+    EXPECT_NE(r.code, 0) << r.out;
+    EXPECT_NE(r.out.find("/dev/full: write error"), std::string::npos) << r.out;
+  }
+}
+
 TEST(Cli, HelpOnEveryCommand) {
   for (const char* c : {"--help", "robots --help", "fk --help", "run --help", "scene --help",
                         "calibrate --help", "train --help", "dataset --help", "ik --help"}) {
@@ -136,7 +188,7 @@ TEST(Cli, FkSetsAnySolverOption) {
       << typo.out;
   const CliRun bad = Cli("fk --robot three_chamber --res 3 --actuation 1.3,1,1 --set threads=x");
   EXPECT_NE(bad.code, 0);
-  EXPECT_NE(bad.out.find("--set: solver.threads: expected an integer >= 0, got \"x\""),
+  EXPECT_NE(bad.out.find("--set: solver.threads: expected an integer in [0, 256], got \"x\""),
             std::string::npos)
       << bad.out;
 }

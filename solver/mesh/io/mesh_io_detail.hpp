@@ -7,6 +7,8 @@
 /// std::from_chars (locale-independent, allocation-free); a number must be followed by a blank,
 /// the end of the line, a comment or the end of the file, otherwise the token is reported as
 /// non-numeric. The cursor never moves past the end of the buffer.
+#include "softkin/solver/common/output_file.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <charconv>
@@ -346,19 +348,12 @@ inline std::ostream& WriteRow(std::ostream& o, const M& X, int j) {
   return o << Num{X(j, 0)} << ' ' << Num{X(j, 1)} << ' ' << Num{X(j, 2)};
 }
 
-/// Opens `path` for writing (full double precision for any value not written through Num); throws
-/// naming the path on failure.
-inline std::ofstream OpenForWrite(const std::string& path) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) Fail(path, "cannot open file for writing", "a writable path (does the folder exist?)");
-  out.precision(17);
-  return out;
-}
-
-/// Flushes and checks a writer's stream.
-inline void FinishWrite(std::ofstream& out, const std::string& path) {
-  out.flush();
-  if (!out) Fail(path, "write error", "enough disk space and a writable file");
+/// The stream of an output file, set to full double precision for any value not written through
+/// Num. (OutputFile, solver/common/output_file.hpp, writes beside the target and renames it in
+/// Commit(), after checking every write.)
+inline std::ostream& ForWrite(OutputFile& file) {
+  file.stream().precision(17);
+  return file.stream();
 }
 
 }  // namespace detail

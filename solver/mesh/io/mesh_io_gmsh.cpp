@@ -509,7 +509,8 @@ void WriteGmsh(const std::string& path, const Mesh& mesh, const std::string& ver
   const bool v4 = version == "4.1";
   if (!v4 && version != "2.2" && version != "2")
     detail::Fail(path, "unsupported Gmsh version " + detail::Quote(version), "\"2.2\" or \"4.1\"");
-  std::ofstream out = detail::OpenForWrite(path);
+  OutputFile out_file(path);
+  std::ostream& out = detail::ForWrite(out_file);
   const int nv = mesh.num_vertices(), ne = mesh.num_elements();
   auto gmsh_type = [](const Element& e) { return e.type == ElementType::Tet ? 4 : 6; };
   // Elementary entities (volumes): one per region, tag = position in the sorted regions + 1 (> 0).
@@ -532,7 +533,7 @@ void WriteGmsh(const std::string& path, const Mesh& mesh, const std::string& ver
       out << '\n';
     }
     out << "$EndElements\n";
-    detail::FinishWrite(out, path);
+    out_file.Commit();
     return;
   }
 
@@ -593,7 +594,7 @@ void WriteGmsh(const std::string& path, const Mesh& mesh, const std::string& ver
     i = j;
   }
   out << "$EndElements\n";
-  detail::FinishWrite(out, path);
+  out_file.Commit();
 }
 
 }  // namespace softkin

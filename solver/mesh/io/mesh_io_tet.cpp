@@ -116,17 +116,19 @@ void WriteTet(const std::string& path, const Mesh& mesh, const std::string& labe
     detail::Fail(path, "cannot write " + std::to_string(mesh.num_prisms()) + " prisms to .tet",
                  "a tet-only mesh (use Gmsh or VTK for prisms)");
   {
-    std::ofstream out = detail::OpenForWrite(path);
+    OutputFile out_file(path);
+    std::ostream& out = detail::ForWrite(out_file);
     out << mesh.num_vertices() << " vertices\n" << mesh.num_elements() << " tets\n";
     for (int j = 0; j < mesh.num_vertices(); ++j) detail::WriteRow(out, mesh.vertices, j) << '\n';
     for (const auto& e : mesh.elements)
       out << "4 " << e.v[0] << ' ' << e.v[1] << ' ' << e.v[2] << ' ' << e.v[3] << '\n';
-    detail::FinishWrite(out, path);
+    out_file.Commit();
   }
   if (!labels_path.empty()) {
-    std::ofstream out = detail::OpenForWrite(labels_path);
+    OutputFile out_file(labels_path);
+    std::ostream& out = detail::ForWrite(out_file);
     for (const auto& e : mesh.elements) out << e.region << '\n';
-    detail::FinishWrite(out, labels_path);
+    out_file.Commit();
   }
 }
 

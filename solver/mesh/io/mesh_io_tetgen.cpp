@@ -167,16 +167,18 @@ void WriteTetGen(const std::string& base_in, const Mesh& mesh) {
                  "a tet-only mesh (use Gmsh or VTK for prisms)");
   {
     const std::string p = base + ".node";
-    std::ofstream out = detail::OpenForWrite(p);
+    OutputFile out_file(p);
+    std::ostream& out = detail::ForWrite(out_file);
     out << "# SoftKin mesh: <#points> <dim> <#attributes> <#boundary markers>\n";
     out << mesh.num_vertices() << " 3 0 0\n";
     for (int j = 0; j < mesh.num_vertices(); ++j)
       detail::WriteRow(out << j + 1 << ' ', mesh.vertices, j) << '\n';
-    detail::FinishWrite(out, p);
+    out_file.Commit();
   }
   {
     const std::string p = base + ".ele";
-    std::ofstream out = detail::OpenForWrite(p);
+    OutputFile out_file(p);
+    std::ostream& out = detail::ForWrite(out_file);
     out << "# SoftKin mesh: <#tetrahedra> <nodes per tet> <#attributes (region)>\n";
     out << mesh.num_elements() << " 4 1\n";
     for (int i = 0; i < mesh.num_elements(); ++i) {
@@ -184,7 +186,7 @@ void WriteTetGen(const std::string& base_in, const Mesh& mesh) {
       out << i + 1 << ' ' << e.v[0] + 1 << ' ' << e.v[1] + 1 << ' ' << e.v[2] + 1 << ' '
           << e.v[3] + 1 << ' ' << e.region << '\n';
     }
-    detail::FinishWrite(out, p);
+    out_file.Commit();
   }
 }
 

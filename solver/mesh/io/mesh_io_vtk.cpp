@@ -524,7 +524,8 @@ Mesh ReadVtk(const std::string& path, const std::string& tag_array, MeshReport* 
 }
 
 void WriteVtk(const std::string& path, const Mesh& mesh) {
-  std::ofstream out = detail::OpenForWrite(path);
+  OutputFile out_file(path);
+  std::ostream& out = detail::ForWrite(out_file);
   const int nv = mesh.num_vertices(), ne = mesh.num_elements();
   long long size = 0;
   for (const auto& e : mesh.elements) size += 1 + e.k();
@@ -543,7 +544,7 @@ void WriteVtk(const std::string& path, const Mesh& mesh) {
   for (const auto& e : mesh.elements) out << (e.type == ElementType::Tet ? 10 : 13) << '\n';
   out << "CELL_DATA " << ne << "\nSCALARS region int 1\nLOOKUP_TABLE default\n";
   for (const auto& e : mesh.elements) out << e.region << '\n';
-  detail::FinishWrite(out, path);
+  out_file.Commit();
 }
 
 }  // namespace softkin

@@ -122,7 +122,8 @@ void WriteVtu(const std::string& path, const Mesh& mesh,
               const Eigen::MatrixX3d* rest_positions) {
   CheckPositions(path, mesh, X);
   const std::vector<double> strain = ElementStrain(mesh, X, rest_regions, rest_positions);
-  std::ofstream out = detail::OpenForWrite(path);
+  OutputFile out_file(path);
+  std::ostream& out = detail::ForWrite(out_file);
   const int nv = mesh.num_vertices(), ne = mesh.num_elements();
   out << "<?xml version=\"1.0\"?>\n"
       << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
@@ -180,11 +181,12 @@ void WriteVtu(const std::string& path, const Mesh& mesh,
     out << "          " << (e.type == ElementType::Tet ? 10 : 13) << '\n';
   out << "        </DataArray>\n      </Cells>\n";
   out << "    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
-  detail::FinishWrite(out, path);
+  out_file.Commit();
 }
 
 void WritePvd(const std::string& path, const std::vector<std::pair<double, std::string>>& steps) {
-  std::ofstream out = detail::OpenForWrite(path);
+  OutputFile out_file(path);
+  std::ostream& out = detail::ForWrite(out_file);
   out << "<?xml version=\"1.0\"?>\n"
       << "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
       << "  <Collection>\n";
@@ -192,7 +194,7 @@ void WritePvd(const std::string& path, const std::vector<std::pair<double, std::
     out << "    <DataSet timestep=\"" << detail::Num{t} << "\" group=\"\" part=\"0\" file=\""
         << XmlEscape(file) << "\"/>\n";
   out << "  </Collection>\n</VTKFile>\n";
-  detail::FinishWrite(out, path);
+  out_file.Commit();
 }
 
 void WriteSurfaceObj(const std::string& path, const Mesh& mesh,
@@ -251,7 +253,8 @@ void WriteSurfaceObj(const std::string& path, const Mesh& mesh,
     return a->element != b->element ? a->element < b->element : a->local < b->local;
   });
 
-  std::ofstream out = detail::OpenForWrite(path);
+  OutputFile out_file(path);
+  std::ostream& out = detail::ForWrite(out_file);
   out << "# SoftKin boundary surface: " << order.size() << " vertices, " << boundary.size()
       << " faces\n";
   for (int v : order) detail::WriteRow(out << "v ", X, v) << '\n';
@@ -263,7 +266,7 @@ void WriteSurfaceObj(const std::string& path, const Mesh& mesh,
     if (lf.d >= 0) out << ' ' << new_index[e.v[lf.d]] + 1;
     out << '\n';
   }
-  detail::FinishWrite(out, path);
+  out_file.Commit();
 }
 
 }  // namespace softkin
