@@ -83,6 +83,9 @@ nlohmann::json FkResultJson(const Scene& scene, const Eigen::VectorXd& c, const 
     j["linear_iterations"] = r.linear_iterations;
     j["load_steps"] = r.load_steps;
   }
+  j["inverted_elements"] = r.inverted_elements;  // body elements: > 0 is a wrong state
+  j["inverted_actuation_elements"] = r.inverted_actuation_elements;
+  j["min_volume_ratio"] = r.min_volume_ratio;
   j["n_vertices"] = scene.mesh.num_vertices();
   j["n_elements"] = scene.mesh.num_elements();
   j["actuation"] = std::vector<double>(c.data(), c.data() + c.size());

@@ -290,8 +290,8 @@ std::string LastErrorLine(const std::string& log) {
 
 }  // namespace
 
-FkResult CalculixSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
-                               const Eigen::MatrixX3d*) {
+FkResult CalculixSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c,
+                                   const Eigen::MatrixX3d*) {
   const Model& m = *model_;
   const auto t0 = Clock::now();
   FkResult r;

@@ -84,8 +84,12 @@ class CalculixSolver : public FkSolver {
  public:
   CalculixSolver(std::shared_ptr<const Model> model, const FkOptions& fk, CalculixOptions options);
   std::string name() const override { return name_; }
-  FkResult Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
-                 const Eigen::MatrixX3d* warm_start = nullptr) override;
+
+ protected:
+  FkResult SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c,
+                     const Eigen::MatrixX3d* warm_start) override;
+
+ public:
   /// The converged increments of the last Solve, in load order.
   const std::vector<CalculixIncrement>& increments() const { return history_; }
 

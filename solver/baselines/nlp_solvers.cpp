@@ -46,8 +46,8 @@ class RatioUpdateSolver : public FkSolver {
   }
   std::string name() const override { return ToString(options_.solver); }
 
-  FkResult Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
-                 const Eigen::MatrixX3d* warm_start) override {
+  FkResult SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c,
+                     const Eigen::MatrixX3d* warm_start) override {
     const Model& m = *model_;
     const auto t0 = Clock::now();
     FkResult r;
@@ -653,8 +653,8 @@ class IpoptHardSolver : public FkSolver {
       : FkSolver(std::move(model)), options_(options) {}
   std::string name() const override { return ToString(options_.solver); }
 
-  FkResult Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
-                 const Eigen::MatrixX3d* warm_start) override {
+  FkResult SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c,
+                     const Eigen::MatrixX3d* warm_start) override {
     const Model& m = *model_;
     const auto t0 = Clock::now();
     FkResult r;

@@ -97,8 +97,9 @@ void CheckOutputPath(const NamedPath& out) {
   if (IsSpecial(p)) return;
   if (fs::is_directory(p, ec)) fail("is a folder", "a file name");
   const fs::path parent = Parent(p);
-  if (!fs::exists(parent, ec)) fail("the folder '" + parent.string() + "' does not exist",
-                                    "a path in an existing folder (create it first)");
+  if (!fs::exists(parent, ec))
+    fail("the folder '" + parent.string() + "' does not exist",
+         "a path in an existing folder (create it first)");
   if (!fs::is_directory(parent, ec))
     fail("'" + parent.string() + "' is not a folder", "a path in an existing folder");
   // The file is written beside itself and renamed: the folder must be writable.

@@ -54,6 +54,7 @@ void CheckOutputPath(const NamedPath& out);
 
 /// Throws std::invalid_argument if an output names the same file as an input or as another
 /// output. Empty paths are skipped.
-void CheckDistinctPaths(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs);
+void CheckDistinctPaths(const std::vector<NamedPath>& inputs,
+                        const std::vector<NamedPath>& outputs);
 
 }  // namespace softkin

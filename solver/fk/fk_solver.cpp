@@ -1,8 +1,12 @@
 #include "softkin/solver/fk/fk_solver.hpp"
 
 #include "softkin/solver/fk/energy.hpp"
+#include "softkin/solver/mesh/element_geometry.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 
 namespace softkin {
@@ -40,6 +44,12 @@ std::string FkResult::BriefReport() const {
                 time_s);
   std::string s = buf;
   if (!message.empty()) s += " (" + message + ")";
+  if (inverted_elements > 0) {
+    std::snprintf(buf, sizeof(buf),
+                  "; WARNING: %d inverted body element(s), smallest volume ratio %.3g",
+                  inverted_elements, min_volume_ratio);
+    s += buf;
+  }
   if (collision_active) {
     std::snprintf(buf, sizeof(buf),
                   "; collisions: %d springs left, %s (max penetration %.3g mm), check %.3f s, "
@@ -54,6 +64,34 @@ std::string FkResult::BriefReport() const {
     }
   }
   return s;
+}
+
+FkResult FkSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
+                         const Eigen::MatrixX3d* warm_start) {
+  FkResult r = SolveImpl(c, warm_start);
+  ReportInvertedElements(*model_, &r);
+  return r;
+}
+
+void ReportInvertedElements(const Model& model, FkResult* r) {
+  const Eigen::MatrixX3d& X = r->positions;
+  if (X.rows() != model.num_vertices() || !X.allFinite()) return;
+  int body = 0, actuation = 0;
+  double worst = std::numeric_limits<double>::infinity();
+  ElemRows P = ElemRows::Zero();
+  for (const ModelElement& e : model.elements()) {
+    for (int j = 0; j < e.k; ++j) P.row(j) = X.row(e.v[j]);
+    const double ratio = RowsVolume(P, e.k) / e.rest_volume;
+    if (e.role == ElementRole::Body) {
+      worst = std::min(worst, ratio);
+      body += ratio <= 0.0;
+    } else {
+      actuation += ratio <= 0.0;
+    }
+  }
+  r->inverted_elements = body;
+  r->inverted_actuation_elements = actuation;
+  r->min_volume_ratio = std::isfinite(worst) ? worst : 1.0;  // 1: no body elements
 }
 
 std::string SolveInputError(const Model& m, const Eigen::Ref<const Eigen::VectorXd>& c,

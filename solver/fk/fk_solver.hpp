@@ -32,6 +32,11 @@ struct FkResult {
   double max_move = 0;        ///< last per-iteration vertex move / model size
   double time_s = 0, local_time_s = 0, global_time_s = 0;
   int aa_accepted = 0, aa_rejected = 0;
+  /// Elements with signed volume <= 0 at `positions`: body elements (a state no material takes;
+  /// BriefReport warns) and actuation elements (a chamber's elements may fold while its cavity
+  /// volume is right), and the smallest signed / rest volume of a body element.
+  int inverted_elements = 0, inverted_actuation_elements = 0;
+  double min_volume_ratio = 1.0;
   int linear_iterations = 0;          ///< newton: Krylov operator products
   int load_steps = 0;                 ///< newton: converged load steps
   std::vector<double> volume_ratios;  ///< achieved volume ratio per actuator
@@ -52,13 +57,17 @@ class FkSolver {
   virtual std::string name() const = 0;
   /// Solves for actuation c (one value per actuator, within its range). warm_start: #V x 3
   /// positions to start from (nullptr: rest shape). Bad input yields status InvalidInput with a
-  /// message (never an exception from here), non-convergence IterationCap or Diverged.
-  virtual FkResult Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
-                         const Eigen::MatrixX3d* warm_start = nullptr) = 0;
+  /// message (never an exception from here), non-convergence IterationCap or Diverged. Every
+  /// result reports its inverted elements (ReportInvertedElements).
+  FkResult Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
+                 const Eigen::MatrixX3d* warm_start = nullptr);
   const Model& model() const { return *model_; }
 
  protected:
   explicit FkSolver(std::shared_ptr<const Model> m) : model_(std::move(m)) {}
+  /// The solver's own Solve().
+  virtual FkResult SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c,
+                             const Eigen::MatrixX3d* warm_start) = 0;
   /// Fills in what every Solve() starts from: the solver's name, the actuation, the positions
   /// (the warm start, or the rest shape). Returns false, with status invalid_input and the reason
   /// (SolveInputError) in *r, if c or the warm start is bad.
@@ -66,6 +75,12 @@ class FkSolver {
                    FkResult* r) const;
   std::shared_ptr<const Model> model_;
 };
+
+/// Counts the elements of `model` whose signed volume at r->positions is not positive (body and
+/// actuation elements apart) and the smallest signed / rest volume ratio of a body element, into
+/// r->inverted_elements, inverted_actuation_elements and min_volume_ratio. Positions that are
+/// missing or not finite leave them unset.
+void ReportInvertedElements(const Model& model, FkResult* r);
 
 /// Checks an actuation vector (CheckActuation) and an optional warm start (#V x 3, finite) for
 /// `model`; returns "" or the reason. Every solver's Solve() reports it as invalid_input.

@@ -242,8 +242,8 @@ void LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
   r->message = "iteration cap of " + std::to_string(options_.max_iterations) + " reached";
 }
 
-FkResult LocalGlobalSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
-                                  const Eigen::MatrixX3d* warm_start) {
+FkResult LocalGlobalSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c,
+                                      const Eigen::MatrixX3d* warm_start) {
   const Model& m = *model_;
   const auto t0 = Clock::now();
   FkResult r;

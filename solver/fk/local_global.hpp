@@ -40,8 +40,12 @@ class LocalGlobalSolver : public FkSolver {
   LocalGlobalSolver(std::shared_ptr<const Model> model, const FkOptions& options,
                     ContactTermFactory contacts = {});
   std::string name() const override { return ToString(options_.solver); }
-  FkResult Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
-                 const Eigen::MatrixX3d* warm_start = nullptr) override;
+
+ protected:
+  FkResult SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c,
+                     const Eigen::MatrixX3d* warm_start) override;
+
+ public:
   const FkOptions& options() const { return options_; }
 
  private:

@@ -351,8 +351,8 @@ FkResult NewtonSolver::Fallback(const Eigen::VectorXd& c, const Eigen::MatrixX3d
   return f;
 }
 
-FkResult NewtonSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c_in,
-                             const Eigen::MatrixX3d* warm_start) {
+FkResult NewtonSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c_in,
+                                 const Eigen::MatrixX3d* warm_start) {
   const Model& m = *model_;
   const auto t0 = Clock::now();
   FkResult r;

@@ -57,8 +57,12 @@ class NewtonSolver : public FkSolver {
   NewtonSolver(std::shared_ptr<const Model> model, const FkOptions& options,
                ContactTermFactory contacts = {});
   std::string name() const override { return ToString(FkSolverType::kNewton); }
-  FkResult Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
-                 const Eigen::MatrixX3d* warm_start = nullptr) override;
+
+ protected:
+  FkResult SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c,
+                     const Eigen::MatrixX3d* warm_start) override;
+
+ public:
   const FkOptions& options() const { return options_; }
 
   /// The load stepping's limits (the defaults are what FkOptions selects by name).

@@ -99,19 +99,23 @@ TEST(CheckOutputPath, NamesTheOptionThePathAndTheReason) {
   const fs::path d = FreshDir("check");
   EXPECT_NO_THROW(CheckOutputPath({"--json", (d / "new.json").string()}));
   EXPECT_NO_THROW(CheckOutputPath({"--json", "/dev/null"}));
-  const std::string missing = MessageOf<std::invalid_argument>(
-      [&] { CheckOutputPath({"--vtu", (d / "nodir" / "x.vtu").string()}); });
+  const std::string missing = MessageOf<std::invalid_argument>([&] {
+    CheckOutputPath({"--vtu", (d / "nodir" / "x.vtu").string()});
+  });
   EXPECT_NE(missing.find("--vtu '"), std::string::npos) << missing;
   EXPECT_NE(missing.find("does not exist"), std::string::npos) << missing;
-  const std::string folder =
-      MessageOf<std::invalid_argument>([&] { CheckOutputPath({"--json", d.string()}); });
+  const std::string folder = MessageOf<std::invalid_argument>([&] {
+    CheckOutputPath({"--json", d.string()});
+  });
   EXPECT_NE(folder.find("is a folder"), std::string::npos) << folder;
   WriteTextFile((d / "file").string(), "x");
-  const std::string under_file = MessageOf<std::invalid_argument>(
-      [&] { CheckOutputPath({"--obj", (d / "file" / "x.obj").string()}); });
+  const std::string under_file = MessageOf<std::invalid_argument>([&] {
+    CheckOutputPath({"--obj", (d / "file" / "x.obj").string()});
+  });
   EXPECT_NE(under_file.find("is not a folder"), std::string::npos) << under_file;
-  const std::string empty =
-      MessageOf<std::invalid_argument>([] { CheckOutputPath({"--out", ""}); });
+  const std::string empty = MessageOf<std::invalid_argument>([] {
+    CheckOutputPath({"--out", ""});
+  });
   EXPECT_NE(empty.find("empty path"), std::string::npos) << empty;
 }
 
@@ -128,14 +132,15 @@ TEST(CheckDistinctPaths, FindsTheSameFileUnderAnyName) {
   EXPECT_NE(same.find("--json"), std::string::npos) << same;
   EXPECT_NE(same.find("same file as the input --scene"), std::string::npos) << same;
   const std::string twice = MessageOf<std::invalid_argument>([&] {
-    CheckDistinctPaths({}, {{"--json", (d / "o").string()}, {"--vtu", (d / "x" / ".." / "o").string()}});
+    CheckDistinctPaths(
+        {}, {{"--json", (d / "o").string()}, {"--vtu", (d / "x" / ".." / "o").string()}});
   });
   EXPECT_NE(twice.find("same file as the output --json"), std::string::npos) << twice;
-  EXPECT_NO_THROW(CheckDistinctPaths({{"--scene", scene.string()}},
-                                     {{"--json", (d / "o.json").string()},
-                                      {"--vtu", (d / "o.vtu").string()},
-                                      {"--obj", ""},
-                                      {"--out", "/dev/stdout"}}));
+  EXPECT_NO_THROW(
+      CheckDistinctPaths({{"--scene", scene.string()}}, {{"--json", (d / "o.json").string()},
+                                                         {"--vtu", (d / "o.vtu").string()},
+                                                         {"--obj", ""},
+                                                         {"--out", "/dev/stdout"}}));
 }
 
 }  // namespace
