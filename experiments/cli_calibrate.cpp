@@ -15,7 +15,8 @@ CLI::App* AddCalibrateCommand(CLI::App* app, CalibrateCommandArgs* a) {
       "Calibrate R_omega^A / R_omega^B from a measured elasticity ratio R_m (thesis Eq. 2.9, "
       "Table 2.1) by elongation tests on bimaterial_bar (docs/calibration.md)");
   cal->add_option("--rm", a->rm, "Measured elasticity ratio R_m = E_A / E_B (> 0)")->required();
-  cal->add_option("--res", a->bar.res, "bimaterial_bar resolution (default: its own)");
+  cal->add_option("--res", a->bar.res, "bimaterial_bar resolution (default: its own)")
+      ->check(CLI::Range(1, 1 << 20));
   cal->add_option("--interface", a->bar.interface,
                   "Interface position, fraction of the length from the fixed end (default 0.5)");
   cal->add_option("--stretch", a->bar.stretch_mm,

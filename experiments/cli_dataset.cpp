@@ -37,13 +37,16 @@ CLI::App* AddDatasetCommand(CLI::App* app, DatasetCommandArgs* a) {
         return s;
       }());
   o_robot->excludes(o_twin);
-  ds->add_option("--res", a->res, "Robot resolution (default: the robot's own)");
+  ds->add_option("--res", a->res, "Robot resolution (default: the robot's own)")
+      ->check(CLI::Range(1, 1 << 20));
   ds->add_option("--param", a->params,
                  "Robot design parameter NAME=VALUE (repeatable; see `softkin robots`)")
       ->needs(o_robot);
   auto* o_grid =
-      ds->add_option("--grid", a->grid, "N samples per actuator: a grid of N^m (default 16)");
-  auto* o_random = ds->add_option("--random", a->random, "Number of uniform random samples");
+      ds->add_option("--grid", a->grid, "N samples per actuator: a grid of N^m (default 16)")
+          ->check(CLI::Range(1, 1 << 20));
+  auto* o_random = ds->add_option("--random", a->random, "Number of uniform random samples")
+                       ->check(CLI::Range(1, 1 << 30));
   o_grid->excludes(o_random);
   ds->add_option("--seed", a->seed, "Seed of --random (required with it)")->needs(o_random);
   ds->add_option("--block", a->block,

@@ -23,7 +23,9 @@ CLI::App* AddFkCommand(CLI::App* app, FkCommandArgs* a) {
   auto* o_scene =
       fk->add_option("--scene", a->scene, "Scene JSON file (see `softkin scene --schema`)");
   o_robot->excludes(o_scene);
-  fk->add_option("--res", a->res, "Robot resolution (default: the robot's own)")->needs(o_robot);
+  fk->add_option("--res", a->res, "Robot resolution (default: the robot's own)")
+      ->needs(o_robot)
+      ->check(CLI::Range(1, 1 << 20));
   fk->add_option("--param", a->params,
                  "Robot design parameter NAME=VALUE (repeatable; see `softkin robots`)")
       ->needs(o_robot);

@@ -39,7 +39,9 @@ CLI::App* AddIkCommand(CLI::App* app, IkCommandArgs* a) {
   auto* o_scene =
       ik->add_option("--scene", a->scene, "Scene JSON file (see `softkin scene --schema`)");
   o_robot->excludes(o_scene);
-  ik->add_option("--res", a->res, "Robot resolution (default: the robot's own)")->needs(o_robot);
+  ik->add_option("--res", a->res, "Robot resolution (default: the robot's own)")
+      ->needs(o_robot)
+      ->check(CLI::Range(1, 1 << 20));
   ik->add_option("--param", a->params,
                  "Robot design parameter NAME=VALUE (repeatable; see `softkin robots`)")
       ->needs(o_robot);

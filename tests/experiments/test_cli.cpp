@@ -49,7 +49,7 @@ std::string ReadAll(const std::string& path) {
 
 // An output that is also an input (or another output), or that cannot be written, is refused
 // before any solve, and the input is left as it was; a failed write is an error, not exit 0.
-TEST(Cli, BadOutputsAndThreadCountsAreRefusedBeforeAnyWork) {
+TEST(Cli, BadOutputsAndValuesAreRefusedBeforeAnyWork) {
   const std::string dir = TempDir("outputs");
   const std::string scene = dir + "/s.json", path = dir + "/p.txt";
   {
@@ -77,7 +77,14 @@ TEST(Cli, BadOutputsAndThreadCountsAreRefusedBeforeAnyWork) {
            // Thread counts beyond the cap (100000 crashed libgomp).
            {fk + "--threads 100000", "solver.threads: expected an integer in [0, 256]"},
            {"train --dataset " + dir + "/d.csv --out " + dir + "/nets --threads 100000",
-            "--threads: expected an integer in [0, 256]"}}) {
+            "--threads: expected an integer in [0, 256]"},
+           // 0 is no longer a silent "default".
+           {"fk --robot three_chamber --res 0 --actuation 1,1,1", "--res: Value 0 not in range"},
+           {"dataset --robot three_chamber --grid 0 --out " + dir + "/d.csv",
+            "--grid: Value 0 not in range"},
+           {"dataset --robot three_chamber --random 0 --seed 1 --out " + dir + "/d.csv",
+            "--random: Value 0 not in range"},
+           {"calibrate --rm 2 --res 0", "--res: Value 0 not in range"}}) {
     const CliRun r = Cli(c.args);
     EXPECT_EQ(r.code, 2) << c.args << "\n" << r.out;
     EXPECT_NE(r.out.find(c.expect), std::string::npos) << c.args << "\n" << r.out;
