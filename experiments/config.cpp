@@ -1,5 +1,7 @@
 #include "softkin/experiments/config.hpp"
 
+#include "softkin/solver/common/json_text.hpp"
+
 #include "softkin/solver/scene/solver_options_json.hpp"
 
 #include <fstream>
@@ -24,21 +26,8 @@ Config Config::Load(const std::string& path, bool quick) {
   std::stringstream ss;
   ss << f.rdbuf();
   const std::string text = ss.str();
-  try {
-    c.j_ = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    size_t line = 1, col = 1;
-    for (size_t i = 0; i < e.byte && i < text.size() + 1 && i < text.size(); ++i) {
-      if (text[i] == '\n') {
-        ++line;
-        col = 1;
-      } else {
-        ++col;
-      }
-    }
-    throw std::invalid_argument(path + ":" + std::to_string(line) + ":" + std::to_string(col) +
-                                ": invalid JSON (" + e.what() + ")");
-  }
+  // Syntax errors by line and column, duplicate keys and out-of-range numbers by key, as scenes.
+  c.j_ = ParseJsonText(text, path);
   if (!c.j_.is_object()) throw std::invalid_argument(path + ": expected a JSON object at the top");
   if (c.j_.contains("quick")) {
     if (!c.j_["quick"].is_object()) c.Fail("quick", "an object of overrides");

@@ -4,6 +4,7 @@
 /// scene_json_{mesh,regions,vertices,obstacles}.cpp (scene_parser.hpp).
 #include "softkin/solver/scene/scene_json.hpp"
 
+#include "softkin/solver/common/json_text.hpp"
 #include "softkin/solver/scene/scene_keys.hpp"
 #include "softkin/solver/scene/scene_parser.hpp"
 #include "softkin/solver/scene/solver_options_json.hpp"
@@ -25,89 +26,7 @@ namespace fs = std::filesystem;
 }  // namespace
 
 namespace scene_json_detail {
-namespace {
-
-// ------------------------------------------------------------------------------------------------
-// JSON text -> json, with line:column syntax errors and duplicate-key detection
-// ------------------------------------------------------------------------------------------------
-
-json ParseText(const std::string& text, const std::string& source) {
-  struct Frame {
-    bool array = false;
-    std::set<std::string> keys;
-    std::string key;
-    int index = 0;
-  };
-  std::vector<Frame> stack;
-  auto path_of = [&](size_t n) {
-    std::string p;
-    for (size_t i = 0; i < n; ++i) {
-      if (stack[i].array)
-        p += "[" + std::to_string(stack[i].index) + "]";
-      else
-        p += (p.empty() ? "" : ".") + stack[i].key;
-    }
-    return p;
-  };
-  json::parser_callback_t cb = [&](int, json::parse_event_t ev, json& parsed) {
-    switch (ev) {
-      case json::parse_event_t::object_start:
-        stack.push_back(Frame{});
-        break;
-      case json::parse_event_t::array_start: {
-        Frame f;
-        f.array = true;
-        stack.push_back(std::move(f));
-        break;
-      }
-      case json::parse_event_t::key: {
-        const std::string k = parsed.get<std::string>();
-        Frame& f = stack.back();
-        if (!f.keys.insert(k).second) {
-          const std::string p = path_of(stack.size() - 1);
-          throw std::invalid_argument(source + ": " + (p.empty() ? "" : p + ": ") +
-                                      "duplicate key '" + k + "'; expected each key once");
-        }
-        f.key = k;
-        break;
-      }
-      case json::parse_event_t::object_end:
-      case json::parse_event_t::array_end:
-        stack.pop_back();
-        if (!stack.empty() && stack.back().array) ++stack.back().index;
-        break;
-      case json::parse_event_t::value:
-        if (!stack.empty() && stack.back().array) ++stack.back().index;
-        break;
-    }
-    return true;
-  };
-  try {
-    return json::parse(text, cb);
-  } catch (const json::parse_error& e) {
-    // e.byte counts the characters read, the offending one included; turn it into line:column.
-    size_t at = e.byte == 0 ? 0 : e.byte - 1;
-    at = std::min(at, text.size());
-    int line = 1;
-    size_t line_start = 0;
-    for (size_t i = 0; i < at; ++i)
-      if (text[i] == '\n') {
-        ++line;
-        line_start = i + 1;
-      }
-    const size_t column = at - line_start + 1;
-    std::string what = e.what();
-    const auto pe = what.find("parse error");
-    if (pe != std::string::npos) {
-      const auto colon = what.find(": ", pe);
-      if (colon != std::string::npos) what = what.substr(colon + 2);
-    }
-    throw std::invalid_argument(source + ":" + std::to_string(line) + ":" + std::to_string(column) +
-                                ": invalid JSON: " + what);
-  }
-}
-
-}  // namespace
+namespace {}  // namespace
 
 // ------------------------------------------------------------------------------------------------
 // Validation against the key table
@@ -247,7 +166,7 @@ Scene SceneParser::Build(const json& root) {
 
 Scene ParseSceneJson(const std::string& text, const std::string& source,
                      const std::string& base_dir) {
-  const scene_json_detail::json root = scene_json_detail::ParseText(text, source);
+  const scene_json_detail::json root = ParseJsonText(text, source);
   return scene_json_detail::SceneParser(source, base_dir).Build(root);
 }
 
