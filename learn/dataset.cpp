@@ -539,7 +539,12 @@ Dataset LoadDataset(const std::string& path) {
   if (fs::exists(SidecarPath(path))) ds.meta = ReadSidecar(path);
   size_t pos = text.find('\n');
   if (pos == std::string::npos) Bad(path, 1, "expected a header line ending in a line break");
-  const std::vector<std::string> head = SplitFields(text.substr(0, pos));
+  // Lines may end in CRLF (a file saved on Windows or by a spreadsheet): the CR is not data.
+  auto chomp = [](std::string line) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    return line;
+  };
+  const std::vector<std::string> head = SplitFields(chomp(text.substr(0, pos)));
   // index,status,c0..c{m-1},<point>_x,_y,_z ...,J_... ,message
   if (head.size() < 3 || head[0] != "index" || head[1] != "status" || head.back() != "message")
     Bad(path, 1, "expected a header 'index,status,c0,...,message'");
@@ -587,7 +592,7 @@ Dataset LoadDataset(const std::string& path) {
       Bad(path, lineno,
           "the last line has no line break (an interrupted run? run the generation "
           "again to resume it)");
-    const std::string line = text.substr(pos, nl - pos);
+    const std::string line = chomp(text.substr(pos, nl - pos));
     pos = nl + 1;
     const std::vector<std::string> f = SplitFields(line);
     if (f.size() != nfields)

@@ -63,7 +63,7 @@ nlohmann::json ParseJsonText(const std::string& text, const std::string& source)
   };
   try {
     return json::parse(text, cb);
-  } catch (const json::out_of_range& e) {  // a number beyond double's range (1e400)
+  } catch (const json::out_of_range& e) {         // a number beyond double's range (1e400)
     const std::string p = path_of(stack.size());  // the innermost key is the number's
     std::string what = e.what();
     const auto bracket = what.find("] ");
@@ -92,6 +92,5 @@ nlohmann::json ParseJsonText(const std::string& text, const std::string& source)
                                 ": invalid JSON: " + what);
   }
 }
-
 
 }  // namespace softkin

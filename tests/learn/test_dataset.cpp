@@ -276,6 +276,16 @@ TEST_F(DatasetTest, LoaderReturnsTheSamplesAndSkipsFailedOnes) {
     for (int row = 0; row < 6; ++row)
       for (int a = 0; a < 3; ++a) EXPECT_EQ(d.jacobians(i, row * 3 + a), e.J(row, a));
   }
+  // The same file with CRLF line ends (saved on Windows or by a spreadsheet) loads the same.
+  std::string crlf;
+  for (char ch : text) crlf += ch == '\n' ? std::string("\r\n") : std::string(1, ch);
+  std::ofstream(Path("crlf.csv"), std::ios::binary) << crlf;
+  const Dataset w = LoadDataset(Path("crlf.csv"));
+  EXPECT_EQ(w.failed, d.failed);
+  EXPECT_EQ(w.point_names, d.point_names);
+  EXPECT_EQ(w.inputs, d.inputs);
+  EXPECT_EQ(w.positions, d.positions);
+  EXPECT_EQ(w.jacobians, d.jacobians);
 }
 
 TEST_F(DatasetTest, CorruptFilesAreRejectedWithFileAndLine) {
