@@ -1,5 +1,6 @@
 #include "softkin/experiments/cli_args.hpp"
 
+#include "softkin/solver/common/input_file.hpp"
 #include "softkin/solver/scene/solver_options_json.hpp"
 
 #include <CLI/CLI.hpp>
@@ -120,8 +121,14 @@ std::vector<NamedPath> SceneInputs(const std::string& scene, const std::string& 
   std::vector<NamedPath> in;
   if (scene.empty()) return in;
   in.push_back({option, scene});
-  std::ifstream f(scene, std::ios::binary);
-  const nlohmann::json j = nlohmann::json::parse(f, nullptr, /*allow_exceptions=*/false);
+  CheckInputFile(scene, "a scene file (.json)");
+  nlohmann::json j;
+  try {
+    std::ifstream f(scene, std::ios::binary);
+    j = nlohmann::json::parse(f, nullptr, /*allow_exceptions=*/false);
+  } catch (const std::exception&) {  // unreadable: the scene reader says why
+    return in;
+  }
   if (!j.is_object()) return in;
   const std::filesystem::path dir = std::filesystem::path(scene).parent_path();
   auto add = [&](const nlohmann::json& v, const std::string& key) {

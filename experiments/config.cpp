@@ -1,4 +1,5 @@
 #include "softkin/experiments/config.hpp"
+#include "softkin/solver/common/input_file.hpp"
 
 #include "softkin/solver/common/json_text.hpp"
 
@@ -21,6 +22,7 @@ Config Config::Load(const std::string& path, bool quick) {
   Config c;
   c.path_ = path;
   c.quick_ = quick;
+  CheckInputFile(path, "an experiment config (.json)");
   std::ifstream f(path);
   if (!f) throw std::invalid_argument(path + ": cannot open experiment config");
   std::stringstream ss;

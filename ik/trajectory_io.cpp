@@ -1,4 +1,5 @@
 #include "softkin/ik/trajectory_io.hpp"
+#include "softkin/solver/common/input_file.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -66,6 +67,7 @@ double ParseNumber(const std::string& tok, const std::string& path, int line, in
 }  // namespace
 
 Eigen::MatrixX3d ReadWaypoints(const std::string& path) {
+  CheckInputFile(path, "a waypoint file (lines of x y z in mm)");
   std::ifstream in(path);
   if (!in) throw std::invalid_argument(path + ": cannot open the waypoint file");
   std::vector<Eigen::Vector3d> pts;
@@ -117,6 +119,7 @@ std::string WaypointCsvRow(const WaypointResult& w) {
 }
 
 WaypointCsvResume ReadWaypointCsvForResume(const std::string& path, int num_actuators) {
+  CheckInputFile(path, "the waypoint CSV to resume");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::invalid_argument(path + ": cannot open the waypoint CSV");
   std::stringstream buf;

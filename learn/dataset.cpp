@@ -1,4 +1,5 @@
 #include "softkin/learn/dataset.hpp"
+#include "softkin/solver/common/input_file.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -129,6 +130,7 @@ long long ParseIndex(const std::string& s, const std::string& file, long long li
 
 /// The text of a file.
 std::string ReadAll(const std::string& path) {
+  CheckInputFile(path, "a dataset file (CSV or its .json sidecar)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::invalid_argument(path + ": cannot read");
   std::stringstream buf;

@@ -1,6 +1,7 @@
 // The "softkin-fnn v1" file format of Fnn (documented in learn/fnn.hpp): writer and checking
 // reader.
 #include "softkin/learn/fnn.hpp"
+#include "softkin/solver/common/input_file.hpp"
 
 #include "softkin/solver/common/output_file.hpp"
 
@@ -201,6 +202,7 @@ Fnn Fnn::Read(std::istream& in, const std::string& source) {
 }
 
 Fnn Fnn::Load(const std::string& path) {
+  CheckInputFile(path, "a network file (.fnn)");
   std::ifstream f(path, std::ios::binary);
   if (!f) throw std::runtime_error("Fnn::Load: cannot open '" + path + "'");
   return Read(f, path);

@@ -1,4 +1,5 @@
 #include "softkin/solver/mesh/surface.hpp"
+#include "softkin/solver/common/input_file.hpp"
 
 #include <Eigen/Geometry>
 
@@ -26,6 +27,7 @@ std::string Lower(std::string s) {
 }
 
 TriangleSurface ReadObj(const std::string& path) {
+  CheckInputFile(path, "a surface file (.obj)");
   std::ifstream in(path);
   if (!in) Fail(path, "cannot open the file");
   TriangleSurface s;
@@ -86,6 +88,7 @@ struct PointMerger {
 };
 
 TriangleSurface ReadStl(const std::string& path) {
+  CheckInputFile(path, "a surface file (.stl)");
   std::ifstream in(path, std::ios::binary);
   if (!in) Fail(path, "cannot open the file");
   std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

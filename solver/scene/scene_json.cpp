@@ -3,6 +3,7 @@
 /// (scene_keys.hpp), the solver options and the whole scene. The other sections are read in
 /// scene_json_{mesh,regions,vertices,obstacles}.cpp (scene_parser.hpp).
 #include "softkin/solver/scene/scene_json.hpp"
+#include "softkin/solver/common/input_file.hpp"
 
 #include "softkin/solver/common/json_text.hpp"
 #include "softkin/solver/scene/scene_keys.hpp"
@@ -171,6 +172,7 @@ Scene ParseSceneJson(const std::string& text, const std::string& source,
 }
 
 Scene LoadSceneJson(const std::string& path) {
+  CheckInputFile(path, "a scene file (.json)");
   std::ifstream in(path, std::ios::binary);
   if (!in)
     throw std::invalid_argument(path + ": cannot open the scene file (resolved: '" +

@@ -8,6 +8,7 @@
 /// the end of the line, a comment or the end of the file, otherwise the token is reported as
 /// non-numeric. The cursor never moves past the end of the buffer.
 #include "softkin/solver/common/output_file.hpp"
+#include "softkin/solver/common/input_file.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -50,6 +51,7 @@ class Scanner {
   /// Reads `path` (throws "<path>: cannot open ...; expected a readable file" on failure).
   /// `comment` (e.g. '#') starts a comment that runs to the end of the line; 0 disables.
   explicit Scanner(const std::string& path, char comment = 0) : path_(path), comment_(comment) {
+    CheckInputFile(path, "a mesh file");
     std::ifstream in(path, std::ios::binary);
     if (!in) Fail(path, "cannot open file", "a readable mesh file");
     in.seekg(0, std::ios::end);
