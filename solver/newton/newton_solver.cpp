@@ -333,16 +333,15 @@ NewtonSolver::StepEnd NewtonSolver::LoadSteps(const Eigen::VectorXd& c0, const E
 }
 
 FkResult NewtonSolver::Fallback(const Eigen::VectorXd& c, const Eigen::MatrixX3d* start,
-                                const std::string& reason, const FkResult& so_far,
-                                Clock::time_point t0) {
+                                const std::string& from, const std::string& reason,
+                                const FkResult& so_far, Clock::time_point t0) {
   FkOptions o = options_;
   o.solver = FkSolverType::kLgAa;
   if (deadline_) o.time_limit_s = std::max(1e-3, Seconds(Clock::now(), *deadline_));
   LocalGlobalSolver lg(model_, o, contacts_);
   FkResult f = lg.Solve(c, start);
   f.solver = name();
-  f.message = "newton: " + reason + "; continued with lg-aa from " +
-              (start ? "the last converged load step" : "the rest shape") +
+  f.message = "newton: " + reason + "; continued with lg-aa from " + from +
               (f.message.empty() ? "" : ": " + f.message);
   f.iterations += so_far.iterations;
   f.linear_iterations = so_far.linear_iterations;
@@ -369,10 +368,11 @@ FkResult NewtonSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c_in,
                          std::chrono::duration<double>(options_.time_limit_s));
   const std::string unsupported = EquilibriumJacobianUnsupported(m);
   if (!unsupported.empty())  // the reason, without the implicit Jacobian's advice
-    return Fallback(c, warm_start,
+    return Fallback(c, warm_start, warm_start ? "the warm start" : "the rest shape",
                     "not used (" + unsupported.substr(0, unsupported.find(';')) + ")", r, t0);
   if (ContactHandlingActive(m.scene(), options_.collision))
-    return Fallback(c, warm_start, "not used (collision response is on)", r, t0);
+    return Fallback(c, warm_start, warm_start ? "the warm start" : "the rest shape",
+                    "not used (collision response is on)", r, t0);
 
   Eigen::MatrixX3d X = r.positions;
   std::string why;
@@ -389,9 +389,11 @@ FkResult NewtonSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c_in,
     end = LoadSteps(rest, c, &X, &r, &why);
   }
   if (end == StepEnd::Failed) {
-    // From the last converged load step (none: the rest shape), within what is left of the
-    // time limit.
-    FkResult f = Fallback(c, r.load_steps > 0 ? &X : nullptr, why, r, t0);
+    // From the last converged load step (none: the warm start, or the rest shape), within what
+    // is left of the time limit.
+    FkResult f = r.load_steps > 0 ? Fallback(c, &X, "the last converged load step", why, r, t0)
+                 : warm_start     ? Fallback(c, warm_start, "the warm start", why, r, t0)
+                                  : Fallback(c, nullptr, "the rest shape", why, r, t0);
     deadline_.reset();
     return f;
   }

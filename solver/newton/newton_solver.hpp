@@ -108,10 +108,10 @@ class NewtonSolver : public FkSolver {
   /// load step); false if it cannot be computed.
   bool Tangent(const Eigen::VectorXd& c, const Eigen::MatrixX3d& X, const Eigen::VectorXd& dc,
                Eigen::MatrixX3d* dX, FkResult* r);
-  /// lg-aa from `start` (null: the rest shape) for c; its result under this solver's name, with
-  /// `reason` in the message and this solve's Newton counts added.
+  /// lg-aa from `start` (null: the rest shape), which the message calls `from`, for c; its result
+  /// under this solver's name, with `reason` in the message and this solve's Newton counts added.
   FkResult Fallback(const Eigen::VectorXd& c, const Eigen::MatrixX3d* start,
-                    const std::string& reason, const FkResult& so_far,
+                    const std::string& from, const std::string& reason, const FkResult& so_far,
                     std::chrono::steady_clock::time_point t0);
   /// ||2 (A X_rest - B(X_rest; c))||, as the local-global solver's reference (cached per c).
   double ReferenceResidual(const Eigen::VectorXd& c);
