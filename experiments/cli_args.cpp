@@ -59,7 +59,7 @@ RobotParams ParseRobotParams(const std::vector<std::string>& items) {
 
 namespace {
 
-/// A flag's value placeholder in help texts, by the option's type.
+/// The value name a flag shows in help texts ("--tolerance NUMBER"), by the option's type.
 std::string ValueName(const nlohmann::json& default_value) {
   if (default_value.is_boolean()) return "BOOL";
   if (default_value.is_number_integer()) return "INT";

@@ -1,5 +1,6 @@
 #include "softkin/learn/dataset.hpp"
 #include "softkin/solver/common/input_file.hpp"
+#include "softkin/solver/common/output_file.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -161,14 +162,7 @@ nlohmann::json ReadSidecar(const std::string& csv) {
 }
 
 void WriteSidecar(const std::string& csv, const nlohmann::json& j) {
-  const std::string path = SidecarPath(csv), tmp = path + ".tmp";
-  {
-    std::ofstream o(tmp, std::ios::binary | std::ios::trunc);
-    if (!o) throw std::runtime_error("cannot write " + tmp);
-    o << j.dump(2) << "\n";
-    if (!o) throw std::runtime_error("error while writing " + tmp);
-  }
-  fs::rename(tmp, path);
+  WriteTextFile(SidecarPath(csv), j.dump(2) + "\n");
 }
 
 /// Key paths where a and b differ, comma-separated ("" if equal).
@@ -490,37 +484,32 @@ long long MergeDatasets(const std::vector<std::string>& shards, const std::strin
       throw std::invalid_argument("merge: shard " + std::to_string(k) + "/" + std::to_string(n) +
                                   " is missing");
   const long long total = config.value("samples", 0LL);
-  const std::string tmp = out + ".tmp";
   long long written = 0;
   std::string header;
-  {
-    std::ofstream o(tmp, std::ios::binary | std::ios::trunc);
-    if (!o) throw std::runtime_error("cannot write " + tmp);
-    for (const auto& [k, f] : by_k) {
-      const nlohmann::json side = ReadSidecar(f);
-      const long long first = side["shard"].value("first", 0LL),
-                      count = side["shard"].value("count", 0LL);
-      const std::string text = ReadAll(f);
-      const std::string h = text.substr(0, text.find('\n'));
-      if (header.empty()) {
-        header = h;
-        o << header << "\n";
-      }
-      const RawLines raw = ReadRawLines(f, header, first);
-      if (raw.truncated || static_cast<long long>(raw.lines.size()) != count)
-        throw std::invalid_argument("merge: shard " + f +
-                                    " is incomplete: " + std::to_string(raw.lines.size()) + " of " +
-                                    std::to_string(count) + " samples" +
-                                    (raw.truncated ? " and a truncated last line" : "") +
-                                    " (run its generation again to finish it)");
-      if (first != written)
-        throw std::invalid_argument("merge: shard " + f + " starts at sample " +
-                                    std::to_string(first) + ", expected " +
-                                    std::to_string(written));
-      for (const auto& l : raw.lines) o << l << "\n";
-      written += count;
+  // Written beside `out` and renamed in only once every shard is in (OutputFile).
+  OutputFile file(out, std::ios::binary);
+  std::ostream& o = file.stream();
+  for (const auto& [k, f] : by_k) {
+    const nlohmann::json side = ReadSidecar(f);
+    const long long first = side["shard"].value("first", 0LL),
+                    count = side["shard"].value("count", 0LL);
+    const std::string text = ReadAll(f);
+    const std::string h = text.substr(0, text.find('\n'));
+    if (header.empty()) {
+      header = h;
+      o << header << "\n";
     }
-    if (!o) throw std::runtime_error("error while writing " + tmp);
+    const RawLines raw = ReadRawLines(f, header, first);
+    if (raw.truncated || static_cast<long long>(raw.lines.size()) != count)
+      throw std::invalid_argument(
+          "merge: shard " + f + " is incomplete: " + std::to_string(raw.lines.size()) + " of " +
+          std::to_string(count) + " samples" + (raw.truncated ? " and a truncated last line" : "") +
+          " (run its generation again to finish it)");
+    if (first != written)
+      throw std::invalid_argument("merge: shard " + f + " starts at sample " +
+                                  std::to_string(first) + ", expected " + std::to_string(written));
+    for (const auto& l : raw.lines) o << l << "\n";
+    written += count;
   }
   if (written != total)
     throw std::invalid_argument("merge: the shards hold " + std::to_string(written) + " of " +
@@ -528,7 +517,7 @@ long long MergeDatasets(const std::vector<std::string>& shards, const std::strin
   nlohmann::json side = ReadSidecar(by_k.begin()->second);
   side["shard"] = {{"k", 0}, {"n", 1}, {"first", 0}, {"count", total}};
   side["provenance"]["merged_from"] = shards;
-  fs::rename(tmp, out);
+  file.Commit();
   WriteSidecar(out, side);
   return written;
 }

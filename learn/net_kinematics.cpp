@@ -1,5 +1,7 @@
 #include "softkin/learn/net_kinematics.hpp"
 
+#include "softkin/solver/common/output_file.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -89,14 +91,7 @@ void LearnedNets::Save(const std::string& dir) const {
   }
   j["networks"] = files;
   j["info"] = info;
-  const std::string path = (fs::path(dir) / "nets.json").string();
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    out << j.dump(2) << "\n";
-    if (!out) throw std::runtime_error("cannot write " + tmp);
-  }
-  fs::rename(tmp, path);
+  WriteTextFile((fs::path(dir) / "nets.json").string(), j.dump(2) + "\n");
 }
 
 LearnedNets LearnedNets::Load(const std::string& dir) {

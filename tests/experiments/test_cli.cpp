@@ -4,6 +4,7 @@
 #include "softkin/experiments/cli_fk.hpp"
 #include "softkin/experiments/cli_ik.hpp"
 #include "softkin/solver/scene/solver_options_json.hpp"
+#include "tests/solver/fk/fk_test_util.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -206,25 +207,7 @@ TEST(Cli, FkSetsAnySolverOption) {
 TEST(Cli, FkHasAFlagForEveryOptionThatReachesFkOptions) {
   using namespace softkin;
   // A value other than the default for every option.
-  FkOptions want;
-  want.solver = FkSolverType::kLg;
-  want.max_iterations = 5;
-  want.tolerance = 2e-4;
-  want.gradient_tolerance = 3e-3;
-  want.anderson_window = 7;
-  want.anderson_safeguard = AndersonSafeguard::kEnergy;
-  want.continuation_steps = 4;
-  want.threads = 2;
-  want.time_limit_s = 12.5;
-  want.collision.self = true;
-  want.collision.obstacles = false;
-  want.collision.epsilon = 0.1;
-  want.collision.stiffness = 5;
-  want.collision.check_interval = 3;
-  want.collision.update = SpringUpdate::kRefactor;
-  want.collision.self_target = SelfTarget::kAuto;
-  want.collision.self_spring = SelfSpring::kPair;
-  want.collision.obstacle_spring = ObstacleSpring::kPoint;
+  const FkOptions want = test::NonDefaultFkOptions();
   const nlohmann::json wj = SolverOptionsToJson(want), dj = SolverOptionsToJson(FkOptions());
 
   CLI::App app;

@@ -15,6 +15,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 #include <map>
 #include <memory>
 #include <string>
@@ -141,6 +143,16 @@ inline Scene QuadrantChamberBar() {
       {10, 4, 4}, 1.0,
       [](const Eigen::Vector3i& c) { return (c.x() >= 1 && c.y() >= 2 && c.z() >= 2) ? 1 : 0; },
       {{0, Rigid()}}, {test::Pneumatic("p", {1})}, "quadrant_chamber_bar");
+}
+
+/// Expects s.validate() to throw std::invalid_argument whose message contains `fragment`.
+inline void ExpectValidateRejects(const Scene& s, const std::string& fragment) {
+  try {
+    s.validate();
+    ADD_FAILURE() << "accepted; expected an error containing '" << fragment << "'";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace constraints_test

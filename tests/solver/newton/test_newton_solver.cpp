@@ -7,6 +7,7 @@
 #include "softkin/solver/newton/newton_solver.hpp"
 #include "softkin/solver/robots/robots.hpp"
 #include "softkin/solver/sensitivity/free_operator.hpp"
+#include "tests/solver/fk/fk_test_util.hpp"
 
 #include <gtest/gtest.h>
 
@@ -21,14 +22,8 @@ namespace {
 
 /// g(X) = A_ff x + A_fc x_c - B_f(X): the residual Newton drives to zero (free layout).
 Eigen::VectorXd Residual(const Model& m, const Eigen::MatrixX3d& X, const Eigen::VectorXd& c) {
-  std::vector<double> ratios;
-  std::vector<ElemRows> weighted;
-  ComputeLocalRatios(m, X, c, &ratios);
-  LocalStep(m, X, ratios, &weighted, 1);
-  Eigen::MatrixX3d B;
-  AssembleRhs(m, weighted, &B, 1);
   Eigen::VectorXd g;
-  m.GatherFree(m.A() * X - B, &g);
+  m.GatherFree(m.A() * X - test::LocalGlobalRhs(m, X, c), &g);
   return g;
 }
 

@@ -7,6 +7,8 @@
 
 #include "tests/solver/scene/scene_json_test_util.hpp"
 
+#include "tests/solver/fk/fk_test_util.hpp"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -211,25 +213,7 @@ TEST(SolverOptionsJson, EveryOptionHasASchemaEntryWithItsDefault) {
 }
 
 TEST(SolverOptionsJson, RoundTripsEveryOption) {
-  FkOptions o;
-  o.solver = FkSolverType::kLg;
-  o.max_iterations = 123;
-  o.tolerance = 2e-4;
-  o.gradient_tolerance = 3e-3;
-  o.anderson_window = 7;
-  o.anderson_safeguard = AndersonSafeguard::kEnergy;
-  o.continuation_steps = 4;
-  o.threads = 2;
-  o.time_limit_s = 12.5;
-  o.collision.self = true;
-  o.collision.obstacles = false;
-  o.collision.epsilon = 0.1;
-  o.collision.stiffness = 5;
-  o.collision.check_interval = 3;
-  o.collision.update = SpringUpdate::kRefactor;
-  o.collision.self_target = SelfTarget::kAuto;
-  o.collision.self_spring = SelfSpring::kPair;
-  o.collision.obstacle_spring = ObstacleSpring::kPoint;
+  const FkOptions o = test::NonDefaultFkOptions();
   const json j = SolverOptionsToJson(o);
   const FkOptions back = ReadSolverOptionsJson(j, "test", FkOptions());
   EXPECT_EQ(SolverOptionsToJson(back), j);

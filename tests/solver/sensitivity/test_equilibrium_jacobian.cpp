@@ -8,6 +8,7 @@
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/robots/robots.hpp"
 #include "softkin/solver/fk/targets.hpp"
+#include "tests/solver/fk/fk_test_util.hpp"
 
 #include <gtest/gtest.h>
 
@@ -26,16 +27,7 @@ Eigen::VectorXd Vec(std::initializer_list<double> v) {
   return x;
 }
 
-// B(X, c): the right-hand side of the global step, as the local-global solver forms it.
-Eigen::MatrixX3d Rhs(const Model& m, const Eigen::MatrixX3d& X, const Eigen::VectorXd& c) {
-  std::vector<double> ratios;
-  std::vector<ElemRows> weighted;
-  ComputeLocalRatios(m, X, c, &ratios);
-  LocalStep(m, X, ratios, &weighted, 1);
-  Eigen::MatrixX3d B;
-  AssembleRhs(m, weighted, &B, 1);
-  return B;
-}
+using test::LocalGlobalRhs;
 
 FkOptions Opts(double tol = 1e-6, double gtol = 1e-7) {
   FkOptions o;
@@ -94,8 +86,9 @@ TEST(EquilibriumJacobian, RhsDerivativeMatchesCentralDifferences) {
       Eigen::MatrixX3d dB;
       lin.ApplyRhsDerivative(dX, dc, &dB);
       const double h = 1e-6 * model->size() / dX.norm() * std::sqrt(double(X.rows()));
-      const Eigen::MatrixX3d fd =
-          (Rhs(*model, X + h * dX, k.c + h * dc) - Rhs(*model, X - h * dX, k.c - h * dc)) / (2 * h);
+      const Eigen::MatrixX3d fd = (LocalGlobalRhs(*model, X + h * dX, k.c + h * dc) -
+                                   LocalGlobalRhs(*model, X - h * dX, k.c - h * dc)) /
+                                  (2 * h);
       const double rel = (dB - fd).norm() / fd.norm();
       EXPECT_LT(rel, 1e-6) << "trial " << trial << ": |dB| " << dB.norm() << " |fd| " << fd.norm();
       EXPECT_GT(fd.norm(), 0.0);
