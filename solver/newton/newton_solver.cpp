@@ -3,6 +3,7 @@
 /// the line search, adaptive load stepping and the lg-aa fallback.
 #include "softkin/solver/newton/newton_solver.hpp"
 
+#include "softkin/solver/common/blas_threads.hpp"
 #include "softkin/solver/fk/energy.hpp"
 #include "softkin/solver/fk/local_global.hpp"
 #include "softkin/solver/fk/targets.hpp"
@@ -354,6 +355,9 @@ FkResult NewtonSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c_in,
                                  const Eigen::MatrixX3d* warm_start) {
   const Model& m = *model_;
   const auto t0 = Clock::now();
+  // The factor's solves are single right-hand sides between OpenMP loops: BLAS threads only
+  // compete with the OpenMP ones (blas_threads.hpp).
+  const ScopedBlasThreads one_blas_thread(1);
   FkResult r;
   if (!StartResult(c_in, warm_start, &r)) {
     r.time_s = Seconds(t0, Clock::now());

@@ -5,6 +5,7 @@
 /// equilibrium_linearization.cpp.
 #include "softkin/solver/sensitivity/equilibrium_jacobian.hpp"
 
+#include "softkin/solver/common/blas_threads.hpp"
 #include "softkin/solver/common/enum_names.hpp"
 #include "softkin/solver/sensitivity/free_operator.hpp"
 #include "softkin/solver/sensitivity/gmres.hpp"
@@ -478,6 +479,7 @@ EquilibriumJacobianResult ComputeEquilibriumJacobian(const Model& model,
                                                      const Eigen::MatrixXd* initial_guess,
                                                      EquilibriumJacobianWorkspace* workspace) {
   const auto t0 = std::chrono::steady_clock::now();
+  const ScopedBlasThreads one_blas_thread(1);  // single-RHS solves between OpenMP loops
   EquilibriumJacobianResult res;
   auto finish = [&]() {
     res.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
