@@ -11,11 +11,13 @@ using GetThreads = int (*)();
 using SetThreads = void (*)(int);
 
 GetThreads GetFn() {
-  static const auto fn = reinterpret_cast<GetThreads>(dlsym(RTLD_DEFAULT, "openblas_get_num_threads"));
+  static const auto fn =
+      reinterpret_cast<GetThreads>(dlsym(RTLD_DEFAULT, "openblas_get_num_threads"));
   return fn;
 }
 SetThreads SetFn() {
-  static const auto fn = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
+  static const auto fn =
+      reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
   return fn;
 }
 }  // namespace

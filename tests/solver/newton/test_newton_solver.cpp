@@ -115,15 +115,18 @@ TEST(NewtonSolver, SameStateAsLgAaOnEveryEmbeddedRobot) {
         ContactHandlingActive(s, s.solver.collision))
       continue;
     const Eigen::VectorXd c = MidActuation(s);
-    const FkResult nw = MakeFkSolver(model, Options("newton", 1e-8, 1e-8))->Solve(c);
+    const FkResult nw = MakeFkSolver(model, Options("newton", 1e-10, 1e-10))->Solve(c);
     ASSERT_EQ(nw.status, FkStatus::Converged) << nw.BriefReport();
     EXPECT_EQ(nw.solver, "newton");
     EXPECT_EQ(nw.message.find("lg-aa"), std::string::npos) << nw.message;
     ++newton_solved;
-    // A fixed point of lg-aa: one more solve from it hardly moves.
+    // A fixed point of lg-aa: lg-aa started from it stops at its first test and hardly moves.
+    // (newton is run 100 times tighter than lg-aa here: from a state that only just passes the
+    // 1e-8 test, lg-aa crept 2.7 um along a soft mode of multi_segment_gripper in 55 iterations.)
     const FkResult again =
         MakeFkSolver(model, Options("lg-aa", 1e-8, 1e-8))->Solve(c, &nw.positions);
-    EXPECT_LT((again.positions - nw.positions).rowwise().norm().maxCoeff(), 1e-5 * model->size())
+    EXPECT_LE(again.iterations, 2) << again.BriefReport();
+    EXPECT_LT((again.positions - nw.positions).rowwise().norm().maxCoeff(), 1e-8 * model->size())
         << again.BriefReport();
     // lg-aa from rest, at its usual tolerance, ends near it (its error is its creep).
     const FkResult ref = MakeFkSolver(model, Options("lg-aa", 1e-6, 1e-7))->Solve(c);
