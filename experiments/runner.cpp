@@ -25,6 +25,7 @@ struct Entry {
 const Entry kExperiments[] = {
     {"pneumatic_bending", &RunPneumaticBending},
     {"resolution_sweep", &RunResolutionSweep},
+    {"solver_scaling", &RunSolverScaling},
     {"marker_sweep", &RunMarkerSweep},
     {"solver_comparison", &RunSolverComparison},
     {"calibration", &RunCalibration},

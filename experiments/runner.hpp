@@ -39,6 +39,7 @@ Scene ConfigRobot(const Config& cfg, const std::string& robot, int res);
 // Experiments (each in its own file).
 nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunResolutionSweep(const Config& cfg, const std::string& dir, bool verbose);
+nlohmann::json RunSolverScaling(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunAaAblation(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunActuationPaths(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunMarkerSweep(const Config& cfg, const std::string& dir, bool verbose);

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -644,6 +645,42 @@ TEST(Cli, CollisionSweepRejectsABadVariantBeforeRunningAny) {
       << r.out;
   EXPECT_EQ(r.out.find("[ok 1/1]"), std::string::npos) << r.out;  // variant 0 never ran
   EXPECT_FALSE(std::filesystem::exists(dir + "/bad_sweep/steps.csv"));
+}
+
+// A solver scaling study reads every case before it solves: a bad solver name in the last case
+// fails at once with the key. A tiny valid one writes one converged row per (res, solver) and the
+// growth of the iteration count per solver.
+TEST(Cli, SolverScalingChecksEveryCaseAndReportsTheGrowth) {
+  const std::string dir = TempDir("solver_scaling");
+  const std::string bad = dir + "/bad.json";
+  std::ofstream(bad) << R"({"name": "bad_scaling", "experiment": "solver_scaling", "seed": 1,
+    "cases": [{"robot": "three_chamber", "resolutions": [3], "actuation": [1.2, 1, 1],
+               "solvers": ["newton"]},
+              {"robot": "three_chamber", "resolutions": [3], "actuation": [1.2, 1, 1],
+               "solvers": ["newtonn"]}]})";
+  CliRun r = Cli("run " + bad + " --no-plot --results " + dir);
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.out.find(bad + ": cases[1].solvers: expected FK solver names"), std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.out.find("res 3 ("), std::string::npos) << r.out;  // nothing was solved
+  const std::string good = dir + "/good.json";
+  std::ofstream(good) << R"({"name": "tiny_scaling", "experiment": "solver_scaling", "seed": 1,
+    "cases": [{"robot": "three_chamber", "resolutions": [3, 4], "actuation": [1.2, 1, 1],
+               "solvers": ["newton", "lg-aa"]}]})";
+  r = Cli("run " + good + " --no-plot --results " + dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const std::string csv = ReadAll(dir + "/tiny_scaling/scaling.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5) << csv;  // header + 2 res x 2 solvers
+  const auto j = nlohmann::json::parse(ReadAll(dir + "/tiny_scaling/summary.json"));
+  for (const char* solver : {"newton", "lg-aa"}) {
+    const auto& g = j["growth"]["three_chamber"][solver];
+    EXPECT_TRUE(g["all_converged"].get<bool>()) << g;
+    EXPECT_GT(g["iteration_growth"].get<double>(), 0.0) << g;
+  }
+  for (const auto& row : j["rows"]) {
+    EXPECT_EQ(row["status"], "converged") << row;
+    EXPECT_LT(row["residual_ratio"].get<double>(), 1e-6) << row;
+  }
 }
 
 TEST(Cli, IkExperimentsRunTinyConfigsAndRejectBadPaths) {
