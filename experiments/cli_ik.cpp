@@ -6,6 +6,7 @@
 #include "softkin/ik/trajectory.hpp"
 #include "softkin/ik/trajectory_io.hpp"
 #include "softkin/learn/net_kinematics.hpp"
+#include "softkin/solver/common/text_format.hpp"
 #include "softkin/solver/robots/robots.hpp"
 #include "softkin/solver/scene/scene_json.hpp"
 
@@ -376,9 +377,11 @@ int RunSimulatorIk(const IkCommandArgs& a) {
 // ---- IK on the learned kinematics (--nets) ----
 
 /// One target with the direct-IK network: c = N_ik(t), the point predicted by the kinematics.
+/// Converged (as for the iterative methods) only if that point is within lambda (`lambda_sq`,
+/// mm^2, as IkOptions::lambda) of the target; else "no-progress", with the distance in the message.
 WaypointResult DirectWaypoint(const LearnedNets& nets, NetKinematics& kin, int index,
                               const Eigen::Vector3d& target, const Eigen::VectorXd& previous,
-                              const Eigen::VectorXd& range) {
+                              const Eigen::VectorXd& range, double lambda_sq) {
   const auto t0 = std::chrono::steady_clock::now();
   WaypointResult w;
   w.index = index;
@@ -388,9 +391,11 @@ WaypointResult DirectWaypoint(const LearnedNets& nets, NetKinematics& kin, int i
   w.reached = e.p.row(0).transpose();
   w.error_mm = (w.reached - target).norm();
   w.objective = w.error_mm * w.error_mm;
-  w.converged = true;
-  w.termination = IkTermination::kConverged;
-  w.message = "direct";
+  w.converged = std::isfinite(w.objective) && w.objective <= lambda_sq;
+  w.termination = w.converged ? IkTermination::kConverged : IkTermination::kNoProgress;
+  w.message = w.converged ? "direct"
+                          : "direct: N_ik's answer is " + FormatNumber(w.error_mm) +
+                                " mm from the target, beyond lambda";
   w.evaluations = 1;
   w.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (previous.size() == w.c.size()) {
@@ -477,7 +482,7 @@ int RunInteractiveIk(const IkCommandArgs& a, const LearnedNets& nets, NetKinemat
     }
     WaypointResult w;
     if (direct) {
-      w = DirectWaypoint(nets, kin, index, t, previous, range);
+      w = DirectWaypoint(nets, kin, index, t, previous, range, to.ik.lambda);
     } else {
       TrajectoryOptions one = to;
       if (previous.size() == n) one.warm_start = previous;
@@ -515,14 +520,14 @@ int RunLearnedWaypoints(const IkCommandArgs& a, const LearnedNets& nets, NetKine
     Eigen::VectorXd previous;
     for (int i = 0; i < waypoints.rows(); ++i) {
       const WaypointResult w =
-          DirectWaypoint(nets, kin, i, waypoints.row(i).transpose(), previous, range);
+          DirectWaypoint(nets, kin, i, waypoints.row(i).transpose(), previous, range, to.ik.lambda);
       previous = w.c;
       csv << WaypointCsvRow(w) << "\n";
       sum += w.error_mm;
       worst = std::max(worst, w.error_mm);
       total_time += w.time_s;
       max_jump = std::max(max_jump, w.jump);
-      converged += w.error_mm * w.error_mm <= to.ik.lambda;
+      converged += w.converged;
     }
   } else {
     const TrajectoryResult r = FollowTrajectory(

@@ -75,9 +75,9 @@ std::vector<ScalingCase> ReadScalingCases(const Config& cfg) {
 }
 
 /// One (robot, res, solver) solve from rest: its row of scaling.csv.
-nlohmann::json SolveOnce(const Config& cfg, const ScalingCase& sc, const std::string& at,
-                         int res, const std::shared_ptr<const Model>& model,
-                         const FkOptions& opts, bool verbose) {
+nlohmann::json SolveOnce(const Config& cfg, const ScalingCase& sc, const std::string& at, int res,
+                         const std::shared_ptr<const Model>& model, const FkOptions& opts,
+                         bool verbose) {
   Eigen::VectorXd c = model->scene().rest_actuation();
   if (static_cast<Eigen::Index>(sc.actuation.size()) != c.size())
     cfg.Fail(at + ".actuation",

@@ -775,6 +775,34 @@ TEST(Cli, TrainAndLearnedIkFromADataset) {
     EXPECT_EQ(CountLines(text), 2) << text;
     EXPECT_EQ(text.find("nan"), std::string::npos) << text;
   }
+  // A target 1 m away: the direct answer is far from it, and every output says it missed
+  // (the CSV's converged and termination columns, and the count on stderr).
+  r = Cli("ik --nets " + dir + "/nets --method direct --target 0,136,1000 --out " + dir +
+          "/far.csv");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("0 of 1 waypoint(s) within lambda"), std::string::npos) << r.out;
+  {
+    std::istringstream csv(ReadText(dir + "/far.csv"));
+    std::string header, row, cell;
+    std::getline(csv, header);
+    std::getline(csv, row);
+    std::vector<std::string> names, values;
+    for (std::istringstream h(header); std::getline(h, cell, ',');) names.push_back(cell);
+    for (std::istringstream v(row); std::getline(v, cell, ',');) values.push_back(cell);
+    ASSERT_EQ(names.size(), values.size()) << header << "\n" << row;
+    EXPECT_EQ(std::count(names.begin(), names.end(), "converged") +
+                  std::count(names.begin(), names.end(), "termination"),
+              2)
+        << header;
+    for (size_t k = 0; k < names.size(); ++k) {
+      if (names[k] == "converged") {
+        EXPECT_EQ(values[k], "0") << row;
+      }
+      if (names[k] == "termination") {
+        EXPECT_EQ(values[k], "no-progress") << row;
+      }
+    }
+  }
   // Interactive: rows on stdout for good lines, a message naming the line for a bad one, 'quit'
   // stops.
   std::ofstream(dir + "/in.txt") << "2 140 -3\nnot a point\n-4,138,2\nquit\n5 5 5\n";
