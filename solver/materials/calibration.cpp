@@ -1,5 +1,7 @@
 #include "softkin/solver/materials/calibration.hpp"
 
+#include "softkin/solver/common/text_format.hpp"
+
 #include "softkin/solver/factory/fk_factory.hpp"
 
 #include "softkin/solver/fk/energy.hpp"
@@ -162,24 +164,33 @@ CalibrationResult CalibrateROmega(double target_rm, const BarTestOptions& opt, d
     return out;
   };
   double hi = 1.0, f_hi = eval(hi);  // equal materials: R_m close to 1
+  const double f_equal = f_hi;
   if (std::abs(f_hi - goal) <= rel_tol * goal) return done(hi, f_hi);
   // Bracket: step down by factors of 4 until the simulated ratio passes the goal, so that very
   // soft (slowly converging) materials are only simulated when the target needs them.
   double lo = hi, f_lo = f_hi;
-  auto out_of_range = [&](double f_end) {
+  // The range reached: from equal materials down to R_omega = r_end (simulated ratio f_end).
+  auto reached = [&](double r_end, double f_end) {
     std::ostringstream m;
     m << "calibration: R_m = " << target_rm << " is outside the range this specimen reaches with "
-      << "R_omega in [" << r_min << ", 1]: from " << (soft_b ? f_hi : 1.0 / f_hi)
-      << " (equal R_omega) to " << (soft_b ? f_end : 1.0 / f_end) << " or beyond";
-    return std::invalid_argument(m.str());
+      << "R_omega in [" << r_end << ", 1]: from " << (soft_b ? f_equal : 1.0 / f_equal)
+      << " (equal R_omega) to " << (soft_b ? f_end : 1.0 / f_end);
+    return m.str();
   };
-  if (f_hi > goal) throw out_of_range(f_hi);
+  if (f_hi > goal) throw std::invalid_argument(reached(1.0, f_hi) + "; expected a ratio beyond it");
   while (f_lo < goal) {
-    if (lo <= r_min) throw out_of_range(f_lo);
+    if (lo <= r_min)
+      throw std::invalid_argument(reached(lo, f_lo) + " (the lower bound of R_omega)");
     hi = lo;
     f_hi = f_lo;
     lo = std::max(lo / 4.0, r_min);
-    f_lo = eval(lo);
+    try {
+      f_lo = eval(lo);
+    } catch (const std::runtime_error& e) {
+      // A softer material than the solver can stretch: say how far the search got.
+      throw std::invalid_argument(reached(hi, f_hi) + "; at R_omega = " + FormatNumber(lo) + " " +
+                                  std::string(e.what()).substr(13));  // drop "calibration: "
+    }
     if (std::abs(f_lo - goal) <= rel_tol * goal) return done(lo, f_lo);
   }
   // Bisection on log R_omega: f falls from f_lo > goal at lo to f_hi < goal at hi.

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -111,6 +113,19 @@ TEST(Calibration, BadTargetsAndOptionsAreRejectedWithTheRange) {
     ADD_FAILURE() << "accepted an unreachable R_m";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("outside the range"), std::string::npos) << e.what();
+  }
+  // Two bracketing steps (R_omega 0.25, then the bound 0.2): the range still starts at the
+  // equal-material ratio (it used to print the ratio at R_omega = 0.25 as "equal R_omega").
+  {
+    std::ostringstream equal;
+    equal << "from " << RunElongationTest(1.0, 1.0, o).rm << " (equal R_omega)";
+    try {
+      CalibrateROmega(1000.0, o, 1e-3, 0.2);
+      ADD_FAILURE() << "accepted an unreachable R_m";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(equal.str()), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("R_omega in [0.2, 1]"), std::string::npos) << e.what();
+    }
   }
   o.stretch_mm = 0;
   try {
