@@ -5,6 +5,7 @@
 #include "softkin/experiments/cli_ik.hpp"
 #include "softkin/solver/scene/solver_options_json.hpp"
 #include "tests/solver/fk/fk_test_util.hpp"
+#include "tests/solver/scene/scene_json_test_util.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -333,6 +334,28 @@ TEST(Cli, SceneSchemaPrintsKeys) {
   ASSERT_EQ(r.code, 0);
   for (const char* k : {"mesh.file", "regions", "fixed", "markers", "solver"})
     EXPECT_NE(r.out.find(k), std::string::npos) << k;
+}
+
+// `softkin scene` runs what fk checks before it solves: a cable whose path misses its elements
+// loads as JSON but cannot be modelled, and the check says so, naming the file.
+TEST(Cli, SceneCheckBuildsTheModelAsFkDoes) {
+  const std::string dir = TempDir("scene_check");
+  softkin::scene_test::WriteTinyMesh(dir);
+  nlohmann::json good = softkin::scene_test::TinyScene();
+  std::ofstream(dir + "/good.json") << good.dump(2);
+  CliRun r = Cli("scene " + dir + "/good.json");
+  EXPECT_EQ(r.code, 0) << r.out;
+  nlohmann::json bad = good;
+  bad["regions"][1] = {
+      {"tag", 1}, {"role", "cable"}, {"name", "tendon"}, {"path", {{10, 10, 10}, {11, 10, 10}}}};
+  bad["regions"][2] = {{"tag", 2}, {"role", "body"}};
+  std::ofstream(dir + "/bad.json") << bad.dump(2);
+  r = Cli("scene " + dir + "/bad.json");
+  EXPECT_NE(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find(dir + "/bad.json: cable 'tendon': its path does not pass through its "
+                             "actuation elements"),
+            std::string::npos)
+      << r.out;
 }
 
 TEST(Cli, RunWritesSummaryWithConfigCommitAndMachine) {
