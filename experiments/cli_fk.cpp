@@ -148,7 +148,11 @@ int RunFkCommand(const FkCommandArgs& a) {
     WriteJson(a.json_out, j);
   else
     std::cout << j.dump(2) << "\n";
-  if (!a.vtu_out.empty()) WriteVtu(a.vtu_out, scene.mesh, r.positions);
+  if (!a.vtu_out.empty()) {
+    const VtuSolveInfo info{r.status == FkStatus::Converged, r.iterations, r.gradient_ratio,
+                            r.inverted_elements};
+    WriteVtu(a.vtu_out, scene.mesh, r.positions, {}, nullptr, &info);
+  }
   if (!a.obj_out.empty()) WriteSurfaceObj(a.obj_out, scene.mesh, r.positions);
   return r.status == FkStatus::Converged ? 0 : 1;
 }

@@ -168,7 +168,8 @@ BendingSweep Sweep(const BendingParams& p, const std::shared_ptr<const Model>& m
     if (p.vtu_every > 0 && (s % p.vtu_every == 0 || s == steps)) {
       char name[64];
       std::snprintf(name, sizeof(name), "frames/step_%04d.vtu", s);
-      WriteVtu(dir + "/" + name, scene.mesh, X);
+      const VtuSolveInfo info{ok, r.iterations, r.gradient_ratio, r.inverted_elements};
+      WriteVtu(dir + "/" + name, scene.mesh, X, {}, nullptr, &info);
       frames.emplace_back(c[a], name);
     }
     if (verbose) {

@@ -35,15 +35,28 @@ void WriteVtk(const std::string& path, const Mesh& mesh);
 /// Picks the reader by extension: .tet, .node/.ele, .msh, .vtk.
 Mesh ReadMesh(const std::string& path, MeshReport* report = nullptr);
 
-/// ParaView `.vtu` (ASCII XML) of the mesh at positions X (#V x 3): point data "displacement"
-/// (X - rest), cell data "region", "element_type" (VTK type id) and "strain" (a per-element
-/// strain measure: ||F^T F - I||_F / 2 of the best-fit deformation gradient).
-/// `rest_regions` / `rest_positions` (#V x 3): elements of those regions measure their strain from
-/// rest_positions instead of mesh.vertices (a Scene's region_rest, e.g. a remeshed chamber).
+/// The outcome of the solve that produced a `.vtu`, written as its field data (ParaView: the
+/// Information panel; VTK / meshio: field data), so that a frame of a failed solve says so.
+struct VtuSolveInfo {
+  bool converged = false;
+  int iterations = 0;
+  double residual_ratio = 0.0;  ///< FkResult::gradient_ratio
+  int inverted_elements = 0;
+};
+
+/// ParaView `.vtu` (ASCII XML) of the mesh at positions X (#V x 3): the points are the deformed
+/// positions; point data "displacement" is X - rest (so ParaView's Warp By Vector would move them
+/// twice: colour by it, or warp the rest mesh); cell data "region", "element_type" (VTK type id)
+/// and "strain" (||F^T F - I||_F / 2 of the best-fit deformation gradient; -1 where it is
+/// undefined: a degenerate rest shape, or a deformation too large for double precision — never
+/// NaN). `rest_regions` / `rest_positions` (#V x 3): elements of those regions measure their
+/// strain from rest_positions instead of mesh.vertices (a Scene's region_rest, e.g. a remeshed
+/// chamber). `info`: the solve's outcome as field data "converged", "iterations",
+/// "residual_ratio" and "inverted_elements".
 void WriteVtu(const std::string& path, const Mesh& mesh,
               const Eigen::Ref<const Eigen::MatrixX3d>& X,
               const std::vector<int>& rest_regions = {},
-              const Eigen::MatrixX3d* rest_positions = nullptr);
+              const Eigen::MatrixX3d* rest_positions = nullptr, const VtuSolveInfo* info = nullptr);
 /// `.pvd` collection listing (time, file) pairs, files relative to the pvd's folder.
 void WritePvd(const std::string& path, const std::vector<std::pair<double, std::string>>& steps);
 /// Boundary surface (faces used by one element) as Wavefront `.obj` at positions X.

@@ -119,7 +119,7 @@ std::vector<double> ElementStrain(const Mesh& mesh, const Eigen::Ref<const Eigen
 
 void WriteVtu(const std::string& path, const Mesh& mesh,
               const Eigen::Ref<const Eigen::MatrixX3d>& X, const std::vector<int>& rest_regions,
-              const Eigen::MatrixX3d* rest_positions) {
+              const Eigen::MatrixX3d* rest_positions, const VtuSolveInfo* info) {
   CheckPositions(path, mesh, X);
   const std::vector<double> strain = ElementStrain(mesh, X, rest_regions, rest_positions);
   OutputFile out_file(path);
@@ -128,8 +128,24 @@ void WriteVtu(const std::string& path, const Mesh& mesh,
   out << "<?xml version=\"1.0\"?>\n"
       << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
          "header_type=\"UInt64\">\n"
-      << "  <UnstructuredGrid>\n"
-      << "    <Piece NumberOfPoints=\"" << nv << "\" NumberOfCells=\"" << ne << "\">\n";
+      << "  <UnstructuredGrid>\n";
+  if (info)
+    out << "    <FieldData>\n"
+        << "      <DataArray type=\"UInt8\" Name=\"converged\" NumberOfTuples=\"1\" "
+           "format=\"ascii\">"
+        << (info->converged ? 1 : 0) << "</DataArray>\n"
+        << "      <DataArray type=\"Int32\" Name=\"iterations\" NumberOfTuples=\"1\" "
+           "format=\"ascii\">"
+        << info->iterations << "</DataArray>\n"
+        << "      <DataArray type=\"Float64\" Name=\"residual_ratio\" NumberOfTuples=\"1\" "
+           "format=\"ascii\">"
+        << detail::Num{std::isfinite(info->residual_ratio) ? info->residual_ratio : -1.0}
+        << "</DataArray>\n"
+        << "      <DataArray type=\"Int32\" Name=\"inverted_elements\" NumberOfTuples=\"1\" "
+           "format=\"ascii\">"
+        << info->inverted_elements << "</DataArray>\n"
+        << "    </FieldData>\n";
+  out << "    <Piece NumberOfPoints=\"" << nv << "\" NumberOfCells=\"" << ne << "\">\n";
   out << "      <PointData Vectors=\"displacement\">\n"
       << "        <DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" "
          "format=\"ascii\">\n";
@@ -147,12 +163,8 @@ void WriteVtu(const std::string& path, const Mesh& mesh,
     out << "          " << (e.type == ElementType::Tet ? 10 : 13) << '\n';
   out << "        </DataArray>\n"
       << "        <DataArray type=\"Float64\" Name=\"strain\" format=\"ascii\">\n";
-  for (double s : strain) {
-    if (std::isfinite(s))
-      out << "          " << detail::Num{s} << '\n';
-    else
-      out << "          nan\n";
-  }
+  // -1: undefined (degenerate rest shape, or overflow); never NaN, which readers treat unevenly.
+  for (double s : strain) out << "          " << detail::Num{std::isfinite(s) ? s : -1.0} << '\n';
   out << "        </DataArray>\n      </CellData>\n";
   out << "      <Points>\n"
       << "        <DataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\" "

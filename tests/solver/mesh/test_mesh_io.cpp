@@ -839,6 +839,20 @@ TEST_F(MeshIoVtu, WritesArraysAndStrain) {
   // Wrong number of rows is rejected.
   EXPECT_NE(ErrorOf([&] { WriteVtu(Path("bad.vtu"), m, X.topRows(3)); }).find("bad.vtu"),
             std::string::npos);
+  // A state too large for double precision (a solve that ran away): the strain is marked -1,
+  // never written as NaN, and the solve's outcome is in the field data.
+  const Eigen::MatrixX3d huge = 1e200 * X;
+  const VtuSolveInfo info{false, 10000, 0.25, 3};
+  WriteVtu(Path("huge.vtu"), m, huge, {}, nullptr, &info);
+  const std::string t3 = ReadText(Path("huge.vtu"));
+  EXPECT_EQ(t3.find("nan"), std::string::npos);
+  for (double s : ArrayValues(t3, "strain")) EXPECT_EQ(s, -1.0);
+  EXPECT_EQ(ArrayValues(t3, "converged"), std::vector<double>{0.0});
+  EXPECT_EQ(ArrayValues(t3, "iterations"), std::vector<double>{10000.0});
+  EXPECT_EQ(ArrayValues(t3, "residual_ratio"), std::vector<double>{0.25});
+  EXPECT_EQ(ArrayValues(t3, "inverted_elements"), std::vector<double>{3.0});
+  EXPECT_LT(t3.find("<FieldData>"), t3.find("<Piece"));
+  EXPECT_EQ(t2.find("<FieldData>"), std::string::npos);  // no solve, no field data
 }
 
 TEST_F(MeshIoVtu, PvdListsSteps) {
