@@ -16,6 +16,28 @@ std::string Dump(const nlohmann::json& v) {
   std::string s = v.dump();
   return s.size() > 60 ? s.substr(0, 57) + "..." : s;
 }
+/// The JSON kind of a value, in a config's words.
+std::string Kind(const nlohmann::json& v) {
+  if (v.is_boolean()) return "a boolean";
+  if (v.is_number()) return "a number";
+  if (v.is_string()) return "a string";
+  if (v.is_array()) return "an array";
+  if (v.is_object()) return "an object";
+  return "null";
+}
+
+/// Empty if `over` (a quick override) has the kind of `full`, the value it replaces: the same JSON
+/// kind, and for non-empty arrays the same kind of elements; else the kind expected.
+std::string OverrideMismatch(const nlohmann::json& full, const nlohmann::json& over) {
+  if (Kind(full) != Kind(over)) return Kind(full);
+  if (full.is_array() && !full.empty() && !over.empty()) {
+    const std::string a = Kind(full.front());
+    for (const auto& x : over)
+      if (Kind(x) != a) return "an array of " + a.substr(a.find(' ') + 1) + "s";
+  }
+  return "";
+}
+
 }  // namespace
 
 Config Config::Load(const std::string& path, bool quick) {
@@ -34,13 +56,19 @@ Config Config::Load(const std::string& path, bool quick) {
   if (c.j_.contains("quick")) {
     if (!c.j_["quick"].is_object()) c.Fail("quick", "an object of overrides");
     nlohmann::json q = c.j_["quick"];
-    if (quick)
-      for (auto it = q.begin(); it != q.end(); ++it) {
-        if (!c.j_.contains(it.key()))
-          throw std::invalid_argument(path + ": quick." + it.key() +
-                                      ": overrides a key that the config does not have");
-        c.j_[it.key()] = it.value();
-      }
+    // Checked in both modes, so that a full run's validation (the experiment's getters) also
+    // covers the kind of every value a quick run puts in its place, and the other way round.
+    for (auto it = q.begin(); it != q.end(); ++it) {
+      if (!c.j_.contains(it.key()))
+        throw std::invalid_argument(path + ": quick." + it.key() +
+                                    ": overrides a key that the config does not have");
+      const std::string why = OverrideMismatch(c.j_[it.key()], it.value());
+      if (!why.empty())
+        throw std::invalid_argument(path + ": quick." + it.key() + ": expected " + why +
+                                    ", as the config's '" + it.key() + "' (" +
+                                    Dump(c.j_[it.key()]) + "), got " + Dump(it.value()));
+      if (quick) c.j_[it.key()] = it.value();
+    }
     c.j_.erase("quick");
   }
   c.name_ = c.String("name", "");

@@ -44,6 +44,37 @@ TEST(Config, FailNamesNestedKeysWithTheValueFoundThere) {
   std::remove(path.c_str());
 }
 
+// A quick override must have the kind of the value it replaces, in either mode: a quick run must
+// not pass with a value a full run would reject as the wrong kind, or the other way round.
+TEST(Config, QuickOverridesKeepTheKindOfTheirKey) {
+  auto message = [](const std::string& text, bool quick) {
+    const std::string path = WriteTemp("softkin_config_quick.json", text);
+    try {
+      Config::Load(path, quick);
+    } catch (const std::invalid_argument& e) {
+      std::remove(path.c_str());
+      return std::string(e.what());
+    }
+    std::remove(path.c_str());
+    return std::string();
+  };
+  const std::string head = R"({"name": "q", "experiment": "resolution_sweep", "seed": 1, )";
+  for (bool quick : {false, true}) {
+    EXPECT_EQ(message(head + R"("res": 12, "quick": {"res": 6}})", quick), "");
+    EXPECT_EQ(message(head + R"("steps": [1, 2], "quick": {"steps": [3]}})", quick), "");
+    const std::string m1 = message(head + R"("res": 12, "quick": {"res": "6"}})", quick);
+    EXPECT_NE(m1.find("quick.res: expected a number, as the config's 'res' (12), got \"6\""),
+              std::string::npos)
+        << m1;
+    const std::string m2 =
+        message(head + R"("resolutions": [4, 5], "quick": {"resolutions": [3, "4"]}})", quick);
+    EXPECT_NE(m2.find("quick.resolutions: expected an array of numbers"), std::string::npos) << m2;
+    const std::string m3 =
+        message(head + R"("solver": {"solver": "lg"}, "quick": {"solver": "lg"}})", quick);
+    EXPECT_NE(m3.find("quick.solver: expected an object"), std::string::npos) << m3;
+  }
+}
+
 // Every config shipped in experiments/ loads (full and quick), is named after its file, names an
 // experiment type the runner knows, and has the plot script that regenerates its figure.
 TEST(Config, EveryShippedConfigLoadsAndHasAPlotScript) {
