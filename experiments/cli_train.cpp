@@ -186,6 +186,7 @@ int RunTrainCommand(const TrainCommandArgs& a) {
   if (!a.s2r.empty()) return TrainS2rCommand(a, lm);
 
   const Dataset d = LoadDataset(a.dataset);
+  CheckSidecarMatches(d, a.dataset);  // the bounds and provenance of the networks come from it
   const NetsFromDatasetOptions o = NetsOptionsFromArgs(a, d, lm);
   if (!a.quiet)
     std::cerr << "softkin train: " << a.dataset << ": " << d.inputs.rows() << " samples, "

@@ -1,4 +1,5 @@
 #include "softkin/learn/dataset.hpp"
+#include "softkin/solver/common/text_format.hpp"
 #include "softkin/solver/common/input_file.hpp"
 #include "softkin/solver/common/output_file.hpp"
 
@@ -523,6 +524,39 @@ long long MergeDatasets(const std::vector<std::string>& shards, const std::strin
 }
 
 // ---- loading ----
+
+void CheckSidecarMatches(const Dataset& d, const std::string& csv_path) {
+  const std::string side = SidecarPath(csv_path);
+  if (!d.meta.is_object())
+    throw std::invalid_argument(side +
+                                ": not found; expected the sidecar that `softkin dataset` "
+                                "writes beside the CSV (its actuator bounds and source)");
+  auto fail = [&](const std::string& key, const std::string& what) {
+    throw std::invalid_argument(side + ": config." + key + ": " + what);
+  };
+  const nlohmann::json& cfg = d.meta["config"];
+  if (!cfg.contains("points") || cfg["points"] != nlohmann::json(d.point_names))
+    fail("points", "expected the CSV's points " + nlohmann::json(d.point_names).dump() + ", got " +
+                       (cfg.contains("points") ? cfg["points"].dump() : "none") +
+                       " (a sidecar of another dataset?)");
+  const nlohmann::json& b =
+      cfg.contains("actuator_bounds") ? cfg["actuator_bounds"] : nlohmann::json();
+  if (!b.is_array() || static_cast<int>(b.size()) != d.num_actuators)
+    fail("actuator_bounds", "expected " + std::to_string(d.num_actuators) +
+                                " [lower, upper] pairs, one per actuator column of the CSV");
+  for (int a = 0; a < d.num_actuators; ++a) {
+    if (!b[a].is_array() || b[a].size() != 2 || !b[a][0].is_number() || !b[a][1].is_number() ||
+        !(b[a][0].get<double>() < b[a][1].get<double>()))
+      fail("actuator_bounds[" + std::to_string(a) + "]", "expected [lower, upper], lower < upper");
+    const double lo = b[a][0].get<double>(), hi = b[a][1].get<double>(), tol = 1e-9 * (hi - lo);
+    for (Eigen::Index i = 0; i < d.inputs.rows(); ++i)
+      if (d.inputs(i, a) < lo - tol || d.inputs(i, a) > hi + tol)
+        fail("actuator_bounds[" + std::to_string(a) + "]",
+             "[" + FormatNumber(lo) + ", " + FormatNumber(hi) + "] does not hold sample " +
+                 std::to_string(d.index[i]) + " (actuation " + FormatNumber(d.inputs(i, a)) +
+                 "): the sidecar is not this CSV's");
+  }
+}
 
 Dataset LoadDataset(const std::string& path) {
   const std::string text = ReadAll(path);

@@ -133,6 +133,13 @@ struct Dataset {
 /// indices not strictly increasing, a last line without '\n').
 Dataset LoadDataset(const std::string& path);
 
+/// Checks that a dataset read from `csv_path` carries the sidecar `softkin dataset` writes and that
+/// it describes this CSV: the same tracked points, one bound pair per actuator, and every sample's
+/// actuation within those bounds (to 1e-9 of the range). Throws std::invalid_argument naming the
+/// sidecar and the key that does not match (a missing sidecar, or one copied from another robot,
+/// would give a network wrong bounds and provenance).
+void CheckSidecarMatches(const Dataset& d, const std::string& csv_path);
+
 /// The dataset as network samples (learn/sample_set.hpp): X = inputs (n x m), Y = positions
 /// (n x 3P, for N_fk).
 SampleSet PositionSamples(const Dataset& d);

@@ -768,6 +768,49 @@ TEST(Cli, IkExperimentsRunTinyConfigsAndRejectBadPaths) {
 
 namespace {
 
+// train takes the networks' bounds and provenance from the dataset's sidecar: without one, or with
+// one that does not describe the CSV (another dataset's points, bounds that exclude its samples),
+// it refuses before training and names the sidecar's key.
+TEST(Cli, TrainRefusesAMissingOrForeignSidecar) {
+  const std::string dir = TempDir("train_sidecar");
+  CliRun r =
+      Cli("dataset --robot three_chamber --res 3 --grid 3 --gradient-tolerance 1e-3 "
+          "--quiet --out " +
+          dir + "/d.csv");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const std::string csv = ReadAll(dir + "/d.csv");
+  const auto side = nlohmann::json::parse(ReadAll(dir + "/d.csv.json"));
+  auto train = [&](const std::string& name) {
+    return Cli("train --dataset " + dir + "/" + name + " --out " + dir + "/nets_" + name +
+               " --hidden 4 --epochs 2 --what fk --threads 1 --quiet");
+  };
+  std::ofstream(dir + "/none.csv") << csv;
+  r = train("none.csv");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find(dir + "/none.csv.json: not found"), std::string::npos) << r.out;
+  std::ofstream(dir + "/points.csv") << csv;
+  nlohmann::json other = side;
+  other["config"]["points"] = {"fingertip"};
+  std::ofstream(dir + "/points.csv.json") << other.dump(2);
+  r = train("points.csv");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("points.csv.json: config.points: expected the CSV's points"),
+            std::string::npos)
+      << r.out;
+  std::ofstream(dir + "/bounds.csv") << csv;
+  nlohmann::json narrow = side;
+  narrow["config"]["actuator_bounds"][1] = {1.0, 1.2};
+  std::ofstream(dir + "/bounds.csv.json") << narrow.dump(2);
+  r = train("bounds.csv");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("bounds.csv.json: config.actuator_bounds[1]: [1, 1.2] does not hold"),
+            std::string::npos)
+      << r.out;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/nets_bounds.csv/nets.json"));
+  r = train("d.csv");  // its own sidecar
+  EXPECT_EQ(r.code, 0) << r.out;
+}
+
 TEST(Cli, TrainAndLearnedIkFromADataset) {
   const std::string dir = TempDir("learn");
   // 27 samples of the coarse three_chamber with implicit Jacobians, loose forward solves.
