@@ -130,6 +130,26 @@ long long ParseIndex(const std::string& s, const std::string& file, long long li
   return v;
 }
 
+/// Checks the fields of one sample line against the header `head` (m actuation columns): the
+/// field count, the status, finite numbers in an ok row, empty outputs in a failed row. Throws
+/// with file:line. Returns true for an ok row.
+bool CheckSampleFields(const std::vector<std::string>& f, const std::vector<std::string>& head,
+                       int m, const std::string& path, long long lineno) {
+  const size_t nfields = head.size();
+  if (f.size() != nfields)
+    Bad(path, lineno,
+        "expected " + std::to_string(nfields) + " fields, found " + std::to_string(f.size()));
+  if (f[1] == "failed") {
+    for (size_t j = 2 + m; j + 1 < nfields; ++j)
+      if (!f[j].empty())
+        Bad(path, lineno, "a failed sample must have empty position and Jacobian fields");
+    return false;
+  }
+  if (f[1] != "ok") Bad(path, lineno, "column status: expected ok or failed, got '" + f[1] + "'");
+  for (size_t j = 2; j + 1 < nfields; ++j) ParseNumber(f[j], path, lineno, head[j]);
+  return true;
+}
+
 /// The text of a file.
 std::string ReadAll(const std::string& path) {
   CheckInputFile(path, "a dataset file (CSV or its .json sidecar)");
@@ -201,6 +221,9 @@ struct RawLines {
 };
 RawLines ReadRawLines(const std::string& path, const std::string& header, long long first) {
   const std::string text = ReadAll(path);
+  const std::vector<std::string> head = SplitFields(header);
+  int m = 0;  // actuation columns c0, c1, ... after index and status
+  while (2 + m < static_cast<int>(head.size()) && head[2 + m] == "c" + std::to_string(m)) ++m;
   RawLines r;
   size_t pos = 0;
   long long lineno = 0;
@@ -218,12 +241,15 @@ RawLines ReadRawLines(const std::string& path, const std::string& header, long l
             "the header differs from the one this dataset's config gives:\n  found    " + line +
                 "\n  expected " + header);
     } else {
-      const size_t comma = line.find(',');
-      const long long idx = ParseIndex(line.substr(0, comma), path, lineno);
+      const std::vector<std::string> f = SplitFields(line);
+      const long long idx = ParseIndex(f[0], path, lineno);
       const long long want = first + static_cast<long long>(r.lines.size());
       if (idx != want)
         Bad(path, lineno,
             "sample index " + std::to_string(idx) + ", expected " + std::to_string(want));
+      // A complete line is kept only if it is a valid sample: a resume must not carry a corrupt
+      // row into a dataset it reports as complete.
+      CheckSampleFields(f, head, m, path, lineno);
       r.lines.push_back(line);
     }
     pos = nl + 1;
@@ -629,14 +655,10 @@ Dataset LoadDataset(const std::string& path) {
           "sample index " + std::to_string(idx) + " after " + std::to_string(last_index) +
               " (indices must increase)");
     last_index = idx;
-    if (f[1] == "failed") {
-      for (size_t j = 2 + m; j + 1 < nfields; ++j)
-        if (!f[j].empty())
-          Bad(path, lineno, "a failed sample must have empty position and Jacobian fields");
+    if (!CheckSampleFields(f, head, m, path, lineno)) {
       ++ds.failed;
       continue;
     }
-    if (f[1] != "ok") Bad(path, lineno, "column status: expected ok or failed, got '" + f[1] + "'");
     for (int a = 0; a < m; ++a) in.push_back(ParseNumber(f[2 + a], path, lineno, head[2 + a]));
     for (int j = 0; j < 3 * P; ++j)
       pos_v.push_back(ParseNumber(f[2 + m + j], path, lineno, head[2 + m + j]));

@@ -195,6 +195,43 @@ TEST_F(DatasetTest, ResumedRunEqualsUninterruptedRun) {
   }
 }
 
+// A resume keeps only valid complete rows: a row with a corrupt number, a missing field or an
+// unknown status in the part already written stops the run with its file and line (it used to be
+// kept, and the dataset reported complete).
+TEST_F(DatasetTest, ResumeRefusesACorruptRowBeforeTheEnd) {
+  const DatasetSampling s = Grid(3, 8);  // 27 samples
+  DatasetRunOptions o;
+  o.jacobian = true;
+  o.out = Path("part.csv");
+  o.stop_after = 12;
+  Run(s, o);
+  const std::string part = Read(o.out);
+  o.stop_after = -1;
+  // Line 6 of the file is sample 4: "4,ok,c0,...".
+  size_t l6 = 0;
+  for (int k = 1; k < 6; ++k) l6 = part.find('\n', l6) + 1;
+  const size_t end6 = part.find('\n', l6);
+  const size_t c0 = part.find(',', part.find(',', l6) + 1) + 1;  // after index and status
+  std::string spoiled = part, short_row = part, bad_status = part;
+  spoiled[c0] = 'x';                                       // a corrupt number
+  short_row.erase(c0 - 1, end6 - (c0 - 1));                // "4,ok": fields missing
+  bad_status.replace(part.find(',', l6) + 1, 2, "maybe");  // an unknown status
+  for (const auto& [text, what] :
+       std::vector<std::pair<std::string, std::string>>{{spoiled, "expected a number"},
+                                                        {short_row, "fields, found 2"},
+                                                        {bad_status, "expected ok or failed"}}) {
+    Write(o.out, text);
+    try {
+      Run(s, o);
+      ADD_FAILURE() << "resumed over a corrupt row (" << what << ")";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(o.out + ":6: "), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(Read(o.out), text);  // nothing lost or appended
+  }
+}
+
 TEST_F(DatasetTest, MergedShardsEqualTheUnshardedRun) {
   const DatasetSampling s = Grid(4, 8);  // 64 samples, 8 blocks
   DatasetRunOptions o;
