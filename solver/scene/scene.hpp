@@ -108,6 +108,11 @@ struct Marker {
 struct Scene {
   std::string name;
   Mesh mesh;
+  /// For a mesh read from a file (scene JSON): the 0-based position in that file of each mesh
+  /// vertex (MeshReport::source_vertex; readers drop vertices no element uses). Empty for a
+  /// generated mesh. Vertex indices written in the scene JSON (index files, markers[].vertex) are
+  /// file positions and are mapped through it.
+  std::vector<int> mesh_source_vertex;
   std::map<int, Material> body;     ///< region tag -> body material
   std::vector<Actuator> actuators;  ///< in actuation-vector order
   std::vector<int> fixed;           ///< sorted, unique vertex indices held at rest positions

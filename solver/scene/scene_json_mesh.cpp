@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <iostream>
 #include <string>
 
 namespace softkin {
@@ -14,7 +15,7 @@ namespace scene_json_detail {
 
 namespace fs = std::filesystem;
 
-void SceneParser::ReadMeshSection(const json& m, Scene* scene) const {
+void SceneParser::ReadMeshSection(const json& m, Scene* scene) {
   CheckObject(m, "mesh", "mesh");
   const std::string file_key = m.at("file").get<std::string>();
   if (file_key.empty()) Fail("mesh.file: expected a file name, got \"\"");
@@ -34,17 +35,20 @@ void SceneParser::ReadMeshSection(const json& m, Scene* scene) const {
       format = "gmsh";
     else if (ext == ".vtk")
       format = "vtk";
+    else if (ext == ".vtu")
+      format = "vtu";
     else if (ext.empty() && fs::exists(file.string() + ".node"))
       format = "tetgen";
     else
       Fail("mesh.format: cannot tell the mesh format of '" + file.string() +
-           "' from its extension; expected a .tet, .node, .ele, .msh or .vtk file, or mesh.format "
-           "set to one of: tet, tetgen, gmsh, vtk");
+           "' from its extension; expected a .tet, .node, .ele, .msh, .vtk or .vtu file, or "
+           "mesh.format set to one of: tet, tetgen, gmsh, vtk, vtu");
   }
   if (!labels.empty() && format != "tet")
     Fail("mesh.labels: only used by the tet format (the mesh is read as " + format + ")");
-  if (!tag_array.empty() && format != "vtk")
-    Fail("mesh.tag_array: only used by the vtk format (the mesh is read as " + format + ")");
+  if (!tag_array.empty() && format != "vtk" && format != "vtu")
+    Fail("mesh.tag_array: only used by the vtk and vtu formats (the mesh is read as " + format +
+         ")");
 
   fs::path read_path = file;
   if (format == "tetgen") {
@@ -67,15 +71,18 @@ void SceneParser::ReadMeshSection(const json& m, Scene* scene) const {
            labels + "\")");
   }
 
+  MeshReport report;
   try {
     if (format == "tet")
-      scene->mesh = ReadTet(read_path.string(), labels_path.string());
+      scene->mesh = ReadTet(read_path.string(), labels_path.string(), &report);
     else if (format == "tetgen")
-      scene->mesh = ReadTetGen(read_path.string());
+      scene->mesh = ReadTetGen(read_path.string(), &report);
     else if (format == "gmsh")
-      scene->mesh = ReadGmsh(read_path.string());
+      scene->mesh = ReadGmsh(read_path.string(), &report);
+    else if (format == "vtu")
+      scene->mesh = ReadVtu(read_path.string(), tag_array, &report);
     else
-      scene->mesh = ReadVtk(read_path.string(), tag_array);
+      scene->mesh = ReadVtk(read_path.string(), tag_array, &report);
   } catch (const std::exception& e) {
     // Keep the reader's "<file>:<line>: ..." message intact; add the key it came from.
     const std::string what = e.what();
@@ -83,6 +90,12 @@ void SceneParser::ReadMeshSection(const json& m, Scene* scene) const {
     Fail(std::string(from_labels ? "mesh.labels" : "mesh.file") + ": cannot read the " + format +
          " mesh: " + what);
   }
+  PrintMeshReport(report, std::cerr);
+  scene->mesh_source_vertex = report.source_vertex;
+  const int file_vertices = scene->mesh.num_vertices() + report.unused_vertices;
+  file_to_mesh_.assign(static_cast<std::size_t>(file_vertices), -1);
+  for (int j = 0; j < scene->mesh.num_vertices(); ++j)
+    file_to_mesh_[static_cast<std::size_t>(report.source_vertex[j])] = j;
   const double scale = Get(m, "mesh", "scale").get<double>();
   if (scale != 1.0) scene->mesh.vertices *= scale;
 }

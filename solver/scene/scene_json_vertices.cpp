@@ -30,14 +30,15 @@ void SceneParser::ReadBox(const json& box, const std::string& pattern, const std
 }
 
 std::vector<int> SceneParser::ReadIndexFile(const json& entry, const std::string& pattern,
-                                            const std::string& path, const Mesh& mesh) const {
+                                            const std::string& path) const {
   const std::string name = entry.at("file").get<std::string>();
   const int base = AsInt(Get(entry, pattern, "base"));
   const fs::path file = Resolve(name);
   std::ifstream in(file);
   if (!in) Fail(path + ".file: cannot open '" + file.string() + "' (from \"" + name + "\")");
-  const int n = mesh.num_vertices();
+  const int n = static_cast<int>(file_to_mesh_.size());
   std::vector<int> out;
+  int dropped = 0;
   std::string line;
   int line_no = 0;
   while (std::getline(in, line)) {
@@ -53,16 +54,30 @@ std::vector<int> SceneParser::ReadIndexFile(const json& entry, const std::string
           path + ".file: " + file.string() + ":" + std::to_string(line_no) + ": ";
       if (ec != std::errc() || ptr != tok.data() + tok.size())
         Fail(where + "expected an integer vertex index, got '" + tok + "'");
-      if (v - base < 0 || v - base >= n)
+      const int mv = MeshVertexOfFile(v - base);
+      if (mv == -2)
         Fail(where + "vertex index " + tok + " is out of range; expected " + std::to_string(base) +
-             " to " + std::to_string(n - 1 + base) + " (" + std::to_string(n) + " vertices, base " +
-             std::to_string(base) + ")");
-      out.push_back(static_cast<int>(v - base));
+             " to " + std::to_string(n - 1 + base) + " (" + std::to_string(n) +
+             " vertices in the mesh file, base " + std::to_string(base) + ")");
+      if (mv < 0)
+        ++dropped;  // used by no element: dropped by the reader, nothing to hold or move
+      else
+        out.push_back(mv);
     }
   }
   if (in.bad()) Fail(path + ".file: error while reading '" + file.string() + "'");
-  if (out.empty()) Fail(path + ".file: '" + file.string() + "' lists no vertex index");
+  if (out.empty())
+    Fail(path + ".file: '" + file.string() + "' lists no vertex index" +
+         (dropped ? " of a vertex used by an element (the " + std::to_string(dropped) +
+                        " listed are used by none and were dropped with the mesh file's unused "
+                        "vertices)"
+                  : std::string()));
   return out;
+}
+
+int SceneParser::MeshVertexOfFile(long long v) const {
+  if (v < 0 || v >= static_cast<long long>(file_to_mesh_.size())) return -2;
+  return file_to_mesh_[static_cast<std::size_t>(v)];
 }
 
 std::vector<int> SceneParser::ReadSelection(const json& f, const std::string& pattern,
@@ -91,7 +106,7 @@ std::vector<int> SceneParser::ReadSelection(const json& f, const std::string& pa
       Fail(path + ".plane selects no vertex (tolerance " + Num(tol) + "; " + BoundsText(mesh) +
            ")");
   } else {
-    sel = ReadIndexFile(f, pattern, path, mesh);
+    sel = ReadIndexFile(f, pattern, path);
   }
   std::sort(sel.begin(), sel.end());
   sel.erase(std::unique(sel.begin(), sel.end()), sel.end());
@@ -204,10 +219,15 @@ std::vector<Marker> SceneParser::ReadMarkers(const json& markers, const Mesh& me
     name_path[mk.name] = path;
     if (m.contains("vertex")) {
       const int v = AsInt(m.at("vertex"));
-      if (v < 0 || v >= mesh.num_vertices())
+      const int mv = MeshVertexOfFile(v);
+      if (mv == -2)
         Fail(path + ".vertex: expected a vertex index in [0, " +
-             std::to_string(mesh.num_vertices() - 1) + "], got " + std::to_string(v));
-      mk.vertices = {v};
+             std::to_string(file_to_mesh_.size() - 1) + "], got " + std::to_string(v));
+      if (mv < 0)
+        Fail(path + ".vertex: vertex " + std::to_string(v) +
+             " of the mesh file is used by no element (the reader dropped it); expected a "
+             "vertex of the mesh's elements");
+      mk.vertices = {mv};
     } else if (m.contains("nearest")) {
       if (mesh.num_vertices() == 0) Fail(path + ".nearest: the mesh has no vertices");
       mk.vertices = {NearestVertex(mesh, AsVec(m.at("nearest")))};

@@ -45,17 +45,18 @@ void AddMeshKeys(std::vector<KeySpec>* t) {
                    "Mesh file, relative to the JSON's folder (TetGen: the .node or .ele file, or "
                    "the base name)."));
   t->push_back(Key("mesh.format", S, Opt,
-                   "Reader; auto picks it from the extension (.tet, .node/.ele, .msh, .vtk).")
+                   "Reader; auto picks it from the extension (.tet, .node/.ele, .msh, .vtk, "
+                   ".vtu).")
                    .Def("auto")
-                   .Choices({"auto", "tet", "tetgen", "gmsh", "vtk"}));
+                   .Choices({"auto", "tet", "tetgen", "gmsh", "vtk", "vtu"}));
   t->push_back(Key("mesh.labels", S, Opt,
                    "tet only: file with one region tag per tet, in tet order, relative to the "
                    "JSON's folder (without it every tet is region 0).")
                    .Def("")
                    .DefText("none"));
   t->push_back(Key("mesh.tag_array", S, Opt,
-                   "vtk only: integer cell-data array holding the region tags (none: the first "
-                   "integer cell-data array).")
+                   "vtk and vtu only: integer cell-data array holding the region tags (none: the "
+                   "first integer cell-data array).")
                    .Def("")
                    .DefText("none"));
   t->push_back(Key("mesh.scale", N, Opt,

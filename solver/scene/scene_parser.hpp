@@ -65,14 +65,17 @@ class SceneParser {
 
   // ---- The sections, in the order Build reads them ----
 
-  /// mesh (scene_json_mesh.cpp).
-  void ReadMeshSection(const json& m, Scene* scene) const;
+  /// mesh (scene_json_mesh.cpp); sets file_to_mesh_.
+  void ReadMeshSection(const json& m, Scene* scene);
   /// regions[]: body materials and actuators (scene_json_regions.cpp).
   void ReadRegions(const json& regions, Scene* scene) const;
   /// fixed[], motions[], markers[] (scene_json_vertices.cpp).
   void ReadFixed(const json& fixed, Scene* scene) const;
   void ReadMotions(const json& motions, Scene* scene) const;
   std::vector<Marker> ReadMarkers(const json& markers, const Mesh& mesh) const;
+  /// The mesh vertex of 0-based file position `v` (an index written in the scene): -1 if the
+  /// reader dropped it (no element uses it), -2 if v is out of the file's range.
+  int MeshVertexOfFile(long long v) const;
   /// obstacles[] (scene_json_obstacles.cpp).
   std::vector<TriangleSurface> ReadObstacles(const json& obstacles) const;
   /// solver (scene_json.cpp).
@@ -96,8 +99,10 @@ class SceneParser {
   /// `pattern` ("fixed[]" or "motions[]"), already checked by CheckObject.
   std::vector<int> ReadSelection(const json& entry, const std::string& pattern,
                                  const std::string& path, const Mesh& mesh) const;
+  /// Indices of an index file: file positions (see Scene::mesh_source_vertex) mapped to mesh
+  /// vertices; those of dropped (unused) vertices are left out.
   std::vector<int> ReadIndexFile(const json& entry, const std::string& pattern,
-                                 const std::string& path, const Mesh& mesh) const;
+                                 const std::string& path) const;
   void ReadBox(const json& box, const std::string& pattern, const std::string& path,
                Eigen::Vector3d* lo, Eigen::Vector3d* hi) const;
   std::string BoundsText(const Mesh& mesh) const {
@@ -108,6 +113,8 @@ class SceneParser {
 
   std::string src_;
   std::string base_;
+  /// File position -> mesh vertex (-1: dropped as unused), one entry per vertex of the mesh file.
+  std::vector<int> file_to_mesh_;
 };
 
 }  // namespace scene_json_detail

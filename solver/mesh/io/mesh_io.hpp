@@ -5,34 +5,52 @@
 /// truncated files, indices out of range, NaN/Inf, degenerate elements, unknown element types.
 #include "softkin/solver/mesh/mesh.hpp"
 
+#include <iosfwd>
 #include <string>
 #include <vector>
 
 namespace softkin {
 
 /// The thesis group's `.tet` format ("N vertices", "M tets", N lines "x y z", M lines "4 a b c d",
-/// 0-based). If `labels_path` is non-empty it holds one integer per tet (region tag).
+/// 0-based). A file that looks 1-based (no tet uses vertex 0, and a tet uses vertex N, or the
+/// tets only form a clean mesh when read 1-based) is refused with an error that says so.
+/// If `labels_path` is non-empty it holds one integer per tet (region tag).
 Mesh ReadTet(const std::string& path, const std::string& labels_path = "",
              MeshReport* report = nullptr);
 void WriteTet(const std::string& path, const Mesh& mesh, const std::string& labels_path = "");
 
-/// TetGen `.node` + `.ele` (`base` without extension). The first element attribute is the region.
+/// TetGen `.node` + `.ele` (`base` without extension), 4 or 10 (tetgen -o2, read by the corners)
+/// nodes per tet. The first element attribute is the region.
 Mesh ReadTetGen(const std::string& base, MeshReport* report = nullptr);
 void WriteTetGen(const std::string& base, const Mesh& mesh);
 
-/// Gmsh ASCII `.msh` 2.2 and 4.1: tetrahedra (type 4) and prisms (type 6); the physical group is
-/// the region tag. Lower-dimensional elements are skipped.
+/// Gmsh `.msh` 2.2 (ASCII) and 4.1 (ASCII or binary, either byte order): tetrahedra (type 4) and
+/// prisms (type 6), and higher-order ones (11, 29-31; 13, 18) read by their corner nodes; the
+/// physical group is the region tag. Lower-dimensional elements are skipped.
 Mesh ReadGmsh(const std::string& path, MeshReport* report = nullptr);
 /// Writes Gmsh 2.2 ASCII (version 2.2 or 4.1 accepted as `version`).
 void WriteGmsh(const std::string& path, const Mesh& mesh, const std::string& version = "2.2");
 
-/// Legacy ASCII VTK unstructured grid (cell types 10 tet, 13 wedge); the region is the cell-data
-/// scalar array named `tag_array` (or the first integer cell-data array if empty).
+/// Legacy VTK unstructured grid, ASCII or BINARY (big-endian, as VTK and meshio write it): cell
+/// types 10 tet, 13 wedge, 24 quadratic tet and 26 quadratic wedge (read by their corners);
+/// the region is the cell-data array named `tag_array` (or, if empty, the first integer
+/// cell-data array, else the first one with a tag-like name and integer values).
 Mesh ReadVtk(const std::string& path, const std::string& tag_array = "",
              MeshReport* report = nullptr);
 void WriteVtk(const std::string& path, const Mesh& mesh);
 
-/// Picks the reader by extension: .tet, .node/.ele, .msh, .vtk.
+/// VTK XML UnstructuredGrid `.vtu` (one Piece): DataArrays in ascii, inline base64 `binary` or
+/// raw appended format, either byte order, UInt32 or UInt64 headers; compressed files are
+/// refused. Cell types and the region array as for ReadVtk. WriteVtu's output reads back as the
+/// mesh at the positions it was written at (its Points; the displacement array is not used).
+Mesh ReadVtu(const std::string& path, const std::string& tag_array = "",
+             MeshReport* report = nullptr);
+
+/// Prints a reader's notes and warnings as "softkin: note: ..." / "softkin: warning: ..." lines
+/// (what every reader does when it is given no MeshReport).
+void PrintMeshReport(const MeshReport& report, std::ostream& os);
+
+/// Picks the reader by extension: .tet, .node/.ele, .msh, .vtk, .vtu.
 Mesh ReadMesh(const std::string& path, MeshReport* report = nullptr);
 
 /// The outcome of the solve that produced a `.vtu`, written as its field data (ParaView: the

@@ -23,6 +23,7 @@
 #include <utility>
 #include <vector>
 
+#include "softkin/solver/mesh/io/mesh_io.hpp"
 #include "softkin/solver/mesh/mesh.hpp"
 
 namespace softkin {
@@ -81,6 +82,17 @@ class Scanner {
   void Seek(Pos pos) {
     p_ = pos.p;
     line_ = pos.line;
+  }
+
+  /// Raw access for binary parts: the file's bytes, the cursor, and a jump forward to `q` (lines
+  /// are counted over the skipped bytes, so later messages still name the right line).
+  const char* Begin() const { return data_.data(); }
+  const char* End() const { return end_; }
+  const char* Ptr() const { return p_; }
+  long long Offset() const { return static_cast<long long>(p_ - data_.data()); }
+  void JumpTo(const char* q) {
+    for (; p_ < q && p_ < end_; ++p_)
+      if (*p_ == '\n') ++line_;
   }
 
   /// True when the cursor is at the end of the file.
@@ -241,15 +253,22 @@ class Scanner {
   char comment_ = 0;
 };
 
-/// Copies `src` into `*dst` when dst is set, otherwise prints notes and warnings to std::cerr as
-/// "softkin: note: ..." / "softkin: warning: ...".
-inline void Deliver(const MeshReport& src, MeshReport* dst) {
+/// Moves `src` into `*dst` when dst is set, otherwise prints it to std::cerr (PrintMeshReport).
+inline void Deliver(MeshReport& src, MeshReport* dst) {
   if (dst) {
-    *dst = src;
+    *dst = std::move(src);
     return;
   }
-  for (const auto& n : src.notes) std::cerr << "softkin: note: " << n << '\n';
-  for (const auto& w : src.warnings) std::cerr << "softkin: warning: " << w << '\n';
+  PrintMeshReport(src, std::cerr);
+}
+
+/// The note for `n` higher-order elements read by their corner nodes, put first in `rep`.
+inline void NoteCornersOnly(const std::string& path, int n, MeshReport* rep) {
+  if (n <= 0) return;
+  rep->notes.insert(rep->notes.begin(),
+                    path + ": read " + std::to_string(n) +
+                        " higher-order elements by their corner nodes (SoftKin's elements are "
+                        "linear; the mid-edge nodes are dropped as unused)");
 }
 
 /// Converts a VTK wedge (base normal pointing away from the top) to SoftKin/Gmsh prism order and

@@ -7,6 +7,8 @@
 
 #include "softkin/solver/mesh/io/mesh_io.hpp"
 #include "softkin/solver/mesh/io/mesh_io_detail.hpp"
+#include "softkin/solver/mesh/io/mesh_io_gmsh_binary.hpp"
+#include "softkin/solver/mesh/io/mesh_io_gmsh_types.hpp"
 
 namespace softkin {
 
@@ -14,84 +16,9 @@ namespace {
 
 using detail::Scanner;
 
-struct GmshType {
-  int nodes = 0;  ///< 0: unknown type
-  int dim = 0;
-  const char* name = "";
-};
-
-GmshType LookupGmshType(long long t) {
-  switch (t) {
-    case 1:
-      return {2, 1, "2-node line"};
-    case 2:
-      return {3, 2, "3-node triangle"};
-    case 3:
-      return {4, 2, "4-node quadrangle"};
-    case 4:
-      return {4, 3, "4-node tetrahedron"};
-    case 5:
-      return {8, 3, "8-node hexahedron"};
-    case 6:
-      return {6, 3, "6-node prism"};
-    case 7:
-      return {5, 3, "5-node pyramid"};
-    case 8:
-      return {3, 1, "3-node line"};
-    case 9:
-      return {6, 2, "6-node triangle"};
-    case 10:
-      return {9, 2, "9-node quadrangle"};
-    case 11:
-      return {10, 3, "10-node tetrahedron"};
-    case 12:
-      return {27, 3, "27-node hexahedron"};
-    case 13:
-      return {18, 3, "18-node prism"};
-    case 14:
-      return {14, 3, "14-node pyramid"};
-    case 15:
-      return {1, 0, "1-node point"};
-    case 16:
-      return {8, 2, "8-node quadrangle"};
-    case 17:
-      return {20, 3, "20-node hexahedron"};
-    case 18:
-      return {15, 3, "15-node prism"};
-    case 19:
-      return {13, 3, "13-node pyramid"};
-    case 20:
-      return {9, 2, "9-node triangle"};
-    case 21:
-      return {10, 2, "10-node triangle"};
-    case 22:
-      return {12, 2, "12-node triangle"};
-    case 23:
-      return {15, 2, "15-node triangle"};
-    case 24:
-      return {15, 2, "15-node triangle"};
-    case 25:
-      return {21, 2, "21-node triangle"};
-    case 26:
-      return {4, 1, "4-node line"};
-    case 27:
-      return {5, 1, "5-node line"};
-    case 28:
-      return {6, 1, "6-node line"};
-    case 29:
-      return {20, 3, "20-node tetrahedron"};
-    case 30:
-      return {35, 3, "35-node tetrahedron"};
-    case 31:
-      return {56, 3, "56-node tetrahedron"};
-    case 92:
-      return {64, 3, "64-node hexahedron"};
-    case 93:
-      return {125, 3, "125-node hexahedron"};
-    default:
-      return {};
-  }
-}
+using detail::Corners;
+using detail::GmshType;
+using detail::LookupGmshType;
 
 constexpr const char* kEntityNames[4] = {"point entity", "curve entity", "surface entity",
                                          "volume entity"};
@@ -103,7 +30,9 @@ const char* PerLine(long long type) {
   return "as many node tags as the element type has nodes";
 }
 
-constexpr const char* kWanted = "element type 4 (4-node tetrahedron) or 6 (6-node prism)";
+constexpr const char* kWanted =
+    "a tetrahedron (element type 4, or 11/29/30/31 of higher order) or a prism (6, or 13/18 of "
+    "second order)";
 
 /// Checks an element type; returns true if the element is a tet/prism to keep, false if it is a
 /// lower-dimensional element to skip; fails on unknown and unsupported 3D types.
@@ -113,7 +42,7 @@ bool CheckType(Scanner& s, long long type, GmshType* info) {
     s.FailHere("unknown element type " + std::to_string(type),
                std::string(kWanted) + ", or a lower-dimensional element to skip");
   if (info->dim < 3) return false;
-  if (type != 4 && type != 6)
+  if (Corners(type) == 0)
     s.FailHere("unsupported element type " + std::to_string(type) + " (" + info->name + ")",
                kWanted);
   return true;
@@ -127,6 +56,8 @@ struct Reader {
   detail::TagIndex nodes;
   bool have_nodes = false, have_elements = false;
   std::map<int, int> volume_physical;  // 4.1: volume entity tag -> first physical tag
+  int higher_order = 0;                // elements read as their corner nodes
+  int binary_size = 0;                 // binary 4.1: the size_t width; 0 for ASCII
 
   explicit Reader(const std::string& path) : s(path) {}
 
@@ -198,6 +129,20 @@ struct Reader {
     return i;
   }
 
+  /// Reads the node tags of a kept element (the rest of its line) and adds its corners.
+  void AddElement(long long type, const GmshType& info, int region, int line) {
+    Element e;
+    const int k = Corners(type);
+    e.type = k == 4 ? ElementType::Tet : ElementType::Prism;
+    e.region = region;
+    for (int a = 0; a < k; ++a) e.v[a] = NodeIndex(s.Integer("a node tag"));
+    for (int a = k; a < info.nodes; ++a) NodeIndex(s.Integer("a node tag"));
+    s.ExpectEol(PerLine(type));
+    if (info.nodes > k) ++higher_order;
+    mesh.elements.push_back(e);
+    element_lines.push_back(line);
+  }
+
   // ---------------- 2.2 ----------------
   void Nodes2(int opened) {
     const long long n = Count("the number of nodes");
@@ -248,13 +193,7 @@ struct Reader {
         s.NextLine();
         continue;
       }
-      Element e;
-      e.type = info.nodes == 4 ? ElementType::Tet : ElementType::Prism;
-      e.region = region;
-      for (int a = 0; a < info.nodes; ++a) e.v[a] = NodeIndex(s.Integer("a node tag"));
-      s.ExpectEol(PerLine(type));
-      mesh.elements.push_back(e);
-      element_lines.push_back(line);
+      AddElement(type, info, region, line);
       s.NextLine();
     }
     ExpectEnd("Elements", opened);
@@ -395,13 +334,7 @@ struct Reader {
           s.NextLine();
           continue;
         }
-        Element e;
-        e.type = info.nodes == 4 ? ElementType::Tet : ElementType::Prism;
-        e.region = region;
-        for (int a = 0; a < info.nodes; ++a) e.v[a] = NodeIndex(s.Integer("a node tag"));
-        s.ExpectEol(PerLine(type));
-        mesh.elements.push_back(e);
-        element_lines.push_back(line);
+        AddElement(type, info, region, line);
         s.NextLine();
       }
       total += m;
@@ -424,12 +357,19 @@ struct Reader {
       s.FailHere("file ends inside $MeshFormat", "'<version> <file-type> <data-size>'");
     const std::string version(s.Word());
     const long long file_type = s.Integer("the file type");
-    if (file_type != 0)
-      s.FailHere("binary .msh file (file type " + std::to_string(file_type) + ")",
-                 "an ASCII .msh file (file type 0; in Gmsh: File > Export, uncheck 'Save in binary "
-                 "format', or -format msh22/msh41 without -bin)");
-    s.Integer("the data size");
+    if (file_type != 0 && (file_type != 1 || version != "4.1"))
+      s.FailHere("binary .msh " + version + " file (file type " + std::to_string(file_type) + ")",
+                 "an ASCII .msh file (file type 0) or a binary 4.1 one (file type 1; in Gmsh: "
+                 "-format msh41 -bin, or File > Export as version 4.1)");
+    const long long data_size = s.Integer("the data size");
     s.ExpectEol("'<version> <file-type> <data-size>'");
+    if (file_type == 1) {
+      if (data_size != 4 && data_size != 8)
+        s.FailHere("data size " + std::to_string(data_size), "8 (or 4): the size of size_t");
+      binary_size = static_cast<int>(data_size);
+      s.NextLine();
+      return;  // ReadGmsh goes on with ReadGmshBinaryBody
+    }
     double ver = 0.0;
     {
       const auto r = std::from_chars(version.data(), version.data() + version.size(), ver);
@@ -500,7 +440,17 @@ struct Reader {
 Mesh ReadGmsh(const std::string& path, MeshReport* report) {
   Reader r(path);
   r.Read();
+  if (r.binary_size > 0) {
+    detail::GmshBody body;
+    detail::ReadGmshBinaryBody(r.s, r.binary_size, &body);
+    body.origin.bytes = true;
+    MeshReport rep = ValidateAndOrient(body.mesh, path, body.origin);
+    detail::NoteCornersOnly(path, body.higher_order, &rep);
+    detail::Deliver(rep, report);
+    return std::move(body.mesh);
+  }
   MeshReport rep = ValidateAndOrient(r.mesh, path, r.element_lines, r.vertex_lines);
+  detail::NoteCornersOnly(path, r.higher_order, &rep);
   detail::Deliver(rep, report);
   return std::move(r.mesh);
 }

@@ -1,5 +1,7 @@
 /// \file mesh_io_tet.cpp
 /// The thesis group's `.tet` format and its per-tet label file.
+#include <cmath>
+
 #include "softkin/solver/mesh/io/mesh_io.hpp"
 #include "softkin/solver/mesh/io/mesh_io_detail.hpp"
 
@@ -42,6 +44,53 @@ void ReadLabels(const std::string& labels_path, Mesh& mesh) {
   if (i < ne)
     s.FailHere("file ends after " + std::to_string(i) + " of " + std::to_string(ne) + " labels",
                std::to_string(ne) + " labels, one per tet");
+}
+
+/// True if `mesh` (indices in range) has no degenerate element and no fold once every element is
+/// oriented positively.
+bool CleanWhenOriented(Mesh mesh) {
+  const double h = mesh.size();
+  for (auto& e : mesh.elements) {
+    const double vol = SignedVolume(e, mesh.vertices);
+    if (!(std::abs(vol) > 1e-12 * h * h * h)) return false;
+    if (vol < 0) FlipElement(e);
+  }
+  return FoldedElementPairs(mesh).empty();
+}
+
+/// The thesis format is 0-based. A 1-based file uses no vertex 0; it is refused when it also uses
+/// index N (the vertex count, out of range when 0-based), or when it reads as a clean mesh 1-based
+/// but as a degenerate or folded one 0-based. A 0-based file that merely leaves vertex 0 unused
+/// reads normally (the vertex is dropped with a note).
+void CheckZeroBased(const Mesh& mesh, const std::string& path, const std::vector<int>& lines) {
+  const int nv = mesh.num_vertices();
+  int top = -1, top_elem = 0;
+  for (int i = 0; i < mesh.num_elements(); ++i)
+    for (int a = 0; a < 4; ++a) {
+      const int v = mesh.elements[i].v[a];
+      if (v == 0 || v < 0 || v > nv) return;  // 0-based, or out of range (reported later)
+      if (v > top) {
+        top = v;
+        top_elem = i;
+      }
+    }
+  if (top < 0) return;
+  const char* expected =
+      "0-based vertex indices (the .tet format counts vertices from 0): subtract 1 from every "
+      "index of the tet lines";
+  if (top == nv)
+    detail::Fail(detail::At(path, lines[top_elem]),
+                 "the file looks 1-based: this tet uses vertex " + std::to_string(nv) +
+                     " (the vertex count) and no tet uses vertex 0",
+                 expected);
+  Mesh one_based = mesh;
+  for (auto& e : one_based.elements)
+    for (int a = 0; a < 4; ++a) --e.v[a];
+  if (!CleanWhenOriented(mesh) && CleanWhenOriented(one_based))
+    detail::Fail(path,
+                 "the file looks 1-based: no tet uses vertex 0, and the tets are degenerate or "
+                 "overlap when read 0-based but not when read 1-based",
+                 expected);
 }
 
 }  // namespace
@@ -104,6 +153,7 @@ Mesh ReadTet(const std::string& path, const std::string& labels_path, MeshReport
                            " declared tets");
 
   if (!labels_path.empty()) ReadLabels(labels_path, mesh);
+  CheckZeroBased(mesh, path, element_lines);
 
   MeshReport v = ValidateAndOrient(mesh, path, element_lines, vertex_lines);
   v.warnings.insert(v.warnings.begin(), rep.warnings.begin(), rep.warnings.end());

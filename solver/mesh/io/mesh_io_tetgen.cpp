@@ -77,8 +77,9 @@ long long ReadTetGenNodes(const std::string& base, Mesh* out, long long* first_i
 
 /// Reads the tets of TetGen's <base>.ele (node indices numbered from first_index, nv nodes) into
 /// mesh->elements, with each one's line in *element_lines (for ValidateAndOrient's messages).
-void ReadTetGenElements(const std::string& base, long long nv, long long first_index, Mesh* out,
-                        std::vector<int>* element_lines_out) {
+/// Returns the nodes per tetrahedron (4, or 10 for tetgen -o2, read by their corners).
+long long ReadTetGenElements(const std::string& base, long long nv, long long first_index,
+                             Mesh* out, std::vector<int>* element_lines_out) {
   Mesh& mesh = *out;
   std::vector<int>& element_lines = *element_lines_out;
   Scanner s(base + ".ele", '#');
@@ -92,10 +93,9 @@ void ReadTetGenElements(const std::string& base, long long nv, long long first_i
   s.ExpectEol(header);
   if (ne < 0 || ne > INT_MAX)
     s.FailHere("number of tetrahedra " + std::to_string(ne), "a count >= 0");
-  if (npt == 10)
-    s.FailHere("quadratic tetrahedra (10 nodes per tetrahedron)",
-               "only linear tetrahedra: 4 nodes per tetrahedron (run tetgen without -o2)");
-  if (npt != 4) s.FailHere(std::to_string(npt) + " nodes per tetrahedron", "4");
+  if (npt != 4 && npt != 10)
+    s.FailHere(std::to_string(npt) + " nodes per tetrahedron",
+               "4, or 10 (tetgen -o2; read by the 4 corner nodes)");
   if (nattr < 0 || nattr > 1000)
     s.FailHere("number of attributes " + std::to_string(nattr), "a count in [0, 1000]");
   s.NextLine();
@@ -118,13 +118,13 @@ void ReadTetGenElements(const std::string& base, long long nv, long long first_i
     }
     Element e;
     e.type = ElementType::Tet;
-    for (int a = 0; a < 4; ++a) {
+    for (int a = 0; a < npt; ++a) {
       const long long n = s.Integer("a node index");
       if (n < first_index || n >= first_index + nv)
         s.FailHere("node index " + std::to_string(n) + " is out of range",
                    "a node index in [" + std::to_string(first_index) + ", " +
                        std::to_string(first_index + nv - 1) + "] (numbering of the .node file)");
-      e.v[a] = static_cast<int>(n - first_index);
+      if (a < 4) e.v[a] = static_cast<int>(n - first_index);  // corners come first
     }
     for (long long a = 0; a < nattr; ++a) {
       const double x = s.Double("an attribute");
@@ -136,10 +136,12 @@ void ReadTetGenElements(const std::string& base, long long nv, long long first_i
         e.region = static_cast<int>(r);
       }
     }
-    s.ExpectEol("'<index> n1 n2 n3 n4' followed by the declared number of attributes");
+    s.ExpectEol(npt == 4 ? "'<index> n1 n2 n3 n4' followed by the declared number of attributes"
+                         : "'<index> n1 ... n10' followed by the declared number of attributes");
     mesh.elements.push_back(e);
     s.NextLine();
   }
+  return npt;
 }
 
 }  // namespace
@@ -150,11 +152,12 @@ Mesh ReadTetGen(const std::string& base_in, MeshReport* report) {
   std::vector<int> element_lines;
   long long first_index = 0;  // 0 or 1, from the first node
   const long long nv = ReadTetGenNodes(base, &mesh, &first_index);
-  ReadTetGenElements(base, nv, first_index, &mesh, &element_lines);
+  const long long npt = ReadTetGenElements(base, nv, first_index, &mesh, &element_lines);
 
   // Coordinates were checked against the .node file's lines as they were read (ReadTetGenNodes);
   // elements name the .ele file.
   MeshReport rep = ValidateAndOrient(mesh, base + ".ele", element_lines, {});
+  if (npt == 10) detail::NoteCornersOnly(base + ".ele", mesh.num_elements(), &rep);
   detail::Deliver(rep, report);
   return mesh;
 }

@@ -5,7 +5,9 @@
 #include <cmath>
 
 #include "softkin/solver/mesh/io/mesh_io.hpp"
+#include "softkin/solver/mesh/io/mesh_io_binary.hpp"
 #include "softkin/solver/mesh/io/mesh_io_detail.hpp"
+#include "softkin/solver/mesh/io/mesh_io_vtk_common.hpp"
 
 namespace softkin {
 
@@ -21,17 +23,6 @@ bool IEquals(std::string_view a, const char* b) {
         std::toupper(static_cast<unsigned char>(b[i])))
       return false;
   return true;
-}
-
-bool IsIntegerType(std::string_view t) { return !(IEquals(t, "float") || IEquals(t, "double")); }
-
-bool NameSuggestsTag(std::string_view name) {
-  std::string n(name);
-  for (char& c : n) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  for (const char* w :
-       {"region", "tag", "label", "material", "physical", "attribute", "domain", "entity"})
-    if (n.find(w) != std::string::npos) return true;
-  return false;
 }
 
 /// Lower-dimensional VTK cell types that are skipped (vertex, lines, polygons, quadratic and
@@ -98,12 +89,8 @@ const char* VtkCellName(long long t) {
   }
 }
 
-struct CellArray {
-  std::string name;
-  int line = 0;  ///< line of the array header
-  bool integer_type = false;
-  std::vector<double> values;  ///< one per cell (single-component arrays only)
-};
+using detail::CellArray;
+using detail::KeptPoints;
 
 struct Reader {
   Scanner s;
@@ -122,6 +109,7 @@ struct Reader {
   int mode = 0;
   long long mode_count = 0;
   std::vector<CellArray> cell_arrays;
+  bool binary = false;  ///< BINARY file: vertex_lines and cell_lines hold byte offsets
 
   explicit Reader(const std::string& path) : s(path) {}
 
@@ -138,8 +126,39 @@ struct Reader {
     return n;
   }
 
-  /// Reads n numbers of a data array, keeping them in *keep if given.
-  void Values(long long n, const char* what, std::vector<double>* keep) {
+  /// "<file>:<line>" (ASCII) or "<file>: byte offset <n>" (binary) for a recorded location.
+  std::string Where(long long at) const {
+    return binary ? s.path() + ": byte offset " + std::to_string(at)
+                  : detail::At(s.path(), static_cast<int>(at));
+  }
+
+  /// Binary data (big-endian) of n values of VTK type `type`, starting on the line after the
+  /// keyword line; at[i] receives each value's byte offset when given.
+  std::vector<double> BinaryValues(long long n, std::string_view type, const char* what,
+                                   std::vector<int>* at = nullptr) {
+    const detail::NumType t = detail::NumTypeOf(type);
+    if (t == detail::NumType::None)
+      s.FailHere("data type " + detail::Quote(type),
+                 "a VTK data type (float, double, int, unsigned_char, vtktypeint64, ...)");
+    s.NextLine();
+    detail::ByteReader r(s.path(), s.Begin(), s.Ptr(), s.End(), /*little_endian=*/false);
+    std::vector<double> v;
+    v.reserve(static_cast<std::size_t>(detail::SafeReserve(n, s.size())));
+    for (long long i = 0; i < n; ++i) {
+      if (at) at->push_back(static_cast<int>(std::min<long long>(r.Offset(), INT_MAX)));
+      v.push_back(r.Number(t, what));
+    }
+    s.JumpTo(r.Ptr());
+    return v;
+  }
+
+  /// Reads n numbers of a data array of VTK type `type`, keeping them in *keep if given.
+  void Values(long long n, std::string_view type, const char* what, std::vector<double>* keep) {
+    if (binary) {
+      std::vector<double> v = BinaryValues(n, type, what);
+      if (keep) *keep = std::move(v);
+      return;
+    }
     if (keep) keep->reserve(static_cast<std::size_t>(detail::SafeReserve(n, s.size())));
     for (long long i = 0; i < n; ++i) {
       const double v = s.StreamDouble(what);
@@ -161,8 +180,18 @@ struct Reader {
 
   void Points() {
     num_points = Count("the number of points");
-    RequireWord("the point data type (float or double)");
+    const std::string type(RequireWord("the point data type (float or double)"));
     s.ExpectEol("'POINTS <n> <type>'");
+    if (binary) {
+      std::vector<int> at;
+      const std::vector<double> v = BinaryValues(3 * num_points, type, "a point coordinate", &at);
+      mesh.vertices.resize(num_points, 3);
+      for (long long j = 0; j < num_points; ++j) {
+        for (int d = 0; d < 3; ++d) mesh.vertices(j, d) = v[static_cast<std::size_t>(3 * j + d)];
+        vertex_lines.push_back(at[static_cast<std::size_t>(3 * j)]);
+      }
+      return;
+    }
     const long long cap = detail::SafeReserve(num_points, s.size());
     mesh.vertices.resize(cap, 3);
     vertex_lines.reserve(static_cast<std::size_t>(cap));
@@ -198,6 +227,11 @@ struct Reader {
     s.ExpectEol("'CELLS <n> <size>' or (VTK 5.1) 'CELLS <#offsets> <#connectivity>'");
     const Scanner::Pos here = s.Tell();
     const std::string_view w = s.StreamWord();
+    if (binary) {
+      if (!IEquals(w, "OFFSETS")) s.Seek(here);
+      BinaryCells(a, b, IEquals(w, "OFFSETS"));
+      return;
+    }
     if (IEquals(w, "OFFSETS")) {
       // VTK 5.1: OFFSETS <type> (a values) then CONNECTIVITY <type> (b values).
       RequireWord("the OFFSETS data type");
@@ -270,6 +304,67 @@ struct Reader {
                  std::to_string(b) + " as declared on line " + std::to_string(cells_line));
   }
 
+  /// BINARY cells: classic (a cells in b int32 numbers 'k i1 .. ik') or, when `v51`, OFFSETS
+  /// (a values) and CONNECTIVITY (b values) of the types their lines name.
+  void BinaryCells(long long a, long long b, bool v51) {
+    std::vector<int> at;
+    if (v51) {
+      const std::string otype(RequireWord("the OFFSETS data type"));
+      s.ExpectEol("'OFFSETS <type>'");
+      const std::vector<double> o = BinaryValues(a, otype, "an offset", &at);
+      num_cells = a > 0 ? a - 1 : 0;
+      for (long long i = 0; i < a; ++i) {
+        const double v = o[static_cast<std::size_t>(i)];
+        const long long prev = offsets.empty() ? 0 : offsets.back();
+        if ((i == 0 && v != 0) || v < static_cast<double>(prev) || v > static_cast<double>(b))
+          detail::Fail(Where(at[static_cast<std::size_t>(i)]), "offset " + std::to_string(v),
+                       "non-decreasing offsets from 0 to " + std::to_string(b));
+        offsets.push_back(static_cast<long long>(v));
+      }
+      if (a == 0) offsets.push_back(0);
+      if (offsets.back() != b)
+        s.FailHere("last offset " + std::to_string(offsets.back()),
+                   std::to_string(b) + " (the connectivity size)");
+      const std::string_view c = s.StreamWord();
+      if (!IEquals(c, "CONNECTIVITY")) s.FailHere("found " + detail::Quote(c), "CONNECTIVITY");
+      const std::string ctype(RequireWord("the CONNECTIVITY data type"));
+      s.ExpectEol("'CONNECTIVITY <type>'");
+      at.clear();
+      for (double v : BinaryValues(b, ctype, "a point index", &at))
+        conn.push_back(BinaryPoint(v, at[conn.size()]));
+      for (long long q = 0; q < num_cells; ++q)
+        cell_lines.push_back(offsets[q] < b ? at[static_cast<std::size_t>(offsets[q])] : 0);
+      return;
+    }
+    const std::vector<double> v = BinaryValues(b, "int", "a CELLS entry", &at);
+    num_cells = a;
+    offsets.push_back(0);
+    std::size_t pos = 0;
+    for (long long q = 0; q < a; ++q) {
+      const long long k = pos < v.size() ? static_cast<long long>(v[pos]) : -1;
+      if (k < 0 || static_cast<long long>(pos) + 1 + k > b)
+        detail::Fail(pos < at.size() ? Where(at[pos]) : s.Here(),
+                     "cell " + std::to_string(q) + " with " + std::to_string(k) + " points",
+                     "cells using " + std::to_string(b) + " numbers in all (CELLS line " +
+                         std::to_string(cells_line) + ")");
+      cell_lines.push_back(at[pos]);
+      for (long long i = 1; i <= k; ++i) conn.push_back(BinaryPoint(v[pos + i], at[pos + i]));
+      pos += 1 + k;
+      offsets.push_back(static_cast<long long>(conn.size()));
+    }
+    if (static_cast<long long>(pos) != b)
+      s.FailHere("cells use " + std::to_string(pos) + " numbers",
+                 std::to_string(b) + " as declared on line " + std::to_string(cells_line));
+  }
+
+  int BinaryPoint(double v, int at) const {
+    if (!(v >= 0 && v < static_cast<double>(num_points)))
+      detail::Fail(Where(at),
+                   "point index " + std::to_string(static_cast<long long>(v)) + " is out of range",
+                   "a point index in [0, " + std::to_string(num_points) + ")");
+    return static_cast<int>(v);
+  }
+
   void CellTypes() {
     if (num_cells < 0) s.FailHere("CELL_TYPES before CELLS", "CELLS first");
     const long long n = Count("the number of cell types");
@@ -278,26 +373,33 @@ struct Reader {
       s.FailHere("CELL_TYPES count " + std::to_string(n),
                  std::to_string(num_cells) + " (the number of cells)");
     cell_types.reserve(static_cast<std::size_t>(n));
+    std::vector<int> at;
+    const std::vector<double> bt =
+        binary ? BinaryValues(n, "int", "a cell type", &at) : std::vector<double>();
     for (long long c = 0; c < n; ++c) {
-      if (!s.SkipWs())
+      if (!binary && !s.SkipWs())
         s.FailHere(
             "file ends after " + std::to_string(c) + " of " + std::to_string(n) + " cell types",
             std::to_string(n) + " cell types");
-      const long long t = s.StreamInteger("a cell type");
-      if (t == 10 || t == 13) {
+      const long long where = binary ? at[static_cast<std::size_t>(c)] : s.line();
+      const long long t = binary ? static_cast<long long>(bt[static_cast<std::size_t>(c)])
+                                 : s.StreamInteger("a cell type");
+      if (KeptPoints(t) > 0) {
         const long long k = offsets[c + 1] - offsets[c];
-        const long long want = t == 10 ? 4 : 6;
+        const long long want = KeptPoints(t);
         if (k != want)
-          detail::Fail(detail::At(s.path(), cell_lines[c]),
+          detail::Fail(Where(cell_lines[c]),
                        "cell " + std::to_string(c) + " (" + VtkCellName(t) + ") has " +
                            std::to_string(k) + " points",
                        std::to_string(want) + " points for a " + VtkCellName(t));
       } else if (!IsSkippedCellType(t)) {
         const char* name = VtkCellName(t);
-        s.FailHere(
-            (name ? "unsupported" : "unknown") + std::string(" cell type ") + std::to_string(t) +
-                (name ? std::string(" (") + name + ")" : std::string()),
-            "10 (tetra) or 13 (wedge), or a lower-dimensional cell type to skip (1, 3, 5, 9, ...)");
+        detail::Fail(Where(where),
+                     (name ? "unsupported" : "unknown") + std::string(" cell type ") +
+                         std::to_string(t) +
+                         (name ? std::string(" (") + name + ")" : std::string()),
+                     "10 (tetra), 13 (wedge), 24 (quadratic tetra) or 26 (quadratic wedge), or a "
+                     "lower-dimensional cell type to skip (1, 3, 5, 9, ...)");
       }
       cell_types.push_back(static_cast<unsigned char>(t));
     }
@@ -325,10 +427,10 @@ struct Reader {
     }
     std::vector<double>* keep = nullptr;
     if (mode == 2 && ncomp == 1) {
-      cell_arrays.push_back({name, line, IsIntegerType(type), {}});
+      cell_arrays.push_back({name, line, detail::IsIntegerType(type), {}});
       keep = &cell_arrays.back().values;
     }
-    Values(mode_count * ncomp, "a data value", keep);
+    Values(mode_count * ncomp, type, "a data value", keep);
   }
 
   /// FIELD name n, then n arrays 'name ncomp ntuples type' + values.
@@ -361,10 +463,10 @@ struct Reader {
         if (ntup != mode_count)
           s.FailHere("field array with " + std::to_string(ntup) + " tuples",
                      std::to_string(mode_count) + " (CELL_DATA count)");
-        cell_arrays.push_back({name, line, IsIntegerType(type), {}});
+        cell_arrays.push_back({name, line, detail::IsIntegerType(type), {}});
         keep = &cell_arrays.back().values;
       }
-      Values(ncomp * ntup, "a field value", keep);
+      Values(ncomp * ntup, type, "a field value", keep);
     }
   }
 
@@ -379,11 +481,10 @@ struct Reader {
     if (!s.NextLine()) s.FailHere("file ends after the title line", "ASCII");
     if (!s.SkipBlankLines()) s.FailHere("file ends after the title line", "ASCII");
     const std::string_view fmt = s.Word();
-    if (IEquals(fmt, "BINARY"))
-      s.FailHere("binary legacy VTK file",
-                 "an ASCII legacy VTK file (write it with ASCII encoding)");
-    if (!IEquals(fmt, "ASCII")) s.FailHere("found " + detail::Quote(fmt), "ASCII");
-    s.ExpectEol("ASCII");
+    binary = IEquals(fmt, "BINARY");
+    if (!binary && !IEquals(fmt, "ASCII"))
+      s.FailHere("found " + detail::Quote(fmt), "ASCII or BINARY");
+    s.ExpectEol("ASCII or BINARY");
     s.NextLine();
     if (!s.SkipBlankLines()) s.FailHere("file ends before DATASET", "DATASET UNSTRUCTURED_GRID");
     if (!IEquals(s.Word(), "DATASET"))
@@ -433,23 +534,24 @@ struct Reader {
                  IEquals(key, "TENSORS6")) {
         RequireData(key.c_str());
         RequireWord("the array name");
-        RequireWord("the data type");
+        const std::string type(RequireWord("the data type"));
         s.ExpectEol("'<KEYWORD> <name> <type>'");
         const long long per = IEquals(key, "TENSORS") ? 9 : IEquals(key, "TENSORS6") ? 6 : 3;
-        Values(mode_count * per, "a data value", nullptr);
+        Values(mode_count * per, type, "a data value", nullptr);
       } else if (IEquals(key, "TEXTURE_COORDINATES") || IEquals(key, "COLOR_SCALARS")) {
         RequireData(key.c_str());
         RequireWord("the array name");
         const long long dim = Count("the number of components");
-        if (IEquals(key, "TEXTURE_COORDINATES")) RequireWord("the data type");
+        std::string type = "unsigned_char";  // binary COLOR_SCALARS are bytes
+        if (IEquals(key, "TEXTURE_COORDINATES")) type = RequireWord("the data type");
         s.ExpectEol("'<KEYWORD> <name> <components> [<type>]'");
-        Values(mode_count * dim, "a data value", nullptr);
+        Values(mode_count * dim, type, "a data value", nullptr);
       } else if (IEquals(key, "LOOKUP_TABLE")) {
         RequireData("LOOKUP_TABLE");
         RequireWord("the table name");
         const long long n = Count("the table size");
         s.ExpectEol("'LOOKUP_TABLE <name> <size>'");
-        Values(4 * n, "a table value", nullptr);
+        Values(4 * n, "unsigned_char", "a table value", nullptr);
       } else {
         s.FailHere("unknown keyword " + detail::Quote(key),
                    "POINTS, CELLS, CELL_TYPES, CELL_DATA, POINT_DATA, SCALARS, FIELD or another "
@@ -460,29 +562,6 @@ struct Reader {
     if (num_cells < 0) s.FailHere("no CELLS section", "CELLS <n> <size>");
     if (!have_types) s.FailHere("no CELL_TYPES section", "CELL_TYPES <n>");
   }
-
-  /// Region values per cell from the chosen array (nullptr: all 0).
-  const CellArray* ChooseRegionArray(const std::string& tag_array) const {
-    if (!tag_array.empty()) {
-      for (const auto& a : cell_arrays)
-        if (a.name == tag_array) return &a;
-      std::string names;
-      for (const auto& a : cell_arrays) names += (names.empty() ? "" : ", ") + a.name;
-      detail::Fail(s.path(),
-                   "no single-component cell data array named " + detail::Quote(tag_array),
-                   names.empty() ? std::string("a CELL_DATA array of that name (the file has none)")
-                                 : "one of: " + names);
-    }
-    for (const auto& a : cell_arrays)
-      if (a.integer_type) return &a;
-    for (const auto& a : cell_arrays) {
-      if (!NameSuggestsTag(a.name)) continue;
-      bool integral = true;
-      for (double v : a.values) integral = integral && v == std::round(v) && std::abs(v) <= INT_MAX;
-      if (integral) return &a;
-    }
-    return nullptr;
-  }
 };
 
 }  // namespace
@@ -490,35 +569,14 @@ struct Reader {
 Mesh ReadVtk(const std::string& path, const std::string& tag_array, MeshReport* report) {
   Reader r(path);
   r.Read();
-  const CellArray* tags = r.ChooseRegionArray(tag_array);
-  if (tags && static_cast<long long>(tags->values.size()) != r.num_cells)
-    detail::Fail(detail::At(path, tags->line),
-                 "array " + detail::Quote(tags->name) + " has " +
-                     std::to_string(tags->values.size()) + " values",
-                 std::to_string(r.num_cells) + " (one per cell)");
-  std::vector<int> element_lines;
-  r.mesh.elements.reserve(static_cast<std::size_t>(r.num_cells));
-  element_lines.reserve(static_cast<std::size_t>(r.num_cells));
-  for (long long c = 0; c < r.num_cells; ++c) {
-    const int t = r.cell_types[c];
-    if (t != 10 && t != 13) continue;
-    Element e;
-    e.type = t == 10 ? ElementType::Tet : ElementType::Prism;
-    for (int a = 0; a < e.k(); ++a) e.v[a] = r.conn[static_cast<std::size_t>(r.offsets[c] + a)];
-    if (t == 13) detail::VtkWedgeSwap(e.v);
-    if (tags) {
-      const double v = tags->values[static_cast<std::size_t>(c)];
-      if (!(v == std::round(v) && std::abs(v) <= INT_MAX))
-        detail::Fail(detail::At(path, tags->line),
-                     "array " + detail::Quote(tags->name) + " holds the non-integer region " +
-                         std::to_string(v) + " for cell " + std::to_string(c),
-                     "integer region tags");
-      e.region = static_cast<int>(v);
-    }
-    r.mesh.elements.push_back(e);
-    element_lines.push_back(r.cell_lines[c]);
-  }
-  MeshReport rep = ValidateAndOrient(r.mesh, path, element_lines, r.vertex_lines);
+  const CellArray* tags = detail::ChooseRegionArray(path, r.cell_arrays, tag_array);
+  MeshOrigin origin;
+  const int higher_order = detail::AddVtkElements(path, r.cell_types, r.offsets, r.conn, tags,
+                                                  r.cell_lines, &r.mesh, &origin.element_at);
+  origin.vertex_at.assign(r.vertex_lines.begin(), r.vertex_lines.end());
+  origin.bytes = r.binary;
+  MeshReport rep = ValidateAndOrient(r.mesh, path, origin);
+  detail::NoteCornersOnly(path, higher_order, &rep);
   detail::Deliver(rep, report);
   return std::move(r.mesh);
 }

@@ -58,6 +58,11 @@ constexpr LocalFace kPrismFaces[5] = {
 
 }  // namespace
 
+void PrintMeshReport(const MeshReport& report, std::ostream& os) {
+  for (const auto& n : report.notes) os << "softkin: note: " << n << '\n';
+  for (const auto& w : report.warnings) os << "softkin: warning: " << w << '\n';
+}
+
 Mesh ReadMesh(const std::string& path, MeshReport* report) {
   const std::string ext = detail::LowerExtension(path);
   if (ext == ".tet") return ReadTet(path, "", report);
@@ -65,8 +70,10 @@ Mesh ReadMesh(const std::string& path, MeshReport* report) {
     return ReadTetGen(path.substr(0, path.size() - ext.size()), report);
   if (ext == ".msh") return ReadGmsh(path, report);
   if (ext == ".vtk") return ReadVtk(path, "", report);
+  if (ext == ".vtu") return ReadVtu(path, "", report);
   detail::Fail(path, "unknown mesh file extension " + detail::Quote(ext.empty() ? "(none)" : ext),
-               ".tet, .node/.ele (TetGen), .msh (Gmsh 2.2/4.1) or .vtk (legacy ASCII)");
+               ".tet, .node/.ele (TetGen), .msh (Gmsh 2.2/4.1), .vtk (legacy VTK) or .vtu (VTK "
+               "XML)");
 }
 
 std::vector<double> ElementStrain(const Mesh& mesh, const Eigen::Ref<const Eigen::MatrixX3d>& X,

@@ -468,8 +468,8 @@ TEST_F(MeshIoErrors, GmshOtherProblems) {
   const std::string head = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n";
   const std::string nodes = "$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$EndNodes\n";
   // binary
-  const std::string b = WriteText("bin.msh", "$MeshFormat\n4.1 1 8\n");
-  ExpectErrorAt(ErrorOf([&] { ReadGmsh(b); }), b, 2, "binary .msh file");
+  const std::string b = WriteText("bin.msh", "$MeshFormat\n2.2 1 8\n");
+  ExpectErrorAt(ErrorOf([&] { ReadGmsh(b); }), b, 2, "binary .msh 2.2 file");
   // version 4.0
   const std::string v = WriteText("v40.msh", "$MeshFormat\n4 0 8\n$EndMeshFormat\n");
   ExpectErrorAt(ErrorOf([&] { ReadGmsh(v); }), v, 2, "unsupported .msh version 4");
@@ -530,8 +530,8 @@ TEST_F(MeshIoErrors, VtkUnknownCellType) {
 TEST_F(MeshIoErrors, VtkOtherProblems) {
   const std::string head = "# vtk DataFile Version 3.0\nt\nASCII\nDATASET UNSTRUCTURED_GRID\n";
   const std::string pts = "POINTS 4 double\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n";
-  const std::string b = WriteText("bin.vtk", "# vtk DataFile Version 3.0\nt\nBINARY\n");
-  ExpectErrorAt(ErrorOf([&] { ReadVtk(b); }), b, 3, "binary legacy VTK");
+  const std::string b = WriteText("bin.vtk", "# vtk DataFile Version 3.0\nt\nUTF8\n");
+  ExpectErrorAt(ErrorOf([&] { ReadVtk(b); }), b, 3, "ASCII or BINARY");
   const std::string t = WriteText("trunc.vtk", head + "POINTS 4 double\n0 0 0\n1 0 0\n");
   ExpectErrorAt(ErrorOf([&] { ReadVtk(t); }), t, 8, "file ends after 2 of 4 points");
   const std::string r =
@@ -618,7 +618,7 @@ TEST_F(MeshIoGmsh, Reads41EntitiesBlocksAndNonContiguousTags) {
                                   "$EndElements\n");
   MeshReport r;
   const Mesh m = ReadGmsh(p, &r);
-  ASSERT_EQ(m.num_vertices(), 6);
+  ASSERT_EQ(m.num_vertices(), 5);
   ASSERT_EQ(m.num_elements(), 2);
   EXPECT_EQ(m.elements[0].region, 42);
   EXPECT_EQ(m.elements[1].region, 0);
@@ -628,9 +628,9 @@ TEST_F(MeshIoGmsh, Reads41EntitiesBlocksAndNonContiguousTags) {
   EXPECT_EQ((std::array<int, 4>{m.elements[1].v[0], m.elements[1].v[1], m.elements[1].v[2],
                                 m.elements[1].v[3]}),
             (std::array<int, 4>{0, 2, 1, 4}));
-  EXPECT_EQ(m.vertices(5, 0), 0.5);
   EXPECT_EQ(r.flipped, 0);
-  EXPECT_EQ(r.unused_vertices, 1);  // the parametric surface node
+  EXPECT_EQ(r.unused_vertices, 1);  // the parametric surface node, dropped
+  EXPECT_EQ(r.source_vertex, (std::vector<int>{0, 1, 2, 3, 4}));
 }
 
 TEST_F(MeshIoTetGen, ZeroBasedWithAttributesMarkersAndComments) {
@@ -657,10 +657,10 @@ TEST_F(MeshIoTetGen, ZeroBasedWithAttributesMarkersAndComments) {
 
 TEST_F(MeshIoTetGen, Errors) {
   WriteText("q.node", "4 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n");
-  WriteText("q.ele", "1 10 0\n1 1 2 3 4 5 6 7 8 9 10\n");
+  WriteText("q.ele", "1 5 0\n1 1 2 3 4 5\n");
   std::string msg = ErrorOf([&] { ReadTetGen(Path("q")); });
-  ExpectErrorAt(msg, Path("q.ele"), 1, "quadratic tetrahedra");
-  EXPECT_NE(msg.find("only linear"), std::string::npos) << msg;
+  ExpectErrorAt(msg, Path("q.ele"), 1, "5 nodes per tetrahedron");
+  EXPECT_NE(msg.find("10 (tetgen -o2"), std::string::npos) << msg;
   WriteText("q.ele", "1 4 0\n1 1 2 3 5\n");
   ExpectErrorAt(ErrorOf([&] { ReadTetGen(Path("q")); }), Path("q.ele"), 2,
                 "node index 5 is out of range");
@@ -716,13 +716,15 @@ TEST_F(MeshIoReport, UnusedVertexAndDisconnectedTets) {
                 "4 0 1 2 3\n4 4 6 5 7\n");  // the second tet is negatively oriented
   MeshReport r;
   const Mesh m = ReadTet(p, "", &r);
-  EXPECT_EQ(m.num_vertices(), 9);
+  EXPECT_EQ(m.num_vertices(), 8);  // the unused vertex is dropped
   EXPECT_EQ(r.unused_vertices, 1);
   EXPECT_EQ(r.components, 2);
-  ASSERT_EQ(r.warnings.size(), 2u);
-  EXPECT_NE(r.warnings[0].find("1 of 9 vertices are not used"), std::string::npos) << r.warnings[0];
-  EXPECT_NE(r.warnings[0].find("vertex 8"), std::string::npos) << r.warnings[0];
-  EXPECT_NE(r.warnings[1].find("2 disconnected parts"), std::string::npos) << r.warnings[1];
+  ASSERT_EQ(r.notes.size(), 2u);
+  EXPECT_NE(r.notes[0].find("dropped 1 of 9 vertices that no element uses"), std::string::npos)
+      << r.notes[0];
+  EXPECT_NE(r.notes[0].find("vertex 8"), std::string::npos) << r.notes[0];
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_NE(r.warnings[0].find("2 disconnected parts"), std::string::npos) << r.warnings[0];
   int count = 0;
   const std::vector<int> comp = ElementComponents(m, &count);
   EXPECT_EQ(count, 2);
@@ -732,7 +734,8 @@ TEST_F(MeshIoReport, UnusedVertexAndDisconnectedTets) {
   ::testing::internal::CaptureStderr();
   ReadTet(p);
   const std::string err = ::testing::internal::GetCapturedStderr();
-  EXPECT_NE(err.find("softkin: warning: " + p + ": 1 of 9 vertices"), std::string::npos) << err;
+  EXPECT_NE(err.find("softkin: note: " + p + ": dropped 1 of 9 vertices"), std::string::npos)
+      << err;
   EXPECT_NE(err.find("softkin: warning: " + p + ": the mesh has 2 disconnected parts"),
             std::string::npos)
       << err;

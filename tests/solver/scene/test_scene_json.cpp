@@ -129,6 +129,34 @@ TEST(SceneJsonTiny, RegionSelectorAndZeroBasedFile) {
   EXPECT_EQ(LoadFrom(dir.path(), j).fixed, (std::vector<int>{0, 1, 2, 3}));
 }
 
+// A mesh file with an unused vertex: the reader drops it, and the indices written in the scene
+// (index files, markers[].vertex) still mean positions in the file.
+TEST(SceneJsonTiny, IndicesAreFilePositionsWhenUnusedVerticesAreDropped) {
+  TempDir dir;
+  WriteTinyMesh(dir.path());
+  // The tiny mesh with an unused vertex inserted at file position 2.
+  WriteFile(dir.path() / "tiny.tet",
+            "7 vertices\n3 tets\n0 0 0\n1 0 0\n9 9 9\n0 0 1\n0 1 0\n1 1 0\n0 1 1\n"
+            "4 0 3 1 4\n4 1 4 3 5\n4 3 5 4 6\n");
+  WriteFile(dir.path() / "fixed.txt", "3 7\n");  // 1-based: the unused vertex and the last one
+  json j = TinyScene();
+  j["fixed"] = json::parse(R"([{"file": "fixed.txt", "base": 1}])");
+  j["markers"] = json::parse(R"([{"name": "a", "vertex": 4}])");
+  const Scene s = LoadFrom(dir.path(), j);
+  ASSERT_EQ(s.mesh.num_vertices(), 6);
+  EXPECT_EQ(s.mesh_source_vertex, (std::vector<int>{0, 1, 3, 4, 5, 6}));
+  EXPECT_EQ(s.fixed, std::vector<int>{5});                // file vertex 6
+  EXPECT_EQ(s.markers[0].vertices, std::vector<int>{3});  // file vertex 4
+  EXPECT_DOUBLE_EQ(s.mesh.vertices(3, 1), 2.0);           // (0, 1, 0) scaled by 2
+  j["markers"] = json::parse(R"([{"name": "a", "vertex": 2}])");
+  ExpectError([&] { LoadFrom(dir.path(), j); },
+              {"markers[0].vertex: vertex 2 of the mesh file is used by no element"});
+  WriteFile(dir.path() / "fixed.txt", "3\n");
+  j["markers"] = json::parse(R"([{"name": "a", "vertex": 4}])");
+  ExpectError([&] { LoadFrom(dir.path(), j); },
+              {"fixed[0].file", "lists no vertex index of a vertex used by an element"});
+}
+
 TEST(SceneJsonTiny, CableAndDeaRolesAndDefaults) {
   TempDir dir;
   WriteTinyMesh(dir.path());
@@ -223,9 +251,8 @@ TEST(SceneJsonTiny, OtherMeshFormats) {
       [&] { LoadFrom(dir.path(), j); },
       {"scene.json: regions[0].tag: no element of the mesh has region tag 0 (the mesh's tags: 7)"});
   j["mesh"] = {{"file", "tiny_tg.node"}, {"tag_array", "part"}};
-  ExpectError(
-      [&] { LoadFrom(dir.path(), j); },
-      {"scene.json: mesh.tag_array: only used by the vtk format (the mesh is read as tetgen)"});
+  ExpectError([&] { LoadFrom(dir.path(), j); }, {"scene.json: mesh.tag_array: only used by the vtk "
+                                                 "and vtu formats (the mesh is read as tetgen)"});
   j["mesh"] = {{"file", "missing_tg.node"}};
   ExpectError([&] { LoadFrom(dir.path(), j); }, {"scene.json: mesh.file: file not found: '" +
                                                  (dir.path() / "missing_tg.node").string()});
@@ -482,7 +509,7 @@ TEST(SceneJsonErrors, MeshFormatKeys) {
   j["mesh"]["format"] = "stl";
   ExpectError(
       [&] { LoadFrom(dir.path(), j); },
-      {"scene.json: mesh.format: expected one of: auto, tet, tetgen, gmsh, vtk, got \"stl\""});
+      {"scene.json: mesh.format: expected one of: auto, tet, tetgen, gmsh, vtk, vtu, got \"stl\""});
 }
 
 TEST(SceneJsonErrors, IndexFileBadLineAndOutOfRange) {
