@@ -1,11 +1,13 @@
 /// \file scene_json_mesh.cpp
 /// Scene JSON: the mesh section (format, file, labels, tag array, scale) and the mesh reader it
 /// picks (mesh_io.hpp).
+#include "softkin/solver/common/text_format.hpp"
 #include "softkin/solver/mesh/io/mesh_io.hpp"
 #include "softkin/solver/scene/scene_parser.hpp"
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <string>
@@ -97,7 +99,17 @@ void SceneParser::ReadMeshSection(const json& m, Scene* scene) {
   for (int j = 0; j < scene->mesh.num_vertices(); ++j)
     file_to_mesh_[static_cast<std::size_t>(report.source_vertex[j])] = j;
   const double scale = Get(m, "mesh", "scale").get<double>();
-  if (scale != 1.0) scene->mesh.vertices *= scale;
+  if (scale != 1.0) {
+    scene->mesh.vertices *= scale;
+    // Volumes (size^3) and the energy's terms (size^5) must stay within double precision: a
+    // scale that puts the mesh's size outside [1e-30, 1e30] mm would overflow or underflow them.
+    const double size = scene->mesh.num_vertices() > 0 ? scene->mesh.size() : 1.0;
+    if (!scene->mesh.vertices.allFinite() || !(size >= 1e-30 && size <= 1e30))
+      Fail("mesh.scale: " + FormatNumber(scale) + " makes the mesh " +
+           (std::isfinite(size) ? FormatNumber(size) + " mm" : std::string("infinitely")) +
+           " across; expected a scale that keeps its size within [1e-30, 1e30] mm (volumes and "
+           "energies must stay within double precision)");
+  }
 }
 
 }  // namespace scene_json_detail

@@ -294,6 +294,13 @@ TEST(SceneJsonErrors, WrongTypeAndRange) {
   j = TinyScene();
   j["mesh"]["scale"] = 0;
   ExpectSceneError(j, {"mesh.scale: expected a number > 0, got 0"});
+  // A valid number whose product with the coordinates overflows (or underflows the size).
+  j = TinyScene();
+  j["mesh"]["scale"] = 1e308;
+  ExpectSceneError(j, {"mesh.scale: 1e+308 makes the mesh infinitely across", "[1e-30, 1e30]"});
+  j = TinyScene();
+  j["mesh"]["scale"] = 1e-200;
+  ExpectSceneError(j, {"mesh.scale: 1e-200 makes the mesh", "expected a scale"});
   j = TinyScene();
   j["regions"] = json::object();
   ExpectSceneError(j, {"regions: expected an array of objects"});
