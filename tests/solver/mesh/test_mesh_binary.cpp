@@ -15,45 +15,16 @@
 
 #include "softkin/solver/mesh/io/mesh_io.hpp"
 #include "softkin/solver/mesh/mesh.hpp"
+#include "tests/solver/mesh/mesh_io_test_util.hpp"
 
 namespace softkin {
 namespace {
 
 namespace fs = std::filesystem;
 
-class MeshBinary : public ::testing::Test {
- protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("softkin_mesh_binary_" + std::string(info->name()) + "_" +
-            std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  std::string Write(const std::string& name, const std::string& bytes) const {
-    const std::string p = (dir_ / name).string();
-    std::ofstream(p, std::ios::binary) << bytes;
-    return p;
-  }
-  fs::path dir_;
-};
-
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::runtime_error& e) {
-    return e.what();
-  }
-  return "<no exception>";
-}
-
-void ExpectHas(const std::string& msg, const std::string& text) {
-  EXPECT_NE(msg.find(text), std::string::npos) << "expected '" << text << "' in: " << msg;
-}
+using mesh_test::ErrorOf;
+using mesh_test::ExpectHas;
+using MeshBinary = mesh_test::MeshIoTest;
 
 /// Builds a byte string of numbers in a chosen byte order.
 struct Bytes {
@@ -125,26 +96,26 @@ std::string Gmsh41Binary(bool big) {
 TEST_F(MeshBinary, Gmsh41InBothByteOrders) {
   for (bool big : {false, true}) {
     MeshReport r;
-    const Mesh m = ReadGmsh(Write(big ? "be.msh" : "le.msh", Gmsh41Binary(big)), &r);
+    const Mesh m = ReadGmsh(WriteText(big ? "be.msh" : "le.msh", Gmsh41Binary(big)), &r);
     ExpectTwoTets(m, 7, 7);
     EXPECT_EQ(r.unused_vertices, 0);
     EXPECT_EQ(r.flipped, 0);
   }
   // ReadMesh dispatches it like an ASCII one.
-  ExpectTwoTets(ReadMesh((dir_ / "le.msh").string()), 7, 7);
+  ExpectTwoTets(ReadMesh(Path("le.msh")), 7, 7);
 }
 
 TEST_F(MeshBinary, Gmsh41TruncatedOrBadNamesTheByteOffset) {
   const std::string whole = Gmsh41Binary(false);
   const std::size_t nodes = whole.find("$Nodes\n") + 7;
-  const std::string p = Write("cut.msh", whole.substr(0, nodes + 100));
+  const std::string p = WriteText("cut.msh", whole.substr(0, nodes + 100));
   const std::string msg = ErrorOf([&] { ReadGmsh(p); });
   ExpectHas(msg, p + ": byte offset ");
   ExpectHas(msg, "data ends inside");
   ExpectHas(msg, "; expected ");
   std::string bad = whole;
   bad[bad.find("4.1 1 8\n") + 8] = 2;  // the endianness check int reads 2
-  const std::string q = Write("bad.msh", bad);
+  const std::string q = WriteText("bad.msh", bad);
   ExpectHas(ErrorOf([&] { ReadGmsh(q); }), q + ": byte offset 20: endianness check reads 2");
 }
 
@@ -177,20 +148,20 @@ std::string VtkBinary(bool v51) {
 
 TEST_F(MeshBinary, LegacyVtkClassicAnd51) {
   MeshReport r;
-  ExpectTwoTets(ReadVtk(Write("c.vtk", VtkBinary(false)), "", &r), 7, 8);
-  ExpectTwoTets(ReadMesh(Write("n.vtk", VtkBinary(true)), &r), 7, 8);
+  ExpectTwoTets(ReadVtk(WriteText("c.vtk", VtkBinary(false)), "", &r), 7, 8);
+  ExpectTwoTets(ReadMesh(WriteText("n.vtk", VtkBinary(true)), &r), 7, 8);
 }
 
 TEST_F(MeshBinary, LegacyVtkTruncatedNamesTheByteOffset) {
   const std::string whole = VtkBinary(false);
-  const std::string p = Write("cut.vtk", whole.substr(0, whole.find("POINTS 5 float\n") + 30));
+  const std::string p = WriteText("cut.vtk", whole.substr(0, whole.find("POINTS 5 float\n") + 30));
   const std::string msg = ErrorOf([&] { ReadVtk(p); });
   ExpectHas(msg, p + ": byte offset ");
   ExpectHas(msg, "data ends inside a point coordinate");
   std::string bad = whole;
   const std::size_t cells = bad.find("CELLS 3 13\n") + 11;
   bad[cells + 4 * 6 + 3] = 9;  // second cell's first index (big-endian int 1 -> 9)
-  const std::string q = Write("bad.vtk", bad);
+  const std::string q = WriteText("bad.vtk", bad);
   const std::string m2 = ErrorOf([&] { ReadVtk(q); });
   ExpectHas(m2, q + ": byte offset " + std::to_string(cells + 4 * 6) + ": point index 9");
 }
@@ -263,7 +234,7 @@ TEST_F(MeshBinary, VtuInlineBase64AndRawAppended) {
   std::vector<std::string> inline_arrays;
   for (const auto& d : le.data)
     inline_arrays.push_back(" format=\"binary\">\n" + Base64(d) + "\n</DataArray>");
-  const std::string a = Write(
+  const std::string a = WriteText(
       "b64.vtu", VtuXml("byte_order=\"LittleEndian\" header_type=\"UInt32\"", inline_arrays, ""));
   MeshReport r;
   ExpectTwoTets(ReadVtu(a, "", &r), 7, 8);
@@ -276,16 +247,16 @@ TEST_F(MeshBinary, VtuInlineBase64AndRawAppended) {
                               "\"/>");
     raw += d;
   }
-  const std::string b =
-      Write("raw.vtu", VtuXml("byte_order=\"BigEndian\" header_type=\"UInt64\"", appended_arrays,
-                              "<AppendedData encoding=\"raw\">\n_" + raw + "\n</AppendedData>\n"));
+  const std::string b = WriteText(
+      "raw.vtu", VtuXml("byte_order=\"BigEndian\" header_type=\"UInt64\"", appended_arrays,
+                        "<AppendedData encoding=\"raw\">\n_" + raw + "\n</AppendedData>\n"));
   ExpectTwoTets(ReadMesh(b, &r), 7, 8);
 }
 
 TEST_F(MeshBinary, VtuCompressedIsRefused) {
-  const std::string p = Write("z.vtu",
-                              "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" "
-                              "compressor=\"vtkZLibDataCompressor\">\n</VTKFile>\n");
+  const std::string p = WriteText("z.vtu",
+                                  "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" "
+                                  "compressor=\"vtkZLibDataCompressor\">\n</VTKFile>\n");
   const std::string msg = ErrorOf([&] { ReadVtu(p); });
   ExpectHas(msg, p + ":2:");
   ExpectHas(msg, "compressed data");
@@ -306,7 +277,7 @@ TEST_F(MeshBinary, WriteVtuOutputRoundTripsThroughReadMesh) {
   tet.region = 5;
   m.elements = {prism, tet};
   ValidateAndOrient(m, "mixed");
-  const std::string p = (dir_ / "out.vtu").string();
+  const std::string p = Path("out.vtu");
   WriteVtu(p, m, m.vertices);
   MeshReport r;
   const Mesh back = ReadMesh(p, &r);

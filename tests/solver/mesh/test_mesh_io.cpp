@@ -20,6 +20,7 @@
 
 #include "softkin/solver/mesh/mesh.hpp"
 #include "softkin/solver/mesh/io/mesh_io.hpp"
+#include "tests/solver/mesh/mesh_io_test_util.hpp"
 
 namespace softkin {
 namespace {
@@ -29,34 +30,8 @@ namespace fs = std::filesystem;
 // ---------------------------------------------------------------------------------------------
 // helpers
 
-/// Per-test temporary folder, removed afterwards.
-class MeshIoTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("softkin_mesh_io_" + std::string(info->test_suite_name()) + "_" + info->name() + "_" +
-            std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
-  std::string WriteText(const std::string& name, const std::string& text) const {
-    const std::string p = Path(name);
-    std::ofstream(p, std::ios::binary) << text;
-    return p;
-  }
-  static std::string ReadText(const std::string& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-  }
-  fs::path dir_;
-};
+using mesh_test::ErrorOf;
+using mesh_test::MeshIoTest;
 
 // Suite names for the groups of tests below (all share the temp-folder fixture).
 using MeshIoRoundTrip = MeshIoTest;
@@ -67,16 +42,6 @@ using MeshIoVtk = MeshIoTest;
 using MeshIoVtu = MeshIoTest;
 using MeshIoObj = MeshIoTest;
 using MeshIoReport = MeshIoTest;
-
-/// Message of the std::runtime_error thrown by f, or "<no exception>".
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::runtime_error& e) {
-    return e.what();
-  }
-  return "<no exception>";
-}
 
 /// The message names "<file>:<line>:" and contains `text`.
 void ExpectErrorAt(const std::string& msg, const std::string& file, int line,

@@ -16,45 +16,16 @@
 
 #include "softkin/solver/mesh/io/mesh_io.hpp"
 #include "softkin/solver/mesh/mesh.hpp"
+#include "tests/solver/mesh/mesh_io_test_util.hpp"
 
 namespace softkin {
 namespace {
 
 namespace fs = std::filesystem;
 
-class MeshTopology : public ::testing::Test {
- protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("softkin_mesh_topology_" + std::string(info->name()) + "_" +
-            std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  std::string Write(const std::string& name, const std::string& text) const {
-    const std::string p = (dir_ / name).string();
-    std::ofstream(p, std::ios::binary) << text;
-    return p;
-  }
-  fs::path dir_;
-};
-
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::runtime_error& e) {
-    return e.what();
-  }
-  return "<no exception>";
-}
-
-void ExpectHas(const std::string& msg, const std::string& text) {
-  EXPECT_NE(msg.find(text), std::string::npos) << "expected '" << text << "' in: " << msg;
-}
+using mesh_test::ErrorOf;
+using mesh_test::ExpectHas;
+using MeshTopology = mesh_test::MeshIoTest;
 
 bool AnyHas(const std::vector<std::string>& lines, const std::string& text) {
   for (const auto& l : lines)
@@ -104,10 +75,11 @@ std::string BlockTet(int pad_front, int pad_back, int shift, bool reverse = fals
 
 TEST_F(MeshTopology, UnusedVerticesAreDroppedWithANoteAndAMap) {
   // Node tag 3 (the third node) is used by no element, as Gmsh leaves geometry points.
-  const std::string p = Write("u.msh",
-                              "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
-                              "$Nodes\n5\n1 0 0 0\n2 1 0 0\n3 9 9 9\n4 0 1 0\n5 0 0 1\n$EndNodes\n"
-                              "$Elements\n1\n1 4 2 7 1 1 2 4 5\n$EndElements\n");
+  const std::string p =
+      WriteText("u.msh",
+                "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
+                "$Nodes\n5\n1 0 0 0\n2 1 0 0\n3 9 9 9\n4 0 1 0\n5 0 0 1\n$EndNodes\n"
+                "$Elements\n1\n1 4 2 7 1 1 2 4 5\n$EndElements\n");
   MeshReport r;
   const Mesh m = ReadGmsh(p, &r);
   ASSERT_EQ(m.num_vertices(), 4);
@@ -136,13 +108,13 @@ TEST(MeshTopologyValidate, UnusedNonFiniteVertexDoesNotFail) {
 // ---- 2. duplicate elements ----
 
 TEST_F(MeshTopology, DuplicateElementsFromOverlappingPhysicalGroupsAreRefused) {
-  const std::string p = Write("dup.msh",
-                              "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
-                              "$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$EndNodes\n"
-                              "$Elements\n2\n"
-                              "1 4 2 1 1 1 2 3 4\n"
-                              "2 4 2 2 1 2 1 3 4\n"
-                              "$EndElements\n");
+  const std::string p = WriteText("dup.msh",
+                                  "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
+                                  "$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$EndNodes\n"
+                                  "$Elements\n2\n"
+                                  "1 4 2 1 1 1 2 3 4\n"
+                                  "2 4 2 2 1 2 1 3 4\n"
+                                  "$EndElements\n");
   const std::string msg = ErrorOf([&] { ReadGmsh(p); });
   ExpectHas(msg, p + ":14:");
   ExpectHas(msg, "element 1 (tet, region 2) has the same vertices as element 0 (tet, region 1)");
@@ -167,7 +139,7 @@ TEST(MeshTopologyValidate, DuplicatePairsIgnoreVertexOrder) {
 
 TEST_F(MeshTopology, OneBasedTetUsingIndexNIsRefused) {
   const std::string p =
-      Write("one.tet", "4 vertices\n1 tets\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n4 1 2 3 4\n");
+      WriteText("one.tet", "4 vertices\n1 tets\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n4 1 2 3 4\n");
   const std::string msg = ErrorOf([&] { ReadTet(p); });
   ExpectHas(msg, p + ":7:");
   ExpectHas(msg, "looks 1-based");
@@ -177,12 +149,12 @@ TEST_F(MeshTopology, OneBasedTetUsingIndexNIsRefused) {
 TEST_F(MeshTopology, OneBasedTetWhoseLargestIndexExistsIsRefused) {
   // 1-based indices with a spare last vertex: every index is in range when read 0-based, but the
   // tets then connect the wrong vertices.
-  const std::string p = Write("shift.tet", BlockTet(0, 1, 1));
+  const std::string p = WriteText("shift.tet", BlockTet(0, 1, 1));
   const std::string msg = ErrorOf([&] { ReadTet(p); });
   ExpectHas(msg, "looks 1-based");
   // The same tets after an unused vertex 0 are a valid 0-based file: vertex 0 is dropped.
   MeshReport r;
-  const Mesh m = ReadTet(Write("pad.tet", BlockTet(1, 0, 1)), "", &r);
+  const Mesh m = ReadTet(WriteText("pad.tet", BlockTet(1, 0, 1)), "", &r);
   EXPECT_EQ(m.num_vertices(), 12);
   EXPECT_EQ(r.unused_vertices, 1);
   EXPECT_EQ(r.source_vertex.front(), 1);
@@ -194,10 +166,10 @@ TEST_F(MeshTopology, OneBasedTetWhoseLargestIndexExistsIsRefused) {
 TEST_F(MeshTopology, CoincidentVerticesWarnWithTheirFilePositions) {
   // Two tets that would share the face (1, 2, 3); the second uses copies 5, 6, 7 of those
   // vertices, so the mesh is cut along the face.
-  const std::string p = Write("crack.tet",
-                              "8 vertices\n2 tets\n"
-                              "0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n1 0 0\n0 1 0\n0 0 1\n"
-                              "4 0 1 2 3\n4 4 5 7 6\n");
+  const std::string p = WriteText("crack.tet",
+                                  "8 vertices\n2 tets\n"
+                                  "0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n1 0 0\n0 1 0\n0 0 1\n"
+                                  "4 0 1 2 3\n4 4 5 7 6\n");
   MeshReport r;
   ReadTet(p, "", &r);
   ASSERT_FALSE(r.warnings.empty());
@@ -208,10 +180,10 @@ TEST_F(MeshTopology, CoincidentVerticesWarnWithTheirFilePositions) {
 TEST_F(MeshTopology, FoldedNeighboursAreRefusedNamingBothElements) {
   // Tets (0,1,2,3) and (0,1,2,4) share face (0,1,2); vertex 4 lies on the same side as vertex 3,
   // so the second tet overlaps the first whichever way it is oriented.
-  const std::string p = Write("fold.tet",
-                              "5 vertices\n2 tets\n"
-                              "0 0 0\n1 0 0\n0 1 0\n0 0 1\n0.2 0.2 0.5\n"
-                              "4 0 1 2 3\n4 0 2 1 4\n");
+  const std::string p = WriteText("fold.tet",
+                                  "5 vertices\n2 tets\n"
+                                  "0 0 0\n1 0 0\n0 1 0\n0 0 1\n0.2 0.2 0.5\n"
+                                  "4 0 1 2 3\n4 0 2 1 4\n");
   const std::string msg = ErrorOf([&] { ReadTet(p); });
   ExpectHas(msg, p + ":9:");
   ExpectHas(msg, "element 1 (tet, region 0) and element 0 (tet, region 0) (line 8)");
@@ -221,7 +193,7 @@ TEST_F(MeshTopology, FoldedNeighboursAreRefusedNamingBothElements) {
 
 TEST_F(MeshTopology, AllReversedMeshIsFlippedWithANote) {
   MeshReport r;
-  const Mesh m = ReadTet(Write("rev.tet", BlockTet(0, 0, 0, /*reverse=*/true)), "", &r);
+  const Mesh m = ReadTet(WriteText("rev.tet", BlockTet(0, 0, 0, /*reverse=*/true)), "", &r);
   EXPECT_EQ(r.flipped, 12);
   EXPECT_TRUE(AnyHas(r.notes, "flipped 12 of 12"));
   EXPECT_TRUE(r.warnings.empty());
@@ -238,9 +210,9 @@ TEST_F(MeshTopology, GmshTet10IsReadByItsCorners) {
   for (int i = 0; i < 10; ++i)
     nodes << i + 1 << ' ' << P[i][0] << ' ' << P[i][1] << ' ' << P[i][2] << '\n';
   const std::string p =
-      Write("t10.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n10\n" + nodes.str() +
-                           "$EndNodes\n$Elements\n1\n"
-                           "1 11 2 3 1 1 2 3 4 5 6 7 8 9 10\n$EndElements\n");
+      WriteText("t10.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n10\n" + nodes.str() +
+                               "$EndNodes\n$Elements\n1\n"
+                               "1 11 2 3 1 1 2 3 4 5 6 7 8 9 10\n$EndElements\n");
   MeshReport r;
   const Mesh m = ReadGmsh(p, &r);
   ASSERT_EQ(m.num_vertices(), 4);
@@ -252,21 +224,22 @@ TEST_F(MeshTopology, GmshTet10IsReadByItsCorners) {
 }
 
 TEST_F(MeshTopology, TetGenO2AndVtkQuadraticTetAreReadByTheirCorners) {
-  Write("q.node",
-        "10 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 0.5 0 0\n6 0.5 0.5 0\n"
-        "7 0 0.5 0\n8 0 0 0.5\n9 0 0.5 0.5\n10 0.5 0 0.5\n");
-  Write("q.ele", "1 10 1\n1 1 2 3 4 5 6 7 8 9 10 4\n");
+  WriteText("q.node",
+            "10 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 0.5 0 0\n6 0.5 0.5 0\n"
+            "7 0 0.5 0\n8 0 0 0.5\n9 0 0.5 0.5\n10 0.5 0 0.5\n");
+  WriteText("q.ele", "1 10 1\n1 1 2 3 4 5 6 7 8 9 10 4\n");
   MeshReport r;
-  Mesh m = ReadTetGen((dir_ / "q").string(), &r);
+  Mesh m = ReadTetGen(Path("q"), &r);
   ASSERT_EQ(m.num_vertices(), 4);
   EXPECT_EQ(m.elements[0].region, 4);
   EXPECT_TRUE(AnyHas(r.notes, "higher-order elements by their corner nodes"));
 
-  const std::string v = Write("q.vtk",
-                              "# vtk DataFile Version 3.0\nq\nASCII\nDATASET UNSTRUCTURED_GRID\n"
-                              "POINTS 10 double\n0 0 0 1 0 0 0 1 0 0 0 1 0.5 0 0 0.5 0.5 0\n"
-                              "0 0.5 0 0 0 0.5 0 0.5 0.5 0.5 0 0.5\n"
-                              "CELLS 1 11\n10 0 1 2 3 4 5 6 7 8 9\nCELL_TYPES 1\n24\n");
+  const std::string v =
+      WriteText("q.vtk",
+                "# vtk DataFile Version 3.0\nq\nASCII\nDATASET UNSTRUCTURED_GRID\n"
+                "POINTS 10 double\n0 0 0 1 0 0 0 1 0 0 0 1 0.5 0 0 0.5 0.5 0\n"
+                "0 0.5 0 0 0 0.5 0 0.5 0.5 0.5 0 0.5\n"
+                "CELLS 1 11\n10 0 1 2 3 4 5 6 7 8 9\nCELL_TYPES 1\n24\n");
   m = ReadVtk(v, "", &r);
   ASSERT_EQ(m.num_vertices(), 4);
   EXPECT_NEAR(SignedVolume(m.elements[0], m.vertices), 1.0 / 6, 1e-15);
