@@ -157,7 +157,7 @@ bool NewtonSolver::Direction(const Eigen::VectorXd& c, const State& s, double et
   return true;
 }
 
-void NewtonSolver::Acceleration(const Eigen::VectorXd& c, const State& s, const Eigen::VectorXd& d,
+bool NewtonSolver::Acceleration(const Eigen::VectorXd& c, const State& s, const Eigen::VectorXd& d,
                                 State* probe, Eigen::MatrixX3d* acc, FkResult* r) {
   // Along a bending mode the equilibrium path turns (rotations), so x + t d leaves it
   // quadratically and the line search cuts t to 1/4-1/8 for many iterations (docs/newton.md).
@@ -173,7 +173,7 @@ void NewtonSolver::Acceleration(const Eigen::VectorXd& c, const State& s, const 
   probe->X = s.X;
   m.ScatterFree(s.x + h * d, &probe->X);
   Evaluate(c, probe);
-  if (!std::isfinite(probe->residual) || !workspace_.factor()) return;
+  if (!std::isfinite(probe->residual) || !workspace_.factor()) return false;
   FreeOperator op(m, &lin_);  // lin_ is still set up at s (Direction)
   const Eigen::VectorXd Hd = op.Apply(d).col(0);
   const Eigen::VectorXd second = (2.0 / (h * h)) * (probe->g - s.g - h * Hd);
@@ -184,16 +184,17 @@ void NewtonSolver::Acceleration(const Eigen::VectorXd& c, const State& s, const 
     gm.Consume(op.Apply(op.Precondition(gm.Request())).col(0));
   r->linear_iterations += gm.products() + 1;
   const Eigen::VectorXd a = op.Precondition(gm.y()).col(0);
-  if (a.allFinite() && gm.rel() < 1.0 && a.norm() < kMaxAccelerationRatio * d.norm())
-    m.ScatterFree(0.5 * a, acc);
+  const bool used = a.allFinite() && gm.rel() < 1.0 && a.norm() < kMaxAccelerationRatio * d.norm();
+  if (used) m.ScatterFree(0.5 * a, acc);
   r->global_time_s += Seconds(t0, Clock::now());
+  return used;
 }
 
 NewtonSolver::StepEnd NewtonSolver::NewtonStep(const Eigen::VectorXd& c, bool final,
                                                Eigen::MatrixX3d* Xp, FkResult* r,
                                                std::string* why) {
   const Model& m = *model_;
-  State s, trial;
+  State s, trial, probe;
   s.X = *Xp;
   m.ApplyConstraints(c, &s.X);
   Evaluate(c, &s);
@@ -269,20 +270,30 @@ NewtonSolver::StepEnd NewtonSolver::NewtonStep(const Eigen::VectorXd& c, bool fi
     // until the step lowers the frozen-ratio energy (Armijo) or the residual |g| (the hybrid rule
     // of lg-aa's safeguard: with volume-coupled ratios or blended bodies the equilibrium is not a
     // minimum of the energy, and near it the residual decides).
+    // The line search's rule at step t for the evaluated trial.
+    auto decreases = [&](double t) {
+      const double frozen = LocalStep(m, trial.X, s.ratios, &scratch_, options_.threads);
+      if (!std::isfinite(trial.residual) || !trial.X.allFinite() || !std::isfinite(frozen))
+        return false;
+      return frozen <= s.energy + kArmijo * t * slope ||
+             trial.residual <= (1.0 - kArmijo * t) * s.residual;
+    };
     double t = 1.0;
     trial.X = s.X + D;
     Evaluate(c, &trial);
     bool accepted = std::isfinite(trial.residual) && trial.X.allFinite() &&
                     trial.residual <= kGoodStep * s.residual;
-    if (!accepted) Acceleration(c, s, d, &trial, &Acc, r);
-    for (int h = 0; h <= kMaxHalvings && !accepted; ++h, t *= 0.5) {
+    int first_halving = 0;
+    if (!accepted && !Acceleration(c, s, d, &probe, &Acc, r)) {
+      // No acceleration: the path is the straight line, whose t = 1 trial is already evaluated.
+      accepted = decreases(1.0);
+      first_halving = 1;
+      t = 0.5;
+    }
+    for (int h = first_halving; h <= kMaxHalvings && !accepted; ++h, t *= 0.5) {
       trial.X = s.X + t * D + t * t * Acc;
-      const double frozen = LocalStep(m, trial.X, s.ratios, &scratch_, options_.threads);
       Evaluate(c, &trial);
-      if (!std::isfinite(trial.residual) || !trial.X.allFinite() || !std::isfinite(frozen))
-        continue;
-      accepted = frozen <= s.energy + kArmijo * t * slope ||
-                 trial.residual <= (1.0 - kArmijo * t) * s.residual;
+      accepted = decreases(t);
     }
     ++r->iterations;
     if (!accepted) {

@@ -103,8 +103,8 @@ class NewtonSolver : public FkSolver {
   /// The geodesic acceleration of the Newton direction d at s: *acc (#V x 3) = a / 2 with
   /// H a = -g''[d, d], the second derivative of g along d by differences (h = 0.1); zero when it
   /// is not finite or |a| >= 1.5 |d|. *probe is scratch. Uses the linearisation and factor that
-  /// Direction left.
-  void Acceleration(const Eigen::VectorXd& c, const State& s, const Eigen::VectorXd& d,
+  /// Direction left. Returns whether *acc is used (false: it is zero).
+  bool Acceleration(const Eigen::VectorXd& c, const State& s, const Eigen::VectorXd& d,
                     State* probe, Eigen::MatrixX3d* acc, FkResult* r);
   /// Adaptive load stepping from x0 (an equilibrium at c0) to c. Returns the status; *X the last
   /// converged state.
