@@ -486,11 +486,6 @@ TEST(Cli, TessellateMeshesABoxChamberInABoxBody) {
 
 namespace {
 
-std::string ReadText(const std::string& path) {
-  std::ifstream f(path);
-  return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-}
-
 int CountLines(const std::string& text) {
   int n = 0;
   for (char c : text) n += c == '\n';
@@ -562,7 +557,7 @@ TEST(Cli, IkReachesAForwardSolvedTargetAndResumesATrajectory) {
           " --samples 2 --gradient-tolerance 1e-3 --method gauss-newton --out " + dir + "/one.csv");
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("[1/1]"), std::string::npos) << r.out;  // progress on stderr
-  std::string text = ReadText(dir + "/one.csv");
+  std::string text = ReadAll(dir + "/one.csv");
   ASSERT_EQ(CountLines(text), 2) << text;
   EXPECT_EQ(text.rfind("index,target_x,target_y,target_z,c0,c1,c2,reached_x", 0), 0u) << text;
   // error_mm is column 11 (after index, target x3, c0..c2, reached x3): within lambda = 0.2 mm.
@@ -586,7 +581,7 @@ TEST(Cli, IkReachesAForwardSolvedTargetAndResumesATrajectory) {
       dir + "/samples.csv --out " + dir + "/path.csv";
   r = Cli(run);
   ASSERT_EQ(r.code, 0) << r.out;
-  const std::string full = ReadText(dir + "/path.csv");
+  const std::string full = ReadAll(dir + "/path.csv");
   ASSERT_EQ(CountLines(full), 4) << full;
   EXPECT_TRUE(std::filesystem::exists(dir + "/samples.csv"));
   const size_t second_row = full.find('\n', full.find('\n') + 1) + 1;
@@ -594,7 +589,7 @@ TEST(Cli, IkReachesAForwardSolvedTargetAndResumesATrajectory) {
   r = Cli(run + " --resume");
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("resuming"), std::string::npos) << r.out;
-  const std::string resumed = ReadText(dir + "/path.csv");
+  const std::string resumed = ReadAll(dir + "/path.csv");
   ASSERT_EQ(CountLines(resumed), 4) << resumed;
   EXPECT_EQ(resumed.substr(0, second_row), full.substr(0, second_row));
   EXPECT_EQ(resumed.substr(second_row, 2), "1,") << resumed;
@@ -693,7 +688,7 @@ TEST(Cli, SolverScalingChecksEveryCaseAndReportsTheGrowth) {
   r = Cli("run " + good + " --no-plot --results " + dir);
   ASSERT_EQ(r.code, 0) << r.out;
   const std::string csv = ReadAll(dir + "/tiny_scaling/scaling.csv");
-  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5) << csv;  // header + 2 res x 2 solvers
+  EXPECT_EQ(CountLines(csv), 5) << csv;  // header + 2 res x 2 solvers
   const auto j = nlohmann::json::parse(ReadAll(dir + "/tiny_scaling/summary.json"));
   for (const char* solver : {"newton", "lg-aa"}) {
     const auto& g = j["growth"]["three_chamber"][solver];
@@ -837,7 +832,7 @@ TEST(Cli, TrainAndLearnedIkFromADataset) {
     r = Cli(std::string("ik --nets ") + dir + "/nets --method " + method +
             " --target 0,136,0 --quiet --out " + dir + "/ik.csv");
     ASSERT_EQ(r.code, 0) << method << "\n" << r.out;
-    const std::string text = ReadText(dir + "/ik.csv");
+    const std::string text = ReadAll(dir + "/ik.csv");
     EXPECT_EQ(CountLines(text), 2) << text;
     EXPECT_EQ(text.find("nan"), std::string::npos) << text;
   }
@@ -848,7 +843,7 @@ TEST(Cli, TrainAndLearnedIkFromADataset) {
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("0 of 1 waypoint(s) within lambda"), std::string::npos) << r.out;
   {
-    std::istringstream csv(ReadText(dir + "/far.csv"));
+    std::istringstream csv(ReadAll(dir + "/far.csv"));
     std::string header, row, cell;
     std::getline(csv, header);
     std::getline(csv, row);
@@ -921,7 +916,7 @@ TEST(Cli, ArchitectureSweepResumesFinishedNetworks) {
   EXPECT_EQ(second["rows"], first["rows"]);
   // An interrupted journal (the last record cut mid-write) and a changed setting: the cut record
   // and the rows of other settings are trained again, the intact record is reused.
-  std::string journal = ReadText(dir + "/tiny_arch/architecture.jsonl");
+  std::string journal = ReadAll(dir + "/tiny_arch/architecture.jsonl");
   ASSERT_EQ(CountLines(journal), 2) << journal;
   const size_t second_line = journal.find('\n') + 1;
   std::ofstream(dir + "/tiny_arch/architecture.jsonl") << journal.substr(0, second_line + 20);
