@@ -188,8 +188,11 @@ CalibrationResult CalibrateROmega(double target_rm, const BarTestOptions& opt, d
       f_lo = eval(lo);
     } catch (const std::runtime_error& e) {
       // A softer material than the solver can stretch: say how far the search got.
+      std::string why = e.what();
+      const std::string prefix = "calibration: ";  // SolveBar's, already in reached()'s message
+      if (why.rfind(prefix, 0) == 0) why.erase(0, prefix.size());
       throw std::invalid_argument(reached(hi, f_hi) + "; at R_omega = " + FormatNumber(lo) + " " +
-                                  std::string(e.what()).substr(13));  // drop "calibration: "
+                                  why);
     }
     if (std::abs(f_lo - goal) <= rel_tol * goal) return done(lo, f_lo);
   }
