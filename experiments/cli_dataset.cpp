@@ -203,10 +203,15 @@ void ReportSummary(const DatasetRunSummary& s) {
   char line[300];
   std::snprintf(line, sizeof line,
                 "softkin dataset: samples [%lld, %lld): %lld already in the file, %lld written "
-                "(%lld failed) in %.1f s (%.1f ms/sample, %lld forward solves)\n",
-                s.first, s.first + s.count, s.already, s.written, s.failed, s.time_s,
+                "(%lld failed, %lld with inverted elements) in %.1f s (%.1f ms/sample, %lld "
+                "forward solves)\n",
+                s.first, s.first + s.count, s.already, s.written, s.failed, s.inverted, s.time_s,
                 s.written > 0 ? 1e3 * s.time_s / s.written : 0.0, s.fk_solves);
   std::cerr << line;
+  if (s.inverted > 0)
+    std::cerr << "softkin dataset: WARNING: " << s.inverted
+              << " sample(s) solved to states with inverted body elements: marked 'inverted' "
+                 "in the status column and left out of training\n";
 }
 
 }  // namespace

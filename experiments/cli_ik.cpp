@@ -329,6 +329,9 @@ void ReportSimulatorEnd(const IkCommandArgs& a, const TrajectoryResult& r) {
             << r.max_error_mm << " mm; largest actuation jump " << r.max_jump << " ("
             << 100.0 * r.max_jump_fraction << " % of the range); " << r.total_time_s << " s; wrote "
             << a.out << "\n";
+  if (r.inverted > 0)
+    std::cerr << "softkin ik: WARNING: " << r.inverted << " of " << r.waypoints.size()
+              << " waypoint(s) reached with inverted body elements (column inverted_elements)\n";
 }
 
 /// `softkin ik` on the simulator (no --nets).
@@ -368,6 +371,10 @@ int RunSimulatorIk(const IkCommandArgs& a) {
                     w.iterations, w.fk_solves, w.time_s);
       std::cerr << line << (w.error_mm < 0 ? " (" + w.message + ")" : std::string()) << "\n";
     }
+    if (w.inverted_elements > 0)  // a warning even with --quiet: the reached point is not physical
+      std::cerr << "softkin ik: WARNING: waypoint " << w.index << ": " << w.inverted_elements
+                << " inverted body element(s) in the solved state (smallest volume ratio "
+                << w.min_volume_ratio << "); its reached point is not a physical answer\n";
   };
   const TrajectoryResult r = FollowTrajectory(*kin, waypoints, to, on_waypoint);
   if (!a.quiet) ReportSimulatorEnd(a, r);

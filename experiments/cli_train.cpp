@@ -193,6 +193,9 @@ int RunTrainCommand(const TrainCommandArgs& a) {
               << d.num_actuators << " actuators, " << d.point_names.size() << " point(s)"
               << (d.jacobians.cols() ? ", Jacobians" : "") << "; training" << (o.fk ? " fk" : "")
               << (o.jac ? " jac" : "") << (o.ik ? " ik" : "") << "\n";
+  if (d.failed + d.inverted > 0)
+    std::cerr << "softkin train: left out " << d.failed << " failed sample(s) and " << d.inverted
+              << " with inverted elements (not physical states)\n";
   LearnedNets nets = TrainNetsFromDataset(d, a.dataset, o);
   nets.info["command"] = a.command_line;
   nets.info["git_commit"] = GitCommit();

@@ -45,6 +45,7 @@ nlohmann::json SamplesJson(const ConfigurationSamples& s) {
 /// What a followed path reports: errors, times, counts and continuity.
 struct PathStats {
   int n = 0, converged = 0, failed = 0, outside = 0;
+  int inverted = 0;  ///< waypoints reached with inverted body elements (not physical)
   double mean_err = 0, max_err = 0, time_s = 0, mean_iter = 0;
   long long fk = 0, evals = 0;
   double max_jump = 0, max_jump_fraction = 0, max_reached_step = 0, max_target_step = 0;
@@ -58,6 +59,7 @@ PathStats Stats(const std::vector<WaypointResult>& w, const Kinematics& kin, dou
   int with_err = 0;
   for (size_t i = 0; i < w.size(); ++i) {
     s.converged += w[i].converged;
+    s.inverted += w[i].inverted_elements > 0;
     s.time_s += w[i].time_s;
     s.fk += w[i].fk_solves;
     s.evals += w[i].evaluations;
@@ -90,6 +92,7 @@ PathStats Stats(const std::vector<WaypointResult>& w, const Kinematics& kin, dou
 nlohmann::json StatsJson(const PathStats& s) {
   return {{"waypoints", s.n},
           {"converged", s.converged},
+          {"inverted_waypoints", s.inverted},
           {"kinematics_failures", s.failed},
           {"beyond_lambda", s.outside},
           {"mean_error_mm", s.mean_err},
@@ -257,6 +260,7 @@ nlohmann::json MethodRow(const IkMethodsParams& p, const std::shared_ptr<const M
           {"jacobian", jname},
           {"waypoints", st.n},
           {"converged", st.converged},
+          {"inverted_waypoints", st.inverted},
           {"ms_per_waypoint", ms},
           {"mean_err_mm", st.mean_err},
           {"max_err_mm", st.max_err},

@@ -210,6 +210,7 @@ class StageRunner {
                         {"initial_objective", r.summary.initial_objective},
                         {"final_objective", r.summary.final_objective},
                         {"converged", r.summary.converged()},
+                        {"inverted_elements", r.inverted_elements},
                         {"termination", IkTerminationToString(r.summary.termination)},
                         {"iterations", r.summary.iterations},
                         {"evaluations", r.summary.evaluations},

@@ -165,6 +165,7 @@ Dataset CachedDataset(const DatasetSpec& spec, const std::string& cache_dir, boo
              {"spec", spec.Json()},
              {"samples", d.inputs.rows()},
              {"failed", d.failed},
+             {"inverted", d.inverted},
              {"generated_now", s.written},
              {"already_cached", s.already},
              {"time_s", s.time_s},

@@ -90,6 +90,8 @@ IkPoint IkProblem::EvaluateOnce(const Eigen::Ref<const Eigen::VectorXd>& c, bool
     best_c_ = c;
     best_value_ = pt.value;
     best_p_ = pt.p;
+    best_inverted_ = e.inverted_elements;
+    best_min_volume_ratio_ = e.min_volume_ratio;
   }
   return pt;
 }
@@ -136,6 +138,8 @@ IkResult IkProblem::Finish(const Eigen::Ref<const Eigen::VectorXd>& c0, IkSummar
     res.c = best_c_;
     res.p = best_p_;
     res.objective = best_value_;
+    res.inverted_elements = best_inverted_;
+    res.min_volume_ratio = best_min_volume_ratio_;
     summary.final_objective = best_value_;
     if (summary.history.empty())
       summary.initial_objective = best_value_;

@@ -80,6 +80,8 @@ class IkProblem {
   Eigen::VectorXd best_c_;
   double best_value_ = 0.0;
   Eigen::MatrixX3d best_p_;
+  int best_inverted_ = 0;  ///< inverted body elements in the state behind best_p_
+  double best_min_volume_ratio_ = 1.0;
 };
 
 }  // namespace softkin

@@ -133,6 +133,10 @@ struct IkResult {
   Eigen::VectorXd c;       ///< #actuators, the best actuation found (within the box)
   Eigen::MatrixX3d p;      ///< #points x 3, the tracked points at c, mm
   double objective = 0.0;  ///< O(p(c))
+  /// Body elements inverted in the simulated state at c (KinematicsEval): > 0 means p is not a
+  /// physical answer, whatever the termination says about the objective.
+  int inverted_elements = 0;
+  double min_volume_ratio = 1.0;
   /// broyden only: its dp/dc at c (evaluated or secant-updated), to hand to the next solve as
   /// IkOptions::initial_jacobian; empty for the other methods or when c is not its last iterate.
   Eigen::MatrixXd J;

@@ -22,6 +22,11 @@ struct KinematicsEval {
   /// 3 #points x #actuators Jacobian dp/dc (row 3 i + d is coordinate d of point i), mm per unit
   /// of actuation; empty unless requested.
   Eigen::MatrixXd J;
+  /// Body elements inverted (signed volume <= 0) in the simulated state behind p, and the
+  /// smallest signed / rest volume of a body element there: p of such a state is not a
+  /// physical answer. 0 and 1 for kinematics without a mesh (networks, PCC models).
+  int inverted_elements = 0;
+  double min_volume_ratio = 1.0;
   int fk_solves = 0;    ///< forward solves this evaluation took (simulator), or 0
   double time_s = 0.0;  ///< wall time of this evaluation
 };

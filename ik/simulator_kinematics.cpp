@@ -288,6 +288,8 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
   if (have_last && last_c_.size() == c.size() && last_c_ == c) {
     X = last_X_;
     centre_start = last_start_;  // where the reused state was solved from
+    ev.inverted_elements = last_inverted_;
+    ev.min_volume_ratio = last_min_volume_ratio_;
   } else {
     FkResult r;
     // First-order prediction from the previous state and its implicit Jacobian.
@@ -325,6 +327,8 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
       return finish();
     }
     X = r.positions;
+    ev.inverted_elements = r.inverted_elements;
+    ev.min_volume_ratio = r.min_volume_ratio;
     // Keep dX/dc first-order along the path: Broyden's secant update from the step just solved
     // (scaled by the ranges, as IK's broyden), so the next prediction is still close.
     if (have_last && options_.jacobian == JacobianMode::kImplicit && options_.secant_update &&
@@ -361,6 +365,8 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
     last_X_ = X;
     last_c_ = c;
     last_start_ = centre_start;
+    last_inverted_ = ev.inverted_elements;
+    last_min_volume_ratio_ = ev.min_volume_ratio;
   }
   ev.p = Points(X);
   if (!with_jacobian) {

@@ -184,6 +184,8 @@ class SimulatorKinematics : public Kinematics {
   Eigen::VectorXd lower_, upper_;
   Eigen::MatrixX3d last_X_;
   Eigen::MatrixX3d last_start_;  ///< where last_X_ was solved from (empty: rest shape)
+  int last_inverted_ = 0;        ///< inverted body elements of last_X_
+  double last_min_volume_ratio_ = 1.0;
   Eigen::VectorXd last_c_;
   /// The last implicit dX/dc (3 #V x #columns), the actuation it was taken at and its columns.
   Eigen::MatrixXd jac_dXdc_;

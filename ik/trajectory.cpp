@@ -303,6 +303,8 @@ TrajectoryResult FollowTrajectory(Kinematics& kin,
       wr.error_mm = (wr.reached - wr.target).norm();
       wr.objective = ik.objective;
       wr.converged = ik.summary.converged();
+      wr.inverted_elements = ik.inverted_elements;
+      wr.min_volume_ratio = ik.min_volume_ratio;
     } else {  // not even c_prev could be evaluated: no point to report
       wr.reached = Eigen::Vector3d::Zero();
       wr.error_mm = -1.0;
@@ -320,6 +322,7 @@ TrajectoryResult FollowTrajectory(Kinematics& kin,
     }
     c_prev = wr.c;
     if (wr.converged) ++res.converged;
+    if (wr.inverted_elements > 0) ++res.inverted;
     if (wr.error_mm >= 0) {
       err_sum += wr.error_mm;
       ++err_count;

@@ -90,6 +90,10 @@ struct WaypointResult {
   double error_mm = 0.0;
   double objective = 0.0;  ///< error_mm^2 (-1 as error_mm)
   bool converged = false;  ///< objective <= lambda
+  /// Body elements inverted in the simulated state at c (IkResult): > 0 flags a reached point
+  /// that is not a physical answer (converged counts the objective only).
+  int inverted_elements = 0;
+  double min_volume_ratio = 1.0;
   IkTermination termination = IkTermination::kConverged;
   std::string message;
   int iterations = 0;
@@ -108,6 +112,7 @@ struct TrajectoryResult {
   double max_jump_fraction = 0.0;  ///< the same as a fraction of the range
   int max_jump_index = -1;         ///< the waypoint where it happened (-1: fewer than 2 waypoints)
   int converged = 0;               ///< waypoints with O <= lambda
+  int inverted = 0;                ///< waypoints whose state has inverted body elements
   double mean_error_mm = 0.0, max_error_mm = 0.0;  ///< over the waypoints with a reached point
   /// Sample the kept answer of the first waypoint started from (-1: warm start given).
   int initial_sample = -1;

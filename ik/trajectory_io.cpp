@@ -101,7 +101,7 @@ std::string WaypointCsvHeader(int num_actuators) {
   s << "index,target_x,target_y,target_z";
   for (int a = 0; a < num_actuators; ++a) s << ",c" << a;
   s << ",reached_x,reached_y,reached_z,error_mm,objective,converged,termination,iterations,"
-       "evaluations,fk_solves,time_s,jump";
+       "evaluations,fk_solves,time_s,jump,inverted_elements";
   return s.str();
 }
 
@@ -114,7 +114,7 @@ std::string WaypointCsvRow(const WaypointResult& w) {
   s << std::setprecision(10) << "," << w.reached.x() << "," << w.reached.y() << "," << w.reached.z()
     << "," << w.error_mm << "," << w.objective << "," << (w.converged ? 1 : 0) << ","
     << IkTerminationToString(w.termination) << "," << w.iterations << "," << w.evaluations << ","
-    << w.fk_solves << "," << w.time_s << "," << w.jump;
+    << w.fk_solves << "," << w.time_s << "," << w.jump << "," << w.inverted_elements;
   return s.str();
 }
 
@@ -146,7 +146,7 @@ WaypointCsvResume ReadWaypointCsvForResume(const std::string& path, int num_actu
     std::stringstream ss(line);
     std::string tok;
     while (std::getline(ss, tok, ',')) f.push_back(tok);
-    const size_t expected = 4 + num_actuators + 12;
+    const size_t expected = 4 + num_actuators + 13;
     if (f.size() != expected)
       throw std::invalid_argument(Where(path, lineno) + "expected " + std::to_string(expected) +
                                   " columns, found " + std::to_string(f.size()));

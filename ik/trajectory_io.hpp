@@ -10,7 +10,8 @@
 ///
 /// Waypoint CSV: the header from WaypointCsvHeader, then one WaypointCsvRow per waypoint:
 ///   index,target_x,target_y,target_z,c0..c{n-1},reached_x,reached_y,reached_z,error_mm,
-///   objective,converged,termination,iterations,evaluations,fk_solves,time_s,jump
+///   objective,converged,termination,iterations,evaluations,fk_solves,time_s,jump,
+///   inverted_elements
 /// (numbers with 17 significant digits for the actuation, so a resumed run continues exactly).
 
 #include "softkin/ik/trajectory.hpp"

@@ -73,7 +73,8 @@ std::string Sanitize(std::string s) {
 std::string SampleLine(long long index, const Eigen::VectorXd& c, const KinematicsEval& ev,
                        int num_points, bool jacobian) {
   const int m = static_cast<int>(c.size());
-  std::string line = std::to_string(index) + (ev.ok ? ",ok" : ",failed");
+  const bool inverted = ev.ok && ev.inverted_elements > 0;
+  std::string line = std::to_string(index) + (!ev.ok ? ",failed" : inverted ? ",inverted" : ",ok");
   for (int a = 0; a < m; ++a) line += "," + Num(c[a]);
   const int np = 3 * num_points, nj = jacobian ? 3 * num_points * m : 0;
   if (ev.ok) {
@@ -82,6 +83,9 @@ std::string SampleLine(long long index, const Eigen::VectorXd& c, const Kinemati
     for (int r = 0; r < 3 * num_points && jacobian; ++r)
       for (int a = 0; a < m; ++a) line += "," + Num(ev.J(r, a));
     line += ",";
+    if (inverted)
+      line += std::to_string(ev.inverted_elements) +
+              " inverted body elements (smallest volume ratio " + Num(ev.min_volume_ratio) + ")";
   } else {
     line.append(static_cast<size_t>(np + nj), ',');
     line += "," + Sanitize(ev.message);
@@ -130,11 +134,14 @@ long long ParseIndex(const std::string& s, const std::string& file, long long li
   return v;
 }
 
+enum class SampleStatus { kOk, kInverted, kFailed };
+
 /// Checks the fields of one sample line against the header `head` (m actuation columns): the
-/// field count, the status, finite numbers in an ok row, empty outputs in a failed row. Throws
-/// with file:line. Returns true for an ok row.
-bool CheckSampleFields(const std::vector<std::string>& f, const std::vector<std::string>& head,
-                       int m, const std::string& path, long long lineno) {
+/// field count, the status, finite numbers in an ok or inverted row, empty outputs in a failed
+/// row. Throws with file:line.
+SampleStatus CheckSampleFields(const std::vector<std::string>& f,
+                               const std::vector<std::string>& head, int m, const std::string& path,
+                               long long lineno) {
   const size_t nfields = head.size();
   if (f.size() != nfields)
     Bad(path, lineno,
@@ -143,11 +150,12 @@ bool CheckSampleFields(const std::vector<std::string>& f, const std::vector<std:
     for (size_t j = 2 + m; j + 1 < nfields; ++j)
       if (!f[j].empty())
         Bad(path, lineno, "a failed sample must have empty position and Jacobian fields");
-    return false;
+    return SampleStatus::kFailed;
   }
-  if (f[1] != "ok") Bad(path, lineno, "column status: expected ok or failed, got '" + f[1] + "'");
+  if (f[1] != "ok" && f[1] != "inverted")
+    Bad(path, lineno, "column status: expected ok, inverted or failed, got '" + f[1] + "'");
   for (size_t j = 2; j + 1 < nfields; ++j) ParseNumber(f[j], path, lineno, head[j]);
-  return true;
+  return f[1] == "ok" ? SampleStatus::kOk : SampleStatus::kInverted;
 }
 
 /// The text of a file.
@@ -469,6 +477,7 @@ DatasetRunSummary GenerateDataset(Kinematics& kin, const DatasetSampling& sampli
     if (!csv) throw std::runtime_error("error while writing " + opt.out);
     ++sum.written;
     if (!ev.ok) ++sum.failed;
+    if (ev.ok && ev.inverted_elements > 0) ++sum.inverted;
     bar.Update(sum.already + sum.written);
   }
   bar.Finish(sum.already + sum.written);
@@ -655,8 +664,9 @@ Dataset LoadDataset(const std::string& path) {
           "sample index " + std::to_string(idx) + " after " + std::to_string(last_index) +
               " (indices must increase)");
     last_index = idx;
-    if (!CheckSampleFields(f, head, m, path, lineno)) {
-      ++ds.failed;
+    const SampleStatus status = CheckSampleFields(f, head, m, path, lineno);
+    if (status != SampleStatus::kOk) {
+      ++(status == SampleStatus::kFailed ? ds.failed : ds.inverted);
       continue;
     }
     for (int a = 0; a < m; ++a) in.push_back(ParseNumber(f[2 + a], path, lineno, head[2 + a]));

@@ -22,9 +22,12 @@
 /// numbers in %.17g so they read back exactly):
 ///   index,status,c0..c{m-1},<point>_x,<point>_y,<point>_z ...,J_<point>_<x|y|z>_c<a> ...,message
 /// `index` is the sample's position in the generation order (0-based, over the whole dataset,
-/// also in a shard). `status` is `ok` or `failed`; a failed sample (the kinematics returned
-/// ok = false) has empty p and J fields and the reason in `message` (commas and line breaks
-/// replaced by ';' and ' '); an ok sample has an empty message. No field is ever NaN.
+/// also in a shard). `status` is `ok`, `inverted` or `failed`; a failed sample (the kinematics
+/// returned ok = false) has empty p and J fields and the reason in `message` (commas and line
+/// breaks replaced by ';' and ' '); an inverted sample has p and J of a simulated state with
+/// inverted body elements (KinematicsEval::inverted_elements > 0: not a physical answer), and
+/// their count and smallest volume ratio in `message`; an ok sample has an empty message. No
+/// field is ever NaN. The loader leaves failed and inverted samples out of training.
 /// Jacobian columns (only when the dataset has Jacobians) flatten the 3P x m matrix J = dp/dc
 /// row-major: column (3 q + d) m + a is dp_{q,d}/dc_a (point q, coordinate d = x, y, z,
 /// actuator a), named J_<point>_<coord>_c<a>.
@@ -97,6 +100,7 @@ struct DatasetRunSummary {
   long long already = 0;           ///< samples found complete in the file (resume)
   long long written = 0;           ///< samples written by this run
   long long failed = 0;            ///< of them, failed evaluations
+  long long inverted = 0;          ///< of them, states with inverted body elements
   double time_s = 0;               ///< wall time of this run
   long long fk_solves = 0;         ///< forward solves of this run
 };
@@ -116,7 +120,7 @@ DatasetRunSummary GenerateDataset(Kinematics& kin, const DatasetSampling& sampli
 /// Returns the number of samples written.
 long long MergeDatasets(const std::vector<std::string>& shards, const std::string& out);
 
-/// A dataset loaded for training: only the ok samples, in file order.
+/// A dataset loaded for training: only the ok samples (not failed, not inverted), in file order.
 struct Dataset {
   std::vector<std::string> point_names;  ///< P tracked points
   int num_actuators = 0;                 ///< m
@@ -125,6 +129,7 @@ struct Dataset {
   Eigen::MatrixXd jacobians;             ///< n x 3Pm (row-major J, see the file comment), or n x 0
   std::vector<long long> index;          ///< n generation-order indices
   long long failed = 0;                  ///< failed samples skipped
+  long long inverted = 0;                ///< samples with inverted elements skipped
   nlohmann::json meta;                   ///< the sidecar (null if there is none)
 };
 

@@ -157,10 +157,10 @@ LearnedNets TrainNetsFromDataset(const Dataset& d, const std::string& dataset_pa
   const SampleSet pos = PositionSamples(d);
   const TrainTestSets split = SplitTrainTest(pos, opt.split_seed, opt.train_fraction);
   const double width = WorkspaceWidth(pos.Y);
-  nets.info["dataset"] = {{"path", dataset_path},        {"samples", d.inputs.rows()},
-                          {"failed", d.failed},          {"train", split.train.size()},
-                          {"test", split.test.size()},   {"split_seed", opt.split_seed},
-                          {"workspace_width_mm", width}, {"sidecar", d.meta}};
+  nets.info["dataset"] = {
+      {"path", dataset_path},         {"samples", d.inputs.rows()},  {"failed", d.failed},
+      {"inverted", d.inverted},       {"train", split.train.size()}, {"test", split.test.size()},
+      {"split_seed", opt.split_seed}, {"workspace_width_mm", width}, {"sidecar", d.meta}};
   auto pct = [width](double mm) { return width > 0 ? 100.0 * mm / width : 0.0; };
   if (opt.fk) {
     const NetTrainResult r = TrainNet(split.train, split.test, opt.fk_options);

@@ -106,7 +106,7 @@ def read_marker_table(name, path):
 
 WAYPOINT_COLUMNS = ["index", "target_x", "target_y", "target_z", "reached_x", "reached_y",
                     "reached_z", "error_mm", "objective", "converged", "termination", "iterations",
-                    "evaluations", "fk_solves", "time_s", "jump"]
+                    "evaluations", "fk_solves", "time_s", "jump", "inverted_elements"]
 WAYPOINT_NUMERIC = [c for c in WAYPOINT_COLUMNS if c != "termination"]
 
 

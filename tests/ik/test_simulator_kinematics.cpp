@@ -489,5 +489,29 @@ TEST(Kinematics, SignedActuatorsVentedSidesAndTheKinkAtZero) {
   EXPECT_GT(i0.J.col(1).norm(), 1.0);
 }
 
+// The inverted body elements of the solved state reach every evaluation, also one that reuses
+// the last state: bimaterial_bar twisted 180 degrees and stretched 40 mm, solved by lg-aa from
+// rest, converges to a tangled state (tests/solver/fk/test_inverted_elements.cpp).
+TEST(SimulatorKinematics, ReportsTheInvertedElementsOfTheSolvedState) {
+  auto model = std::make_shared<const Model>(MakeRobot("bimaterial_bar", 4));
+  SimulatorKinematicsOptions o;
+  o.points = {"tip"};
+  const FkOptions fk = Fk(1e-6, 1e-6);
+  SimulatorKinematics k(model, o, &fk);
+  const KinematicsEval rest = k.Evaluate(Vec({0.0, 0.0}), false);
+  ASSERT_TRUE(rest.ok) << rest.message;
+  EXPECT_EQ(rest.inverted_elements, 0);
+  EXPECT_NEAR(rest.min_volume_ratio, 1.0, 1e-9);
+  k.Reset();
+  const KinematicsEval twisted = k.Evaluate(Vec({180.0, 40.0}), false);
+  ASSERT_TRUE(twisted.ok) << twisted.message;
+  EXPECT_GT(twisted.inverted_elements, 0);
+  EXPECT_LT(twisted.min_volume_ratio, 0.0);
+  const KinematicsEval again = k.Evaluate(Vec({180.0, 40.0}), false);  // the state is reused
+  EXPECT_EQ(again.fk_solves, 0);
+  EXPECT_EQ(again.inverted_elements, twisted.inverted_elements);
+  EXPECT_EQ(again.min_volume_ratio, twisted.min_volume_ratio);
+}
+
 }  // namespace
 }  // namespace softkin

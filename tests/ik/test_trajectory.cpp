@@ -1,6 +1,7 @@
 // Algorithm 4 on the PCC finger: continuity on a smooth path, unreachable waypoints reported with
 // their distance, the closest-sample initial guess, the sample cache, streaming and resuming.
 #include "softkin/ik/trajectory.hpp"
+#include "softkin/ik/trajectory_io.hpp"
 #include "softkin/ik/pcc_kinematics.hpp"
 
 #include "ik_test_models.hpp"
@@ -167,6 +168,40 @@ TEST(Trajectory, UnreachableWaypointReportsItsDistanceAndThePathRecovers) {
   EXPECT_TRUE(w.c.allFinite());
   for (int i = 6; i < 12; ++i) EXPECT_TRUE(r.waypoints[i].converged) << i;
   EXPECT_EQ(r.converged, 11);
+}
+
+// The inverted elements of the state behind each answer reach the waypoint, its CSV row and the
+// path's count: PCC standing in for a simulator that folds elements when cable 0 exceeds 5 mm.
+TEST(Trajectory, InvertedStatesAreCarriedToEveryWaypointAndItsRow) {
+  struct Folding : PccKinematics {
+    KinematicsEval Evaluate(const Eigen::Ref<const Eigen::VectorXd>& c, bool with_j) override {
+      KinematicsEval e = PccKinematics::Evaluate(c, with_j);
+      if (c[0] > 5.0) {
+        e.inverted_elements = 7;
+        e.min_volume_ratio = -0.5;
+      }
+      return e;
+    }
+  } k;
+  const Eigen::MatrixX3d path = CirclePath(k, 12);
+  TrajectoryOptions opt;
+  opt.ik.max_iterations = 100;
+  opt.ik.max_evaluations = 2000;
+  const TrajectoryResult r = FollowTrajectory(k, path, opt);
+  int inverted = 0;
+  for (const WaypointResult& w : r.waypoints) {
+    EXPECT_EQ(w.inverted_elements, w.c[0] > 5.0 ? 7 : 0) << w.index << ": c " << w.c.transpose();
+    EXPECT_EQ(w.min_volume_ratio, w.c[0] > 5.0 ? -0.5 : 1.0);
+    inverted += w.c[0] > 5.0;
+    const std::string row = WaypointCsvRow(w);
+    EXPECT_EQ(row.substr(row.rfind(',') + 1), std::to_string(w.inverted_elements)) << row;
+  }
+  EXPECT_GT(inverted, 0);            // the circle needs cable 0 beyond 5 mm somewhere
+  EXPECT_LT(inverted, path.rows());  // and not everywhere
+  EXPECT_EQ(r.inverted, inverted);
+  EXPECT_EQ(r.converged, 12);  // converged is about the objective; the flag is separate
+  const std::string header = WaypointCsvHeader(3);
+  EXPECT_EQ(header.substr(header.rfind(',') + 1), "inverted_elements");
 }
 
 TEST(Trajectory, SampleCacheIsReusedAndRejectedWhenBuiltForSomethingElse) {

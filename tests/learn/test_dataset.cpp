@@ -19,10 +19,11 @@ namespace fs = std::filesystem;
 
 /// PCC positions plus 1e-3 mm times the evaluations since the last Reset (a stand-in for a
 /// warm-started simulator, whose answer depends on where it started); fails (ok = false) when
-/// c0 > fail_above.
+/// c0 > fail_above, and reports 2 inverted body elements when c1 > invert_above.
 class HistoryKinematics : public Kinematics {
  public:
-  explicit HistoryKinematics(double fail_above = 1e300) : fail_above_(fail_above) {}
+  explicit HistoryKinematics(double fail_above = 1e300, double invert_above = 1e300)
+      : fail_above_(fail_above), invert_above_(invert_above) {}
   std::string name() const override { return "history(pcc)"; }
   int num_actuators() const override { return 3; }
   const std::vector<std::string>& point_names() const override { return names_; }
@@ -46,6 +47,10 @@ class HistoryKinematics : public Kinematics {
     }
     e.p = p;
     e.J = with_j ? J : Eigen::MatrixXd();
+    if (c[1] > invert_above_) {
+      e.inverted_elements = 2;
+      e.min_volume_ratio = -0.25;
+    }
     ++since_reset_;
     return e;
   }
@@ -55,7 +60,7 @@ class HistoryKinematics : public Kinematics {
  private:
   PccKinematics pcc_;
   std::vector<std::string> names_ = {"tip", "backbone[2]"};
-  double fail_above_;
+  double fail_above_, invert_above_;
   long long evals_ = 0, since_reset_ = 0;
 };
 
@@ -81,8 +86,9 @@ class DatasetTest : public ::testing::Test {
     o << text;
   }
   /// Runs a generation with a fresh kinematics (as a new process would).
-  DatasetRunSummary Run(const DatasetSampling& s, DatasetRunOptions o, double fail_above = 1e300) {
-    HistoryKinematics k(fail_above);
+  DatasetRunSummary Run(const DatasetSampling& s, DatasetRunOptions o, double fail_above = 1e300,
+                        double invert_above = 1e300) {
+    HistoryKinematics k(fail_above, invert_above);
     o.reset = [&k] { k.Reset(); };
     o.progress = false;
     o.source = {{"kind", "test"}};
@@ -216,10 +222,10 @@ TEST_F(DatasetTest, ResumeRefusesACorruptRowBeforeTheEnd) {
   spoiled[c0] = 'x';                                       // a corrupt number
   short_row.erase(c0 - 1, end6 - (c0 - 1));                // "4,ok": fields missing
   bad_status.replace(part.find(',', l6) + 1, 2, "maybe");  // an unknown status
-  for (const auto& [text, what] :
-       std::vector<std::pair<std::string, std::string>>{{spoiled, "expected a number"},
-                                                        {short_row, "fields, found 2"},
-                                                        {bad_status, "expected ok or failed"}}) {
+  for (const auto& [text, what] : std::vector<std::pair<std::string, std::string>>{
+           {spoiled, "expected a number"},
+           {short_row, "fields, found 2"},
+           {bad_status, "expected ok, inverted or failed"}}) {
     Write(o.out, text);
     try {
       Run(s, o);
@@ -323,6 +329,39 @@ TEST_F(DatasetTest, LoaderReturnsTheSamplesAndSkipsFailedOnes) {
   EXPECT_EQ(w.inputs, d.inputs);
   EXPECT_EQ(w.positions, d.positions);
   EXPECT_EQ(w.jacobians, d.jacobians);
+}
+
+// A sample whose simulated state has inverted body elements keeps its numbers but is marked
+// `inverted` (with the count in the message), and the loader leaves it out of training.
+TEST_F(DatasetTest, SamplesWithInvertedElementsAreMarkedAndLeftOutOfTraining) {
+  const DatasetSampling s = Grid(4, 64);
+  DatasetRunOptions o;
+  o.out = Path("d.csv");
+  // c0 in {0, 6.67, 13.3, 20}: 32 fail; c1 in {0, 6.67, 13.3, 20}: of the rest, 16 invert.
+  const DatasetRunSummary r = Run(s, o, /*fail_above=*/12.0, /*invert_above=*/12.0);
+  EXPECT_EQ(r.failed, 32);
+  EXPECT_EQ(r.inverted, 16);
+  const std::string text = Read(o.out);
+  std::istringstream lines(text);
+  std::string line;
+  int marked = 0;
+  while (std::getline(lines, line))
+    if (line.find(",inverted,") != std::string::npos) {
+      ++marked;
+      EXPECT_NE(line.find("2 inverted body elements (smallest volume ratio -0.25)"),
+                std::string::npos)
+          << line;
+      EXPECT_EQ(line.find(",,"), std::string::npos) << "an inverted row keeps its numbers";
+    }
+  EXPECT_EQ(marked, 16);
+  const Dataset d = LoadDataset(o.out);
+  EXPECT_EQ(d.failed, 32);
+  EXPECT_EQ(d.inverted, 16);
+  ASSERT_EQ(d.inputs.rows(), 16);
+  for (Eigen::Index i = 0; i < d.inputs.rows(); ++i) {
+    EXPECT_LT(d.inputs(i, 0), 12.0);
+    EXPECT_LT(d.inputs(i, 1), 12.0);
+  }
 }
 
 TEST_F(DatasetTest, CorruptFilesAreRejectedWithFileAndLine) {
