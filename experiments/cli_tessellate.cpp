@@ -2,6 +2,8 @@
 
 #include "softkin/experiments/cli_args.hpp"
 #include "softkin/experiments/results.hpp"
+#include "softkin/solver/common/memory_guard.hpp"
+#include "softkin/solver/common/text_format.hpp"
 #include "softkin/solver/mesh/io/mesh_io.hpp"
 
 #include <nlohmann/json.hpp>
@@ -92,6 +94,12 @@ int RunTessellateCommand(const TessellateCommandArgs& a) {
                     {{"--out", a.out}, {"--json", a.json_out}});
   const TriangleSurface body = ReadSurfaceMesh(a.body);
   const TriangleSurface chamber = ReadSurfaceMesh(a.chamber);
+  const double tets = EstimateTessellationTets(chamber, body, o);
+  CheckMemoryEstimate("--size " + FormatNumber(o.cell_size), tets * kTessellationBytesPerTet,
+                      "about " + std::to_string(std::llround(tets)) + " tets for these surfaces",
+                      "use a larger --size");
+  std::cerr << "softkin tessellate: meshing, about " << std::llround(tets)
+            << " tets expected (CGAL Mesh_3 reports nothing until it is done)\n";
   TessellationReport rep;
   const Mesh mesh = Tessellate(chamber, body, o, &rep);
   WriteTessellation(a.out, ext, mesh);

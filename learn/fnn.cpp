@@ -135,6 +135,15 @@ Fnn Fnn::WithHiddenLayers(int inputs, const std::vector<int>& hidden, int output
   return Fnn(sizes);
 }
 
+double Fnn::CountParameters(int inputs, const std::vector<int>& hidden, int outputs) {
+  double w = 0, prev = inputs;
+  for (int h : hidden) {
+    w += static_cast<double>(h) * (prev + 1);
+    prev = h;
+  }
+  return w + static_cast<double>(outputs) * (prev + 1);
+}
+
 int Fnn::parameter_offset(int l) const {
   assert(l >= 1 && l <= num_layers());
   int off = 0;

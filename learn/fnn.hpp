@@ -119,6 +119,9 @@ class Fnn {
   explicit Fnn(const std::vector<int>& layer_sizes);
   /// Convenience: sizes {inputs, hidden..., outputs}.
   static Fnn WithHiddenLayers(int inputs, const std::vector<int>& hidden, int outputs);
+  /// W of WithHiddenLayers(inputs, hidden, outputs), as a double (no int overflow, nothing
+  /// allocated): to size a job before building the network.
+  static double CountParameters(int inputs, const std::vector<int>& hidden, int outputs);
 
   // ---- shape ----
   /// Number of weight layers L (hidden layers + 1); 0 for an empty network.

@@ -184,6 +184,12 @@ double NormalizedMse(const Fnn& net, const SampleSet& s) {
          (static_cast<double>(n.size()) * net.num_outputs());
 }
 
+double LmMemoryBytes(double num_parameters, int num_outputs, int block_size) {
+  const double rows =
+      block_size > 0 ? static_cast<double>(block_size) * num_outputs : std::max(2048, num_outputs);
+  return 8.0 * num_parameters * (2.0 * num_parameters + rows);
+}
+
 LmSummary TrainLevenbergMarquardt(Fnn& net, const SampleSet& train, const SampleSet* validation,
                                   const LmOptions& options, const SampleSet* test) {
   std::string why;

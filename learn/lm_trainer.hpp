@@ -99,6 +99,11 @@ struct LmSummary {
   std::string BriefReport() const;
 };
 
+/// Bytes the trainer allocates for a network of W parameters and n_L outputs: H and its factor
+/// (2 W^2 doubles) and one block's transposed Jacobian (W x block rows; block_size as in
+/// LmOptions, 0: automatic).
+double LmMemoryBytes(double num_parameters, int num_outputs, int block_size);
+
 /// Train `net` on `train` by Levenberg-Marquardt (see the file comment). `validation` (may be null
 /// or empty) drives early stopping; `test` (may be null or empty) is only evaluated and recorded.
 /// The sets' columns must match the network (n_0 inputs, n_L outputs) unless options.initialize

@@ -1,5 +1,8 @@
 #include "softkin/learn/train_nets.hpp"
 
+#include "softkin/solver/common/memory_guard.hpp"
+#include "softkin/solver/common/text_format.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -76,9 +79,23 @@ nlohmann::json NetTrainResult::Json() const {
   return j;
 }
 
+void CheckTrainingMemory(const std::string& name, int inputs, const NetTrainOptions& opt,
+                         int outputs) {
+  const double W = Fnn::CountParameters(inputs, opt.hidden, outputs);
+  std::string sizes = std::to_string(inputs);
+  for (int h : opt.hidden) sizes += "-" + std::to_string(h);
+  sizes += "-" + std::to_string(outputs);
+  CheckMemoryEstimate(name + ": network " + sizes, LmMemoryBytes(W, outputs, opt.lm.block_size),
+                      "Levenberg-Marquardt's W x W normal matrix and its factor, W = " +
+                          FormatNumber(W) + " weights",
+                      "use fewer hidden neurons");
+}
+
 NetTrainResult TrainNet(const SampleSet& train, const SampleSet& test, const NetTrainOptions& opt) {
   std::string why;
   if (!opt.IsValid(&why)) throw std::invalid_argument("TrainNet: " + why);
+  CheckTrainingMemory("TrainNet", static_cast<int>(train.X.cols()), opt,
+                      static_cast<int>(train.Y.cols()));
   if (train.size() < 2)
     throw std::invalid_argument("TrainNet: the training set needs >= 2 samples");
   SampleSet tr = train, val;
@@ -139,9 +156,13 @@ LearnedNets TrainNetsFromDataset(const Dataset& d, const std::string& dataset_pa
                                 "`softkin dataset --jacobian implicit` or leave jac out");
   if (!(opt.train_fraction > 0.0 && opt.train_fraction < 1.0))
     throw std::invalid_argument("train_fraction: expected a fraction in (0, 1)");
+  const int m = d.num_actuators, n_points = 3 * static_cast<int>(d.point_names.size());
+  // Refuse a network that cannot fit before any other is trained.
+  if (opt.fk) CheckTrainingMemory("N_fk (--hidden)", m, opt.fk_options, n_points);
+  if (opt.jac) CheckTrainingMemory("N_J (--hidden-jac)", m, opt.jac_options, n_points * m);
+  if (opt.ik) CheckTrainingMemory("N_ik (--hidden-ik)", 3, opt.ik_options, m);
   LearnedNets nets;
   nets.points = d.point_names;
-  const int m = d.num_actuators;
   nets.lower = d.inputs.colwise().minCoeff().transpose();
   nets.upper = d.inputs.colwise().maxCoeff().transpose();
   if (d.meta.is_object() && d.meta.contains("config") &&

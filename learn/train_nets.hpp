@@ -51,6 +51,13 @@ struct NetTrainResult {
 /// empty. Throws std::invalid_argument for invalid options or sets.
 NetTrainResult TrainNet(const SampleSet& train, const SampleSet& test, const NetTrainOptions& opt);
 
+/// Throws std::invalid_argument, naming `name` (e.g. "N_fk (--hidden)") and the estimate, if the
+/// Levenberg-Marquardt training of an inputs-hidden-outputs network would not fit in memory
+/// (LmMemoryBytes, CheckMemoryEstimate). TrainNet checks it; call it first to refuse a job before
+/// any network of it is trained.
+void CheckTrainingMemory(const std::string& name, int inputs, const NetTrainOptions& opt,
+                         int outputs);
+
 /// The largest extent, over x, y and z, of the first tracked point (columns 0-2 of P), mm: the
 /// "workspace width" that errors are quoted against (Sec. 5.3.3).
 double WorkspaceWidth(const Eigen::Ref<const Eigen::MatrixXd>& P);

@@ -2,12 +2,78 @@
 
 #include "softkin/solver/fk/actuation.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace softkin {
+
+void Model::CheckRotationsHeld(const std::vector<int>& part,
+                               const std::array<std::vector<char>, 3>& held) const {
+  // A small rigid motion u(x) = t + w x (x - o) leaves every prescribed coordinate in place iff
+  // e_d . t + (r_v x e_d) . w = 0 for each held (v, d), r_v = x_v - o. Stack these rows a = [e_d,
+  // r_v x e_d] (r in units of the part's size) into M = sum a a^T (6 x 6): a (near) zero
+  // eigenvalue is a rigid motion the held coordinates do not stop. The energy is invariant under
+  // rotations, so the solve would then "converge" to an arbitrary one.
+  const Eigen::MatrixX3d& X = scene_.mesh.vertices;
+  Eigen::Vector3d lo = X.row(part.front()).transpose(), hi = lo, o = Eigen::Vector3d::Zero();
+  int n_held = 0;
+  for (int v : part) {
+    lo = lo.cwiseMin(X.row(v).transpose());
+    hi = hi.cwiseMax(X.row(v).transpose());
+    if (held[0][v] || held[1][v] || held[2][v]) {
+      o += X.row(v).transpose();
+      ++n_held;
+    }
+  }
+  const double size = (hi - lo).norm();
+  if (n_held == 0 || !(size > 0)) return;  // translations: reported per axis before
+  o /= n_held;
+  Eigen::Matrix<double, 6, 6> M = Eigen::Matrix<double, 6, 6>::Zero();
+  for (int v : part)
+    for (int d = 0; d < 3; ++d) {
+      if (!held[d][v]) continue;
+      const Eigen::Vector3d r = (X.row(v).transpose() - o) / size;
+      Eigen::Matrix<double, 6, 1> a;
+      a.head<3>() = Eigen::Vector3d::Unit(d);
+      a.tail<3>() = r.cross(Eigen::Vector3d::Unit(d));
+      M += a * a.transpose();
+    }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(M);
+  // The rows have norm ~1; a gap of 1e-10 to the largest eigenvalue separates a genuinely held
+  // set (a fixed face: ~(width / size)^2 per vertex) from a collinear one (rounding only).
+  if (eig.eigenvalues()[0] > 1e-10 * eig.eigenvalues()[5]) return;
+  const Eigen::Matrix<double, 6, 1> z = eig.eigenvectors().col(0);
+  Eigen::Vector3d w = z.tail<3>();
+  std::string what;
+  char buf[200];
+  if (w.norm() > 1e-6) {
+    w.normalize();
+    std::snprintf(buf, sizeof(buf), "rotate about the axis [%.3g, %.3g, %.3g]", w.x(), w.y(),
+                  w.z());
+    what = buf;
+  } else {
+    const Eigen::Vector3d t = z.head<3>().normalized();
+    std::snprintf(buf, sizeof(buf), "slide along [%.3g, %.3g, %.3g]", t.x(), t.y(), t.z());
+    what = buf;
+  }
+  std::string where;
+  for (int v : part)
+    if (held[0][v] || held[1][v] || held[2][v]) {
+      where = "vertex " + std::to_string(v);
+      break;
+    }
+  throw std::invalid_argument(
+      "scene '" + scene_.name + "': the connected part of the mesh with vertex " +
+      std::to_string(part.front()) + " has " + std::to_string(n_held) +
+      " held vertex(es) (first: " + where + "), which leave a rigid motion free: it could " + what +
+      " (a rigid-motion null space: the energy does not change, so the answer would be "
+      "arbitrary). Hold at least three non-collinear points of each part, e.g. a whole face");
+}
 
 Model::Model(const Scene& scene) : scene_(scene) {
   scene_.validate();
@@ -172,6 +238,11 @@ void Model::SetUpConstraints() {
               std::string(1, "xyz"[d]) + " (a rigid-motion null space)");
       }
     }
+    std::vector<std::vector<int>> parts(nv);
+    for (int v = 0; v < nv; ++v)
+      if (!inc_offset_.empty() && inc_offset_[v + 1] > inc_offset_[v]) parts[find(v)].push_back(v);
+    for (const std::vector<int>& part : parts)
+      if (!part.empty()) CheckRotationsHeld(part, held);
   }
 
   const auto t0 = std::chrono::steady_clock::now();

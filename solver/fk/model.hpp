@@ -149,6 +149,11 @@ class Model {
   double factor_time_s() const { return factor_time_s_; }
 
  private:
+  /// Throws std::invalid_argument if the coordinates held in one connected part of the mesh
+  /// (`part`: its vertices; held[d][v]: coordinate d of v is prescribed) leave a rigid motion of
+  /// that part free, e.g. a rotation about a single fixed vertex or a line of fixed vertices.
+  void CheckRotationsHeld(const std::vector<int>& part,
+                          const std::array<std::vector<char>, 3>& held) const;
   struct Group {
     int actuator = -1, side = 0;
     std::vector<int> elements;

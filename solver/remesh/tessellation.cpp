@@ -2,6 +2,8 @@
 // tetrahedral remeshing (tessellation.hpp). All of SoftKin's CGAL meshing lives in this file so
 // that only one translation unit pays for Mesh_3's compile time.
 #include "softkin/solver/remesh/tessellation.hpp"
+
+#include "softkin/solver/common/memory_guard.hpp"
 #include "softkin/solver/common/text_format.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -169,6 +171,29 @@ double EnclosedVolume(const TriangleSurface& s) {
   return v / 6.0;
 }
 
+double EstimateTessellationTets(const TriangleSurface& chamber, const TriangleSurface& body,
+                                const TessellationOptions& opt) {
+  // A regular tet of circumradius R has edge 4 R / sqrt(6) and volume (edge)^3 / (6 sqrt(2));
+  // Mesh_3's tets are smaller than the bound: 2.2-2.5 times as many (a box at sizes 2 and 0.5).
+  auto tet_volume = [](double r) {
+    const double a = 4.0 * r / std::sqrt(6.0);
+    return a * a * a / (6.0 * std::sqrt(2.0));
+  };
+  const double ccs = opt.chamber_cell_size > 0 ? opt.chamber_cell_size : opt.cell_size;
+  const double fs = opt.facet_size > 0 ? opt.facet_size : opt.cell_size;
+  const double vc = std::abs(EnclosedVolume(chamber)), vb = std::abs(EnclosedVolume(body)) - vc;
+  double area = 0;  // one tet per surface facet of circumradius fs (equilateral: 3 sqrt(3)/4 fs^2)
+  for (const TriangleSurface* s : {&chamber, &body})
+    for (int f = 0; f < s->faces.rows(); ++f) {
+      const Eigen::Vector3d a = s->vertices.row(s->faces(f, 0)).transpose();
+      const Eigen::Vector3d b = s->vertices.row(s->faces(f, 1)).transpose();
+      const Eigen::Vector3d c = s->vertices.row(s->faces(f, 2)).transpose();
+      area += 0.5 * (b - a).cross(c - a).norm();
+    }
+  return 2.5 * (std::max(vb, 0.0) / tet_volume(opt.cell_size) + vc / tet_volume(ccs)) +
+         area / (0.75 * std::sqrt(3.0) * fs * fs);
+}
+
 void CheckChamberInBody(TriangleSurface* chamber, TriangleSurface* body) {
   const std::string sc = SourceOf(*chamber, "chamber surface"),
                     sb = SourceOf(*body, "body surface");
@@ -213,6 +238,12 @@ Mesh Tessellate(const TriangleSurface& chamber_in, const TriangleSurface& body_i
   if (!opt.IsValid(&why)) throw std::invalid_argument("tessellation option " + why);
   TriangleSurface chamber = chamber_in, body = body_in;
   CheckChamberInBody(&chamber, &body);
+  const double tets = EstimateTessellationTets(chamber, body, opt);
+  CheckMemoryEstimate("tessellation cell size " + FormatNumber(opt.cell_size) + " mm",
+                      tets * kTessellationBytesPerTet,
+                      "about " + std::to_string(std::llround(tets)) + " tets at " +
+                          std::to_string(kTessellationBytesPerTet) + " bytes each",
+                      "use a larger cell size");
 
   // Mesh_3's randomness: the domain's generator and CGAL's default one (used by the refinement
   // and exudation steps). Sliver perturbation is off: it is time-limited, hence not reproducible.

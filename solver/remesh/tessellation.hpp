@@ -81,13 +81,22 @@ double EnclosedVolume(const TriangleSurface& s);
 /// body). Throws std::invalid_argument naming the surface's `source` and what was expected.
 void CheckChamberInBody(TriangleSurface* chamber, TriangleSurface* body);
 
+/// Roughly the number of tets Tessellate makes for these surfaces and sizes (within ~30 % on
+/// boxes): 2.5 times the volumes over that of a regular tet of the cell size's circumradius, plus
+/// one tet per surface facet. Tessellate refuses a mesh whose estimate, at
+/// kTessellationBytesPerTet (Mesh_3's peak: ~0.55 KiB per tet measured), would not fit in memory.
+double EstimateTessellationTets(const TriangleSurface& chamber, const TriangleSurface& body,
+                                const TessellationOptions& options);
+constexpr int kTessellationBytesPerTet = 1024;
+
 /// T(S_c, S_b): the labelled tet mesh of the body S_b with the chamber S_c inside it.
 /// chamber, body: closed triangle surfaces (#V x 3 mm, #F x 3 indices; checked with
 /// CheckChamberInBody). Returns the tets of the body (tag options.body_region) and of the chamber
 /// (tag options.chamber_region), positively oriented (mesh.hpp), vertices numbered in order of
 /// first use, no unused vertices. Throws std::invalid_argument for bad surfaces or options and
 /// std::runtime_error if Mesh_3 produces no tets of a region (e.g. sizes far larger than the
-/// chamber).
+/// chamber); std::invalid_argument before meshing if the estimated mesh would not fit in memory
+/// (CheckMemoryEstimate).
 Mesh Tessellate(const TriangleSurface& chamber, const TriangleSurface& body,
                 const TessellationOptions& options = {}, TessellationReport* report = nullptr);
 

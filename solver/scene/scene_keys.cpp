@@ -250,9 +250,10 @@ void AddObstacleKeys(std::vector<KeySpec>* t) {
   t->push_back(Key("obstacles[].height", N, R, "Cylinder length along the axis (mm).")
                    .Above(0.0)
                    .Roles({"cylinder"}));
-  t->push_back(Key("obstacles[].segments", I, Opt, "Number of sides of the cylinder's polygon.")
+  t->push_back(Key("obstacles[].segments", I, Opt,
+                   "Number of sides of the cylinder's polygon (4 triangles each).")
                    .Def(48)
-                   .AtLeast(3)
+                   .In(3, 100000)
                    .Roles({"cylinder"}));
   t->push_back(
       Key("obstacles[].file", S, R, "Surface file (.obj or .stl), relative to the JSON's folder.")

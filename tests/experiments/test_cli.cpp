@@ -469,6 +469,13 @@ TEST(Cli, TessellateMeshesABoxChamberInABoxBody) {
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("big.obj"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("strictly inside"), std::string::npos) << r.out;
+  // A size whose mesh cannot fit in memory (~1e9 tets here) is refused before meshing.
+  r = Cli("tessellate --body " + dir + "/body.obj --chamber " + dir +
+          "/chamber.obj --size 0.01 --out " + dir + "/fine.vtk");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("--size 0.01: needs an estimated"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("use a larger --size"), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/fine.vtk"));
   // Bad sizes and output formats name the flag.
   r = Cli("tessellate --body " + dir + "/body.obj --chamber " + dir +
           "/chamber.obj --size -1 --out " + dir + "/m.vtk");
@@ -804,6 +811,20 @@ TEST(Cli, TrainRefusesAMissingOrForeignSidecar) {
   EXPECT_FALSE(std::filesystem::exists(dir + "/nets_bounds.csv/nets.json"));
   r = train("d.csv");  // its own sidecar
   EXPECT_EQ(r.code, 0) << r.out;
+  // A network whose Levenberg-Marquardt matrices cannot fit is refused with the option and the
+  // estimate, before any network of the job is trained.
+  r = Cli("train --dataset " + dir + "/d.csv --out " + dir +
+          "/wide --hidden 10000,10000 --what fk --quiet");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("N_fk (--hidden): network 3-10000-10000-3: needs an estimated"),
+            std::string::npos)
+      << r.out;
+  r = Cli("train --dataset " + dir + "/d.csv --out " + dir +
+          "/wide_ik --hidden 4 --hidden-ik 10000,10000 --what fk,ik --quiet");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("N_ik (--hidden-ik)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("use fewer hidden neurons"), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/wide_ik/fk.fnn"));
 }
 
 TEST(Cli, TrainAndLearnedIkFromADataset) {

@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <random>
 
@@ -35,14 +37,23 @@ Scene CableBar(int body_cells) {
       {Cable("tendon", {1}, path)}, "cable_bar");
 }
 
-/// An 6 x 6 one-layer prism sheet (edge 2, thickness 2), every prism a DEA element; one corner
-/// vertex fixed (the sheet is free to grow in its plane).
+/// An 6 x 6 one-layer prism sheet (edge 2, thickness 2), every prism a DEA element; held 3-2-1
+/// on its bottom corners (free to grow in its plane and in thickness, no rigid motion left): the
+/// corner at the origin fixed, the one at x = 12 held on y and z, the one at y = 12 on z.
 Scene DeaSheet() {
   Scene s;
   s.name = "dea_sheet";
   s.mesh = test::PrismSlab(6, 6, 1, 2.0, [](int, int, int) { return 1; });
   s.actuators = {Dea("skin", {1})};
-  s.fixed = {0};
+  auto at = [&s](double x, double y) {
+    for (int v = 0; v < s.mesh.num_vertices(); ++v)
+      if ((s.mesh.vertices.row(v) - Eigen::RowVector3d(x, y, 0.0)).norm() < 1e-9) return v;
+    ADD_FAILURE() << "no vertex at (" << x << ", " << y << ", 0)";
+    return 0;
+  };
+  s.fixed = {at(0, 0)};
+  s.fixed_axis[1] = {at(12, 0)};
+  s.fixed_axis[2] = {std::min(at(12, 0), at(0, 12)), std::max(at(12, 0), at(0, 12))};
   std::vector<int> all(s.mesh.num_vertices());
   for (int i = 0; i < s.mesh.num_vertices(); ++i) all[i] = i;
   s.markers = {{"all", all}};

@@ -560,5 +560,69 @@ TEST(Constraints, SymmetryPlaneHalfModelMatchesFullModel) {
   EXPECT_NEAR(rh.volume_ratios[0], rf.volume_ratios[0], 1e-7);
 }
 
+// Supports that leave a rigid rotation free are refused when the model is built, naming the
+// axis: one fixed vertex, a line of fixed vertices (a hinge), a plane held on z with one vertex
+// fixed (a spin about z). A whole face, and the 3-2-1 support that holds nothing but the rigid
+// motion, pass.
+TEST(RigidNullSpace, SupportsThatLeaveARotationFreeAreRefused) {
+  auto bar = []() {
+    Scene s = test::VoxelScene(
+        {4, 2, 2}, 1.0, [](const Eigen::Vector3i&) { return 0; }, {{0, Material{"body", 1.0, 1.0}}},
+        {}, "bar");
+    s.fixed.clear();
+    return s;
+  };
+  auto vertex_at = [](const Scene& s, double x, double y, double z) {
+    for (int v = 0; v < s.mesh.num_vertices(); ++v)
+      if ((s.mesh.vertices.row(v) - Eigen::RowVector3d(x, y, z)).norm() < 1e-9) return v;
+    ADD_FAILURE() << "no vertex at " << x << ", " << y << ", " << z;
+    return 0;
+  };
+  auto refusal = [](const Scene& s) -> std::string {
+    try {
+      const Model m(s);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "";
+  };
+  {
+    Scene s = bar();
+    s.fixed = {vertex_at(s, 0, 0, 0)};
+    const std::string e = refusal(s);
+    EXPECT_NE(e.find("rigid-motion null space"), std::string::npos) << e;
+    EXPECT_NE(e.find("could rotate about the axis"), std::string::npos) << e;
+    EXPECT_NE(e.find("three non-collinear points"), std::string::npos) << e;
+  }
+  {
+    Scene s = bar();  // a hinge along y at x = 0, z = 0
+    s.fixed = {vertex_at(s, 0, 0, 0), vertex_at(s, 0, 1, 0), vertex_at(s, 0, 2, 0)};
+    const std::string e = refusal(s);
+    EXPECT_NE(e.find("could rotate about the axis [0, 1, 0]"), std::string::npos) << e;
+  }
+  {
+    Scene s = bar();  // resting on z = 0 (held on z), one vertex pinned: free to spin about z
+    for (int v = 0; v < s.mesh.num_vertices(); ++v)
+      if (s.mesh.vertices(v, 2) == 0.0) s.fixed_axis[2].push_back(v);
+    s.fixed = {vertex_at(s, 0, 0, 0)};
+    const std::string e = refusal(s);
+    EXPECT_NE(e.find("could rotate about the axis [0, 0, 1]"), std::string::npos) << e;
+  }
+  {
+    Scene s = bar();  // the x = 0 face
+    for (int v = 0; v < s.mesh.num_vertices(); ++v)
+      if (s.mesh.vertices(v, 0) == 0.0) s.fixed.push_back(v);
+    EXPECT_EQ(refusal(s), "");
+  }
+  {
+    Scene s = bar();  // 3-2-1: the origin fixed, (4, 0, 0) held on y and z, (0, 2, 0) on z
+    const int a = vertex_at(s, 0, 0, 0), b = vertex_at(s, 4, 0, 0), c = vertex_at(s, 0, 2, 0);
+    s.fixed = {a};
+    s.fixed_axis[1] = {b};
+    s.fixed_axis[2] = {std::min(b, c), std::max(b, c)};
+    EXPECT_EQ(refusal(s), "");
+  }
+}
+
 }  // namespace
 }  // namespace softkin

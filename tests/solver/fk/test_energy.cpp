@@ -567,7 +567,8 @@ TEST(Targets, ShapesPerElementTypeTets) { CheckTargets(Model(MixedTetScene()), "
 TEST(Targets, ShapesPerElementTypePrisms) { CheckTargets(Model(MixedPrismScene()), "prisms"); }
 
 TEST(Targets, SinglePneumaticTetScene) {
-  // One tet, all pneumatic, vertex 0 fixed.
+  // One tet, all pneumatic, held 3-2-1 (no rigid motion left, free to deform): vertex 0 fixed,
+  // vertex 1 held on y and z, vertex 2 on z.
   Scene s;
   s.name = "one_tet";
   s.mesh.vertices.resize(4, 3);
@@ -578,6 +579,8 @@ TEST(Targets, SinglePneumaticTetScene) {
   s.mesh.elements = {e};
   s.actuators = {Pneumatic("p", {5})};
   s.fixed = {0};
+  s.fixed_axis[1] = {1};
+  s.fixed_axis[2] = {1, 2};
   s.validate();
   const Model m(s);
   std::mt19937 rng(5);

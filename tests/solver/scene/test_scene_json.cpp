@@ -705,6 +705,10 @@ TEST(SceneJsonErrors, ObstaclesAndCollisionOptions) {
                    {"obstacles[0].file: file not found", "no_such_surface.obj"});
   ExpectSceneError(with_obstacle(json::parse(R"({"type": "sphere"})")),
                    {"obstacles[0].type: expected one of: box, cylinder, file"});
+  // A polygon of 1e9 sides would allocate gigabytes: the key's range says where the limit is.
+  ExpectSceneError(with_obstacle(json::parse(R"({"type": "cylinder", "base": [9, 0, 0],
+      "axis": [0, 0, 1], "radius": 1, "height": 2, "segments": 1e9})")),
+                   {"obstacles[0].segments: expected an integer in [3, 100000]"});
   json j = SignedMotionScene();
   j["solver"]["collision"] = json::parse(R"({"self": "yes"})");
   ExpectSceneError(j, {"solver.collision.self: expected a boolean (true or false)"});
