@@ -33,8 +33,7 @@ void CheckMemoryEstimate(const std::string& what, double bytes, const std::strin
   const double budget = kMemoryBudgetFraction * have;
   if (std::isfinite(bytes) && bytes <= budget) return;
   const std::string need = std::isfinite(bytes) ? FormatBytes(bytes) : std::string("unbounded");
-  throw std::invalid_argument(what + ": needs an estimated " + need + " (" + how +
-                              "), more than " +
+  throw std::invalid_argument(what + ": needs an estimated " + need + " (" + how + "), more than " +
                               std::to_string(static_cast<int>(100 * kMemoryBudgetFraction)) +
                               " % of this machine's " + FormatBytes(have) + "; " + advice);
 }

@@ -195,7 +195,7 @@ Scene MakeTwistingRobot(int res, const RobotParams& P) {
   a.regions = {1};
   a.rest = 1.0;
   a.min = 1.0;
-  a.max = kTwistMaxAlpha;
+  a.max = Param(P, "max_ratio", kTwistDefaultMaxRatio);
   s.actuators.push_back(a);
   const double eps = 1e-6 * kTwistLength;
   s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), eps);
@@ -220,7 +220,8 @@ RobotEntry TwistingRobotEntry() {
       "Plant-inspired twisting robot (thesis Sec. 3.4.1, Fig. 3.7-3.8): a 100 mm long cylinder of "
       "radius 10 mm (z = long axis, z = 0 fixed, tip face z = 100) of Ecoflex 00-30 (Mooney-Rivlin "
       "c1 = 0.0418, c2 = 0.0106 MPa; region 0) with a spiral tube chamber (region 1, pneumatic "
-      "actuator 'chamber', volume ratio in [1, 120]) around the helix of radius helix_radius from "
+      "actuator 'chamber', volume ratio in [1, max_ratio], 3 by default, up to 120 with remeshing) "
+      "around the helix of radius helix_radius from "
       "z = 8 to 92, meshed by CGAL Mesh_3 from generated surfaces, T(S_c, S_b) "
       "(solver/remesh/tessellation.hpp). For large ratios use progressive remeshing "
       "(solver/remesh/remesh.hpp). "
@@ -239,7 +240,12 @@ RobotEntry TwistingRobotEntry() {
         "thickness (mm, from the +x side) of a strain-limiting strip along the body (region 2); 0: "
         "none. "
         "With a strip the robot bends toward +x as it twists, and coils (Fig. 3.8)"},
-       {"strip_weight", 20.0, 1.0, 1000.0, "the strip's element weight, relative to the body's"}}};
+       {"strip_weight", 20.0, 1.0, 1000.0, "the strip's element weight, relative to the body's"},
+       {"max_ratio", kTwistDefaultMaxRatio, 1.5, kTwistMaxAlpha,
+        "top of the chamber's volume-ratio range. Solved on the initial mesh the body stays free "
+        "of inverted elements up to about 3 (res 1: one inverted tet at 3.5 with the Mooney-Rivlin "
+        "body, at 4 with shape blending); beyond, chamber-wall tets fold. Raise it (to 120) with "
+        "progressive remeshing (fig3_7_twisting_remesh) or to study the folded states"}}};
   return {info, kTwistMinRes, kTwistMaxRes, &MakeTwistingRobot};
 }
 
