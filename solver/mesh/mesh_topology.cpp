@@ -7,38 +7,12 @@
 #include <cmath>
 #include <tuple>
 
+#include "softkin/solver/mesh/element_faces.hpp"
 #include "softkin/solver/mesh/mesh.hpp"
 
 namespace softkin {
 
 namespace {
-
-/// Local faces of a positively oriented element, listed so that their normals (right-hand rule)
-/// point out of the element; d = -1 for triangles.
-struct LocalFace {
-  int a, b, c, d;
-};
-constexpr LocalFace kTetFaces[4] = {{0, 2, 1, -1}, {0, 1, 3, -1}, {1, 2, 3, -1}, {0, 3, 2, -1}};
-constexpr LocalFace kPrismFaces[5] = {
-    {0, 2, 1, -1}, {3, 4, 5, -1}, {0, 1, 4, 3}, {1, 2, 5, 4}, {2, 0, 3, 5}};
-
-/// One element face: its sorted vertex set (INT_MAX pads a triangle), its owner and which way its
-/// cycle turns (true when, starting at the smallest vertex, the next vertex is smaller than the
-/// previous one). Two faces with the same set and the same turn are oriented alike.
-struct FaceRec {
-  std::array<int, 4> key;
-  int element;
-  bool turn;
-};
-
-FaceRec MakeFace(const Element& e, const LocalFace& f, int element) {
-  std::array<int, 4> cyc = {e.v[f.a], e.v[f.b], e.v[f.c], f.d >= 0 ? e.v[f.d] : INT_MAX};
-  const int n = f.d >= 0 ? 4 : 3;
-  const int m = static_cast<int>(std::min_element(cyc.begin(), cyc.begin() + n) - cyc.begin());
-  const bool turn = cyc[(m + 1) % n] < cyc[(m + n - 1) % n];
-  std::sort(cyc.begin(), cyc.end());
-  return {cyc, element, turn};
-}
 
 void AddPair(int a, int b, std::vector<std::pair<int, int>>* out) {
   out->emplace_back(std::min(a, b), std::max(a, b));
@@ -47,18 +21,7 @@ void AddPair(int a, int b, std::vector<std::pair<int, int>>* out) {
 }  // namespace
 
 std::vector<std::pair<int, int>> FoldedElementPairs(const Mesh& mesh) {
-  std::vector<FaceRec> faces;
-  faces.reserve(static_cast<std::size_t>(mesh.num_tets()) * 4 +
-                static_cast<std::size_t>(mesh.num_prisms()) * 5);
-  for (int i = 0; i < mesh.num_elements(); ++i) {
-    const Element& e = mesh.elements[i];
-    const bool tet = e.type == ElementType::Tet;
-    for (int f = 0; f < (tet ? 4 : 5); ++f)
-      faces.push_back(MakeFace(e, (tet ? kTetFaces : kPrismFaces)[f], i));
-  }
-  std::sort(faces.begin(), faces.end(), [](const FaceRec& a, const FaceRec& b) {
-    return std::tie(a.key, a.element) < std::tie(b.key, b.element);
-  });
+  const std::vector<MeshFace> faces = SortedMeshFaces(mesh);
   std::vector<std::pair<int, int>> out;
   for (std::size_t i = 0; i < faces.size();) {
     std::size_t j = i + 1;

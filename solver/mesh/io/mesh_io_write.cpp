@@ -3,11 +3,13 @@
 /// the per-element strain measure.
 #include <algorithm>
 #include <Eigen/Dense>
+#include <climits>
 #include <cmath>
 #include <limits>
 
 #include "softkin/solver/mesh/io/mesh_io.hpp"
 #include "softkin/solver/mesh/io/mesh_io_detail.hpp"
+#include "softkin/solver/mesh/element_faces.hpp"
 
 namespace softkin {
 
@@ -46,15 +48,6 @@ std::string XmlEscape(const std::string& s) {
   }
   return r;
 }
-
-/// Local faces of a positively oriented element, listed so that their normals (right-hand rule)
-/// point out of the element. Triangles have d = -1.
-struct LocalFace {
-  int a, b, c, d;
-};
-constexpr LocalFace kTetFaces[4] = {{0, 2, 1, -1}, {0, 1, 3, -1}, {1, 2, 3, -1}, {0, 3, 2, -1}};
-constexpr LocalFace kPrismFaces[5] = {
-    {0, 2, 1, -1}, {3, 4, 5, -1}, {0, 1, 4, 3}, {1, 2, 5, 4}, {2, 0, 3, 5}};
 
 }  // namespace
 
@@ -219,33 +212,11 @@ void WritePvd(const std::string& path, const std::vector<std::pair<double, std::
 void WriteSurfaceObj(const std::string& path, const Mesh& mesh,
                      const Eigen::Ref<const Eigen::MatrixX3d>& X) {
   CheckPositions(path, mesh, X);
-  // Every element face as (sorted vertex key, element, local face); faces that occur once are on
-  // the boundary. Sorting a flat array avoids hashing and per-face allocation.
-  struct FaceRec {
-    std::array<int, 4> key;  // sorted vertex ids, key[3] = INT_MAX for triangles
-    int element;
-    int local;
-  };
-  std::vector<FaceRec> faces;
-  faces.reserve(static_cast<std::size_t>(mesh.num_tets()) * 4 +
-                static_cast<std::size_t>(mesh.num_prisms()) * 5);
-  for (int i = 0; i < mesh.num_elements(); ++i) {
-    const Element& e = mesh.elements[i];
-    const bool tet = e.type == ElementType::Tet;
-    const LocalFace* lf = tet ? kTetFaces : kPrismFaces;
-    const int nf = tet ? 4 : 5;
-    for (int f = 0; f < nf; ++f) {
-      FaceRec r{
-          {e.v[lf[f].a], e.v[lf[f].b], e.v[lf[f].c], lf[f].d >= 0 ? e.v[lf[f].d] : INT_MAX}, i, f};
-      std::sort(r.key.begin(), r.key.end());
-      faces.push_back(r);
-    }
-  }
-  std::sort(faces.begin(), faces.end(),
-            [](const FaceRec& a, const FaceRec& b) { return a.key < b.key; });
+  // Faces that occur once are on the boundary.
+  const std::vector<MeshFace> faces = SortedMeshFaces(mesh);
 
   std::vector<int> new_index(mesh.num_vertices(), -1);
-  std::vector<const FaceRec*> boundary;
+  std::vector<const MeshFace*> boundary;
   int nused = 0;
   for (std::size_t i = 0; i < faces.size();) {
     std::size_t j = i + 1;
@@ -268,7 +239,7 @@ void WriteSurfaceObj(const std::string& path, const Mesh& mesh,
       new_index[v] = nused++;
       order.push_back(v);
     }
-  std::sort(boundary.begin(), boundary.end(), [](const FaceRec* a, const FaceRec* b) {
+  std::sort(boundary.begin(), boundary.end(), [](const MeshFace* a, const MeshFace* b) {
     return a->element != b->element ? a->element < b->element : a->local < b->local;
   });
 
@@ -277,7 +248,7 @@ void WriteSurfaceObj(const std::string& path, const Mesh& mesh,
   out << "# SoftKin boundary surface: " << order.size() << " vertices, " << boundary.size()
       << " faces\n";
   for (int v : order) detail::WriteRow(out << "v ", X, v) << '\n';
-  for (const FaceRec* r : boundary) {
+  for (const MeshFace* r : boundary) {
     const Element& e = mesh.elements[r->element];
     const LocalFace& lf = (e.type == ElementType::Tet ? kTetFaces : kPrismFaces)[r->local];
     out << "f " << new_index[e.v[lf.a]] + 1 << ' ' << new_index[e.v[lf.b]] + 1 << ' '
