@@ -55,6 +55,7 @@ Config Config::Load(const std::string& path, bool quick) {
   if (!c.j_.is_object()) throw std::invalid_argument(path + ": expected a JSON object at the top");
   if (c.j_.contains("quick")) {
     if (!c.j_["quick"].is_object()) c.Fail("quick", "an object of overrides");
+    c.has_quick_ = true;
     nlohmann::json q = c.j_["quick"];
     // Checked in both modes, so that a full run's validation (the experiment's getters) also
     // covers the kind of every value a quick run puts in its place, and the other way round.

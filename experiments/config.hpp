@@ -25,6 +25,13 @@ class Config {
   const std::string& path() const { return path_; }
   unsigned seed() const { return seed_; }
   bool quick() const { return quick_; }
+  /// Whether the file has a "quick" object (whose overrides a quick run puts in place).
+  bool has_quick() const { return has_quick_; }
+  /// Set on a config that is only to be checked: each experiment reads and checks all its
+  /// settings, then returns at once when this is set. A --quick run checks the full settings this
+  /// way first, so that a value its overrides hide cannot wait to fail in the full run.
+  bool check_only() const { return check_only_; }
+  void set_check_only(bool on) { check_only_ = on; }
   /// The effective config (after merging quick), as recorded in results.
   const nlohmann::json& json() const { return j_; }
 
@@ -51,7 +58,7 @@ class Config {
  private:
   std::string path_, name_, type_;
   unsigned seed_ = 0;
-  bool quick_ = false;
+  bool quick_ = false, has_quick_ = false, check_only_ = false;
   nlohmann::json j_;
   mutable std::set<std::string> used_;
 };

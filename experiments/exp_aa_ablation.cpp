@@ -147,6 +147,7 @@ nlohmann::json RunCase(const AaAblationParams& p, const std::string& robot, cons
 
 nlohmann::json RunAaAblation(const Config& cfg, const std::string& dir, bool verbose) {
   const AaAblationParams p = ReadAaAblationParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   CsvWriter csv(dir + "/aa_ablation.csv",
                 {"robot", "level", "variant", "iterations", "time_s", "energy", "status",
                  "aa_accepted", "aa_rejected", "iteration_ratio", "time_ratio"});

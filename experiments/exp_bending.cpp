@@ -187,6 +187,7 @@ BendingSweep Sweep(const BendingParams& p, const std::shared_ptr<const Model>& m
 
 nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bool verbose) {
   const BendingParams p = ReadBendingParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   const Scene& scene = p.scene;
   const auto t_model0 = std::chrono::steady_clock::now();
   auto model = std::make_shared<const Model>(scene);

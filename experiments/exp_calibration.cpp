@@ -150,6 +150,7 @@ nlohmann::json CalibrateRm(const Config& cfg, const CalibrationParams& p, size_t
 
 nlohmann::json RunCalibration(const Config& cfg, const std::string& dir, bool verbose) {
   const CalibrationParams p = ReadCalibrationParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   const nlohmann::json curve_j = CalibrationCurve(p, dir, verbose);
   CsvWriter cal_csv(dir + "/calibration.csv",
                     {"rm", "res", "tets", "r_omega_ratio", "r_omega_a", "r_omega_b", "achieved_rm",

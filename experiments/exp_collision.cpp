@@ -703,6 +703,7 @@ nlohmann::json RunCostsRobot(const Config& cfg, const CollisionCostsParams& p, c
 
 nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool verbose) {
   const CollisionSweepParams p = ReadCollisionSweepParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   std::filesystem::create_directories(dir + "/frames");
   CsvWriter csv(dir + "/steps.csv", {"variant",
                                      "step",
@@ -749,6 +750,7 @@ nlohmann::json RunCollisionSweep(const Config& cfg, const std::string& dir, bool
 
 nlohmann::json RunCollisionCosts(const Config& cfg, const std::string& dir, bool verbose) {
   const CollisionCostsParams p = ReadCollisionCostsParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   CsvWriter csv(dir + "/costs.csv",
                 {"robot", "label", "tets", "mesh_gen_s", "col_check_s", "col_resp_s", "solver_s",
                  "step_s", "steps", "collision_free"});

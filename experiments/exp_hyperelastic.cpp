@@ -110,6 +110,7 @@ nlohmann::json FitMaterial(const Config& cfg, const HyperelasticParams& p, const
 
 nlohmann::json RunHyperelasticFit(const Config& cfg, const std::string& dir, bool verbose) {
   const HyperelasticParams p = ReadHyperelasticParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   CsvWriter curve_csv(dir + "/curve.csv", {"material", "strain", "r_omega"});
   CsvWriter resp_csv(dir + "/response.csv",
                      {"material", "end_stretch", "mid_stretch", "mooney_rivlin", "law_homogeneous",

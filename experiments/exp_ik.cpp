@@ -277,6 +277,7 @@ nlohmann::json MethodRow(const IkMethodsParams& p, const std::shared_ptr<const M
 
 nlohmann::json RunIkInitialGuess(const Config& cfg, const std::string& dir, bool verbose) {
   const InitialGuessParams p = ReadInitialGuessParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   const IkExperimentSetup& s = p.s;
   SimulatorKinematics kin(s.scene, s.KinematicsFor({s.point}), &s.fk);
   Eigen::VectorXd c_target;
@@ -325,6 +326,7 @@ nlohmann::json RunIkInitialGuess(const Config& cfg, const std::string& dir, bool
 
 nlohmann::json RunIkTrajectory(const Config& cfg, const std::string& dir, bool verbose) {
   const TrajectoryParams p = ReadTrajectoryParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   const IkExperimentSetup& s = p.s;
   const nlohmann::json& paths = p.paths;
   SimulatorKinematics kin(s.scene, s.KinematicsFor({s.point}), &s.fk);
@@ -365,6 +367,7 @@ nlohmann::json RunIkTrajectory(const Config& cfg, const std::string& dir, bool v
 
 nlohmann::json RunIkMethods(const Config& cfg, const std::string& dir, bool verbose) {
   const IkMethodsParams p = ReadIkMethodsParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   const IkExperimentSetup& s = p.s;
   auto model = std::make_shared<const Model>(s.scene);
   SimulatorKinematics probe(model, s.KinematicsFor({s.point}), &s.fk);

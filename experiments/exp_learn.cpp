@@ -126,6 +126,7 @@ nlohmann::json ArchitectureRow(const ArchitectureParams& p, const ArchitectureDa
 
 nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, bool verbose) {
   const ArchitectureParams p = ReadArchitectureParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   // Resume: every finished network is appended to architecture.jsonl with the settings that
   // produced it; a rerun reuses the rows whose settings match and trains only the others.
   ResumeJournal journal(dir + "/architecture.jsonl");
@@ -341,6 +342,7 @@ nlohmann::json IkMethodRow(const IkMethodsSetup& s, const std::string& method, C
 
 nlohmann::json RunLearnIkMethods(const Config& cfg, const std::string& dir, bool verbose) {
   const IkMethodsParams p = ReadIkMethodsParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   // Data and networks.
   nlohmann::json dinfo;
   const Dataset d = CachedDataset(p.spec, DatasetCacheDir(dir), verbose, &dinfo);
@@ -542,6 +544,7 @@ MethodPath DirectPath(const LearnedNets& nets, const Eigen::MatrixX3d& waypoints
 
 nlohmann::json RunLearnRedundantPath(const Config& cfg, const std::string& dir, bool verbose) {
   const RedundantPathParams p = ReadRedundantPathParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   nlohmann::json dinfo;
   const Dataset d = CachedDataset(p.spec, DatasetCacheDir(dir), verbose, &dinfo);
   LearnedNets nets = CachedNets(d, dinfo["path"].get<std::string>(), p.spec.Tag(), p.nets,

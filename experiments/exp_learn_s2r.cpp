@@ -124,6 +124,7 @@ nlohmann::json S2rRow(const DataSourceParams& p, const std::string& source, cons
 
 nlohmann::json RunLearnDataSource(const Config& cfg, const std::string& dir, bool verbose) {
   const DataSourceParams p = ReadDataSourceParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   nlohmann::json sim_info, twin_info;
   const Dataset sim = CachedDataset(p.sim_spec, DatasetCacheDir(dir), verbose, &sim_info);
   const Dataset twin = CachedDataset(p.twin_spec, DatasetCacheDir(dir), verbose, &twin_info);
@@ -281,6 +282,7 @@ void SweepTwin(const S2rSweepParams& p, const DatasetSpec& ts, const Dataset& tw
 
 nlohmann::json RunLearnS2rSweep(const Config& cfg, const std::string& dir, bool verbose) {
   const S2rSweepParams p = ReadS2rSweepParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   nlohmann::json sim_info;
   const Dataset sim = CachedDataset(p.sim_spec, DatasetCacheDir(dir), verbose, &sim_info);
   NetsFromDatasetOptions o;
@@ -395,6 +397,7 @@ nlohmann::json TwinPathRow(const DatasetSpec& ts, const LearnedNets& nets, bool 
 
 nlohmann::json RunLearnS2rPaths(const Config& cfg, const std::string& dir, bool verbose) {
   const S2rPathsParams p = ReadS2rPathsParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   nlohmann::json sim_info;
   const Dataset sim = CachedDataset(p.sim_spec, DatasetCacheDir(dir), verbose, &sim_info);
   const LearnedNets nominal = CachedNets(sim, sim_info["path"].get<std::string>(), p.sim_spec.Tag(),

@@ -117,6 +117,7 @@ nlohmann::json SweepPath(const ActuationPathsParams& p, size_t k, FkSolver& solv
 
 nlohmann::json RunActuationPaths(const Config& cfg, const std::string& dir, bool verbose) {
   const ActuationPathsParams p = ReadActuationPathsParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   const Scene& scene = p.scene;
   const int tip = p.tip;
   auto model = std::make_shared<const Model>(scene);

@@ -299,6 +299,7 @@ nlohmann::json PlaceStage(const PickPlaceParams& p, const ObjectPlacement& o,
 
 nlohmann::json RunIkPickAndPlace(const Config& cfg, const std::string& dir, bool verbose) {
   const PickPlaceParams p = ReadPickPlaceParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   const GripperPoints g = TrackedPoints(p);
   SimulatorKinematics kin(p.s.scene, p.s.KinematicsFor(g.names), &p.s.fk);
   IkOptions ik = p.s.ik;

@@ -308,6 +308,7 @@ nlohmann::json ProgressiveJson(const ProgressiveResult& prog, const nlohmann::js
 
 nlohmann::json RunTwistingRemesh(const Config& cfg, const std::string& dir, bool verbose) {
   const TwistingRemeshParams p = ReadTwistingRemeshParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   std::filesystem::create_directories(dir + "/shapes");
   TwistingOutput out(p, dir, verbose);
 

@@ -76,6 +76,7 @@ nlohmann::json SolveAtResolution(const Config& cfg, const ResolutionParams& p, i
 
 nlohmann::json RunResolutionSweep(const Config& cfg, const std::string& dir, bool verbose) {
   const ResolutionParams p = ReadResolutionParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   CsvWriter csv(
       dir + "/resolution.csv",
       {"res", "n_vertices", "n_tets", "build_s", "factor_s", "iterations", "solve_s",

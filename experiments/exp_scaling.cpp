@@ -108,6 +108,7 @@ nlohmann::json SolveOnce(const Config& cfg, const ScalingCase& sc, const std::st
 
 nlohmann::json RunSolverScaling(const Config& cfg, const std::string& dir, bool verbose) {
   const std::vector<ScalingCase> cases = ReadScalingCases(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   CsvWriter csv(dir + "/scaling.csv",
                 {"robot", "solver", "res", "n_vertices", "n_tets", "iterations",
                  "linear_iterations", "solve_s", "us_per_vertex", "residual_ratio", "converged"});

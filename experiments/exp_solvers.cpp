@@ -368,6 +368,7 @@ void AddSpeedupVsCalculix(const SolverComparisonParams& p, Totals* t, nlohmann::
 
 nlohmann::json RunSolverComparison(const Config& cfg, const std::string& dir, bool verbose) {
   const SolverComparisonParams p = ReadSolverComparisonParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   auto model = std::make_shared<const Model>(p.scene);
   CsvWriter csv(dir + "/trajectories.csv",
                 {"method", "step", "actuation", "bend_deg", "tip_x", "tip_y", "tip_z", "iterations",

@@ -222,6 +222,7 @@ nlohmann::json SweepVariant(const MarkerSweepParams& p, const Variant& var, cons
 
 nlohmann::json RunMarkerSweep(const Config& cfg, const std::string& dir, bool verbose) {
   const MarkerSweepParams p = ReadMarkerSweepParams(cfg);
+  if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   nlohmann::json summary_variants = nlohmann::json::array();
   CsvWriter csv(dir + "/markers.csv", {"variant", "step", "value", "marker", "x", "y", "z",
                                        "iterations", "time_s", "converged"});

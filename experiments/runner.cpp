@@ -78,6 +78,18 @@ nlohmann::json RunExperiment(const std::string& config_path, const RunOptions& o
     for (const auto& t : ExperimentTypes()) known += (known.empty() ? "" : ", ") + t;
     cfg.Fail("experiment", "one of " + known);
   }
+  if (opt.quick && cfg.has_quick()) {
+    // The full settings, which the quick overrides hide, are checked too (reading only).
+    Config full = Config::Load(config_path, false);
+    full.set_check_only(true);
+    try {
+      fn(full, std::string(), false);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("--quick: the full settings (without the quick "
+                                              "overrides) are invalid: ") +
+                                  e.what());
+    }
+  }
   const std::string dir = ResultDir(opt.results_root, cfg.name());
   WriteJson(dir + "/config.json", cfg.json());
   nlohmann::json run;

@@ -95,5 +95,39 @@ TEST(Config, EveryShippedConfigLoadsAndHasAPlotScript) {
   EXPECT_GE(checked, 30);
 }
 
+// A --quick run also checks the full settings its overrides hide, before any work: a bad full
+// value fails the quick (CI) run at once, not hours into the full one. The quick run itself still
+// runs when both are valid.
+TEST(Config, QuickRunsCheckTheFullSettingsToo) {
+  const std::string root = ::testing::TempDir() + "/softkin_quick_full";
+  std::filesystem::remove_all(root);
+  auto run = [&](const std::string& steps) -> std::string {
+    const std::string path = WriteTemp("softkin_config_quick_full.json",
+                                       R"({"name": "quick_full", "experiment": "pneumatic_bending",
+        "seed": 1, "robot": "three_chamber", "res": 3, "actuators": ["c1"], "steps": )" +
+                                           steps + R"(, "quick": {"steps": 2}})");
+    RunOptions o;
+    o.quick = true;
+    o.plot = false;
+    o.verbose = false;
+    o.results_root = root;
+    try {
+      RunExperiment(path, o);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "";
+  };
+  const std::string bad = run("0");
+  EXPECT_NE(bad.find("--quick: the full settings (without the quick overrides) are invalid"),
+            std::string::npos)
+      << bad;
+  EXPECT_NE(bad.find("steps: expected an integer >= 1"), std::string::npos) << bad;
+  EXPECT_FALSE(std::filesystem::exists(root + "/quick_full/summary.json"));
+  EXPECT_EQ(run("40"), "");
+  EXPECT_TRUE(std::filesystem::exists(root + "/quick_full/summary.json"));
+  std::filesystem::remove_all(root);
+}
+
 }  // namespace
 }  // namespace softkin
