@@ -17,6 +17,7 @@
 #include "softkin/solver/robots/robots.hpp"
 #include "softkin/solver/fk/rotation.hpp"
 #include "softkin/solver/fk/targets.hpp"
+#include "softkin/solver/mesh/io/mesh_io.hpp"
 
 #include <benchmark/benchmark.h>
 #include <omp.h>
@@ -236,6 +237,17 @@ void ResolutionThreadSweep(benchmark::internal::Benchmark* b) {
 // ---- benchmarks --------------------------------------------------------------------------------
 
 /// Model construction: element constants, assembly of A, A_ff, A_fc, CHOLMOD analyse + factor.
+/// Reading the thesis group's real finger mesh (data/thesis/finger_chamber1.tet, 94,240 tets, with
+/// its region labels): parsing, orientation and the topology checks (folds, cracks, duplicates).
+void BM_ReadTetFingerChamber(benchmark::State& state) {
+  const std::string dir = SOFTKIN_THESIS_DATA;
+  for (auto _ : state) {
+    const Mesh m = ReadTet(dir + "/finger_chamber1.tet", dir + "/finger_chamber1_labels.txt");
+    benchmark::DoNotOptimize(m.elements.data());
+  }
+}
+BENCHMARK(BM_ReadTetFingerChamber)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 void BM_Factorization(benchmark::State& state) {
   const Fixture& f = GetFixture(static_cast<int>(state.range(0)));
   const Scene scene = f.model->scene();

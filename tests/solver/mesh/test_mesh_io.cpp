@@ -137,9 +137,9 @@ TEST(MeshIoReal, FingerChamberTetWithLabels) {
       ReadTet(dir + "/finger_chamber1.tet", dir + "/finger_chamber1_labels.txt", &report);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // Recorded only: the read time is a benchmark (bench_fk BM_ReadTetFingerChamber), not a test.
   std::cout << "[ timing   ] ReadTet(finger_chamber1.tet + labels): " << seconds * 1e3 << " ms\n";
   RecordProperty("read_ms", static_cast<int>(seconds * 1e3));
-  EXPECT_LT(seconds, 10.0);  // generous: the requirement is well under 2 s in Release
 
   EXPECT_EQ(m.num_vertices(), 18014);
   EXPECT_EQ(m.num_elements(), 94240);
