@@ -21,13 +21,13 @@ void Model::CheckRotationsHeld(const std::vector<int>& part,
   // rotations, so the solve would then "converge" to an arbitrary one.
   const Eigen::MatrixX3d& X = scene_.mesh.vertices;
   Eigen::Vector3d lo = X.row(part.front()).transpose(), hi = lo, o = Eigen::Vector3d::Zero();
-  int n_held = 0;
+  int n_held = 0, first_held = -1;
   for (int v : part) {
     lo = lo.cwiseMin(X.row(v).transpose());
     hi = hi.cwiseMax(X.row(v).transpose());
     if (held[0][v] || held[1][v] || held[2][v]) {
       o += X.row(v).transpose();
-      ++n_held;
+      if (n_held++ == 0) first_held = v;
     }
   }
   const double size = (hi - lo).norm();
@@ -61,16 +61,11 @@ void Model::CheckRotationsHeld(const std::vector<int>& part,
     std::snprintf(buf, sizeof(buf), "slide along [%.3g, %.3g, %.3g]", t.x(), t.y(), t.z());
     what = buf;
   }
-  std::string where;
-  for (int v : part)
-    if (held[0][v] || held[1][v] || held[2][v]) {
-      where = "vertex " + std::to_string(v);
-      break;
-    }
   throw std::invalid_argument(
       "scene '" + scene_.name + "': the connected part of the mesh with vertex " +
       std::to_string(part.front()) + " has " + std::to_string(n_held) +
-      " held vertex(es) (first: " + where + "), which leave a rigid motion free: it could " + what +
+      " held vertex(es) (first: vertex " + std::to_string(first_held) +
+      "), which leave a rigid motion free: it could " + what +
       " (a rigid-motion null space: the energy does not change, so the answer would be "
       "arbitrary). Hold at least three non-collinear points of each part, e.g. a whole face");
 }

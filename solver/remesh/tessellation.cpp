@@ -5,6 +5,7 @@
 
 #include "softkin/solver/common/memory_guard.hpp"
 #include "softkin/solver/common/text_format.hpp"
+#include "softkin/solver/fk/actuation.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Mesh_complex_3_in_triangulation_3.h>
@@ -184,12 +185,9 @@ double EstimateTessellationTets(const TriangleSurface& chamber, const TriangleSu
   const double vc = std::abs(EnclosedVolume(chamber)), vb = std::abs(EnclosedVolume(body)) - vc;
   double area = 0;  // one tet per surface facet of circumradius fs (equilateral: 3 sqrt(3)/4 fs^2)
   for (const TriangleSurface* s : {&chamber, &body})
-    for (int f = 0; f < s->faces.rows(); ++f) {
-      const Eigen::Vector3d a = s->vertices.row(s->faces(f, 0)).transpose();
-      const Eigen::Vector3d b = s->vertices.row(s->faces(f, 1)).transpose();
-      const Eigen::Vector3d c = s->vertices.row(s->faces(f, 2)).transpose();
-      area += 0.5 * (b - a).cross(c - a).norm();
-    }
+    for (int f = 0; f < s->faces.rows(); ++f)
+      area += TriangleArea(s->vertices.row(s->faces(f, 0)), s->vertices.row(s->faces(f, 1)),
+                           s->vertices.row(s->faces(f, 2)));
   return 2.5 * (std::max(vb, 0.0) / tet_volume(opt.cell_size) + vc / tet_volume(ccs)) +
          area / (0.75 * std::sqrt(3.0) * fs * fs);
 }
