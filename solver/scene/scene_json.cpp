@@ -141,13 +141,28 @@ void SceneParser::ReadSolverOptions(const json& solver, FkOptions* o) const {
   }
 }
 
-Scene SceneParser::Build(const json& root) {
+Scene SceneParser::Build(const json& given_root, const Mesh* given,
+                         const MeshReport* given_report) {
+  json with_mesh;
+  if (given && given_root.is_object()) {
+    if (given_root.contains("mesh"))
+      Fail("mesh: leave this key out: the mesh is given as arrays (vertices, elements, tags)");
+    with_mesh = given_root;
+    with_mesh["mesh"] = {{"file", "(arrays)"}};  // the key table requires a mesh object
+  }
+  const json& root = with_mesh.is_null() ? given_root : with_mesh;
   CheckObject(root, "", "");
   Scene scene;
   scene.name = Get(root, "", "name").get<std::string>();
   if (scene.name.empty()) scene.name = fs::path(src_).stem().string();
 
-  ReadMeshSection(root.at("mesh"), &scene);
+  if (given) {
+    scene.mesh = *given;
+    if (given_report) scene.mesh_source_vertex = given_report->source_vertex;
+    MapFileVertices(given_report ? *given_report : MeshReport(), scene.mesh.num_vertices());
+  } else {
+    ReadMeshSection(root.at("mesh"), &scene);
+  }
   ReadRegions(root.at("regions"), &scene);
   ReadFixed(root.at("fixed"), &scene);
   ReadMotions(Get(root, "", "motions"), &scene);
@@ -169,6 +184,12 @@ Scene ParseSceneJson(const std::string& text, const std::string& source,
                      const std::string& base_dir) {
   const scene_json_detail::json root = ParseJsonText(text, source);
   return scene_json_detail::SceneParser(source, base_dir).Build(root);
+}
+
+Scene ParseSceneJsonWithMesh(const std::string& text, const std::string& source, Mesh mesh,
+                             const MeshReport& report) {
+  const scene_json_detail::json root = ParseJsonText(text, source);
+  return scene_json_detail::SceneParser(source, ".").Build(root, &mesh, &report);
 }
 
 Scene LoadSceneJson(const std::string& path) {

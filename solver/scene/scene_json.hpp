@@ -15,6 +15,12 @@ Scene LoadSceneJson(const std::string& path);
 /// Parses scene JSON text; `source` names it in messages, `base_dir` resolves relative paths.
 Scene ParseSceneJson(const std::string& text, const std::string& source,
                      const std::string& base_dir);
+/// A scene whose mesh is already in memory (built from arrays, as the Python module does): `text`
+/// is a scene JSON without the "mesh" key, read as ParseSceneJson reads it. `mesh` must have been
+/// checked by ValidateAndOrient; `report` is what that returned, so that vertex indices in `text`
+/// are positions in the arrays (before unused vertices were dropped).
+Scene ParseSceneJsonWithMesh(const std::string& text, const std::string& source, Mesh mesh,
+                             const MeshReport& report);
 /// Human-readable schema: every key with its type, default and doc line.
 std::string SceneSchema();
 

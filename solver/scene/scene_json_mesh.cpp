@@ -94,10 +94,7 @@ void SceneParser::ReadMeshSection(const json& m, Scene* scene) {
   }
   PrintMeshReport(report, std::cerr);
   scene->mesh_source_vertex = report.source_vertex;
-  const int file_vertices = scene->mesh.num_vertices() + report.unused_vertices;
-  file_to_mesh_.assign(static_cast<std::size_t>(file_vertices), -1);
-  for (int j = 0; j < scene->mesh.num_vertices(); ++j)
-    file_to_mesh_[static_cast<std::size_t>(report.source_vertex[j])] = j;
+  MapFileVertices(report, scene->mesh.num_vertices());
   const double scale = Get(m, "mesh", "scale").get<double>();
   if (scale != 1.0) {
     scene->mesh.vertices *= scale;
@@ -109,6 +106,15 @@ void SceneParser::ReadMeshSection(const json& m, Scene* scene) {
            (std::isfinite(size) ? FormatNumber(size) + " mm" : std::string("infinitely")) +
            " across; expected a scale that keeps its size within [1e-30, 1e30] mm (volumes and "
            "energies must stay within double precision)");
+  }
+}
+
+void SceneParser::MapFileVertices(const MeshReport& report, int num_vertices) {
+  const int file_vertices = num_vertices + report.unused_vertices;
+  file_to_mesh_.assign(static_cast<std::size_t>(file_vertices), -1);
+  for (int j = 0; j < num_vertices; ++j) {
+    const int f = report.source_vertex.empty() ? j : report.source_vertex[j];
+    file_to_mesh_[static_cast<std::size_t>(f)] = j;
   }
 }
 

@@ -25,7 +25,11 @@ class SceneParser {
   SceneParser(std::string source, std::string base_dir)
       : src_(std::move(source)), base_(std::move(base_dir)) {}
 
-  Scene Build(const json& root);
+  /// The scene of `root`. With `given` (a mesh already in memory, checked by ValidateAndOrient,
+  /// and its report), `root` has no "mesh" key and its vertex indices are positions in the
+  /// arrays the mesh came from.
+  Scene Build(const json& root, const Mesh* given = nullptr,
+              const MeshReport* given_report = nullptr);
 
  private:
   /// What the regions[] entries sharing one actuator name gave (ReadRegions).
@@ -67,6 +71,8 @@ class SceneParser {
 
   /// mesh (scene_json_mesh.cpp); sets file_to_mesh_.
   void ReadMeshSection(const json& m, Scene* scene);
+  /// Sets file_to_mesh_ from a reader's report on a mesh of `num_vertices` kept vertices.
+  void MapFileVertices(const MeshReport& report, int num_vertices);
   /// regions[]: body materials and actuators (scene_json_regions.cpp).
   void ReadRegions(const json& regions, Scene* scene) const;
   /// fixed[], motions[], markers[] (scene_json_vertices.cpp).

@@ -157,6 +157,41 @@ TEST(SceneJsonTiny, IndicesAreFilePositionsWhenUnusedVerticesAreDropped) {
               {"fixed[0].file", "lists no vertex index of a vertex used by an element"});
 }
 
+TEST(SceneJsonTiny, MeshGivenInMemoryIsReadLikeAFile) {
+  // The tiny mesh with an unused vertex at position 2, given as arrays (the Python module's
+  // scene from arrays): the same checks as a file, and indices are positions in the arrays.
+  Mesh m;
+  m.vertices.resize(7, 3);
+  m.vertices << 0, 0, 0, 1, 0, 0, 9, 9, 9, 0, 0, 1, 0, 1, 0, 1, 1, 0, 0, 1, 1;
+  const int tets[3][4] = {{0, 3, 1, 4}, {1, 4, 3, 5}, {3, 5, 4, 6}};
+  for (int i = 0; i < 3; ++i) {
+    Element e;
+    e.v = {{tets[i][0], tets[i][1], tets[i][2], tets[i][3], -1, -1}};
+    e.region = i;
+    m.elements.push_back(e);
+  }
+  Mesh checked = m;
+  const MeshReport report = ValidateAndOrient(checked, "arrays");
+  EXPECT_EQ(report.unused_vertices, 1);
+  json j = TinyScene();
+  j.erase("mesh");
+  j["fixed"] = json::parse(R"([{"plane": {"point": [0, 0, 0], "normal": [0, 1, 0]}}])");
+  j["markers"] = json::parse(R"([{"name": "a", "vertex": 4}])");
+  const Scene s = ParseSceneJsonWithMesh(j.dump(), "arrays", checked, report);
+  EXPECT_EQ(s.name, "tiny");
+  ASSERT_EQ(s.mesh.num_vertices(), 6);
+  EXPECT_EQ(s.fixed, (std::vector<int>{0, 1, 2}));        // y = 0: array rows 0, 1, 3
+  EXPECT_EQ(s.markers[0].vertices, std::vector<int>{3});  // array row 4
+  ASSERT_EQ(s.num_actuators(), 1);
+  EXPECT_EQ(s.actuators[0].regions, (std::vector<int>{1, 2}));
+  j["markers"] = json::parse(R"([{"name": "a", "vertex": 2}])");
+  ExpectError([&] { ParseSceneJsonWithMesh(j.dump(), "arrays", checked, report); },
+              {"arrays: markers[0].vertex: vertex 2 of the mesh file is used by no element"});
+  j["mesh"] = json::parse(R"({"file": "tiny.tet"})");
+  ExpectError([&] { ParseSceneJsonWithMesh(j.dump(), "arrays", checked, report); },
+              {"arrays: mesh: leave this key out"});
+}
+
 TEST(SceneJsonTiny, CableAndDeaRolesAndDefaults) {
   TempDir dir;
   WriteTinyMesh(dir.path());
