@@ -50,6 +50,9 @@ PACKAGES=(
   libcgal-dev
   pkg-config
   calculix-ccx
+  python3-dev
+  pybind11-dev
+  python3-pytest
 )
 
 log() { echo "[setup] $*"; }

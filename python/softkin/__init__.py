@@ -1,0 +1,185 @@
+"""SoftKin in Python: soft-robot scenes, forward kinematics and Jacobians with NumPy arrays.
+
+Lengths are in mm. Arrays are float64 (positions, actuations) or int64 (indices) NumPy arrays,
+always copies. Bad input raises ValueError with the same message as the ``softkin`` command
+(file:line, or the key path); a solve that fails raises RuntimeError only where no result can be
+returned (a Jacobian); ``FkSolver.solve`` returns its status instead.
+
+    import softkin
+    scene = softkin.robot("pneumatic_finger")
+    solver = softkin.FkSolver(scene, solver="lg-aa")
+    result = solver.solve([2.0])
+    result.markers["tip"]          # (3,) mm
+    result.write_vtu("bent.vtu")   # for ParaView
+"""
+
+import json as _json
+
+import numpy as _np
+
+from . import _softkin
+from ._softkin import FkResult, Scene
+
+__all__ = [
+    "FkResult",
+    "FkSolver",
+    "Scene",
+    "SimulatorKinematics",
+    "load_scene",
+    "robot",
+    "robots",
+    "scene_from_arrays",
+    "solve_fk",
+]
+
+
+def robots():
+    """The embedded robot generators: a list of dicts with name, description,
+    default_resolution, resolution_doc and params (name, default, min, max, doc)."""
+    return _softkin._robots()
+
+
+def robot(name, res=None, **params):
+    """Builds embedded robot ``name`` at resolution ``res`` (None: its default), with its design
+    parameters as keyword arguments (``softkin.robots()`` lists them and their ranges)."""
+    if res is None:
+        res = 0
+    elif isinstance(res, bool) or not isinstance(res, (int, _np.integer)) or res < 1:
+        raise ValueError(f"res: expected an integer >= 1, or None for the robot's default; got {res!r}")
+    return _softkin._robot(name, int(res), {k: float(v) for k, v in params.items()})
+
+
+def load_scene(path):
+    """Loads a scene JSON file (``softkin scene --schema`` documents its keys); relative paths in
+    it are relative to its folder."""
+    return _softkin._load_scene(str(path))
+
+
+def scene_from_arrays(vertices, elements, tags, regions, fixed, markers=(), motions=(),
+                      obstacles=(), solver=None, name="arrays"):
+    """A scene from arrays, e.g. a mesh read with meshio or gmsh.
+
+    vertices: #V x 3 rest positions, mm. elements: #E x 4 (tets) or #E x 6 (prisms), 0-based rows
+    of vertices; orientation is fixed as for files. tags: #E region tags. The other arguments are
+    the scene JSON's keys of the same names (lists of dicts; ``softkin scene --schema``), e.g.
+    regions=[{"tag": 0, "role": "body"}, {"tag": 1, "role": "pneumatic", "name": "chamber"}],
+    fixed=[{"plane": {"point": [0, 0, 0], "normal": [1, 0, 0]}}]. Vertex indices in them are
+    rows of ``vertices``. The mesh gets the same checks as a mesh file (folds, duplicates,
+    cracks; unused vertices are dropped with a note).
+    """
+    spec = {"name": name, "regions": list(regions), "fixed": list(fixed),
+            "markers": list(markers), "motions": list(motions), "obstacles": list(obstacles)}
+    if solver is not None:
+        spec["solver"] = dict(solver)
+    return _softkin._scene_from_arrays(
+        _np.asarray(vertices, dtype=_np.float64), _np.asarray(elements, dtype=_np.int64),
+        _np.asarray(tags, dtype=_np.int64), _json.dumps(spec), name)
+
+
+def _options_json(options):
+    return _json.dumps(options)
+
+
+class FkSolver:
+    """A forward-kinematics solver on one scene, reused across solves (it keeps the model's
+    factorisation). ``solver`` is one of lg, lg-aa, newton, ceres, ipopt-lbfgs, ipopt-newton,
+    ipopt-hard, calculix-linear, calculix-nonlinear; the other keyword arguments are the scene
+    JSON's ``solver`` options (e.g. max_iterations=20000, tolerance=1e-7, threads=2), over the
+    scene's own.
+    """
+
+    def __init__(self, scene, solver="lg-aa", **options):
+        options = dict(options)
+        options["solver"] = solver
+        self._impl = _softkin._FkSolver(scene, _options_json(options))
+
+    @property
+    def scene(self):
+        return self._impl.scene
+
+    @property
+    def name(self):
+        return self._impl.name
+
+    @property
+    def options(self):
+        """Every solver option in effect, as a dict in the scene JSON's layout."""
+        return _json.loads(self._impl._options_json)
+
+    def solve(self, c, warm_start=None):
+        """Solves for actuation ``c`` (#A values, or a number for one actuator) from the rest
+        shape, or from ``warm_start`` (#V x 3 positions, e.g. a previous result's). Returns an
+        FkResult; check ``result.converged``."""
+        return self._impl.solve(_np.atleast_1d(_np.asarray(c, dtype=_np.float64)), warm_start)
+
+    def jacobian(self, c, mode="implicit", warm_start=None):
+        """dX/dc at the equilibrium for ``c``: a dict with ``dX`` (#V x 3 x #A, mm per unit of
+        actuation), ``markers`` (name -> 3 x #A), ``result`` (the FkResult at c) and ``mode``.
+        Modes: implicit (differentiating the equilibrium: no extra solves), fd (central
+        differences, probes solved like c itself), fd-warm (probes start from the state at c);
+        differences step 1/160 of each actuator's range, one-sided at a bound. Raises
+        RuntimeError when the solve at c or a probe does not converge."""
+        return self._impl.jacobian(_np.atleast_1d(_np.asarray(c, dtype=_np.float64)), mode,
+                                   warm_start)
+
+    def __repr__(self):
+        return f"<softkin.FkSolver {self.name} on {self.scene!r}>"
+
+
+def solve_fk(scene, c, solver="lg-aa", **options):
+    """One shot: builds an FkSolver and solves for ``c``."""
+    return FkSolver(scene, solver=solver, **options).solve(c)
+
+
+class SimulatorKinematics:
+    """The simulator as IK sees it: tracked points p(c) (#P x 3, mm) and the Jacobian J(c)
+    (3 #P x #A; row 3 i + d is coordinate d of point i). ``jacobian``: implicit, fd or fd-warm.
+    ``points``: marker names ("tip"), "name[*]" for every vertex of a marker, "name[i]" for one;
+    empty: every marker. Solves warm-start from the previous one (``reset()`` forgets it).
+    ``solver`` and ``options`` as for FkSolver."""
+
+    def __init__(self, scene, jacobian="implicit", points=(), fd_step=1.0 / 160.0,
+                 solver="lg-aa", **options):
+        options = dict(options)
+        options["solver"] = solver
+        self._impl = _softkin._SimulatorKinematics(scene, jacobian, list(points), float(fd_step),
+                                                   _options_json(options))
+
+    @property
+    def point_names(self):
+        return self._impl.point_names
+
+    @property
+    def num_actuators(self):
+        return self._impl.num_actuators
+
+    @property
+    def lower(self):
+        return self._impl.lower
+
+    @property
+    def upper(self):
+        return self._impl.upper
+
+    @property
+    def total_fk_solves(self):
+        return self._impl.total_fk_solves
+
+    def evaluate(self, c, with_jacobian=True):
+        """A dict with p, J (when with_jacobian), inverted_elements, min_volume_ratio, fk_solves,
+        time_s and message. Raises RuntimeError when c cannot be evaluated (outside the bounds,
+        a solve that fails)."""
+        return self._impl.evaluate(_np.atleast_1d(_np.asarray(c, dtype=_np.float64)),
+                                   with_jacobian)
+
+    def p(self, c):
+        """Tracked points at c, #P x 3, mm."""
+        return self.evaluate(c, with_jacobian=False)["p"]
+
+    def J(self, c):
+        """dp/dc at c, 3 #P x #A."""
+        return self.evaluate(c, with_jacobian=True)["J"]
+
+    def reset(self):
+        """Forgets the warm-start state: the next solve starts from the rest shape."""
+        self._impl.reset()

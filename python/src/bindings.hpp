@@ -1,0 +1,23 @@
+#pragma once
+/// \file bindings.hpp
+/// The parts of the Python module softkin._softkin (python/src/module.cpp), one per area:
+/// scenes (bind_scene.cpp), forward kinematics and its Jacobian (bind_fk.cpp), kinematics for IK
+/// (bind_kinematics.cpp). Shared here: the Scene handle the Python objects keep alive.
+#include "softkin/solver/scene/scene.hpp"
+
+#include <pybind11/pybind11.h>
+
+#include <memory>
+
+namespace softkin {
+namespace python {
+
+/// A scene as Python holds it: immutable once built, shared by the solvers made from it.
+using SceneHandle = std::shared_ptr<const Scene>;
+
+void BindScene(pybind11::module_& m);
+void BindFk(pybind11::module_& m);
+void BindKinematics(pybind11::module_& m);
+
+}  // namespace python
+}  // namespace softkin
