@@ -37,7 +37,7 @@ struct Command {
 
 }  // namespace
 
-int RunCli(int argc, char** argv) {
+int RunCli(int argc, char** argv, bool rethrow) {
   CLI::App app{
       "SoftKin: geometry-based kinematics of soft robots (forward kinematics, "
       "experiments). Units: mm."};
@@ -71,9 +71,15 @@ int RunCli(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    if (rethrow && e.get_exit_code() != 0) throw std::invalid_argument(e.what());
     return app.exit(e) == 0 ? 0 : 2;
   }
 
+  if (rethrow) {
+    for (const Command& c : commands)
+      if (c.app->parsed()) return c.run();
+    return 0;
+  }
   try {
     for (const Command& c : commands)
       if (c.app->parsed()) return c.run();

@@ -53,6 +53,7 @@ PACKAGES=(
   python3-dev
   pybind11-dev
   python3-pytest
+  python3-meshio
 )
 
 log() { echo "[setup] $*"; }

@@ -18,18 +18,26 @@ import json as _json
 import numpy as _np
 
 from . import _softkin
-from ._softkin import FkResult, Scene
+from ._softkin import FkResult, Kinematics, PccKinematics, Scene
+from . import ik
 
 __all__ = [
     "FkResult",
     "FkSolver",
+    "Kinematics",
+    "PccKinematics",
     "Scene",
     "SimulatorKinematics",
+    "cli",
+    "dataset",
+    "ik",
+    "load_nets",
     "load_scene",
     "robot",
     "robots",
     "scene_from_arrays",
     "solve_fk",
+    "train",
 ]
 
 
@@ -131,55 +139,67 @@ def solve_fk(scene, c, solver="lg-aa", **options):
     return FkSolver(scene, solver=solver, **options).solve(c)
 
 
-class SimulatorKinematics:
-    """The simulator as IK sees it: tracked points p(c) (#P x 3, mm) and the Jacobian J(c)
-    (3 #P x #A; row 3 i + d is coordinate d of point i). ``jacobian``: implicit, fd or fd-warm.
-    ``points``: marker names ("tip"), "name[*]" for every vertex of a marker, "name[i]" for one;
-    empty: every marker. Solves warm-start from the previous one (``reset()`` forgets it).
-    ``solver`` and ``options`` as for FkSolver."""
+class SimulatorKinematics(_softkin._SimulatorKinematics):
+    """The simulator as IK sees it (a Kinematics): tracked points p(c) (#P x 3, mm) and the
+    Jacobian J(c) (3 #P x #A; row 3 i + d is coordinate d of point i). ``jacobian``: implicit,
+    fd or fd-warm. ``points``: marker names ("tip"), "name[*]" for every vertex of a marker,
+    "name[i]" for one; empty: every marker. Solves warm-start from the previous one (``reset()``
+    forgets it). ``solver`` and ``options`` as for FkSolver."""
 
     def __init__(self, scene, jacobian="implicit", points=(), fd_step=1.0 / 160.0,
                  solver="lg-aa", **options):
         options = dict(options)
         options["solver"] = solver
-        self._impl = _softkin._SimulatorKinematics(scene, jacobian, list(points), float(fd_step),
-                                                   _options_json(options))
+        super().__init__(scene, jacobian, list(points), float(fd_step), _options_json(options))
 
-    @property
-    def point_names(self):
-        return self._impl.point_names
 
-    @property
-    def num_actuators(self):
-        return self._impl.num_actuators
+def cli(args):
+    """Runs a ``softkin`` command in this process, e.g. ``softkin.cli(["run",
+    "experiments/configs/fig2_11.json", "--quick"])``; returns its exit code (0 ok, 1 a solve or
+    job failed). Bad input raises ValueError with the command's message. Output and progress go
+    to the process's stdout and stderr."""
+    return _softkin._cli([str(a) for a in args])
 
-    @property
-    def lower(self):
-        return self._impl.lower
 
-    @property
-    def upper(self):
-        return self._impl.upper
+def _flags(options):
+    """Keyword arguments as command-line flags: a_b=v -> --a-b v; True -> --a-b; False/None: left
+    out; lists and tuples -> comma lists."""
+    out = []
+    for key, value in options.items():
+        if value is None or value is False:
+            continue
+        flag = "--" + key.replace("_", "-")
+        if value is True:
+            out.append(flag)
+        elif isinstance(value, (list, tuple)):
+            out += [flag, ",".join(str(v) for v in value)]
+        elif isinstance(value, dict):
+            for k, v in value.items():
+                out += [flag, f"{k}={v}"]
+        else:
+            out += [flag, str(value)]
+    return out
 
-    @property
-    def total_fk_solves(self):
-        return self._impl.total_fk_solves
 
-    def evaluate(self, c, with_jacobian=True):
-        """A dict with p, J (when with_jacobian), inverted_elements, min_volume_ratio, fk_solves,
-        time_s and message. Raises RuntimeError when c cannot be evaluated (outside the bounds,
-        a solve that fails)."""
-        return self._impl.evaluate(_np.atleast_1d(_np.asarray(c, dtype=_np.float64)),
-                                   with_jacobian)
+def dataset(out, robot, **options):
+    """Generates (or resumes) a learning dataset CSV ``out`` of embedded robot ``robot``, as
+    ``softkin dataset`` does (docs/datasets.md): options are its flags with underscores, e.g.
+    res=6, grid=8 (or random=500, seed=1), jacobian="implicit", points="tip", shard="1/4",
+    param={"gap": 2}, quiet=True. Rerunning with the same options continues where a killed run
+    stopped. Returns the exit code (1: some samples failed and were recorded so)."""
+    return cli(["dataset", "--robot", robot, "--out", str(out)] + _flags(options))
 
-    def p(self, c):
-        """Tracked points at c, #P x 3, mm."""
-        return self.evaluate(c, with_jacobian=False)["p"]
 
-    def J(self, c):
-        """dp/dc at c, 3 #P x #A."""
-        return self.evaluate(c, with_jacobian=True)["J"]
+def train(dataset_path, out, **options):
+    """Trains the networks of Sec. 5.3 on dataset CSV ``dataset_path`` into directory ``out``, as
+    ``softkin train`` does: e.g. what="fk,jac", hidden=(35, 35), hidden_jac=(64, 64),
+    epochs=200, seed=1, quiet=True. Returns the learned kinematics (``load_nets(out)``)."""
+    cli(["train", "--dataset", str(dataset_path), "--out", str(out)] + _flags(options))
+    return load_nets(out)
 
-    def reset(self):
-        """Forgets the warm-start state: the next solve starts from the rest shape."""
-        self._impl.reset()
+
+def load_nets(directory, jacobian="network", use_s2r=False):
+    """The learned kinematics (N_fk, N_J and optionally N_s2r) in a directory written by
+    ``softkin train``, as a Kinematics. ``jacobian``: network (N_J) or fk-derivative (the
+    derivative of N_fk)."""
+    return _softkin._load_nets(str(directory), jacobian, bool(use_s2r))

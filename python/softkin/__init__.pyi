@@ -5,6 +5,8 @@ from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Union
 import numpy as np
 import numpy.typing as npt
 
+from . import ik as ik
+
 ArrayLike = npt.ArrayLike
 Vec = npt.NDArray[np.float64]
 Idx = npt.NDArray[np.int64]
@@ -100,16 +102,18 @@ class FkSolver:
 
 def solve_fk(scene: Scene, c: ArrayLike, solver: str = ..., **options: Any) -> FkResult: ...
 
-class SimulatorKinematics:
+class Kinematics:
+    """Subclass in Python: call Kinematics.__init__ and implement compute(c, with_jacobian)."""
     def __init__(
         self,
-        scene: Scene,
-        jacobian: str = ...,
-        points: Sequence[str] = ...,
-        fd_step: float = ...,
-        solver: str = ...,
-        **options: Any,
+        points: Sequence[str],
+        lower: ArrayLike,
+        upper: ArrayLike,
+        rest: Optional[ArrayLike] = ...,
+        name: str = ...,
     ) -> None: ...
+    @property
+    def name(self) -> str: ...
     @property
     def point_names(self) -> List[str]: ...
     @property
@@ -119,8 +123,38 @@ class SimulatorKinematics:
     @property
     def upper(self) -> Vec: ...
     @property
+    def rest(self) -> Vec: ...
+    @property
     def total_fk_solves(self) -> int: ...
     def evaluate(self, c: ArrayLike, with_jacobian: bool = ...) -> Dict[str, Any]: ...
     def p(self, c: ArrayLike) -> Vec: ...  # (#P, 3)
     def J(self, c: ArrayLike) -> Vec: ...  # (3 #P, #A)
+
+class PccKinematics(Kinematics):
+    def __init__(
+        self,
+        length: float = ...,
+        cable_offset: float = ...,
+        max_pull: float = ...,
+        backbone_points: int = ...,
+        axial: bool = ...,
+    ) -> None: ...
+
+def cli(args: Sequence[Union[str, PathLike]]) -> int: ...
+def dataset(out: Union[str, PathLike], robot: str, **options: Any) -> int: ...
+def train(dataset_path: Union[str, PathLike], out: Union[str, PathLike], **options: Any) -> Kinematics: ...
+def load_nets(
+    directory: Union[str, PathLike], jacobian: str = ..., use_s2r: bool = ...
+) -> Kinematics: ...
+
+class SimulatorKinematics(Kinematics):
+    def __init__(
+        self,
+        scene: Scene,
+        jacobian: str = ...,
+        points: Sequence[str] = ...,
+        fd_step: float = ...,
+        solver: str = ...,
+        **options: Any,
+    ) -> None: ...
     def reset(self) -> None: ...

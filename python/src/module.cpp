@@ -10,4 +10,6 @@ PYBIND11_MODULE(_softkin, m) {
   softkin::python::BindScene(m);
   softkin::python::BindFk(m);
   softkin::python::BindKinematics(m);
+  softkin::python::BindIk(m);
+  softkin::python::BindCli(m);
 }
