@@ -71,10 +71,15 @@ def scene_from_arrays(vertices, elements, tags, regions, fixed, markers=(), moti
     of vertices; orientation is fixed as for files. tags: #E region tags. The other arguments are
     the scene JSON's keys of the same names (lists of dicts; ``softkin scene --schema``), e.g.
     regions=[{"tag": 0, "role": "body"}, {"tag": 1, "role": "pneumatic", "name": "chamber"}],
+    or regions as a dict tag -> role or tag -> entry, e.g. {0: "body", 1: {"role": "pneumatic",
+    "name": "chamber"}},
     fixed=[{"plane": {"point": [0, 0, 0], "normal": [1, 0, 0]}}]. Vertex indices in them are
     rows of ``vertices``. The mesh gets the same checks as a mesh file (folds, duplicates,
     cracks; unused vertices are dropped with a note).
     """
+    if isinstance(regions, dict):  # {tag: "role"} or {tag: {"role": ..., ...}}
+        regions = [dict(v, tag=int(k)) if isinstance(v, dict) else {"tag": int(k), "role": v}
+                   for k, v in regions.items()]
     spec = {"name": name, "regions": list(regions), "fixed": list(fixed),
             "markers": list(markers), "motions": list(motions), "obstacles": list(obstacles)}
     if solver is not None:

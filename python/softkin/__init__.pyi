@@ -64,6 +64,10 @@ class FkResult:
     @property
     def time_s(self) -> float: ...
     @property
+    def local_time_s(self) -> float: ...
+    @property
+    def global_time_s(self) -> float: ...
+    @property
     def volume_ratios(self) -> Vec: ...  # (#A,)
     @property
     def inverted_elements(self) -> int: ...
@@ -78,7 +82,7 @@ def scene_from_arrays(
     vertices: ArrayLike,
     elements: ArrayLike,
     tags: ArrayLike,
-    regions: Iterable[Mapping[str, Any]],
+    regions: Union[Iterable[Mapping[str, Any]], Mapping[int, Any]],
     fixed: Iterable[Mapping[str, Any]],
     markers: Iterable[Mapping[str, Any]] = ...,
     motions: Iterable[Mapping[str, Any]] = ...,

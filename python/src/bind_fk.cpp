@@ -200,6 +200,12 @@ void BindFk(py::module_& m) {
                              [](const PyFkResult& p) { return p.r.gradient_ratio; })
       .def_property_readonly("time_s", [](const PyFkResult& p) { return p.r.time_s; })
       .def_property_readonly(
+          "local_time_s", [](const PyFkResult& p) { return p.r.local_time_s; },
+          "Time in the local steps (local-global solvers), s.")
+      .def_property_readonly(
+          "global_time_s", [](const PyFkResult& p) { return p.r.global_time_s; },
+          "Time in the global steps (local-global solvers), s.")
+      .def_property_readonly(
           "volume_ratios",
           [](const PyFkResult& p) {
             return ToNumpyVector(Eigen::Map<const Eigen::VectorXd>(

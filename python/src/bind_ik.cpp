@@ -17,6 +17,46 @@ namespace python {
 
 namespace {
 
+/// `inner` restricted to a narrower box [lower, upper] (softkin.ik's bounds=): IK stays inside it.
+class BoxedKinematics : public Kinematics {
+ public:
+  BoxedKinematics(Kinematics& inner, const py::object& bounds) : inner_(inner) {
+    lower_ = inner.lower();
+    upper_ = inner.upper();
+    if (bounds.is_none()) return;
+    const DoubleArray b = bounds.cast<DoubleArray>();
+    CheckMatrix(b, "bounds", 2, "(" + std::to_string(inner.num_actuators()) + ", 2)");
+    if (b.shape(0) != inner.num_actuators())
+      throw std::invalid_argument("bounds: expected one (min, max) row per actuator, " +
+                                  std::to_string(inner.num_actuators()) + " rows; got " +
+                                  std::to_string(b.shape(0)));
+    auto v = b.unchecked<2>();
+    for (int a = 0; a < inner.num_actuators(); ++a) {
+      if (!(v(a, 0) < v(a, 1)) || v(a, 0) < inner.lower()(a) || v(a, 1) > inner.upper()(a))
+        throw std::invalid_argument(
+            "bounds[" + std::to_string(a) + "]: expected min < max within the actuator's range [" +
+            std::to_string(inner.lower()(a)) + ", " + std::to_string(inner.upper()(a)) +
+            "], got [" + std::to_string(v(a, 0)) + ", " + std::to_string(v(a, 1)) + "]");
+      lower_(a) = v(a, 0);
+      upper_(a) = v(a, 1);
+    }
+  }
+  std::string name() const override { return inner_.name(); }
+  int num_actuators() const override { return inner_.num_actuators(); }
+  const std::vector<std::string>& point_names() const override { return inner_.point_names(); }
+  const Eigen::VectorXd& lower() const override { return lower_; }
+  const Eigen::VectorXd& upper() const override { return upper_; }
+  Eigen::VectorXd rest() const override { return inner_.rest().cwiseMax(lower_).cwiseMin(upper_); }
+  KinematicsEval Evaluate(const Eigen::Ref<const Eigen::VectorXd>& c, bool with_jacobian) override {
+    return inner_.Evaluate(c, with_jacobian);
+  }
+  long long total_fk_solves() const override { return inner_.total_fk_solves(); }
+
+ private:
+  Kinematics& inner_;
+  Eigen::VectorXd lower_, upper_;
+};
+
 /// IK options from the keyword arguments the Python layer passes (its defaults are IkOptions').
 IkOptions ReadIkOptions(const std::string& method, const std::string& gradient, double lambda_mm,
                         int max_iterations, int max_evaluations, double max_time_s) {
@@ -45,8 +85,9 @@ std::string DefaultPoint(const Kinematics& k, const std::string& point) {
   return k.point_names().front();
 }
 
-py::dict Solve(Kinematics& kin, const DoubleArray& target, const std::string& point,
-               const py::object& c0, const IkOptions& o) {
+py::dict Solve(Kinematics& inner, const DoubleArray& target, const std::string& point,
+               const py::object& c0, const py::object& bounds, const IkOptions& o) {
+  BoxedKinematics kin(inner, bounds);
   const Eigen::Vector3d t = ToVector(target, 3, "target (x, y, z in mm)");
   const std::string pt = DefaultPoint(kin, point);
   const PointTrackingObjective objective(kin.point_names(), pt, t);
@@ -56,7 +97,7 @@ py::dict Solve(Kinematics& kin, const DoubleArray& target, const std::string& po
   IkResult r;
   {
     py::gil_scoped_release release;
-    std::lock_guard<std::mutex> lock(KinematicsMutex(&kin));
+    std::lock_guard<std::mutex> lock(KinematicsMutex(&inner));
     r = SolveIk(kin, objective, start, o);
   }
   py::dict d;
@@ -78,8 +119,10 @@ py::dict Solve(Kinematics& kin, const DoubleArray& target, const std::string& po
   return d;
 }
 
-py::dict Follow(Kinematics& kin, const DoubleArray& waypoints, const std::string& point,
-                const py::object& c0, int samples_per_axis, const IkOptions& o) {
+py::dict Follow(Kinematics& inner, const DoubleArray& waypoints, const std::string& point,
+                const py::object& c0, const py::object& bounds, int samples_per_axis,
+                const IkOptions& o) {
+  BoxedKinematics kin(inner, bounds);
   const Eigen::MatrixX3d W = ToPoints(waypoints, "waypoints");
   TrajectoryOptions t;
   t.point = DefaultPoint(kin, point);
@@ -90,7 +133,7 @@ py::dict Follow(Kinematics& kin, const DoubleArray& waypoints, const std::string
   TrajectoryResult r;
   {
     py::gil_scoped_release release;
-    std::lock_guard<std::mutex> lock(KinematicsMutex(&kin));
+    std::lock_guard<std::mutex> lock(KinematicsMutex(&inner));
     r = FollowTrajectory(kin, W, t);
   }
   const int n = static_cast<int>(r.waypoints.size());
@@ -133,26 +176,26 @@ void BindIk(py::module_& m) {
   ik.def(
       "solve",
       [](Kinematics& kin, const DoubleArray& target, const std::string& point, const py::object& c0,
-         const std::string& method, const std::string& gradient, double lambda_mm,
-         int max_iterations, int max_evaluations, double max_time_s) {
-        return Solve(kin, target, point, c0,
+         const py::object& bounds, const std::string& method, const std::string& gradient,
+         double lambda_mm, int max_iterations, int max_evaluations, double max_time_s) {
+        return Solve(kin, target, point, c0, bounds,
                      ReadIkOptions(method, gradient, lambda_mm, max_iterations, max_evaluations,
                                    max_time_s));
       },
-      py::arg("kin"), py::arg("target"), py::arg("point"), py::arg("c0"), py::arg("method"),
-      py::arg("gradient"), py::arg("lambda_mm"), py::arg("max_iterations"),
+      py::arg("kin"), py::arg("target"), py::arg("point"), py::arg("c0"), py::arg("bounds"),
+      py::arg("method"), py::arg("gradient"), py::arg("lambda_mm"), py::arg("max_iterations"),
       py::arg("max_evaluations"), py::arg("max_time_s"));
   ik.def(
       "follow",
       [](Kinematics& kin, const DoubleArray& waypoints, const std::string& point,
-         const py::object& c0, int samples_per_axis, const std::string& method,
-         const std::string& gradient, double lambda_mm, int max_iterations, int max_evaluations,
-         double max_time_s) {
-        return Follow(kin, waypoints, point, c0, samples_per_axis,
+         const py::object& c0, const py::object& bounds, int samples_per_axis,
+         const std::string& method, const std::string& gradient, double lambda_mm,
+         int max_iterations, int max_evaluations, double max_time_s) {
+        return Follow(kin, waypoints, point, c0, bounds, samples_per_axis,
                       ReadIkOptions(method, gradient, lambda_mm, max_iterations, max_evaluations,
                                     max_time_s));
       },
-      py::arg("kin"), py::arg("waypoints"), py::arg("point"), py::arg("c0"),
+      py::arg("kin"), py::arg("waypoints"), py::arg("point"), py::arg("c0"), py::arg("bounds"),
       py::arg("samples_per_axis"), py::arg("method"), py::arg("gradient"), py::arg("lambda_mm"),
       py::arg("max_iterations"), py::arg("max_evaluations"), py::arg("max_time_s"));
   ik.def("methods", [] { return IkMethodNames(); });

@@ -73,6 +73,20 @@ def test_python_kinematics_bounds_and_failures_are_reported():
         kin.p([2.0, 0.0])
 
 
+def test_bounds_keep_ik_inside_a_narrower_box():
+    kin = Linear()
+    target = [1.0 + 5.0, 2.0 + 4.0, 3.0 + 0.7]  # c* = (0.5, 0.2)
+    r = softkin.ik.solve(kin, target, method="gauss-newton", bounds=[[0.0, 0.4], [0.0, 1.0]])
+    assert not r["converged"]
+    assert r["c"][0] == pytest.approx(0.4) and 0.0 <= r["c"][1] <= 1.0
+    r = softkin.ik.solve(kin, target, method="gauss-newton", bounds=[[0.3, 0.7], [0.1, 0.3]])
+    assert r["converged"]
+    with pytest.raises(ValueError, match=r"bounds\[0\]: expected min < max within"):
+        softkin.ik.solve(kin, target, bounds=[[0.5, 1.5], [0.0, 1.0]])
+    with pytest.raises(ValueError, match="bounds: expected one"):
+        softkin.ik.solve(kin, target, bounds=[[0.0, 1.0]])
+
+
 def test_simulator_ik_reaches_a_point_it_produced(three_chamber):
     kin = softkin.SimulatorKinematics(three_chamber, points=["tip"])
     c_true = np.array([1.35, 1.1, 1.0])

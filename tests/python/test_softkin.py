@@ -174,6 +174,14 @@ def test_scene_from_arrays_builds_a_bar_that_bends_away_from_its_chamber():
     tip0 = scene.marker_positions(scene.vertices)["tip"]
     assert r.markers["tip"][2] < tip0[2] - 0.3  # the tip goes down (-z), away from the chamber
     assert r.inverted_elements == 0
+    # Regions as a dict tag -> role (or entry) give the same scene.
+    same = softkin.scene_from_arrays(
+        V, E, T, regions={0: {"role": "body", "r_omega": 1.0},
+                          1: {"role": "pneumatic", "name": "chamber", "min": 1, "max": 2}},
+        fixed=BAR_FIXED, markers=BAR_MARKERS)
+    np.testing.assert_array_equal(softkin.solve_fk(same, 1.6).positions, r.positions)
+    assert softkin.scene_from_arrays(V, E, T, regions={0: "body", 1: "body"},
+                                     fixed=BAR_FIXED).num_actuators == 0
 
 
 def test_scene_from_arrays_refuses_bad_arrays_clearly():
