@@ -41,6 +41,36 @@ __all__ = [
 ]
 
 
+def _floats(x, what):
+    """x as a float64 array, or ValueError naming ``what``."""
+    try:
+        a = _np.asarray(x, dtype=_np.float64)
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"{what}: expected numbers, got {type(x).__name__} ({e})") from None
+    return a
+
+
+def _indices(x, what):
+    """x as an int64 array of whole numbers, or ValueError naming ``what``."""
+    try:
+        a = _np.asarray(x)
+        if a.dtype.kind == "f":
+            if not _np.all(_np.isfinite(a)) or not _np.all(a == _np.round(a)):
+                raise ValueError("not whole numbers")
+        elif a.dtype.kind not in "iub":
+            raise ValueError(f"dtype {a.dtype}")
+        return a.astype(_np.int64)
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"{what}: expected integer indices, got {e}") from None
+
+
+def _actuation(c):
+    c = _np.atleast_1d(_floats(c, "c (one value per actuator)"))
+    if not _np.all(_np.isfinite(c)):
+        raise ValueError(f"c (one value per actuator): expected finite numbers, got {c.tolist()}")
+    return c
+
+
 def robots():
     """The embedded robot generators: a list of dicts with name, description,
     default_resolution, resolution_doc and params (name, default, min, max, doc)."""
@@ -85,8 +115,8 @@ def scene_from_arrays(vertices, elements, tags, regions, fixed, markers=(), moti
     if solver is not None:
         spec["solver"] = dict(solver)
     return _softkin._scene_from_arrays(
-        _np.asarray(vertices, dtype=_np.float64), _np.asarray(elements, dtype=_np.int64),
-        _np.asarray(tags, dtype=_np.int64), _json.dumps(spec), name)
+        _floats(vertices, "vertices"), _indices(elements, "elements"), _indices(tags, "tags"),
+        _json.dumps(spec), name)
 
 
 def _options_json(options):
@@ -122,8 +152,11 @@ class FkSolver:
     def solve(self, c, warm_start=None):
         """Solves for actuation ``c`` (#A values, or a number for one actuator) from the rest
         shape, or from ``warm_start`` (#V x 3 positions, e.g. a previous result's). Returns an
-        FkResult; check ``result.converged``."""
-        return self._impl.solve(_np.atleast_1d(_np.asarray(c, dtype=_np.float64)), warm_start)
+        FkResult; check ``result.converged``. ValueError for a c of the wrong size, not finite
+        or outside the actuators' ranges."""
+        if warm_start is not None:
+            warm_start = _floats(warm_start, "warm_start")
+        return self._impl.solve(_actuation(c), warm_start)
 
     def jacobian(self, c, mode="implicit", warm_start=None):
         """dX/dc at the equilibrium for ``c``: a dict with ``dX`` (#V x 3 x #A, mm per unit of
@@ -132,8 +165,9 @@ class FkSolver:
         differences, probes solved like c itself), fd-warm (probes start from the state at c);
         differences step 1/160 of each actuator's range, one-sided at a bound. Raises
         RuntimeError when the solve at c or a probe does not converge."""
-        return self._impl.jacobian(_np.atleast_1d(_np.asarray(c, dtype=_np.float64)), mode,
-                                   warm_start)
+        if warm_start is not None:
+            warm_start = _floats(warm_start, "warm_start")
+        return self._impl.jacobian(_actuation(c), mode, warm_start)
 
     def __repr__(self):
         return f"<softkin.FkSolver {self.name} on {self.scene!r}>"

@@ -47,9 +47,16 @@ class PyFkSolver {
     Eigen::MatrixX3d warm;
     const bool has_warm = !warm_start.is_none();
     if (has_warm) warm = WarmStart(warm_start);
-    py::gil_scoped_release release;
-    std::lock_guard<std::mutex> lock(mutex_);
-    return {solver_->Solve(cv, has_warm ? &warm : nullptr), scene_};
+    PyFkResult out;
+    {
+      py::gil_scoped_release release;
+      std::lock_guard<std::mutex> lock(mutex_);
+      out = {solver_->Solve(cv, has_warm ? &warm : nullptr), scene_};
+    }
+    // Bad input (an actuation out of range, ...) is an error, as on the command line; a solve
+    // that runs and fails returns its status.
+    if (out.r.status == FkStatus::InvalidInput) throw std::invalid_argument(out.r.message);
+    return out;
   }
 
   py::dict Jacobian(const DoubleArray& c, const std::string& mode, const py::object& warm_start) {
@@ -69,7 +76,9 @@ class PyFkSolver {
       std::lock_guard<std::mutex> lock(mutex_);
       const Eigen::MatrixX3d* start = has_warm ? &warm : nullptr;
       centre = {solver_->Solve(cv, start), scene_};
-      if (centre.r.status != FkStatus::Converged) {
+      if (centre.r.status == FkStatus::InvalidInput) {
+        error = centre.r.message;
+      } else if (centre.r.status != FkStatus::Converged) {
         error = "the forward solve at c did not converge (" +
                 std::string(FkStatusToString(centre.r.status)) + "): " + centre.r.message;
       } else if (mode == "implicit") {
@@ -84,6 +93,7 @@ class PyFkSolver {
         error = Differences(cv, centre.r.positions, probe_start, &dXdc);
       }
     }
+    if (centre.r.status == FkStatus::InvalidInput) throw std::invalid_argument(error);
     if (!error.empty()) throw std::runtime_error(error);
     // dX/dc as #V x 3 x #A (row 3 v + d of dXdc is coordinate d of vertex v).
     py::array_t<double> dX(

@@ -124,6 +124,8 @@ class PyKinematics : public Kinematics {
 
 py::dict EvaluateToDict(Kinematics& k, const DoubleArray& c, bool with_jacobian) {
   const Eigen::VectorXd cv = ToVector(c, k.num_actuators(), "c (one value per actuator)");
+  const std::string bad = CheckKinematicsInput(k, cv);  // bad input: ValueError
+  if (!bad.empty()) throw std::invalid_argument(bad);
   KinematicsEval e;
   {
     py::gil_scoped_release release;

@@ -78,7 +78,12 @@ std::shared_ptr<Scene> SceneFromArrays(const DoubleArray& vertices, const IntArr
                                        const IntArray& tags, const std::string& spec_json,
                                        const std::string& source) {
   Mesh mesh = MeshFromArrays(vertices, elements, tags);
-  const MeshReport report = ValidateAndOrient(mesh, source);
+  MeshReport report;
+  try {
+    report = ValidateAndOrient(mesh, source);
+  } catch (const std::runtime_error& e) {  // the arrays are the input: bad input, ValueError
+    throw std::invalid_argument(e.what());
+  }
   PrintMeshReport(report, std::cerr);
   return std::make_shared<Scene>(ParseSceneJsonWithMesh(spec_json, source, mesh, report));
 }

@@ -4,6 +4,7 @@ with PYTHONPATH set to the build tree's python/ folder."""
 
 import json
 import os
+import subprocess
 import threading
 import xml.etree.ElementTree as ET
 
@@ -159,8 +160,8 @@ def test_simulator_kinematics_p_and_j(finger):
     assert p.shape == (1, 3) and J.shape == (3, 1)
     jac = softkin.FkSolver(finger).jacobian(2.0)
     np.testing.assert_allclose(J[:, 0], jac["markers"]["tip"][:, 0], rtol=1e-3, atol=1e-4)
-    with pytest.raises(RuntimeError, match="chamber"):
-        kin.p(50.0)  # outside [1, 10]
+    with pytest.raises(ValueError, match=r"value 50 is outside its range \[1, 10\]"):
+        kin.p(50.0)
 
 
 def test_scene_from_arrays_builds_a_bar_that_bends_away_from_its_chamber():
@@ -201,7 +202,7 @@ def test_scene_from_arrays_refuses_bad_arrays_clearly():
         softkin.scene_from_arrays(V, E, T, regions=[{"tag": 0, "role": "rubber"}],
                                   fixed=BAR_FIXED)
     dup = np.vstack([E, E[:1]])
-    with pytest.raises(RuntimeError, match="has the same vertices as element 0"):
+    with pytest.raises(ValueError, match="has the same vertices as element 0"):
         softkin.scene_from_arrays(V, dup, np.append(T, T[0]), **kw)
 
 
@@ -228,3 +229,102 @@ def test_python_threads_solve_side_by_side_with_the_serial_answers():
         t.join()
     for i in range(2):
         np.testing.assert_array_equal(out[i], serial[i])
+
+
+def run_cli(args):
+    """The softkin command: the built binary when ctest gives it (SOFTKIN_BIN), else in-process."""
+    binary = os.environ.get("SOFTKIN_BIN")
+    if binary:
+        subprocess.run([binary] + args, check=True, stdout=subprocess.DEVNULL,
+                       stderr=subprocess.DEVNULL)
+    else:
+        assert softkin.cli(args) == 0
+
+
+def vtu_points(path):
+    root = ET.parse(path).getroot()
+    text = root.find(".//Points/DataArray").text
+    return np.array([float(t) for t in text.split()]).reshape(-1, 3)
+
+
+def test_python_equals_the_command_line_bit_for_bit(finger, tmp_path):
+    j, v = tmp_path / "fk.json", tmp_path / "fk.vtu"
+    run_cli(["fk", "--robot", "pneumatic_finger", "--res", "5", "--actuation", "3", "--json",
+             str(j), "--vtu", str(v)])
+    r = softkin.FkSolver(finger).solve(3.0)
+    cli = json.loads(j.read_text())
+    assert cli["status"] == r.status and cli["iterations"] == r.iterations
+    for name, p in r.markers.items():
+        assert cli["markers"][name] == p.tolist(), name  # exact: shortest round-trip text
+    np.testing.assert_array_equal(vtu_points(v), r.positions)
+
+
+def test_jacobian_matches_differences_of_python_solves(finger):
+    solver = softkin.FkSolver(finger, tolerance=1e-10, gradient_tolerance=1e-9)
+    c, h = 2.0, 0.01
+    centre = solver.solve(c)
+    plus = solver.solve(c + h, warm_start=centre.positions)
+    minus = solver.solve(c - h, warm_start=centre.positions)
+    assert centre.converged and plus.converged and minus.converged
+    fd = (plus.positions - minus.positions) / (2 * h)
+    dX = solver.jacobian(c)["dX"][:, :, 0]
+    assert np.abs(dX - fd).max() < 2e-3 * np.abs(fd).max()
+
+
+def write_gmsh22(path, V, E, T):
+    """A Gmsh 2.2 ASCII file: nodes (1-based tags, shortest round-trip text) and tets (type 4)
+    with physical group = tag + 1 (Gmsh groups are positive)."""
+    lines = ["$MeshFormat", "2.2 0 8", "$EndMeshFormat", "$Nodes", str(len(V))]
+    lines += [f"{i + 1} {repr(x)} {repr(y)} {repr(z)}" for i, (x, y, z) in enumerate(V)]
+    lines += ["$EndNodes", "$Elements", str(len(E))]
+    lines += [f"{i + 1} 4 2 {t + 1} {t + 1} " + " ".join(str(v + 1) for v in e)
+              for i, (e, t) in enumerate(zip(E, T))]
+    lines += ["$EndElements"]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_arrays_and_a_file_give_the_same_scene_and_answer(tmp_path):
+    V, E, T = voxel_bar()
+    V = V * 1.1 + 0.05  # coordinates that are not short decimals
+    regions = [{"tag": 0, "role": "body", "r_omega": 1.0},
+               {"tag": 1, "role": "pneumatic", "name": "chamber", "min": 1, "max": 2}]
+    markers = [{"name": "tip", "box": {"min": [6.6, -1, -1], "max": [6.7, 4, 4]}}]
+    fixed = [{"plane": {"point": [0.05, 0, 0], "normal": [1, 0, 0]}}]
+    from_arrays = softkin.scene_from_arrays(V, E, T, regions=regions, fixed=fixed,
+                                            markers=markers, name="bar")
+    write_gmsh22(tmp_path / "bar.msh", V, E, T)
+    file_regions = [dict(r, tag=r["tag"] + 1) for r in regions]
+    (tmp_path / "bar.json").write_text(json.dumps({
+        "name": "bar", "mesh": {"file": "bar.msh"}, "regions": file_regions, "fixed": fixed,
+        "markers": markers}))
+    from_file = softkin.load_scene(tmp_path / "bar.json")
+    np.testing.assert_array_equal(from_arrays.vertices, from_file.vertices)
+    np.testing.assert_array_equal(from_arrays.elements, from_file.elements)
+    np.testing.assert_array_equal(from_arrays.fixed, from_file.fixed)
+    a, b = softkin.solve_fk(from_arrays, 1.5), softkin.solve_fk(from_file, 1.5)
+    assert a.converged and a.iterations == b.iterations
+    np.testing.assert_array_equal(a.positions, b.positions)
+
+
+def test_bad_input_raises_value_error_with_the_reason(finger):
+    V, E, T = voxel_bar()
+    kw = dict(regions=BAR_REGIONS, fixed=BAR_FIXED)
+    with pytest.raises(ValueError, match="vertices: expected numbers"):
+        softkin.scene_from_arrays([["a", "b", "c"]], E, T, **kw)
+    with pytest.raises(ValueError, match="elements: expected integer indices"):
+        softkin.scene_from_arrays(V, E + 0.5, T, **kw)
+    Vn = V.copy()
+    Vn[3, 1] = np.nan
+    with pytest.raises(ValueError, match="NaN|non-finite|not finite"):
+        softkin.scene_from_arrays(Vn, E, T, **kw)
+    solver = softkin.FkSolver(finger)
+    with pytest.raises(ValueError, match="expected finite numbers"):
+        solver.solve(np.nan)
+    with pytest.raises(ValueError, match="chamber"):
+        solver.solve(50.0)  # outside [1, 10]
+    with pytest.raises(ValueError, match="chamber"):
+        solver.jacobian(0.5)
+    with pytest.raises(ValueError, match="no_such_robot"):
+        softkin.robot("no_such_robot")
+    with pytest.raises(ValueError, match="options"):
+        softkin.FkSolver(finger, no_such_option=1)
