@@ -1,6 +1,7 @@
 #include "softkin/experiments/cli_dataset.hpp"
 
 #include "softkin/experiments/cli_args.hpp"
+#include "softkin/experiments/dataset_mpi.hpp"
 #include "softkin/experiments/results.hpp"
 #include "softkin/ik/simulator_kinematics.hpp"
 #include "softkin/learn/dataset.hpp"
@@ -27,7 +28,9 @@ CLI::App* AddDatasetCommand(CLI::App* app, DatasetCommandArgs* a) {
       "with --jacobian, message), one line per sample as it is computed, and a sidecar FILE.json "
       "(robot, res, params, points, sampling, git commit; twin label). Running the same command "
       "again on a partial file resumes it; --shard k/n computes the k-th of n contiguous slices; "
-      "--merge joins the shards. Exit 0 when every sample succeeded, 1 when some were recorded as "
+      "--merge joins the shards; under mpirun (-n N) the ranks share the samples "
+      "(docs/cluster.md). "
+      "Exit 0 when every sample succeeded, 1 when some were recorded as "
       "failed, 2 for bad input. Units: mm. See docs/datasets.md");
   auto* o_robot = ds->add_option("--robot", a->robot, "Embedded robot name (see `softkin robots`)");
   auto* o_twin = ds->add_option(
@@ -258,6 +261,27 @@ int RunDatasetCommand(const DatasetCommandArgs& a) {
   run.provenance = {{"git_commit", GitCommit()}, {"command", a.command_line}};
 
   const long long total = DatasetSize(sampling, source.kin->num_actuators());
+  const int ranks = LaunchedMpiSize();
+  if (ranks > 1) {
+    if (!HaveMpi())
+      throw std::invalid_argument(
+          "dataset: started by an MPI launcher with " + std::to_string(ranks) +
+          " processes, but this softkin was built without MPI (install libopenmpi-dev and "
+          "rebuild); the processes would all write " +
+          a.out);
+    if (!a.shard.empty())
+      throw std::invalid_argument("--shard: not under mpirun, where the ranks share the samples");
+    const bool root = LaunchedMpiRank() == 0;
+    run.progress = run.progress && root;
+    if (run.progress)
+      std::cerr << "softkin dataset: " << source.kin->name() << " of "
+                << (a.robot.empty() ? a.twin : a.robot) << ", " << total << " samples on " << ranks
+                << " MPI ranks, points " << a.points << ", jacobian " << a.jacobian << " -> "
+                << a.out << "\n";
+    const DatasetRunSummary s = GenerateDatasetMpi(*source.kin, sampling, run);
+    if (run.progress) ReportSummary(s);
+    return s.failed > 0 ? 1 : 0;
+  }
   if (!a.quiet)
     std::cerr << "softkin dataset: " << source.kin->name() << " of "
               << (a.robot.empty() ? a.twin : a.robot) << ", " << total << " samples"

@@ -167,6 +167,10 @@ void SimulatorKinematics::Reset() {
   jac_dXdc_.resize(0, 0);
   jac_c_.resize(0);
   jac_columns_.clear();
+  // The implicit mode's preconditioner (factor, and whether its blocks are projected) too: after
+  // Reset the next evaluations are those of a new object, bit for bit (a dataset's blocks).
+  workspace_ = std::make_unique<EquilibriumJacobianWorkspace>();
+  last_implicit_ = EquilibriumJacobianResult();
 }
 
 double SimulatorKinematics::fd_step(int a) const {

@@ -135,7 +135,8 @@ class SimulatorKinematics : public Kinematics {
   KinematicsEval Evaluate(const Eigen::Ref<const Eigen::VectorXd>& c, bool with_jacobian) override;
   long long total_fk_solves() const override { return total_fk_solves_; }
 
-  /// Forgets the warm-start state: the next p solve starts from the rest shape.
+  /// Forgets the warm-start state: the next p solve starts from the rest shape, and the implicit
+  /// Jacobian starts with no initial guess and a new preconditioner, as a new object would.
   void Reset();
   const Model& model() const { return *model_; }
   std::shared_ptr<const Model> shared_model() const { return model_; }

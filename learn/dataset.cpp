@@ -472,6 +472,7 @@ DatasetRunSummary GenerateDataset(Kinematics& kin, const DatasetSampling& sampli
         ev.message = shape ? "non-finite positions or Jacobian" : "wrong output shape";
       }
     }
+    if (opt.after_sample) opt.after_sample();
     if (i < start) continue;
     csv << SampleLine(i, c, ev, np, opt.jacobian) << "\n" << std::flush;
     if (!csv) throw std::runtime_error("error while writing " + opt.out);

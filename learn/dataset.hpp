@@ -92,6 +92,9 @@ struct DatasetRunOptions {
   bool progress = true;  ///< progress bar on stderr
   /// Stop after writing this many new samples (< 0: never); simulates an interruption in tests.
   long long stop_after = -1;
+  /// Called after each sample is evaluated (written or recomputed for a warm start), e.g. for
+  /// the MPI dispatcher to answer the other ranks between samples (experiments/dataset_mpi.hpp).
+  std::function<void()> after_sample;
 };
 
 /// What a run did.
