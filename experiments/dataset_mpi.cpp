@@ -3,6 +3,7 @@
 /// files, and the merge.
 #include "softkin/experiments/dataset_mpi.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -133,6 +134,23 @@ DatasetRunSummary SumOverRanks(const DatasetRunSummary& mine) {
   return out;
 }
 
+/// Rank 0 prints each rank's busy time (its units' time) and the busiest over the mean.
+void ReportBalance(int rank, int size, const DatasetRunSummary& mine, bool print) {
+  std::vector<double> busy(static_cast<std::size_t>(size), 0.0);
+  std::vector<long long> samples(static_cast<std::size_t>(size), 0);
+  MPI_Gather(&mine.time_s, 1, MPI_DOUBLE, busy.data(), 1, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  MPI_Gather(&mine.written, 1, MPI_LONG_LONG, samples.data(), 1, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
+  if (rank != 0 || !print) return;
+  double sum = 0, top = 0;
+  std::cerr << "softkin dataset: busy time per rank:";
+  for (int r = 0; r < size; ++r) {
+    std::cerr << (r ? ", " : " ") << busy[r] << " s (" << samples[r] << " samples)";
+    sum += busy[r];
+    top = std::max(top, busy[r]);
+  }
+  std::cerr << "; busiest / mean " << (sum > 0 ? top / (sum / size) : 1.0) << "\n";
+}
+
 [[noreturn]] void Abort(int rank, const std::exception& e) {
   std::cerr << "softkin dataset: rank " << rank << ": error: " << e.what()
             << " (aborting the job; completed units stay for a rerun)\n";
@@ -211,6 +229,7 @@ DatasetRunSummary GenerateDatasetMpi(Kinematics& kin, const DatasetSampling& sam
   DatasetRunSummary job = SumOverRanks(mine);
   job.first = 0;
   job.count = total;
+  if (!single) ReportBalance(rank, size, mine, run.progress);
   MPI_Barrier(MPI_COMM_WORLD);
   if (!single && rank == 0) {
     try {

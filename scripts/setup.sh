@@ -54,6 +54,8 @@ PACKAGES=(
   pybind11-dev
   python3-pytest
   python3-meshio
+  libopenmpi-dev
+  openmpi-bin
 )
 
 log() { echo "[setup] $*"; }
