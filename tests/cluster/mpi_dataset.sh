@@ -32,6 +32,23 @@ cmp single.csv resumed.csv
 grep -q "23 already in the file, 41 written" resumed.log || { cat resumed.log >&2; exit 1; }
 echo "resumed job: only the missing samples computed, identical to one process"
 
+# A job killed mid-run (SIGKILL to the launcher and its ranks once a few units exist), then
+# rerun: nothing lost or duplicated.
+setsid "${MPI[@]}" -n 2 "$SOFTKIN" "${ARGS[@]}" --quiet --out killed.csv 2> /dev/null &
+job=$!
+for _ in $(seq 1 600); do
+  n_files=0
+  [[ -d killed.csv.parts ]] && n_files=$(find killed.csv.parts -name '*.csv' | wc -l)
+  ((n_files >= 3)) && break
+  sleep 0.1
+done
+kill -KILL -- "-$job" 2> /dev/null || true
+wait "$job" 2> /dev/null || true
+[[ ! -e killed.csv ]] || echo "note: the job finished before the kill (a fast machine)"
+"${MPI[@]}" -n 2 "$SOFTKIN" "${ARGS[@]}" --out killed.csv 2> killed.log
+cmp single.csv killed.csv
+echo "killed job rerun: identical to one process ($(grep -o '[0-9]* already' killed.log))"
+
 # A finished dataset rerun under mpirun: checked by rank 0, nothing recomputed.
 "${MPI[@]}" -n 2 "$SOFTKIN" "${ARGS[@]}" --out n2.csv 2> again.log
 grep -q "64 already in the file, 0 written" again.log || { cat again.log >&2; exit 1; }
