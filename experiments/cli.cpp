@@ -75,14 +75,14 @@ int RunCli(int argc, char** argv, bool rethrow) {
     return app.exit(e) == 0 ? 0 : 2;
   }
 
-  if (rethrow) {
+  const auto run_parsed = [&commands] {
     for (const Command& c : commands)
       if (c.app->parsed()) return c.run();
     return 0;
-  }
+  };
+  if (rethrow) return run_parsed();
   try {
-    for (const Command& c : commands)
-      if (c.app->parsed()) return c.run();
+    return run_parsed();
   } catch (const std::invalid_argument& e) {
     std::cerr << "softkin: error: " << e.what() << "\n";
     return 2;
@@ -90,7 +90,6 @@ int RunCli(int argc, char** argv, bool rethrow) {
     std::cerr << "softkin: error: " << e.what() << "\n";
     return 1;
   }
-  return 0;
 }
 
 }  // namespace softkin

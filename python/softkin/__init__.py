@@ -119,10 +119,6 @@ def scene_from_arrays(vertices, elements, tags, regions, fixed, markers=(), moti
         _json.dumps(spec), name)
 
 
-def _options_json(options):
-    return _json.dumps(options)
-
-
 class FkSolver:
     """A forward-kinematics solver on one scene, reused across solves (it keeps the model's
     factorisation). ``solver`` is one of lg, lg-aa, newton, ceres, ipopt-lbfgs, ipopt-newton,
@@ -134,7 +130,7 @@ class FkSolver:
     def __init__(self, scene, solver="lg-aa", **options):
         options = dict(options)
         options["solver"] = solver
-        self._impl = _softkin._FkSolver(scene, _options_json(options))
+        self._impl = _softkin._FkSolver(scene, _json.dumps(options))
 
     @property
     def scene(self):
@@ -189,7 +185,7 @@ class SimulatorKinematics(_softkin._SimulatorKinematics):
                  solver="lg-aa", **options):
         options = dict(options)
         options["solver"] = solver
-        super().__init__(scene, jacobian, list(points), float(fd_step), _options_json(options))
+        super().__init__(scene, jacobian, list(points), float(fd_step), _json.dumps(options))
 
 
 def cli(args):

@@ -186,14 +186,7 @@ void BindFk(py::module_& m) {
           "positions", [](const PyFkResult& p) { return ToNumpy(p.r.positions); },
           "Deformed vertex positions, #V x 3, mm (never NaN: the last finite iterate).")
       .def_property_readonly(
-          "markers",
-          [](const PyFkResult& p) {
-            const Eigen::MatrixX3d M = p.scene->marker_positions(p.r.positions);
-            py::dict d;
-            for (int i = 0; i < static_cast<int>(p.scene->markers.size()); ++i)
-              d[py::str(p.scene->markers[i].name)] = ToNumpyVector(M.row(i).transpose());
-            return d;
-          },
+          "markers", [](const PyFkResult& p) { return MarkerDict(*p.scene, p.r.positions); },
           "Marker name -> position (3,), mm.")
       .def_property_readonly(
           "status", [](const PyFkResult& p) { return std::string(FkStatusToString(p.r.status)); },

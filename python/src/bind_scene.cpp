@@ -30,6 +30,13 @@ py::array_t<long long> ElementArray(const Mesh& mesh) {
   return out;
 }
 
+/// One field (min or max) of every actuator, #A.
+py::array_t<double> ActuatorBound(const Scene& s, double Actuator::*field) {
+  Eigen::VectorXd v(s.num_actuators());
+  for (int a = 0; a < s.num_actuators(); ++a) v(a) = s.actuators[a].*field;
+  return ToNumpyVector(v);
+}
+
 py::dict ActuatorDict(const Actuator& a) {
   py::dict d;
   d["name"] = a.name;
@@ -114,6 +121,14 @@ py::list Robots() {
 
 }  // namespace
 
+py::dict MarkerDict(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX3d>& X) {
+  const Eigen::MatrixX3d M = scene.marker_positions(X);
+  py::dict d;
+  for (int i = 0; i < static_cast<int>(scene.markers.size()); ++i)
+    d[py::str(scene.markers[i].name)] = ToNumpyVector(M.row(i).transpose());
+  return d;
+}
+
 void BindScene(py::module_& m) {
   py::class_<Scene, std::shared_ptr<Scene>>(m, "Scene",
                                             "A robot: rest mesh (mm), materials, actuators, held "
@@ -147,20 +162,10 @@ void BindScene(py::module_& m) {
           "One dict per actuator, in actuation-vector order: name, type, min, max, rest, weight, "
           "regions.")
       .def_property_readonly(
-          "lower",
-          [](const Scene& s) {
-            Eigen::VectorXd v(s.num_actuators());
-            for (int a = 0; a < s.num_actuators(); ++a) v(a) = s.actuators[a].min;
-            return ToNumpyVector(v);
-          },
+          "lower", [](const Scene& s) { return ActuatorBound(s, &Actuator::min); },
           "Lower bounds of the actuation, #A.")
       .def_property_readonly(
-          "upper",
-          [](const Scene& s) {
-            Eigen::VectorXd v(s.num_actuators());
-            for (int a = 0; a < s.num_actuators(); ++a) v(a) = s.actuators[a].max;
-            return ToNumpyVector(v);
-          },
+          "upper", [](const Scene& s) { return ActuatorBound(s, &Actuator::max); },
           "Upper bounds of the actuation, #A.")
       .def_property_readonly(
           "rest", [](const Scene& s) { return ToNumpyVector(s.rest_actuation()); },
@@ -186,11 +191,7 @@ void BindScene(py::module_& m) {
               throw std::invalid_argument(
                   "positions: expected " + std::to_string(s.mesh.num_vertices()) +
                   " rows (one per vertex), got " + std::to_string(P.rows()));
-            const Eigen::MatrixX3d M = s.marker_positions(P);
-            py::dict d;
-            for (int i = 0; i < static_cast<int>(s.markers.size()); ++i)
-              d[py::str(s.markers[i].name)] = ToNumpyVector(M.row(i).transpose());
-            return d;
+            return MarkerDict(s, P);
           },
           py::arg("positions"), "Marker name -> mean position (3,) at positions #V x 3.")
       .def("__repr__", [](const Scene& s) {

@@ -7,6 +7,7 @@
 #include "softkin/ik/kinematics.hpp"
 #include "softkin/solver/scene/scene.hpp"
 
+#include <Eigen/Core>
 #include <pybind11/pybind11.h>
 
 #include <memory>
@@ -23,6 +24,10 @@ void BindFk(pybind11::module_& m);
 void BindKinematics(pybind11::module_& m);
 void BindIk(pybind11::module_& m);
 void BindCli(pybind11::module_& m);
+
+/// Marker name -> mean position (3,) at positions X (#V x 3), as FkResult.markers and
+/// Scene.marker_positions give them (bind_scene.cpp).
+pybind11::dict MarkerDict(const Scene& scene, const Eigen::Ref<const Eigen::MatrixX3d>& X);
 
 /// The lock of one Kinematics object: its calls run with the GIL released, one at a time.
 std::mutex& KinematicsMutex(const Kinematics* k);
