@@ -44,8 +44,23 @@ for _ in $(seq 1 600); do
 done
 kill -KILL -- "-$job" 2> /dev/null || true
 wait "$job" 2> /dev/null || true
+# The ranks are not in the launcher's process group: they exit once they lose it. Rerun only
+# then (a rank still appending to a unit while the rerun resumes it would duplicate its lines).
+for _ in $(seq 1 300); do
+  pgrep -f -- "--out killed.csv" > /dev/null || break
+  sleep 0.1
+done
+if pgrep -f -- "--out killed.csv" > /dev/null; then
+  echo "ranks of the killed job still running after 30 s" >&2
+  exit 1
+fi
 [[ ! -e killed.csv ]] || echo "note: the job finished before the kill (a fast machine)"
-"${MPI[@]}" -n 2 "$SOFTKIN" "${ARGS[@]}" --out killed.csv 2> killed.log
+if ! "${MPI[@]}" -n 2 "$SOFTKIN" "${ARGS[@]}" --out killed.csv 2> killed.log; then
+  echo "rerun after the kill failed; the parts were:" >&2
+  ls -l killed.csv.parts >&2 || true
+  cat killed.log >&2
+  exit 1
+fi
 cmp single.csv killed.csv
 echo "killed job rerun: identical to one process ($(grep -o '[0-9]* already' killed.log))"
 
