@@ -9,6 +9,7 @@
 #include "softkin/experiments/cli_scene.hpp"
 #include "softkin/experiments/cli_tessellate.hpp"
 #include "softkin/experiments/cli_train.hpp"
+#include "softkin/experiments/mpi_job.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -83,12 +84,11 @@ int RunCli(int argc, char** argv, bool rethrow) {
   if (rethrow) return run_parsed();
   try {
     return run_parsed();
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "softkin: error: " << e.what() << "\n";
-    return 2;
   } catch (const std::exception& e) {
+    // In an MPI job the other ranks may wait for this one: the whole job stops.
+    if (MpiStarted()) MpiAbortJob(e);
     std::cerr << "softkin: error: " << e.what() << "\n";
-    return 1;
+    return dynamic_cast<const std::invalid_argument*>(&e) ? 2 : 1;
   }
 }
 

@@ -2,6 +2,7 @@
 
 #include "softkin/experiments/cli_args.hpp"
 #include "softkin/experiments/dataset_mpi.hpp"
+#include "softkin/experiments/mpi_job.hpp"
 #include "softkin/experiments/results.hpp"
 #include "softkin/ik/simulator_kinematics.hpp"
 #include "softkin/learn/dataset.hpp"
@@ -29,9 +30,11 @@ CLI::App* AddDatasetCommand(CLI::App* app, DatasetCommandArgs* a) {
       "(robot, res, params, points, sampling, git commit; twin label). Running the same command "
       "again on a partial file resumes it; --shard k/n computes the k-th of n contiguous slices; "
       "--merge joins the shards; under mpirun (-n N) the ranks share the samples "
-      "(docs/cluster.md). "
-      "Exit 0 when every sample succeeded, 1 when some were recorded as "
-      "failed, 2 for bad input. Units: mm. See docs/datasets.md");
+      "(docs/cluster.md; " +
+          MpiSupportNote() +
+          "). "
+          "Exit 0 when every sample succeeded, 1 when some were recorded as "
+          "failed, 2 for bad input. Units: mm. See docs/datasets.md");
   auto* o_robot = ds->add_option("--robot", a->robot, "Embedded robot name (see `softkin robots`)");
   auto* o_twin = ds->add_option(
       "--twin", a->twin, "A 'hardware' twin (docs/twins.md): " + [] {
@@ -69,6 +72,9 @@ CLI::App* AddDatasetCommand(CLI::App* app, DatasetCommandArgs* a) {
       ->expected(1, -1);
   ds->add_option("--out", a->out, "Output CSV (its sidecar is FILE.json)")->required();
   ds->add_flag("--quiet", a->quiet, "No progress on stderr");
+  ds->add_flag("--dry-run", a->dry_run,
+               "Print the plan as JSON on stdout (samples, warm-start units of --block, the "
+               "shard's slice) and exit without computing or writing anything");
   return ds;
 }
 
@@ -261,14 +267,22 @@ int RunDatasetCommand(const DatasetCommandArgs& a) {
   run.provenance = {{"git_commit", GitCommit()}, {"command", a.command_line}};
 
   const long long total = DatasetSize(sampling, source.kin->num_actuators());
+  if (a.dry_run) {
+    const ShardRange slice = DatasetShard(total, sampling.block, run.shard, run.shards);
+    std::cout << nlohmann::json{{"samples", total},
+                                {"block", sampling.block},
+                                {"units", (total + sampling.block - 1) / sampling.block},
+                                {"shard", {{"k", run.shard}, {"n", run.shards}}},
+                                {"first", slice.first},
+                                {"count", slice.count},
+                                {"out", a.out}}
+                     .dump()
+              << "\n";
+    return 0;
+  }
+  RequireMpiIfLaunched("dataset --out " + a.out);
   const int ranks = LaunchedMpiSize();
   if (ranks > 1) {
-    if (!HaveMpi())
-      throw std::invalid_argument(
-          "dataset: started by an MPI launcher with " + std::to_string(ranks) +
-          " processes, but this softkin was built without MPI (install libopenmpi-dev and "
-          "rebuild); the processes would all write " +
-          a.out);
     if (!a.shard.empty())
       throw std::invalid_argument("--shard: not under mpirun, where the ranks share the samples");
     const bool root = LaunchedMpiRank() == 0;

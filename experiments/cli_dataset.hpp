@@ -28,6 +28,7 @@ struct DatasetCommandArgs {
   std::vector<std::string> merge;
   std::string out;
   bool quiet = false;
+  bool dry_run = false;      ///< --dry-run: print the plan and exit
   std::string command_line;  ///< the whole command line, for the sidecar (set by RunCli)
 };
 

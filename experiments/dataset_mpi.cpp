@@ -3,6 +3,8 @@
 /// files, and the merge.
 #include "softkin/experiments/dataset_mpi.hpp"
 
+#include "softkin/experiments/mpi_job.hpp"
+
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
@@ -19,55 +21,32 @@ namespace softkin {
 
 namespace fs = std::filesystem;
 
-int LaunchedMpiRank() {
-  for (const char* var : {"OMPI_COMM_WORLD_RANK", "PMI_RANK", "PMIX_RANK"})
-    if (const char* v = std::getenv(var)) return std::max(0, std::atoi(v));
-  return 0;
+namespace {
+
+/// The whole dataset in this process.
+DatasetRunSummary GenerateWhole(Kinematics& kin, const DatasetSampling& sampling,
+                                const DatasetRunOptions& run) {
+  DatasetRunOptions o = run;
+  o.shard = 0;
+  o.shards = 1;
+  return GenerateDataset(kin, sampling, o);
 }
 
-int LaunchedMpiSize() {
-  for (const char* var : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"})
-    if (const char* v = std::getenv(var)) return std::max(1, std::atoi(v));
-  if (std::getenv("PMIX_RANK"))
-    if (const char* v = std::getenv("SLURM_NTASKS")) return std::max(1, std::atoi(v));
-  return 1;
-}
+}  // namespace
 
 #ifndef SOFTKIN_HAVE_MPI
 
-bool HaveMpi() { return false; }
-
-DatasetRunSummary GenerateDatasetMpi(Kinematics&, const DatasetSampling&,
-                                     const DatasetRunOptions&) {
-  throw std::logic_error("GenerateDatasetMpi: this softkin was built without MPI");
+DatasetRunSummary GenerateDatasetMpi(Kinematics& kin, const DatasetSampling& sampling,
+                                     const DatasetRunOptions& run) {
+  return GenerateWhole(kin, sampling, run);
 }
 
 #else
-
-bool HaveMpi() { return true; }
 
 namespace {
 
 constexpr int kTagRequest = 1;  // a rank asks rank 0 for a unit
 constexpr int kTagUnit = 2;     // rank 0's answer: a unit index, or -1 when none is left
-
-// Ipopt's sequential MUMPS (libdmumps_seq, linked before Open MPI) exports dummy MPI_Init,
-// MPI_Comm_rank, MPI_Finalize and MPI_Wtime, which would shadow Open MPI's (every rank would be
-// rank 0). Those four are called by their profiling-interface names (PMPI_*), which only the
-// real MPI library defines.
-
-/// MPI for the length of the job (the forward solves use OpenMP on the main thread only).
-struct MpiSession {
-  MpiSession() {
-    int provided = 0;
-    PMPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
-  }
-  ~MpiSession() {
-    int done = 0;
-    MPI_Finalized(&done);
-    if (!done) PMPI_Finalize();
-  }
-};
 
 /// Rank 0's queue of units: it hands them out in order, to itself and to the ranks that ask.
 class UnitQueue {
@@ -119,18 +98,16 @@ std::string UnitPath(const std::string& parts, long long u, long long units) {
 
 /// The job's totals (sums over ranks) on every rank.
 DatasetRunSummary SumOverRanks(const DatasetRunSummary& mine) {
-  long long v[5] = {mine.already, mine.written, mine.failed, mine.inverted, mine.fk_solves};
+  const long long v[5] = {mine.already, mine.written, mine.failed, mine.inverted, mine.fk_solves};
   long long s[5] = {0, 0, 0, 0, 0};
-  MPI_Allreduce(v, s, 5, MPI_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);
-  double t = 0;
-  MPI_Allreduce(&mine.time_s, &t, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  MpiSumOverRanks(v, s, 5);
   DatasetRunSummary out;
   out.already = s[0];
   out.written = s[1];
   out.failed = s[2];
   out.inverted = s[3];
   out.fk_solves = s[4];
-  out.time_s = t;
+  out.time_s = MpiMaxOverRanks(mine.time_s);
   return out;
 }
 
@@ -151,21 +128,12 @@ void ReportBalance(int rank, int size, const DatasetRunSummary& mine, bool print
   std::cerr << "; busiest / mean " << (sum > 0 ? top / (sum / size) : 1.0) << "\n";
 }
 
-[[noreturn]] void Abort(int rank, const std::exception& e) {
-  std::cerr << "softkin dataset: rank " << rank << ": error: " << e.what()
-            << " (aborting the job; completed units stay for a rerun)\n";
-  MPI_Abort(MPI_COMM_WORLD, dynamic_cast<const std::invalid_argument*>(&e) ? 2 : 1);
-  std::abort();
-}
-
 }  // namespace
 
 DatasetRunSummary GenerateDatasetMpi(Kinematics& kin, const DatasetSampling& sampling,
                                      const DatasetRunOptions& run) {
-  MpiSession mpi;
-  int rank = 0, size = 1;
-  PMPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  if (!MpiJob().active()) return GenerateWhole(kin, sampling, run);
+  const int rank = MpiJob().rank, size = MpiJob().size;
   const long long total = DatasetSize(sampling, kin.num_actuators());
   const long long units = (total + sampling.block - 1) / sampling.block;
   const std::string parts = run.out + ".parts";
@@ -179,19 +147,16 @@ DatasetRunSummary GenerateDatasetMpi(Kinematics& kin, const DatasetSampling& sam
         std::cerr << "softkin dataset: " << run.out << " exists (no " << parts
                   << "): rank 0 resumes or checks it alone\n";
       try {
-        DatasetRunOptions o = run;
-        o.shard = 0;
-        o.shards = 1;
-        mine = GenerateDataset(kin, sampling, o);
+        mine = GenerateWhole(kin, sampling, run);
       } catch (const std::exception& e) {
-        Abort(rank, e);
+        MpiAbortJob(e);
       }
     }
   } else {
     try {
       if (rank == 0) fs::create_directories(parts);
     } catch (const std::exception& e) {
-      Abort(rank, e);
+      MpiAbortJob(e);
     }
     MPI_Barrier(MPI_COMM_WORLD);
     if (rank == 0 && run.progress)
@@ -223,7 +188,7 @@ DatasetRunSummary GenerateDatasetMpi(Kinematics& kin, const DatasetSampling& sam
       }
       queue.Serve(true);
     } catch (const std::exception& e) {
-      Abort(rank, e);
+      MpiAbortJob(e);
     }
   }
   DatasetRunSummary job = SumOverRanks(mine);
@@ -240,7 +205,7 @@ DatasetRunSummary GenerateDatasetMpi(Kinematics& kin, const DatasetSampling& sam
       if (run.progress)
         std::cerr << "softkin dataset: merged " << units << " units into " << run.out << "\n";
     } catch (const std::exception& e) {
-      Abort(rank, e);
+      MpiAbortJob(e);
     }
   }
   MPI_Barrier(MPI_COMM_WORLD);

@@ -12,22 +12,12 @@
 
 namespace softkin {
 
-/// The number of processes of the MPI job this process was started in, read from the launcher's
-/// environment before MPI is initialised (Open MPI's mpirun: OMPI_COMM_WORLD_SIZE; MPICH / PMI:
-/// PMI_SIZE; Slurm's srun with PMIx: SLURM_NTASKS with PMIX_RANK); 1 outside a launcher.
-int LaunchedMpiSize();
-
-/// This process's rank in that job (OMPI_COMM_WORLD_RANK, PMI_RANK or PMIX_RANK); 0 outside one.
-int LaunchedMpiRank();
-
-/// Whether this build has MPI (CMake found it: SOFTKIN_HAVE_MPI).
-bool HaveMpi();
-
 /// Generates the dataset of `run` (its shard fields are ignored) across the ranks of the job, as
 /// the file comment says, and returns the job's totals on every rank (count and first: the whole
 /// dataset). If run.out exists already (a finished job, or a one-process file), rank 0 resumes or
-/// checks it alone, as `softkin dataset` does. A rank that fails prints its error and aborts the
-/// job (MPI_Abort); the completed units stay for the rerun. Throws std::logic_error without MPI.
+/// checks it alone, as `softkin dataset` does. Outside an MPI job (MpiJob(), mpi_job.hpp) it is
+/// GenerateDataset of the whole. A rank that fails prints its error and aborts the job
+/// (MpiAbortJob); the completed units stay for the rerun.
 DatasetRunSummary GenerateDatasetMpi(Kinematics& kin, const DatasetSampling& sampling,
                                      const DatasetRunOptions& run);
 

@@ -3,6 +3,7 @@
 #include "softkin/experiments/ik_config.hpp"
 #include "softkin/experiments/results.hpp"
 #include "softkin/experiments/runner.hpp"
+#include "softkin/experiments/sweep.hpp"
 #include "softkin/ik/trajectory_io.hpp"
 
 #include <cstdio>
@@ -377,34 +378,41 @@ nlohmann::json RunIkMethods(const Config& cfg, const std::string& dir, bool verb
   const Eigen::VectorXd closest =
       samples.c.row(ClosestSample(samples, path.waypoints.row(0).transpose())).transpose();
 
-  CsvWriter csv(dir + "/methods.csv",
-                {"method", "jacobian", "waypoints", "converged", "ms_per_waypoint", "mean_err_mm",
-                 "max_err_mm", "fk_calls", "fk_calls_per_waypoint", "evaluations",
-                 "mean_iterations", "failures", "initial_sample", "initial_starts_tried"});
-  nlohmann::json rows = nlohmann::json::array();
   // Resume: each finished method x Jacobian row is journaled with every setting that produced it
-  // (the config but its method and Jacobian lists); a rerun reuses matching rows.
-  ResumeJournal journal(dir + "/methods.jsonl");
+  // (the config but its method and Jacobian lists); a rerun reuses matching rows. Under mpirun the
+  // ranks share the rows (experiments/sweep.hpp).
+  Sweep sweep(dir + "/methods.jsonl", "ik_methods", verbose);
+  struct Unit {
+    IkMethod method;
+    JacobianMode jmode;
+    std::string jname;
+  };
+  std::vector<Unit> units;
+  std::vector<nlohmann::json> keys;
   for (IkMethod m : p.methods) {
     // BOBYQA never asks for J: one run, whatever the mode.
     const bool derivative_free = m == IkMethod::kNloptBobyqa;
     for (size_t k = 0; k < p.jmodes.size(); ++k) {
       if (derivative_free && k > 0) break;
       const std::string jname = derivative_free ? "none" : JacobianModeToString(p.jmodes[k]);
-      const nlohmann::json key = {
-          {"settings", p.settings}, {"method", IkMethodToString(m)}, {"jacobian", jname}};
-      if (const nlohmann::json* done = journal.Reuse(key)) {
-        rows.push_back(*done);
-        csv.RowJson(*done);
-        if (verbose)
-          std::fprintf(stderr, "  %s/%s: resumed from methods.jsonl\n", IkMethodToString(m).c_str(),
-                       jname.c_str());
-        continue;
-      }
-      rows.push_back(MethodRow(p, model, m, p.jmodes[k], jname, path, samples, dir, verbose));
-      journal.Append(key, rows.back());
-      csv.RowJson(rows.back());
+      units.push_back({m, p.jmodes[k], jname});
+      keys.push_back(
+          {{"settings", p.settings}, {"method", IkMethodToString(m)}, {"jacobian", jname}});
     }
+  }
+  sweep.Run(keys, [&](size_t i) {
+    const Unit& u = units[i];
+    return MethodRow(p, model, u.method, u.jmode, u.jname, path, samples, dir, verbose);
+  });
+  if (!Sweep::WritesResults()) return {};
+  CsvWriter csv(dir + "/methods.csv",
+                {"method", "jacobian", "waypoints", "converged", "ms_per_waypoint", "mean_err_mm",
+                 "max_err_mm", "fk_calls", "fk_calls_per_waypoint", "evaluations",
+                 "mean_iterations", "failures", "initial_sample", "initial_starts_tried"});
+  nlohmann::json rows = nlohmann::json::array();
+  for (size_t i = 0; i < units.size(); ++i) {
+    rows.push_back(sweep.Row(i));
+    csv.RowJson(rows.back());
   }
   nlohmann::json j = s.Json();
   j.erase("method");
@@ -414,7 +422,7 @@ nlohmann::json RunIkMethods(const Config& cfg, const std::string& dir, bool verb
   j["closest_sample"] = Vec(closest);
   j["samples"] = SamplesJson(samples);
   j["rows"] = rows;
-  j["resumed_rows"] = journal.reused();
+  j["resumed_rows"] = sweep.resumed();
   return j;
 }
 

@@ -5,6 +5,7 @@
 #include "softkin/experiments/learn_common.hpp"
 #include "softkin/experiments/results.hpp"
 #include "softkin/experiments/runner.hpp"
+#include "softkin/experiments/sweep.hpp"
 #include "softkin/ik/ik_solver.hpp"
 #include "softkin/ik/objectives.hpp"
 #include "softkin/ik/pcc_chamber_kinematics.hpp"
@@ -70,55 +71,52 @@ struct ArchitectureData {
   double range = 0;  ///< the largest actuation range
 };
 
-/// Trains one network (or reuses its journaled row) and returns its row.
+/// The journal key of one network of the sweep: every setting that determines its row.
+nlohmann::json ArchitectureKey(const ArchitectureParams& p, const ArchitectureData& d,
+                               const std::string& net, int h, int b) {
+  return {{"dataset", d.spec_json},
+          {"net", net},
+          {"h", h},
+          {"b", b},
+          {"seed", p.seed},
+          {"epochs", p.lm.max_epochs},
+          {"max_train_time_s", p.lm.max_time_s}};
+}
+
+/// Trains one network and returns its row.
 nlohmann::json ArchitectureRow(const ArchitectureParams& p, const ArchitectureData& d,
-                               const std::string& net, int h, int b, ResumeJournal* journal,
-                               bool verbose) {
+                               const std::string& net, int h, int b, bool verbose) {
   const SampleSet& s = net == "fk" ? d.pos : d.js;
-  const nlohmann::json key = {{"dataset", d.spec_json},
-                              {"net", net},
-                              {"h", h},
-                              {"b", b},
-                              {"seed", p.seed},
-                              {"epochs", p.lm.max_epochs},
-                              {"max_train_time_s", p.lm.max_time_s}};
   // The Jacobian's error is quoted as the tip displacement error of a step of 1/10 of the
   // actuation range (the finite-difference step of Sec. 5.2.1), as % of the workspace width.
   const double scale = net == "fk" ? 100.0 / d.width : 100.0 * 0.1 * d.range / d.width;
-  const nlohmann::json* done = journal->Reuse(key);
-  nlohmann::json row;
-  if (done) {
-    row = *done;
-  } else {
-    const SampleSet train = SelectRows(s, d.split.train_rows),
-                    test = SelectRows(s, d.split.test_rows);
-    NetTrainOptions o;
-    o.hidden.assign(h, b);
-    o.lm = p.lm;
-    o.split_seed = p.seed;
-    const NetTrainResult t = TrainNet(train, test, o);
-    row = {{"robot", d.spec.robot},
-           {"net", net},
-           {"h", h},
-           {"b", b},
-           {"parameters", t.net.num_parameters()},
-           {"test_mean", t.test.mean_dist},
-           {"test_max", t.test.max_dist},
-           {"test_mean_pct", scale * t.test.mean_dist},
-           {"test_max_pct", scale * t.test.max_dist},
-           {"relative", t.test.relative},
-           {"epochs", t.lm.epochs},
-           {"time_s", t.lm.total_time_s},
-           {"termination", LmTerminationToString(t.lm.termination)}};
-    journal->Append(key, row);
-  }
+  const SampleSet train = SelectRows(s, d.split.train_rows),
+                  test = SelectRows(s, d.split.test_rows);
+  NetTrainOptions o;
+  o.hidden.assign(h, b);
+  o.lm = p.lm;
+  o.split_seed = p.seed;
+  const NetTrainResult t = TrainNet(train, test, o);
+  const nlohmann::json row = {{"robot", d.spec.robot},
+                              {"net", net},
+                              {"h", h},
+                              {"b", b},
+                              {"parameters", t.net.num_parameters()},
+                              {"test_mean", t.test.mean_dist},
+                              {"test_max", t.test.max_dist},
+                              {"test_mean_pct", scale * t.test.mean_dist},
+                              {"test_max_pct", scale * t.test.max_dist},
+                              {"relative", t.test.relative},
+                              {"epochs", t.lm.epochs},
+                              {"time_s", t.lm.total_time_s},
+                              {"termination", LmTerminationToString(t.lm.termination)}};
   if (verbose)
     std::fprintf(
         stderr,
-        "  %s N_%s h=%d b=%d: test mean %.4f%% (max %.4f%%) of %.1f mm, %d epochs, %.1f s%s\n",
+        "  %s N_%s h=%d b=%d: test mean %.4f%% (max %.4f%%) of %.1f mm, %d epochs, %.1f s\n",
         d.spec.robot.c_str(), net.c_str(), h, b, row["test_mean_pct"].get<double>(),
         row["test_max_pct"].get<double>(), d.width, row["epochs"].get<int>(),
-        row["time_s"].get<double>(), done ? " (resumed from architecture.jsonl)" : "");
+        row["time_s"].get<double>());
   return row;
 }
 
@@ -128,40 +126,58 @@ nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, b
   const ArchitectureParams p = ReadArchitectureParams(cfg);
   if (cfg.check_only()) return {};  // only the settings were asked for (Config::check_only)
   // Resume: every finished network is appended to architecture.jsonl with the settings that
-  // produced it; a rerun reuses the rows whose settings match and trains only the others.
-  ResumeJournal journal(dir + "/architecture.jsonl");
-  CsvWriter csv(dir + "/architecture.csv",
-                {"robot", "net", "h", "b", "parameters", "test_mean", "test_max", "test_mean_pct",
-                 "test_max_pct", "epochs", "time_s", "termination"});
-  nlohmann::json rows = nlohmann::json::array(), datasets = nlohmann::json::array();
+  // produced it; a rerun reuses the rows whose settings match and trains only the others. Under
+  // mpirun the ranks share the networks (experiments/sweep.hpp) and the datasets' samples.
+  Sweep sweep(dir + "/architecture.jsonl", "architecture", verbose);
+  std::vector<ArchitectureData> data(p.datasets.size());
+  struct Unit {
+    std::size_t d;
+    std::string net;
+    int h, b;
+  };
+  std::vector<Unit> units;
+  std::vector<nlohmann::json> keys;
+  nlohmann::json datasets = nlohmann::json::array();
   for (size_t r = 0; r < p.datasets.size(); ++r) {
-    ArchitectureData d;
+    ArchitectureData& d = data[r];
     d.spec_json = p.datasets[r];
     d.spec = ParseDatasetSpec(d.spec_json, cfg.path() + ": datasets[" + std::to_string(r) + "]");
     nlohmann::json dinfo;
-    const Dataset data = CachedDataset(d.spec, DatasetCacheDir(dir), verbose, &dinfo);
-    d.pos = PositionSamples(data);
+    const Dataset ds = CachedDataset(d.spec, DatasetCacheDir(dir), verbose, &dinfo);
+    d.pos = PositionSamples(ds);
     d.split = SplitTrainTest(d.pos, p.seed);
     d.width = WorkspaceWidth(d.pos.Y);
     dinfo["workspace_width_mm"] = d.width;
     datasets.push_back(dinfo);
-    const bool with_j = p.jac && data.jacobians.cols() > 0;
-    if (with_j) d.js = JacobianSamples(data);
-    for (const auto& b : data.meta["config"]["actuator_bounds"])
+    const bool with_j = p.jac && ds.jacobians.cols() > 0;
+    if (with_j) d.js = JacobianSamples(ds);
+    for (const auto& b : ds.meta["config"]["actuator_bounds"])
       d.range = std::max(d.range, b[1].get<double>() - b[0].get<double>());
     for (const std::string net : {"fk", "jac"}) {
       if (net == "jac" && !with_j) continue;
       for (int h : net == "fk" ? p.layers : p.jac_layers)
         for (int b : net == "fk" ? p.neurons : p.jac_neurons) {
-          const nlohmann::json row = ArchitectureRow(p, d, net, h, b, &journal, verbose);
-          csv.RowJson(row);
-          rows.push_back(row);
+          units.push_back({r, net, h, b});
+          keys.push_back(ArchitectureKey(p, d, net, h, b));
         }
     }
   }
+  sweep.Run(keys, [&](std::size_t i) {
+    const Unit& u = units[i];
+    return ArchitectureRow(p, data[u.d], u.net, u.h, u.b, verbose);
+  });
+  if (!Sweep::WritesResults()) return {};
+  CsvWriter csv(dir + "/architecture.csv",
+                {"robot", "net", "h", "b", "parameters", "test_mean", "test_max", "test_mean_pct",
+                 "test_max_pct", "epochs", "time_s", "termination"});
+  nlohmann::json rows = nlohmann::json::array();
+  for (std::size_t i = 0; i < units.size(); ++i) {
+    rows.push_back(sweep.Row(i));
+    csv.RowJson(rows.back());
+  }
   return {{"rows", rows},
           {"datasets", datasets},
-          {"resumed_rows", journal.reused()},
+          {"resumed_rows", sweep.resumed()},
           {"jacobian_error_note",
            "N_J errors are |dJ| x (range/10) (the tip error of a 1/10-range step), as % of the "
            "workspace width"},

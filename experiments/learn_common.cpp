@@ -1,5 +1,7 @@
 #include "softkin/experiments/learn_common.hpp"
 
+#include "softkin/experiments/dataset_mpi.hpp"
+#include "softkin/experiments/mpi_job.hpp"
 #include "softkin/experiments/results.hpp"
 #include "softkin/ik/simulator_kinematics.hpp"
 #include "softkin/learn/twin.hpp"
@@ -156,9 +158,12 @@ Dataset CachedDataset(const DatasetSpec& spec, const std::string& cache_dir, boo
     else if (auto* s = dynamic_cast<SimulatorKinematics*>(raw))
       s->Reset();
   };
-  run.progress = verbose;
   if (verbose) std::cerr << "  dataset " << path << " (" << kin->name() << ")\n";
-  const DatasetRunSummary s = GenerateDataset(*kin, spec.sampling, run);
+  // Under mpirun (a sweep, experiments/sweep.hpp) the ranks share the samples; rank 0 alone
+  // reports progress.
+  run.progress = verbose && MpiJob().root();
+  const DatasetRunSummary s = MpiJob().active() ? GenerateDatasetMpi(*kin, spec.sampling, run)
+                                                : GenerateDataset(*kin, spec.sampling, run);
   Dataset d = LoadDataset(path);
   if (info) {
     *info = {{"path", path},

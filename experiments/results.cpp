@@ -12,7 +12,14 @@
 #include <stdexcept>
 #include <thread>
 
+#include <cerrno>
+#include <cstring>
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <sys/utsname.h>
+#include <unistd.h>
 
 namespace softkin {
 
@@ -124,45 +131,74 @@ void CsvWriter::RowStrings(const std::vector<std::string>& values) {
 }
 
 ResumeJournal::ResumeJournal(const std::string& path) : path_(path) {
-  {
-    std::ifstream in(path);
-    std::string line;
-    int lineno = 0;
-    while (std::getline(in, line)) {
-      ++lineno;
-      if (line.empty()) continue;
-      try {
-        nlohmann::json j = nlohmann::json::parse(line);
-        if (j.is_object() && j.contains("key") && j.contains("row")) {
-          records_.push_back(std::move(j));
-          continue;
-        }
-      } catch (const nlohmann::json::exception&) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+  ::close(fd);
+  Read(true);
+  opened_ = records_.size();
+}
+
+void ResumeJournal::Read(bool report) {
+  records_.clear();
+  std::ifstream in(path_);
+  std::string line;
+  int lineno = 0;
+  while (std::getline(in, line)) {
+    ++lineno;
+    if (line.empty()) continue;
+    try {
+      nlohmann::json j = nlohmann::json::parse(line);
+      if (j.is_object() && j.contains("key") && j.contains("row")) {
+        records_.push_back(std::move(j));
+        continue;
       }
+    } catch (const nlohmann::json::exception&) {
+    }
+    if (report)
       std::fprintf(stderr,
                    "  %s:%d: not a complete JSON record (an interrupted write?); that unit is "
                    "computed again\n",
-                   path.c_str(), lineno);
-    }
+                   path_.c_str(), lineno);
   }
-  out_.open(path, std::ios::app);
-  if (!out_) throw std::runtime_error("cannot write " + path);
 }
 
+void ResumeJournal::Reload() { Read(false); }
+
 const nlohmann::json* ResumeJournal::Reuse(const nlohmann::json& key) {
-  for (auto it = records_.rbegin(); it != records_.rend(); ++it)
-    if ((*it)["key"] == key) {
-      ++reused_;
-      return &(*it)["row"];
+  for (std::size_t i = records_.size(); i-- > 0;)
+    if (records_[i]["key"] == key) {
+      if (i < opened_) ++reused_;
+      return &records_[i]["row"];
     }
   return nullptr;
 }
 
 void ResumeJournal::Append(const nlohmann::json& key, const nlohmann::json& row) {
-  out_ << nlohmann::json{{"key", key}, {"row", row}}.dump() << "\n";
-  out_.flush();
-  if (!out_) throw std::runtime_error("cannot write " + path_);
-  records_.push_back({{"key", key}, {"row", row}});
+  nlohmann::json record = {{"key", key}, {"row", row}};
+  std::string line = record.dump() + "\n";
+  const int fd = ::open(path_.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) throw std::runtime_error("cannot write " + path_ + ": " + std::strerror(errno));
+  // One writer at a time; a lock that the file system does not support (ENOLCK, ENOSYS) leaves
+  // O_APPEND's single write per record.
+  const bool locked = ::flock(fd, LOCK_EX) == 0;
+  struct stat st {};
+  char last = '\n';
+  if (::fstat(fd, &st) == 0 && st.st_size > 0 && ::pread(fd, &last, 1, st.st_size - 1) != 1)
+    last = '\n';
+  if (last != '\n') line.insert(line.begin(), '\n');  // a record cut by a killed writer
+  std::size_t done = 0;
+  while (done < line.size()) {
+    const ssize_t n = ::write(fd, line.data() + done, line.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    done += static_cast<std::size_t>(n);
+  }
+  const int err = errno;
+  if (locked) ::flock(fd, LOCK_UN);
+  ::close(fd);
+  if (done != line.size())
+    throw std::runtime_error("cannot write " + path_ + ": " + std::strerror(err));
+  records_.push_back(std::move(record));
 }
 
 nlohmann::json CollisionCheckJson(const CollisionCheck& check) {

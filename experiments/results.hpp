@@ -46,20 +46,30 @@ class CsvWriter {
 /// recomputes the rest. A line that does not parse (a write cut by a crash) is reported on stderr
 /// and skipped. The key does not identify the code: after changing the code, delete the journal to
 /// recompute (summaries report how many rows were reused, as "resumed_rows").
+///
+/// Several processes may append to one journal (the ranks of an MPI sweep, experiments/sweep.hpp):
+/// each record is written whole under an exclusive lock of the file (flock), after a newline if a
+/// killed writer left its last line cut.
 class ResumeJournal {
  public:
+  /// Reads the records of `path` (if it exists); throws std::runtime_error if it cannot be
+  /// written.
   explicit ResumeJournal(const std::string& path);
-  /// The row recorded for `key` (the last one if several), counted as reused; or nullptr. The
-  /// pointer is valid until the next Append.
+  /// The row recorded for `key` (the last one if several), or nullptr. A row that was in the file
+  /// when it was opened counts as reused. The pointer is valid until the next Append or Reload.
   const nlohmann::json* Reuse(const nlohmann::json& key);
   void Append(const nlohmann::json& key, const nlohmann::json& row);
-  /// Rows returned by Reuse so far.
+  /// Reads the file again, with the records other processes have appended since.
+  void Reload();
+  /// Rows returned by Reuse so far that were in the file when it was opened.
   int reused() const { return reused_; }
+  const std::string& path() const { return path_; }
 
  private:
+  void Read(bool report);
   std::string path_;
   std::vector<nlohmann::json> records_;
-  std::ofstream out_;
+  std::size_t opened_ = 0;  ///< records in the file when it was opened
   int reused_ = 0;
 };
 

@@ -2,8 +2,10 @@
 
 #include "softkin/solver/robots/robots.hpp"
 
+#include "softkin/experiments/mpi_job.hpp"
 #include "softkin/experiments/results.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -21,6 +23,9 @@ namespace {
 struct Entry {
   const char* type;
   ExperimentFn fn;
+  /// A sweep of independent units (experiments/sweep.hpp) that `mpirun -n N softkin run` shares
+  /// out over the ranks; the others run in one process.
+  bool mpi = false;
 };
 const Entry kExperiments[] = {
     {"pneumatic_bending", &RunPneumaticBending},
@@ -37,9 +42,9 @@ const Entry kExperiments[] = {
     {"twisting_remesh", &RunTwistingRemesh},
     {"ik_initial_guess", &RunIkInitialGuess},
     {"ik_trajectory", &RunIkTrajectory},
-    {"ik_methods", &RunIkMethods},
+    {"ik_methods", &RunIkMethods, true},
     {"ik_pick_and_place", &RunIkPickAndPlace},
-    {"learn_architecture", &RunLearnArchitecture},
+    {"learn_architecture", &RunLearnArchitecture, true},
     {"learn_ik_methods", &RunLearnIkMethods},
     {"learn_data_source", &RunLearnDataSource},
     {"learn_s2r_sweep", &RunLearnS2rSweep},
@@ -70,6 +75,13 @@ ExperimentFn FindExperiment(const std::string& type) {
   return nullptr;
 }
 
+std::vector<std::string> MpiExperimentTypes() {
+  std::vector<std::string> v;
+  for (const auto& e : kExperiments)
+    if (e.mpi) v.push_back(e.type);
+  return v;
+}
+
 nlohmann::json RunExperiment(const std::string& config_path, const RunOptions& opt) {
   Config cfg = Config::Load(config_path, opt.quick);
   ExperimentFn fn = FindExperiment(cfg.type());
@@ -90,8 +102,26 @@ nlohmann::json RunExperiment(const std::string& config_path, const RunOptions& o
                                   e.what());
     }
   }
+  // Under mpirun: only the sweeps share their units over the ranks; rank 0 writes the results.
+  const std::string what = "run " + cfg.name();
+  RequireMpiIfLaunched(what);
+  if (LaunchedMpiSize() > 1) {
+    const auto mpi_types = MpiExperimentTypes();
+    if (std::find(mpi_types.begin(), mpi_types.end(), cfg.type()) == mpi_types.end()) {
+      std::string list;
+      for (const auto& t : mpi_types) list += (list.empty() ? "" : ", ") + t;
+      throw std::invalid_argument(what + ": started by an MPI launcher with " +
+                                  std::to_string(LaunchedMpiSize()) + " processes, but '" +
+                                  cfg.type() +
+                                  "' is not a sweep of independent units; run it as one process "
+                                  "(the sweeps that MPI shares out: " +
+                                  list + ")");
+    }
+  }
+  const MpiPlace& job = MpiJob();
+  const bool root = job.root();
   const std::string dir = ResultDir(opt.results_root, cfg.name());
-  WriteJson(dir + "/config.json", cfg.json());
+  if (root) WriteJson(dir + "/config.json", cfg.json());
   nlohmann::json run;
   run["config_path"] = config_path;
   run["quick"] = opt.quick;
@@ -99,9 +129,12 @@ nlohmann::json RunExperiment(const std::string& config_path, const RunOptions& o
   run["machine"] = MachineInfo();
   run["seed"] = cfg.seed();
   const auto t0 = std::chrono::steady_clock::now();
-  if (opt.verbose)
-    std::cerr << "softkin: running " << cfg.name() << (opt.quick ? " (quick)" : "") << "\n";
-  nlohmann::json summary = fn(cfg, dir, opt.verbose);
+  if (opt.verbose && root)
+    std::cerr << "softkin: running " << cfg.name() << (opt.quick ? " (quick)" : "")
+              << (job.active() ? " on " + std::to_string(job.size) + " MPI ranks" : "") << "\n";
+  nlohmann::json summary = fn(cfg, dir, opt.verbose && root);
+  if (!root) return {};  // the other ranks computed units; rank 0 writes the results
+  run["mpi_ranks"] = job.size;
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   run["wall_time_s"] = wall;
   summary["name"] = cfg.name();

@@ -27,9 +27,14 @@ using ExperimentFn = nlohmann::json (*)(const Config& cfg, const std::string& di
 /// Registered experiment types ("pneumatic_bending", "resolution_sweep", "aa_ablation").
 std::vector<std::string> ExperimentTypes();
 ExperimentFn FindExperiment(const std::string& type);
+/// The types that `mpirun -n N softkin run CONFIG` shares out over the ranks (sweeps of
+/// independent units, experiments/sweep.hpp).
+std::vector<std::string> MpiExperimentTypes();
 
 /// Runs one config; returns the summary written. Throws std::invalid_argument for bad configs and
-/// std::runtime_error if a step fails (finished CSV rows are kept).
+/// std::runtime_error if a step fails (finished CSV rows are kept). Under an MPI launcher, a sweep
+/// type shares its units over the ranks and rank 0 writes the results (the others return {}); any
+/// other type is refused with std::invalid_argument.
 nlohmann::json RunExperiment(const std::string& config_path, const RunOptions& options);
 
 /// The config's robot at resolution `res` with its "robot_params" object (design parameters);
