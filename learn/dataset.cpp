@@ -4,6 +4,8 @@
 #include "softkin/solver/common/output_file.hpp"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <cassert>
 #include <chrono>
 #include <cmath>
@@ -15,6 +17,10 @@
 #include <map>
 #include <sstream>
 #include <stdexcept>
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
 
 namespace softkin {
 
@@ -167,6 +173,31 @@ std::string ReadAll(const std::string& path) {
   buf << in.rdbuf();
   return buf.str();
 }
+
+/// An exclusive lock (flock) on a dataset file for the length of a run, taken before the file
+/// is read or written; a file system without locks (ENOLCK, ENOSYS, EOPNOTSUPP) runs unlocked.
+class WriterLock {
+ public:
+  explicit WriterLock(const std::string& path) {
+    // Create it if missing (empty: "fresh" below), without truncating anything that exists.
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK) {
+      ::close(fd_);
+      throw std::runtime_error(
+          path +
+          " is being written by another process (it holds the file's lock); wait for it "
+          "to finish, or stop it, then run the same command again to resume; or choose "
+          "another output");
+    }
+  }
+  ~WriterLock() { ::close(fd_); }
+  WriterLock(const WriterLock&) = delete;
+  WriterLock& operator=(const WriterLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
 
 nlohmann::json ReadSidecar(const std::string& csv) {
   const std::string path = SidecarPath(csv);
@@ -418,9 +449,13 @@ DatasetRunSummary GenerateDataset(Kinematics& kin, const DatasetSampling& sampli
   sum.first = range.first;
   sum.count = range.count;
 
-  // Resume or start.
+  // One writer per file: a second process started on the same output (a duplicated job, two
+  // shells) stops here instead of interleaving lines with the first.
+  const WriterLock lock(opt.out);
+  // Resume or start (an empty file without a sidecar, from a run killed right after creating it,
+  // holds nothing).
   bool fresh = true;
-  if (fs::exists(opt.out)) {
+  if (fs::exists(opt.out) && (fs::file_size(opt.out) > 0 || fs::exists(SidecarPath(opt.out)))) {
     const nlohmann::json side = ReadSidecar(opt.out);
     std::string d = KeyDifferences(config, side["config"], "config");
     if (d.empty()) d = KeyDifferences(shard, side["shard"], "shard");

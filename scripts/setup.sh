@@ -56,6 +56,10 @@ PACKAGES=(
   python3-meshio
   libopenmpi-dev
   openmpi-bin
+  slurmctld
+  slurmd
+  slurm-client
+  munge
 )
 
 log() { echo "[setup] $*"; }

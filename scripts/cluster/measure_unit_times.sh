@@ -37,8 +37,8 @@ run_one() {  # kind block unit units
   "$softkin" dataset "${args[@]}" --block "$b" --shard "$k/$n" --out "$work/u.csv" --quiet
   t1=$(date +%s.%N)
   local samples=$(( $(wc -l < "$work/u.csv") - 1 ))
-  echo "$kind,$b,$k,$n,$samples,$(echo "$t1 - $t0" | bc -l)" >> "$out"
-  echo "measure: $kind unit $k/$n: $samples samples in $(echo "$t1 - $t0" | bc -l) s" >&2
+  echo "$kind,$b,$k,$n,$samples,$(awk -v a="$t0" -v b="$t1" 'BEGIN {printf "%.3f", b - a}')" >> "$out"
+  echo "measure: $kind unit $k/$n: $samples samples in $(awk -v a="$t0" -v b="$t1" 'BEGIN {printf "%.3f", b - a}') s" >&2
 }
 args=("$@")
 set --

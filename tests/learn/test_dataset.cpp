@@ -7,6 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -199,6 +203,42 @@ TEST_F(DatasetTest, ResumedRunEqualsUninterruptedRun) {
     EXPECT_EQ(Run(s, o).written, 0);
     EXPECT_EQ(Read(o.out), want);
   }
+}
+
+// Two writers of one file: the second stops with the reason, and the first's file is untouched.
+TEST_F(DatasetTest, ASecondWriterOfTheSameFileIsRefused) {
+  const DatasetSampling s = Grid(3, 8);  // 27 samples
+  DatasetRunOptions o;
+  o.out = Path("busy.csv");
+  o.stop_after = 5;
+  Run(s, o);
+  const std::string before = Read(o.out);
+  // Another process writing the file holds its lock (here: another open file description).
+  const int fd = ::open(o.out.c_str(), O_RDWR | O_CLOEXEC);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+  o.stop_after = -1;
+  try {
+    Run(s, o);
+    ADD_FAILURE() << "a second writer was let in";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("busy.csv is being written by another process"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(Read(o.out), before);
+  // A new file is refused as well while it is locked, and left empty.
+  const std::string fresh = Path("fresh.csv");
+  const int fd2 = ::open(fresh.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  ASSERT_EQ(::flock(fd2, LOCK_EX | LOCK_NB), 0);
+  o.out = fresh;
+  EXPECT_THROW(Run(s, o), std::runtime_error);
+  ::close(fd2);
+  // Once the other writer is gone, the run resumes (an empty file without a sidecar is fresh).
+  EXPECT_EQ(Run(s, o).written, 27);
+  ::close(fd);
+  o.out = Path("busy.csv");
+  EXPECT_EQ(Run(s, o).written, 22);
 }
 
 // A resume keeps only valid complete rows: a row with a corrupt number, a missing field or an
