@@ -385,7 +385,10 @@ nlohmann::json RunLearnIkMethods(const Config& cfg, const std::string& dir, bool
                                        "predicted_err_mm", "time_ms", "iterations"});
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& method : p.methods) rows.push_back(IkMethodRow(setup, method, &csv, verbose));
+  const std::string measured_by = p.spec.twin.empty() ? "simulator" : "twin " + p.spec.twin;
   return {{"rows", rows},
+          {"error_measured_by", measured_by},
+          {"thesis_error_measured_by", "hardware"},
           {"dataset", dinfo},
           {"networks", nets.info},
           {"training_time_s", train_s},
@@ -393,8 +396,10 @@ nlohmann::json RunLearnIkMethods(const Config& cfg, const std::string& dir, bool
           {"lambda_mm", eps_mm},
           {"model_lambda_mm", p.net_eps_pct / 100.0 * width},
           {"errors_note",
-           "every error is measured by the simulator at the method's actuation, on seeded random "
-           "targets the simulator reaches (not on the training grid)"}};
+           "every SoftKin error is measured by the " + measured_by +
+               " at the method's actuation, on seeded random targets it reaches (not on the "
+               "training grid); the thesis's errors (thesis_mean_err_mm) were measured on the "
+               "physical robot, so the two are not the same measurement"}};
 }
 
 // ---- Fig. 5.10 / 5.12: the redundant finger_manipulator on a path, learned Jacobian vs direct IK

@@ -176,7 +176,8 @@ const nlohmann::json* ResumeJournal::Reuse(const nlohmann::json& key) {
 void ResumeJournal::Append(const nlohmann::json& key, const nlohmann::json& row) {
   nlohmann::json record = {{"key", key}, {"row", row}};
   std::string line = record.dump() + "\n";
-  const int fd = ::open(path_.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
+  // Read and write: the last byte is read to see whether a killed writer cut its line.
+  const int fd = ::open(path_.c_str(), O_RDWR | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
   if (fd < 0) throw std::runtime_error("cannot write " + path_ + ": " + std::strerror(errno));
   // One writer at a time; a lock that the file system does not support (ENOLCK, ENOSYS) leaves
   // O_APPEND's single write per record.

@@ -8,8 +8,8 @@ RESULTS_DIR/path_<name>.csv for every path it lists and RESULTS_DIR/samples.csv.
 RESULTS_DIR/fig4_2_trajectories.png, one row per path:
   left:  the target waypoints and the reached tip positions in the finger's motion plane (x-z, mm),
          over the sampled configuration space (grey);
-  right: the error |reached - target| per waypoint (mm) with lambda, and our time beside the
-         thesis's.
+  right: the error |reached - target| per waypoint (mm) with lambda, and our time per waypoint
+         beside the thesis's (its total over its number of waypoints, the paths' thesis.waypoints).
 Exit status 2 with a message on stderr if a file is missing or malformed.
 """
 import sys
@@ -50,17 +50,20 @@ def main(argv):
         ax2.axhline(lam, color="k", ls="--", lw=1, label=f"lambda = {lam:g} mm")
         ax2.set_xlabel("waypoint")
         ax2.set_ylabel("error (mm)")
+        # Times compared per waypoint: a quick run follows fewer waypoints than the thesis.
         t = p.get("total_time_s")
-        th = (p.get("thesis") or {}).get("total_time_s")
+        thesis = p.get("thesis") or {}
+        th, th_n = thesis.get("total_time_s"), thesis.get("waypoints")
         title = f"'{name}': error per waypoint"
-        if isinstance(t, (int, float)):
-            title += f"; ours {t:.1f} s"
-        if isinstance(th, (int, float)):
-            title += f" (thesis {th:g} s)"
-        ax2.set_title(title)
+        if isinstance(t, (int, float)) and w:
+            title += f"\nours {t:.1f} s / {len(w)} waypoints = {t / len(w):.2f} s per waypoint"
+        if isinstance(th, (int, float)) and isinstance(th_n, int) and th_n > 0:
+            title += f"\nthesis {th:g} s / {th_n} waypoints = {th / th_n:.2f} s per waypoint"
+        ax2.set_title(title, fontsize=10)
         ax2.grid(True, alpha=0.3)
         ax2.legend(fontsize=8)
-    quick = " (quick run)" if summary.get("quick") else ""
+    quick = (f" (quick run: res {summary.get('res', '?')}, fewer waypoints)"
+             if summary.get("quick") else "")
     fig.suptitle(f"Thesis Fig. 4.2: {summary.get('robot', '?')} following paths (Algorithm 4, "
                  f"{summary.get('method', '?')}, Jacobian {summary.get('jacobian', '?')}){quick}")
     figlib.save_figure(fig, results, NAME)

@@ -4,10 +4,13 @@
 Usage: table5_1_ik_methods.py RESULTS_DIR
 
 Reads RESULTS_DIR/summary.json (rows[].{method, label, ms_per_waypoint, mean_err_mm, max_err_mm,
-thesis_ms_per_waypoint, thesis_mean_err_mm}) and RESULTS_DIR/targets.csv (one row per method x
-target, errors measured by the simulator). Writes RESULTS_DIR/table5_1_ik_methods.png:
+thesis_ms_per_waypoint, thesis_mean_err_mm}; error_measured_by, thesis_error_measured_by) and
+RESULTS_DIR/targets.csv (one row per method x target, errors measured by the simulator or twin).
+Writes RESULTS_DIR/table5_1_ik_methods.png:
   (a) time per waypoint (ms, log scale), ours and the thesis's, per method;
   (b) mean error (mm), ours and the thesis's; (c) the distribution of our errors per method.
+The thesis's bars are hatched and labelled with where their errors were measured (hardware), ours
+with ours (the simulator, or a twin): in (b) they are not the same measurement.
 Exit status 2 with a message on stderr if a file is missing or malformed.
 """
 import os
@@ -36,18 +39,26 @@ def main(argv):
     import matplotlib.pyplot as plt
 
     names = [r.get("label", r["method"]) for r in rows]
+    ours_by = summary.get("error_measured_by", "simulator")
+    thesis_by = summary.get("thesis_error_measured_by", "hardware")
     x = list(range(len(rows)))
     fig, (a, b, c) = plt.subplots(1, 3, figsize=(16, 5))
     w = 0.38
-    a.bar([i - w / 2 for i in x], [max(r["ms_per_waypoint"], 1e-4) for r in rows], w, label="SoftKin")
-    a.bar([i + w / 2 for i in x], [r["thesis_ms_per_waypoint"] for r in rows], w, label="thesis")
+    thesis_style = dict(color="white", edgecolor="C1", hatch="//", lw=1)
+    a.bar([i - w / 2 for i in x], [max(r["ms_per_waypoint"], 1e-4) for r in rows], w,
+          label="SoftKin (this machine)")
+    a.bar([i + w / 2 for i in x], [r["thesis_ms_per_waypoint"] for r in rows], w,
+          label="thesis (its machine)", **thesis_style)
     a.set_yscale("log")
     a.set_ylabel("time per waypoint (ms)")
     a.set_title("(a) IK time per waypoint")
-    b.bar([i - w / 2 for i in x], [r["mean_err_mm"] for r in rows], w, label="SoftKin")
-    b.bar([i + w / 2 for i in x], [r["thesis_mean_err_mm"] for r in rows], w, label="thesis")
+    b.bar([i - w / 2 for i in x], [r["mean_err_mm"] for r in rows], w,
+          label=f"SoftKin, measured by the {ours_by}")
+    b.bar([i + w / 2 for i in x], [r["thesis_mean_err_mm"] for r in rows], w,
+          label=f"thesis, measured on {thesis_by}", **thesis_style)
     b.set_ylabel("mean error (mm)")
-    b.set_title("(b) mean tip error, measured by the simulator")
+    b.set_title(f"(b) mean tip error: ours by the {ours_by},\nthe thesis's on {thesis_by} "
+                "(not the same measurement)", fontsize=10)
     for ax in (a, b):
         ax.set_xticks(x)
         ax.set_xticklabels(names, rotation=20, ha="right", fontsize=8)
@@ -58,7 +69,8 @@ def main(argv):
     c.set_xticks([i + 1 for i in x])
     c.set_xticklabels(names, rotation=20, ha="right", fontsize=8)
     c.set_ylabel("error (mm)")
-    c.set_title(f"(c) errors per target (lambda {summary.get('lambda_mm', 0):.3f} mm)")
+    c.set_title(f"(c) SoftKin's errors per target, by the {ours_by} "
+                f"(lambda {summary.get('lambda_mm', 0):.3f} mm)", fontsize=10)
     c.grid(True, axis="y", alpha=0.3)
     figlib.save_figure(fig, results, NAME)
 
