@@ -23,14 +23,14 @@
 /// targets are fixed in the global step, whose matrix gains k on the springs' rows, kept factored
 /// by SpringSystem (CHOLMOD update/downdate).
 ///
-/// With options.self_spring "pair", a self spring instead pulls v to the exit point taken as a
-/// point of the exit face f, sum_i w_i x_fi (w its barycentric coordinates when detected), plus
-/// an offset delta (eps along the exit direction): E = k ||v - sum_i w_i x_fi - delta||^2. The
-/// face's vertices are unknowns of the global step too, so the spring pushes v out and the face
-/// back with equal and opposite forces, and the target follows the face within the step. The
-/// whole overlap is the target (the face moves too). While a contact persists its face and
-/// weights are kept (delta absorbs the refreshed exit point), so the matrix changes only when a
-/// contact starts, ends, or slides to another face or by a fifth of the face.
+/// With options.self_spring "pair" (the default; "target" is the fixed v_c above), a self spring
+/// instead pulls v to the exit point taken as a point of the exit face f, sum_i w_i x_fi (w its
+/// barycentric coordinates when detected), plus an offset delta (eps along the exit direction): E =
+/// k ||v - sum_i w_i x_fi - delta||^2. The face's vertices are unknowns of the global step too, so
+/// the spring pushes v out and the face back with equal and opposite forces, and the target follows
+/// the face within the step. The whole overlap is the target (the face moves too). While a contact
+/// persists its face and weights are kept (delta absorbs the refreshed exit point), so the matrix
+/// changes only when a contact starts, ends, or slides to another face or by a fifth of the face.
 #include "softkin/solver/collision/collision.hpp"
 #include "softkin/solver/fk/contact_term.hpp"
 #include "softkin/solver/fk/model.hpp"

@@ -85,13 +85,15 @@ struct CollisionOptions {
   /// measured cases it converges no better, and it unbalances the pressed blocks' contact forces
   /// more (docs/collision_response.md).
   SelfTarget self_target = SelfTarget::kWalk;
-  /// What a self-collision spring pulls a vertex v to. "target" (the default, Eq. 3.5): a fixed
-  /// point v_c, half way to the exit point plus eps (both sides of a contact get springs), set at
-  /// each check. "pair": the exit point as a point of the exit face, sum_i w_i x_fi, plus eps:
-  /// the energy k ||v - sum_i w_i x_fi - delta||^2 moves with the face and loads both sides
-  /// equally and oppositely (action and reaction), so it couples v with the face's vertices in
-  /// the global matrix (SpringSystem).
-  SelfSpring self_spring = SelfSpring::kTarget;
+  /// What a self-collision spring pulls a vertex v to. "pair" (the default): the exit point as a
+  /// point of the exit face, sum_i w_i x_fi, plus eps: the energy k ||v - sum_i w_i x_fi -
+  /// delta||^2 moves with the face and loads both sides equally and oppositely (action and
+  /// reaction), so it couples v with the face's vertices in the global matrix (SpringSystem).
+  /// "target" (Eq. 3.5 as the thesis writes it): a fixed point v_c, half way to the exit point
+  /// plus eps (both sides of a contact get springs), set at each check; its forces on the two
+  /// sides of a contact need not balance, and a held contact is sticky, which stiffens a finger
+  /// whose walls touch (docs/collision_response.md).
+  SelfSpring self_spring = SelfSpring::kPair;
   /// What an obstacle spring resists. "plane" (the default): only the normal part of the offset
   /// to v_c (the closest point plus eps), k (n . (v - v_c))^2, against the obstacle's tangent
   /// plane at v_c: a frictionless contact. Its n n^T term couples a vertex's x, y and z, so the

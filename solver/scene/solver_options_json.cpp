@@ -158,9 +158,10 @@ const std::vector<Row>& Rows() {
              "region (the thesis's rule) for every contact, or 'auto': the same within one body, "
              "the closest facing point of the other body's surface between separate bodies."),
       Option("collision.self_spring", &C::self_spring,
-             "What a self-collision spring pulls its vertex to: a fixed 'target' half way to the "
-             "exit point (Eq. 3.5), or 'pair': the exit point as a point of the exit face, which "
-             "moves with the face and loads both sides equally."),
+             "What a self-collision spring pulls its vertex to: 'pair', the exit point as a point "
+             "of the exit face, which moves with the face and loads both sides of the contact "
+             "equally and oppositely; or a fixed 'target' half way to the exit point (Eq. 3.5 as "
+             "the thesis writes it; unbalanced and sticky)."),
       Option("collision.obstacle_spring", &C::obstacle_spring,
              "What an obstacle spring resists: 'plane', only the normal part of the offset to "
              "the closest point plus eps, against the obstacle's tangent plane (frictionless), "

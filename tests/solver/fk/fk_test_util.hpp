@@ -46,7 +46,7 @@ inline FkOptions NonDefaultFkOptions() {
   o.collision.check_interval = 3;
   o.collision.update = SpringUpdate::kRefactor;
   o.collision.self_target = SelfTarget::kAuto;
-  o.collision.self_spring = SelfSpring::kPair;
+  o.collision.self_spring = SelfSpring::kTarget;
   o.collision.obstacle_spring = ObstacleSpring::kPoint;
   return o;
 }
