@@ -78,7 +78,18 @@ int RunCli(int argc, char** argv, bool rethrow) {
 
   const auto run_parsed = [&commands] {
     for (const Command& c : commands)
-      if (c.app->parsed()) return c.run();
+      if (c.app->parsed()) {
+        // Only `dataset` and `run` share their work over MPI ranks; any other command started by
+        // a launcher with several processes would run once per process on the same files.
+        const std::string name = c.app->get_name();
+        if (LaunchedMpiSize() > 1 && name != "dataset" && name != "run")
+          throw std::invalid_argument(
+              name + ": started by an MPI launcher with " + std::to_string(LaunchedMpiSize()) +
+              " processes, but only `softkin dataset` and `softkin run` (sweeps) share work over "
+              "MPI ranks; run `softkin " +
+              name + "` as one process");
+        return c.run();
+      }
     return 0;
   };
   if (rethrow) return run_parsed();

@@ -2,7 +2,8 @@
 # `mpirun -n 2 softkin run CONFIG` of a sweep (experiments/sweep.hpp) equals the one-process run:
 # a tiny fig5_5 architecture sweep (its dataset shared over the ranks too) gives the same table,
 # each network trained once; a rerun after losing two rows trains only those two; an experiment
-# that is not a sweep is refused under mpirun. Usage: mpi_sweep.sh SOFTKIN MPIEXEC
+# that is not a sweep, or a command that does not share work (fk), is refused under mpirun.
+# Usage: mpi_sweep.sh SOFTKIN MPIEXEC
 set -euo pipefail
 SOFTKIN="$1"
 MPIEXEC="$2"
@@ -76,3 +77,13 @@ grep -q "is not a sweep of independent units; run it as one process" refused.log
   { cat refused.log >&2; exit 1; }
 [[ ! -e refused/bend/summary.json ]]
 echo "a non-sweep experiment under mpirun: refused"
+
+# A command that does not share work over ranks is refused under mpirun, before it writes anything.
+if "${MPI[@]}" -n 2 "$SOFTKIN" fk --robot three_chamber --res 2 --actuation 1.2 \
+  --vtu fk.vtu 2> fk.log; then
+  echo "softkin fk ran under mpirun -n 2" >&2
+  exit 1
+fi
+grep -q "fk: started by an MPI launcher with 2 processes" fk.log || { cat fk.log >&2; exit 1; }
+[[ ! -e fk.vtu ]]
+echo "softkin fk under mpirun: refused"
