@@ -405,15 +405,11 @@ nlohmann::json RunIkMethods(const Config& cfg, const std::string& dir, bool verb
     return MethodRow(p, model, u.method, u.jmode, u.jname, path, samples, dir, verbose);
   });
   if (!Sweep::WritesResults()) return {};
-  CsvWriter csv(dir + "/methods.csv",
-                {"method", "jacobian", "waypoints", "converged", "ms_per_waypoint", "mean_err_mm",
-                 "max_err_mm", "fk_calls", "fk_calls_per_waypoint", "evaluations",
-                 "mean_iterations", "failures", "initial_sample", "initial_starts_tried"});
-  nlohmann::json rows = nlohmann::json::array();
-  for (size_t i = 0; i < units.size(); ++i) {
-    rows.push_back(sweep.Row(i));
-    csv.RowJson(rows.back());
-  }
+  const nlohmann::json rows = sweep.WriteTable(
+      dir + "/methods.csv",
+      {"method", "jacobian", "waypoints", "converged", "ms_per_waypoint", "mean_err_mm",
+       "max_err_mm", "fk_calls", "fk_calls_per_waypoint", "evaluations", "mean_iterations",
+       "failures", "initial_sample", "initial_starts_tried"});
   nlohmann::json j = s.Json();
   j.erase("method");
   j.erase("jacobian");

@@ -167,14 +167,10 @@ nlohmann::json RunLearnArchitecture(const Config& cfg, const std::string& dir, b
     return ArchitectureRow(p, data[u.d], u.net, u.h, u.b, verbose);
   });
   if (!Sweep::WritesResults()) return {};
-  CsvWriter csv(dir + "/architecture.csv",
-                {"robot", "net", "h", "b", "parameters", "test_mean", "test_max", "test_mean_pct",
-                 "test_max_pct", "epochs", "time_s", "termination"});
-  nlohmann::json rows = nlohmann::json::array();
-  for (std::size_t i = 0; i < units.size(); ++i) {
-    rows.push_back(sweep.Row(i));
-    csv.RowJson(rows.back());
-  }
+  const nlohmann::json rows =
+      sweep.WriteTable(dir + "/architecture.csv",
+                       {"robot", "net", "h", "b", "parameters", "test_mean", "test_max",
+                        "test_mean_pct", "test_max_pct", "epochs", "time_s", "termination"});
   return {{"rows", rows},
           {"datasets", datasets},
           {"resumed_rows", sweep.resumed()},

@@ -1,7 +1,6 @@
 #include "softkin/experiments/learn_common.hpp"
 
 #include "softkin/experiments/dataset_mpi.hpp"
-#include "softkin/experiments/mpi_job.hpp"
 #include "softkin/experiments/results.hpp"
 #include "softkin/ik/simulator_kinematics.hpp"
 #include "softkin/learn/twin.hpp"
@@ -159,11 +158,10 @@ Dataset CachedDataset(const DatasetSpec& spec, const std::string& cache_dir, boo
       s->Reset();
   };
   if (verbose) std::cerr << "  dataset " << path << " (" << kin->name() << ")\n";
-  // Under mpirun (a sweep, experiments/sweep.hpp) the ranks share the samples; rank 0 alone
-  // reports progress.
-  run.progress = verbose && MpiJob().root();
-  const DatasetRunSummary s = MpiJob().active() ? GenerateDatasetMpi(*kin, spec.sampling, run)
-                                                : GenerateDataset(*kin, spec.sampling, run);
+  run.progress = verbose;
+  // Under mpirun (a sweep, experiments/sweep.hpp) the ranks share the samples; in one process
+  // this is GenerateDataset.
+  const DatasetRunSummary s = GenerateDatasetMpi(*kin, spec.sampling, run);
   Dataset d = LoadDataset(path);
   if (info) {
     *info = {{"path", path},

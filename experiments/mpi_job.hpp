@@ -46,8 +46,8 @@ bool MpiStarted();
 void MpiBarrier();
 
 /// Prints "softkin: rank R: error: ..." and aborts the whole job (MPI_Abort with exit code 2 for
-/// std::invalid_argument, else 1), so that no rank waits forever for one that failed. Outside an
-/// MPI job it only rethrows nothing: callers use it in catch blocks under MpiStarted().
+/// std::invalid_argument, else 1), so that no rank waits forever for one that failed. If MPI was
+/// never started it prints "softkin: error: ..." and exits with that code.
 [[noreturn]] void MpiAbortJob(const std::exception& e);
 
 /// The sum over ranks of each of n values, on every rank (copies them outside a job).

@@ -59,4 +59,11 @@ void Sweep::Run(const std::vector<nlohmann::json>& keys,
   }
 }
 
+nlohmann::json Sweep::WriteTable(const std::string& csv_path,
+                                 const std::vector<std::string>& header) const {
+  CsvWriter csv(csv_path, header);
+  for (const auto& row : rows_) csv.RowJson(row);
+  return nlohmann::json(rows_);
+}
+
 }  // namespace softkin

@@ -24,16 +24,19 @@ class Sweep {
   Sweep(const std::string& journal_path, std::string label, bool verbose);
 
   /// Computes, with compute(i), the row of every keys[i] not in the journal, and journals it. All
-  /// ranks of an MPI job call Run with the same keys. Afterwards Row(i) is each unit's row. An
+  /// ranks of an MPI job call Run with the same keys; WriteTable then gives the rows. An
   /// exception from compute aborts an MPI job (MpiAbortJob) and is rethrown in one process.
   void Run(const std::vector<nlohmann::json>& keys,
            const std::function<nlohmann::json(std::size_t)>& compute);
 
-  /// The row of keys[i] after Run.
-  const nlohmann::json& Row(std::size_t i) const { return rows_.at(i); }
+  /// After Run: writes the rows, in the order of the keys, as a CSV of the columns `header`
+  /// (CsvWriter::RowJson) and returns them as a JSON array.
+  nlohmann::json WriteTable(const std::string& csv_path,
+                            const std::vector<std::string>& header) const;
   /// Units whose rows were in the journal before this run (resumed).
   int resumed() const { return resumed_; }
   /// Whether this process writes the experiment's results: rank 0 of an MPI job, or the only one.
+  /// The other ranks return from the experiment after Run.
   static bool WritesResults();
 
  private:

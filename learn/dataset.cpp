@@ -4,13 +4,13 @@
 #include "softkin/solver/common/output_file.hpp"
 
 #include <algorithm>
-#include <cerrno>
-#include <cstring>
 #include <cassert>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>

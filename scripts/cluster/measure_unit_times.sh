@@ -11,20 +11,28 @@
 #   kind,block,unit,units,samples,seconds
 # to OUT.csv (appending as it goes; rerun to resume). Environment: BLOCK, UNITS_MEASURED, COLD_RUNS.
 set -euo pipefail
-if [[ $# -lt 2 || $1 == -h || $1 == --help ]]; then
-  sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'
-  exit $(( $# < 2 ? 2 : 0 ))
+usage() { sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; }
+case "${1:-}" in -h | --help) usage; exit 0 ;; esac
+if [[ $# -lt 2 ]]; then
+  usage >&2
+  exit 2
 fi
 out=$1 softkin=$2
 shift 2
 block=${BLOCK:-64} measured=${UNITS_MEASURED:-12} cold_runs=${COLD_RUNS:-4}
+for var in BLOCK:$block UNITS_MEASURED:$measured COLD_RUNS:$cold_runs; do
+  if [[ ! ${var#*:} =~ ^[1-9][0-9]*$ ]]; then
+    echo "measure_unit_times: ${var%%:*}: expected an integer >= 1, got '${var#*:}'" >&2
+    exit 2
+  fi
+done
 work=$(mktemp -d "${TMPDIR:-/tmp}/softkin-measure.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 export OMP_NUM_THREADS=1
 
-# The number of samples (the plan of --dry-run).
-total=$("$softkin" dataset "$@" --out "$work/plan.csv" --dry-run |
-  /usr/bin/python3 -c 'import json,sys; print(json.load(sys.stdin)["samples"])')
+# The number of samples (the plan of --dry-run; softkin names a bad argument and exits 2).
+plan=$("$softkin" dataset "$@" --block "$block" --out "$work/plan.csv" --dry-run) || exit $?
+total=$(/usr/bin/python3 -c 'import json,sys; print(json.loads(sys.argv[1])["samples"])' "$plan")
 units=$(( (total + block - 1) / block ))
 [[ -f $out ]] || echo "kind,block,unit,units,samples,seconds" > "$out"
 

@@ -18,7 +18,9 @@ The model:
   * Rank 0 hands the units out in order to whichever rank is free first (dataset_mpi.cpp); the
     ranks start after `startup` and the job ends when the last unit is done, plus rank 0's merge
     (merge-ms-per-sample x N). The dispatch itself is free (rank 0 answers between samples).
-For each rank count the block with the shortest predicted wall time is marked.
+For each rank count the block with the shortest predicted wall time is marked; speed-ups are
+against one rank with the largest block asked for. A malformed TIMES.csv or option exits with
+status 2 and a message naming the file and line, or the option.
 """
 import argparse
 import csv
@@ -28,15 +30,43 @@ import sys
 import numpy as np
 
 
+def fail(message):
+    """Bad input: the message on stderr, exit status 2."""
+    print(f"predict_wall_time: {message}", file=sys.stderr)
+    sys.exit(2)
+
+
+COLUMNS = ["kind", "block", "unit", "units", "samples", "seconds"]
+
+
 def read_times(path):
+    """The warm and cold rows of TIMES.csv; exits 2 naming the file and line of a bad one."""
     warm, cold = [], []
-    with open(path) as f:
-        for row in csv.DictReader(f):
-            rec = (int(row["block"]), int(row["unit"]), int(row["units"]), int(row["samples"]),
-                   float(row["seconds"]))
+    try:
+        f = open(path, newline="")
+    except OSError as e:
+        fail(f"cannot read {path}: {e.strerror}")
+    with f:
+        reader = csv.DictReader(f)
+        missing = [c for c in COLUMNS if c not in (reader.fieldnames or [])]
+        if missing:
+            fail(f"{path}:1: expected the columns {','.join(COLUMNS)} "
+                     f"(measure_unit_times.sh writes them); missing {','.join(missing)}")
+        for row in reader:
+            line = reader.line_num
+            try:
+                rec = (int(row["block"]), int(row["unit"]), int(row["units"]),
+                       int(row["samples"]), float(row["seconds"]))
+            except (TypeError, ValueError):
+                fail(f"{path}:{line}: expected integers block, unit, units, "
+                         f"samples and a number of seconds, got {row}")
+            if row["kind"] not in ("warm", "cold") or rec[0] < 1 or rec[3] < 1 or rec[4] <= 0:
+                fail(f"{path}:{line}: expected kind warm or cold, block and "
+                         f"samples >= 1 and seconds > 0, got {row}")
             (warm if row["kind"] == "warm" else cold).append(rec)
     if not warm or not cold:
-        sys.exit(f"{path}: needs 'warm' and 'cold' rows (measure_unit_times.sh writes both)")
+        fail(f"{path}: needs 'warm' and 'cold' rows "
+                 "(measure_unit_times.sh writes both)")
     return warm, cold
 
 
@@ -50,6 +80,8 @@ def main():
     ap.add_argument("--merge-ms-per-sample", type=float, default=0.15)
     ap.add_argument("--out", help="also write the table as CSV")
     a = ap.parse_args()
+    if a.samples < 1 or min(a.ranks) < 1 or min(a.blocks) < 1:
+        ap.error("--samples, --ranks and --blocks must be >= 1")
     warm, cold = read_times(a.times)
     n = a.samples
 
@@ -65,7 +97,8 @@ def main():
     pos, rate = np.array(pos)[order], np.array(rate)[order]
     t_warm = np.interp(np.arange(n) + 0.5, pos, rate)
     cum = np.concatenate([[0.0], np.cumsum(t_warm)])
-    serial64 = None
+    reference = max(a.blocks)  # speed-ups are against one rank with the largest block
+    serial = None
     print(f"model: t_cold {t_cold:.3f} s, t_warm {t_warm.mean():.3f} s mean "
           f"({t_warm.min():.3f}..{t_warm.max():.3f}), {n} samples")
 
@@ -91,21 +124,23 @@ def main():
             rows.append(row)
             if best is None or wall < best["wall_s"]:
                 best = row
-            if ranks == 1 and b == 64:
-                serial64 = wall
+            if ranks == 1 and b == reference:
+                serial = wall
         best["best"] = True
+    print(f"speed-up: against one rank with block {reference}")
     print(f"{'ranks':>6} {'block':>6} {'units':>6} {'wall':>10} {'speed-up':>9} {'balance':>8}")
     for r in rows:
         mark = "  <- shortest" if r.get("best") else ""
         print(f"{r['ranks']:>6} {r['block']:>6} {r['units']:>6} {r['wall_s']:>9.0f}s "
-              f"{serial64 / r['wall_s']:>8.1f}x {r['busiest_over_mean']:>8.3f}{mark}")
+              f"{serial / r['wall_s']:>8.1f}x {r['busiest_over_mean']:>8.3f}{mark}")
     if a.out:
         with open(a.out, "w", newline="") as f:
-            w = csv.DictWriter(f, ["ranks", "block", "units", "wall_s", "speedup_vs_one_rank_b64",
-                                   "busiest_over_mean", "cpu_s", "best"])
+            w = csv.DictWriter(f, ["ranks", "block", "units", "wall_s", "speedup_vs_one_rank",
+                                   "reference_block", "busiest_over_mean", "cpu_s", "best"])
             w.writeheader()
             for r in rows:
-                w.writerow({**r, "speedup_vs_one_rank_b64": serial64 / r["wall_s"],
+                w.writerow({**r, "speedup_vs_one_rank": serial / r["wall_s"],
+                            "reference_block": reference,
                             "best": int(bool(r.get("best")))})
 
 
