@@ -9,15 +9,12 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
 #include <stdexcept>
-#include <thread>
 
-#include <fcntl.h>
-#include <signal.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 namespace softkin {
@@ -45,6 +42,24 @@ void WriteIds(std::ostream& o, const std::vector<int>& ids) {
 }
 
 }  // namespace
+
+void WriteCalculixMaterial(std::ostream& o, const std::string& name, const std::string& law,
+                           double E, double nu, const Material* mr) {
+  o << "*MATERIAL, NAME=" << name << "\n";
+  if (law == "linear") {
+    o << "*ELASTIC\n" << Num(E) << ", " << Num(nu) << "\n";
+  } else if (mr) {
+    // A Mooney-Rivlin body region keeps its c1 : c2 ratio, scaled to the small-strain modulus E.
+    const double sc = E / (6.0 * (mr->c1 + mr->c2));
+    const double d1 = 6.0 * (1.0 - 2.0 * nu) / E;
+    o << "*HYPERELASTIC, MOONEY-RIVLIN\n"
+      << Num(sc * mr->c1) << ", " << Num(sc * mr->c2) << ", " << Num(d1) << "\n";
+  } else {
+    const double c10 = E / (4.0 * (1.0 + nu));
+    const double d1 = 6.0 * (1.0 - 2.0 * nu) / E;
+    o << "*HYPERELASTIC, NEO HOOKE\n" << Num(c10) << ", " << Num(d1) << "\n";
+  }
+}
 
 void WriteCalculixInput(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& c,
                         const CalculixOptions& opt, const std::string& path) {
@@ -118,20 +133,7 @@ void WriteCalculixInput(const Model& model, const Eigen::Ref<const Eigen::Vector
 
   // Materials and sections.
   auto material = [&](const std::string& name, double E, double expansion, const Material* mr) {
-    o << "*MATERIAL, NAME=" << name << "\n";
-    if (opt.law == "linear") {
-      o << "*ELASTIC\n" << Num(E) << ", " << Num(opt.poisson) << "\n";
-    } else if (mr) {
-      // A Mooney-Rivlin body region keeps its c1 : c2 ratio, scaled to the small-strain modulus E.
-      const double sc = E / (6.0 * (mr->c1 + mr->c2));
-      const double d1 = 6.0 * (1.0 - 2.0 * opt.poisson) / E;
-      o << "*HYPERELASTIC, MOONEY-RIVLIN\n"
-        << Num(sc * mr->c1) << ", " << Num(sc * mr->c2) << ", " << Num(d1) << "\n";
-    } else {
-      const double c10 = E / (4.0 * (1.0 + opt.poisson));
-      const double d1 = 6.0 * (1.0 - 2.0 * opt.poisson) / E;
-      o << "*HYPERELASTIC, NEO HOOKE\n" << Num(c10) << ", " << Num(d1) << "\n";
-    }
+    WriteCalculixMaterial(o, name, opt.law, E, opt.poisson, mr);
     o << "*EXPANSION\n" << Num(expansion) << "\n";
   };
   for (const auto& [name, ids] : sets) {
@@ -166,8 +168,10 @@ void WriteCalculixInput(const Model& model, const Eigen::Ref<const Eigen::Vector
   if (!o) throw std::runtime_error("calculix: error while writing '" + path + "'");
 }
 
-std::vector<std::pair<double, Eigen::MatrixX3d>> ReadCalculixDisplacements(const std::string& dat,
-                                                                           int nv) {
+std::vector<std::pair<double, Eigen::MatrixX3d>> ReadCalculixDisplacements(
+    const std::string& dat, int nv, const std::vector<bool>* printed) {
+  if (printed && static_cast<int>(printed->size()) != nv)
+    throw std::invalid_argument("ReadCalculixDisplacements: printed must have one entry per node");
   std::ifstream in(dat);
   if (!in) throw std::runtime_error("calculix: cannot open '" + dat + "'");
   std::vector<std::pair<double, Eigen::MatrixX3d>> out;
@@ -178,7 +182,7 @@ std::vector<std::pair<double, Eigen::MatrixX3d>> ReadCalculixDisplacements(const
   auto finish = [&]() {
     if (!cur) return;
     for (int v = 0; v < nv; ++v)
-      if (!seen[v])
+      if (!seen[v] && (!printed || (*printed)[v]))
         throw std::runtime_error(dat + ": the block ending before line " + std::to_string(line_no) +
                                  " lacks node " + std::to_string(v + 1));
     cur = nullptr;
@@ -191,7 +195,9 @@ std::vector<std::pair<double, Eigen::MatrixX3d>> ReadCalculixDisplacements(const
       double t = 0;
       if (p == std::string::npos || std::sscanf(line.c_str() + p + 4, "%lf", &t) != 1)
         throw std::runtime_error(dat + ":" + std::to_string(line_no) + ": expected 'time T'");
-      out.emplace_back(t, Eigen::MatrixX3d::Zero(nv, 3));
+      out.emplace_back(
+          t, printed ? Eigen::MatrixX3d::Constant(nv, 3, std::numeric_limits<double>::quiet_NaN())
+                     : Eigen::MatrixX3d::Zero(nv, 3));
       cur = &out.back().second;
       seen.assign(nv, false);
       continue;
@@ -222,73 +228,12 @@ double CalculixRatioAtLoad(double alpha, double load) {
   return r * r * r;
 }
 
-int CountConvergedIncrements(const std::string& sta) {
-  std::ifstream in(sta);
-  int n = 0;
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream ss(line);
-    long step, inc;
-    std::string att;
-    if (ss >> step >> inc >> att && !att.empty() && att.back() != 'U' &&
-        att.find_first_not_of("0123456789") == std::string::npos)
-      ++n;
-  }
-  return n;
-}
-
-std::string FindCcx() {
-  const char* path = std::getenv("PATH");
-  if (!path) return "";
-  std::stringstream ss(path);
-  std::string dir;
-  while (std::getline(ss, dir, ':')) {
-    if (dir.empty()) continue;
-    const fs::path p = fs::path(dir) / "ccx";
-    if (::access(p.c_str(), X_OK) == 0) return p.string();
-  }
-  return "";
-}
-
 CalculixSolver::CalculixSolver(std::shared_ptr<const Model> model, const FkOptions& fk,
                                CalculixOptions options)
     : FkSolver(std::move(model)), name_(ToString(fk.solver)), options_(std::move(options)) {
   if (fk.time_limit_s > 0 && options_.time_limit_s <= 0) options_.time_limit_s = fk.time_limit_s;
   if (fk.continuation_steps > 1) options_.increments = fk.continuation_steps;
 }
-
-namespace {
-
-/// Starts `ccx -i job` in folder `work` (no shell), its output going to `log`; returns the child's
-/// pid, or -1 if fork failed.
-pid_t StartCcx(const std::string& ccx, const fs::path& work, const std::string& log) {
-  const pid_t pid = ::fork();
-  if (pid != 0) return pid;
-  if (::chdir(work.c_str()) != 0) ::_exit(126);
-  const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  if (fd >= 0) {
-    ::dup2(fd, 1);
-    ::dup2(fd, 2);
-    ::close(fd);
-  }
-  ::setenv("OMP_NUM_THREADS", "2", 0);
-  char* const argv[] = {const_cast<char*>("ccx"), const_cast<char*>("-i"), const_cast<char*>("job"),
-                        nullptr};
-  ::execv(ccx.c_str(), argv);
-  ::_exit(127);
-}
-
-/// The last line of file `log` that mentions an error ("" if none).
-std::string LastErrorLine(const std::string& log) {
-  std::ifstream lg(log);
-  std::string line, last;
-  while (std::getline(lg, line))
-    if (line.find("ERROR") != std::string::npos || line.find("error") != std::string::npos)
-      last = line;
-  return last;
-}
-
-}  // namespace
 
 FkResult CalculixSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c,
                                    const Eigen::MatrixX3d*) {
@@ -311,22 +256,11 @@ FkResult CalculixSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c,
   };
   if (!input_ok) return finish(FkStatus::InvalidInput, r.message);
   const std::string ccx = FindCcx();
-  if (ccx.empty())
-    return finish(FkStatus::InvalidInput,
-                  "ccx (CalculiX) is not installed or not on PATH; install the Debian package "
-                  "calculix-ccx (scripts/setup.sh does)");
-  std::string tmpl = (fs::temp_directory_path() / "softkin_ccx_XXXXXX").string();
-  if (!::mkdtemp(tmpl.data()))
+  if (ccx.empty()) return finish(FkStatus::InvalidInput, CcxMissingMessage());
+  const CcxWorkFolder folder(options_.keep_files);
+  if (folder.path().empty())
     return finish(FkStatus::InvalidInput, "cannot create a temporary folder");
-  const fs::path work(tmpl);
-  struct Cleanup {
-    fs::path p;
-    bool keep;
-    ~Cleanup() {
-      std::error_code ec;
-      if (!keep) fs::remove_all(p, ec);
-    }
-  } cleanup{work, options_.keep_files};
+  const fs::path& work = folder.path();
   try {
     WriteCalculixInput(m, c, options_, (work / "job.inp").string());
   } catch (const std::invalid_argument& e) {
@@ -334,38 +268,10 @@ FkResult CalculixSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c,
   } catch (const std::runtime_error& e) {
     return finish(FkStatus::InvalidInput, e.what());
   }
-  // Run ccx -i job in the work folder, output to ccx.log; no shell is involved.
-  const std::string log = (work / "ccx.log").string();
-  const pid_t pid = StartCcx(ccx, work, log);
-  if (pid < 0) return finish(FkStatus::Diverged, "fork failed");
-  int wstatus = 0;
-  bool timed_out = false;
-  // Time-stamp each converged increment as it appears in job.sta (re-read only when it grows).
-  const std::string sta = (work / "job.sta").string();
-  std::vector<double> stamps;
-  std::uintmax_t sta_size = 0;
-  auto poll_sta = [&]() {
-    std::error_code ec;
-    const std::uintmax_t size = fs::file_size(sta, ec);
-    if (ec || size == sta_size) return;
-    sta_size = size;
-    const int n = CountConvergedIncrements(sta);
-    const double now = Seconds(t0, Clock::now());
-    while (static_cast<int>(stamps.size()) < n) stamps.push_back(now);
-  };
-  for (;;) {
-    const pid_t w = ::waitpid(pid, &wstatus, WNOHANG);
-    poll_sta();
-    if (w == pid) break;
-    if (w < 0) return finish(FkStatus::Diverged, "waitpid failed");
-    if (options_.time_limit_s > 0 && Seconds(t0, Clock::now()) > options_.time_limit_s) {
-      ::kill(pid, SIGKILL);
-      ::waitpid(pid, &wstatus, 0);
-      timed_out = true;
-      break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+  const CcxRun run = RunCcxJob(ccx, work, options_.time_limit_s, t0);
+  if (!run.started) return finish(FkStatus::Diverged, run.last_error);
+  const bool timed_out = run.timed_out;
+  const std::vector<double>& stamps = run.increment_wall_s;
   std::vector<std::pair<double, Eigen::MatrixX3d>> blocks;
   try {
     blocks = ReadCalculixDisplacements((work / "job.dat").string(), m.num_vertices());
@@ -386,7 +292,7 @@ FkResult CalculixSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c,
   const bool reached = !history_.empty() && std::abs(history_.back().load - 1.0) < 1e-6;
   if (reached && r.positions.allFinite()) return finish(FkStatus::Converged, "");
   // The last error line of the log says why.
-  const std::string last = LastErrorLine(log);
+  const std::string& last = run.last_error;
   if (!r.positions.allFinite()) r.positions = m.rest_positions();
   char buf[64];
   std::snprintf(buf, sizeof(buf), "ccx stopped at time %.4g of 1",

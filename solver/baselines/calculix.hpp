@@ -23,8 +23,10 @@
 ///    and a fixed number of increments; displacements are printed for every increment.
 /// Not exported (std::invalid_argument with the reason): prism elements, cable and DEA actuators,
 /// motion actuators.
+#include "softkin/solver/baselines/ccx_run.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -39,29 +41,29 @@ struct CalculixOptions {
   bool keep_files = false;     ///< keep the work folder (otherwise removed after parsing)
 };
 
+/// Writes a *MATERIAL card `name` for `law` ("linear": *ELASTIC E, nu; otherwise a hyperelastic
+/// law with small-strain modulus E and Poisson ratio nu: NEO HOOKE with C10 = E / (4 (1 + nu)),
+/// or, for a Mooney-Rivlin region `mr`, MOONEY-RIVLIN with its c1 : c2 ratio; D1 = 6 (1 - 2 nu) /
+/// E).
+void WriteCalculixMaterial(std::ostream& o, const std::string& name, const std::string& law,
+                           double E, double nu, const Material* mr);
+
 /// Writes the .inp deck for actuation c to `path`. Throws std::invalid_argument if the scene uses
 /// something the export does not support, std::runtime_error if the file cannot be written.
 void WriteCalculixInput(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& c,
                         const CalculixOptions& options, const std::string& path);
 
 /// Displacement blocks of a ccx .dat file ("displacements (vx,vy,vz) for set NALL and time T"):
-/// one (T, #V x 3 displacement) pair per increment, in file order. Node numbers are 1-based. Throws
-/// std::runtime_error naming the file and line on malformed content.
+/// one (T, #V x 3 displacement) pair per increment, in file order. Node numbers are 1-based. Every
+/// node must be in every block, or, if `printed` is given, the nodes v with printed[v] (the
+/// others are NaN). Throws std::runtime_error naming the file and line on malformed content.
 std::vector<std::pair<double, Eigen::MatrixX3d>> ReadCalculixDisplacements(
-    const std::string& dat_path, int num_vertices);
-
-/// Number of converged increments listed so far in a ccx .sta file (its lines "STEP INC ATT ITRS
-/// ..." whose attempt column has no 'U', the mark of an attempt that was cut back). 0 if the file
-/// does not exist yet. Used to time-stamp increments while ccx runs.
-int CountConvergedIncrements(const std::string& sta_path);
+    const std::string& dat_path, int num_vertices, const std::vector<bool>* printed = nullptr);
 
 /// The chamber volume ratio a free chamber element has at load fraction `load` (0..1) of a run to
 /// ratio `alpha`: the expansion coefficient cbrt(alpha) - 1 ramps linearly with the load, so the
 /// ratio is (1 + (cbrt(alpha) - 1) load)^3, not linear in the load.
 double CalculixRatioAtLoad(double alpha, double load);
-
-/// Path of the ccx executable found on PATH, or "" if there is none.
-std::string FindCcx();
 
 /// One converged CalculiX increment: its load fraction (the time of the temperature ramp, 0..1),
 /// the wall-clock time since Solve() started when ccx reported it, and the positions.
