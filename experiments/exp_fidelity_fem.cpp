@@ -43,7 +43,7 @@ struct FidelityParams {
   int slices = 24;
   FkOptions opts;
   std::string calibrate_on;  ///< label of the case the parameters are fitted on ("": none)
-  std::array<double, 2> weight_range{0.05, 5.0};  ///< chamber weight multiplier searched
+  std::array<double, 2> weight_range{0.01, 5.0};  ///< chamber weight multiplier searched
   std::array<double, 2> r_omega_range{0.0, 1.0};  ///< body R_omega searched
 };
 
@@ -97,7 +97,7 @@ FidelityParams ReadFidelityParams(const Config& cfg) {
   p.slices = cfg.Int("slices", 24);
   p.opts = cfg.Solver(FkOptions{});
   p.calibrate_on = cfg.String("calibrate_on", "");
-  const auto wr = cfg.NumberList("chamber_weight_scale_range", {0.05, 5.0});
+  const auto wr = cfg.NumberList("chamber_weight_scale_range", {0.01, 5.0});
   const auto rr = cfg.NumberList("body_r_omega_range", {0.0, 1.0});
   cfg.CheckNoUnknownKeys();
   if (wr.size() != 2 || !(wr[0] > 0 && wr[0] < wr[1]))
@@ -154,7 +154,7 @@ std::vector<int> SurfaceVertices(const Mesh& mesh) {
 }
 
 /// Centre line: the mean deformed position of the surface vertices in each of `n` slices of the
-/// rest shape along axis `axis`.
+/// rest shape along axis `axis` (NaN rows for slices with no vertex).
 Eigen::MatrixX3d CentreLine(const Mesh& mesh, const std::vector<int>& surf,
                             const Eigen::MatrixX3d& X, int axis, int n) {
   const double lo = mesh.vertices.col(axis).minCoeff(), hi = mesh.vertices.col(axis).maxCoeff();
@@ -165,7 +165,9 @@ Eigen::MatrixX3d CentreLine(const Mesh& mesh, const std::vector<int>& surf,
     sum.row(b) += X.row(v);
     count[b] += 1;
   }
-  for (int b = 0; b < n; ++b) sum.row(b) /= std::max(1.0, count[b]);
+  for (int b = 0; b < n; ++b)
+    sum.row(b) = count[b] > 0 ? Eigen::RowVector3d(sum.row(b) / count[b])
+                              : Eigen::RowVector3d::Constant(kNaN);  // no vertex in this slice
   return sum;
 }
 
@@ -492,6 +494,7 @@ nlohmann::json RunFidelityFem(const Config& cfg, const std::string& dir, bool ve
         const Eigen::MatrixX3d ls =
             CentreLine(d.scene.mesh, d.surf, c.m.r.positions, d.axis, p.slices);
         for (int b = 0; b < p.slices; ++b) {
+          if (!lf.row(b).allFinite() || !ls.row(b).allFinite()) continue;
           line_csv.Row(
               {double(ci), double(vi), c.fraction, 0.0, double(b), lf(b, 0), lf(b, 1), lf(b, 2)});
           line_csv.Row(
