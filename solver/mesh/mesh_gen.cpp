@@ -1,5 +1,6 @@
 #include "softkin/solver/mesh/mesh_gen.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
@@ -40,10 +41,33 @@ Mesh VoxelTetMesh(const Eigen::Vector3d& origin, double h, const Eigen::Vector3i
   if (cells.minCoeff() < 1)
     throw std::invalid_argument("VoxelTetMesh: every cell count must be >= 1");
   if (!classify) throw std::invalid_argument("VoxelTetMesh: no cell classifier given");
-  const std::int64_t nx = cells[0], ny = cells[1], nz = cells[2];
+  if (std::int64_t(cells[0] + 1) * (cells[1] + 1) * (cells[2] + 1) > std::int64_t(1) << 30)
+    throw std::invalid_argument("VoxelTetMesh: grid too large");
+  std::array<std::vector<double>, 3> lines;
+  for (int d = 0; d < 3; ++d)
+    for (int i = 0; i <= cells[d]; ++i) lines[d].push_back(origin[d] + h * double(i));
+  return RectilinearTetMesh(lines[0], lines[1], lines[2], classify);
+}
+
+Mesh RectilinearTetMesh(const std::vector<double>& xs, const std::vector<double>& ys,
+                        const std::vector<double>& zs, const VoxelClassifier& classify) {
+  const std::vector<double>* axes[3] = {&xs, &ys, &zs};
+  for (int d = 0; d < 3; ++d) {
+    const auto& l = *axes[d];
+    if (l.size() < 2)
+      throw std::invalid_argument(std::string("RectilinearTetMesh: axis ") + "xyz"[d] +
+                                  " needs at least 2 grid lines");
+    for (size_t q = 0; q + 1 < l.size(); ++q)
+      if (!(l[q + 1] > l[q]) || !std::isfinite(l[q + 1]) || !std::isfinite(l[q]))
+        throw std::invalid_argument(std::string("RectilinearTetMesh: the grid lines of axis ") +
+                                    "xyz"[d] + " must be finite and increasing (line " +
+                                    std::to_string(q + 1) + ")");
+  }
+  if (!classify) throw std::invalid_argument("RectilinearTetMesh: no cell classifier given");
+  const std::int64_t nx = xs.size() - 1, ny = ys.size() - 1, nz = zs.size() - 1;
   const std::int64_t vx = nx + 1, vy = ny + 1, vz = nz + 1;
   if (vx * vy * vz > std::int64_t(1) << 30)
-    throw std::invalid_argument("VoxelTetMesh: grid too large");
+    throw std::invalid_argument("RectilinearTetMesh: grid too large");
 
   // 1. Classify the cells (grid order: x fastest).
   std::vector<int> tag(static_cast<size_t>(nx * ny * nz), -1);
@@ -53,7 +77,8 @@ Mesh VoxelTetMesh(const Eigen::Vector3d& origin, double h, const Eigen::Vector3i
   for (std::int64_t k = 0; k < nz; ++k)
     for (std::int64_t j = 0; j < ny; ++j)
       for (std::int64_t i = 0; i < nx; ++i) {
-        const Eigen::Vector3d centre = origin + h * Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5);
+        const Eigen::Vector3d centre(0.5 * (xs[i] + xs[i + 1]), 0.5 * (ys[j] + ys[j + 1]),
+                                     0.5 * (zs[k] + zs[k + 1]));
         const int t = classify(centre, Eigen::Vector3i(int(i), int(j), int(k)));
         tag[i + nx * (j + ny * k)] = t < 0 ? -1 : t;
         if (t < 0) continue;
@@ -73,9 +98,7 @@ Mesh VoxelTetMesh(const Eigen::Vector3d& origin, double h, const Eigen::Vector3i
     for (std::int64_t j = 0; j < vy; ++j)
       for (std::int64_t i = 0; i < vx; ++i) {
         const int id = newid[vid(i, j, k)];
-        if (id >= 0)
-          mesh.vertices.row(id) =
-              (origin + h * Eigen::Vector3d(double(i), double(j), double(k))).transpose();
+        if (id >= 0) mesh.vertices.row(id) << xs[i], ys[j], zs[k];
       }
 
   // 3. Kuhn split. Corner c of a cell has offset (c&1, c>>1&1, c>>2&1). For the axis order

@@ -43,6 +43,14 @@ using VoxelClassifier =
 Mesh VoxelTetMesh(const Eigen::Vector3d& origin, double h, const Eigen::Vector3i& cells,
                   const VoxelClassifier& classify);
 
+/// The same split on a rectilinear grid: cell (i, j, k) spans [xs[i], xs[i+1]] x [ys[j], ys[j+1]]
+/// x [zs[k], zs[k+1]], so grid lines can sit on a design's dimensions (walls, layers) whatever
+/// the cell size; `classify` gets the cell's centre and index. Each axis needs at least 2
+/// strictly increasing finite lines (std::invalid_argument otherwise). VoxelTetMesh is this grid
+/// with equally spaced lines.
+Mesh RectilinearTetMesh(const std::vector<double>& xs, const std::vector<double>& ys,
+                        const std::vector<double>& zs, const VoxelClassifier& classify);
+
 // ------------------------------------------------------------------------------------------------
 // Prism grid (thin shells and membranes)
 // ------------------------------------------------------------------------------------------------

@@ -8,6 +8,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 namespace softkin {
 namespace robots_detail {
@@ -83,14 +86,67 @@ int FingerCell(const FingerLayout& L, int i, int j, int k) {
   return cavity ? 1 : 0;
 }
 
-Scene MakePneumaticFinger(int res, const RobotParams&) {
+/// Grid lines through the breakpoints `b` (increasing), each interval cut into about
+/// len / h cells (at least 1; an even number where `even` says so).
+std::vector<double> DesignLines(const std::vector<double>& b, double h,
+                                const std::vector<bool>& even = {}) {
+  std::vector<double> lines = {b[0]};
+  for (size_t q = 0; q + 1 < b.size(); ++q) {
+    int n = std::max(1, static_cast<int>(std::lround((b[q + 1] - b[q]) / h)));
+    if (q < even.size() && even[q] && n % 2) ++n;
+    for (int i = 1; i <= n; ++i) lines.push_back(b[q] + (b[q + 1] - b[q]) * i / n);
+  }
+  return lines;
+}
+
+/// The finger with its nominal dimensions whatever the resolution: 16 cavities of 5 mm between
+/// 1.5 mm walls (the count at the default res 12), 1.5 mm side walls, roof, floor and base layer,
+/// and a 14.5 mm proximal block; grid lines on every one of these dimensions, each part cut into
+/// cells of about 20 / res mm, an even number across the cavities' width so that the mid-plane
+/// y = 10 is a grid line and the mesh is mirror-symmetric about it.
+Mesh DesignGridFingerMesh(int res) {
+  const double h = kFingerWidth / res;
+  constexpr int kChambers = 16;
+  const double pitch = kFingerWall + kFingerCavity;
+  const double proximal = kFingerLength - kChambers * pitch - kFingerWall;
+  std::vector<double> bx = {0.0, proximal};
+  for (int c = 0; c < kChambers; ++c) {
+    bx.push_back(proximal + c * pitch + kFingerWall);
+    bx.push_back(proximal + (c + 1) * pitch);
+  }
+  bx.push_back(kFingerLength);
+  const double cavity_z0 = kFingerBase + kFingerFloor, cavity_z1 = kFingerHeight - kFingerWall;
+  const auto xs = DesignLines(bx, h);
+  const auto ys = DesignLines({0.0, kFingerWall, kFingerWidth - kFingerWall, kFingerWidth}, h,
+                              {false, true, false});
+  const auto zs = DesignLines({0.0, kFingerBase, cavity_z0, cavity_z1, kFingerHeight}, h);
+  return RectilinearTetMesh(xs, ys, zs, [&](const Eigen::Vector3d& c, const Eigen::Vector3i&) {
+    if (c.z() < kFingerBase) return 2;
+    const double u = c.x() - proximal;
+    const bool in_row = u > 0 && u < kChambers * pitch;
+    const bool cavity = in_row && std::fmod(u, pitch) > kFingerWall && c.y() > kFingerWall &&
+                        c.y() < kFingerWidth - kFingerWall && c.z() > cavity_z0 &&
+                        c.z() < cavity_z1;
+    return cavity ? 1 : 0;
+  });
+}
+
+Scene MakePneumaticFinger(int res, const RobotParams& P) {
   const FingerLayout L = MakeFingerLayout(res);
+  const double design = P.at("design_grid");
+  if (design != 0.0 && design != 1.0)
+    throw std::invalid_argument(
+        "pneumatic_finger: design_grid must be 0 (snap to cells) or 1 "
+        "(grid lines on the design's dimensions), got " +
+        std::to_string(design));
   Scene s;
   s.name = "pneumatic_finger";
-  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), L.h, Eigen::Vector3i(L.nx, L.ny, L.nz),
-                        [&L](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
-                          return FingerCell(L, c[0], c[1], c[2]);
-                        });
+  s.mesh = design == 1.0
+               ? DesignGridFingerMesh(res)
+               : VoxelTetMesh(Eigen::Vector3d::Zero(), L.h, Eigen::Vector3i(L.nx, L.ny, L.nz),
+                              [&L](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
+                                return FingerCell(L, c[0], c[1], c[2]);
+                              });
   s.body[0] = Material{"body", kFingerBodyROmega, 1.0};
   s.body[2] = Material{"inextensible", 1.0, kFingerLayerWeight};
   Actuator a;
@@ -103,7 +159,7 @@ Scene MakePneumaticFinger(int res, const RobotParams&) {
   s.actuators.push_back(a);
 
   const double eps = 1e-6 * L.h;
-  const double xmax = L.nx * L.h, zmax = L.nz * L.h;
+  const double xmax = s.mesh.vertices.col(0).maxCoeff(), zmax = s.mesh.vertices.col(2).maxCoeff();
   s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
   AddDistalFaceMarkers(xmax, zmax, eps, &s);
   s.validate();
@@ -124,8 +180,12 @@ RobotEntry PneumaticFingerEntry() {
       "distal face).",
       kFingerDefaultRes,
       "cells across the 20 mm width (cell size 20/res mm), integer in [5, 40]; 27 res^3 tets; "
-      "features snap to whole cells (16 chambers at res 12)",
-      {}};
+      "features snap to whole cells (16 chambers at res 12) unless design_grid = 1",
+      {{"design_grid", 0.0, 0.0, 1.0,
+        "0: features snap to whole cells of 20/res mm (walls, chamber count and proximal block "
+        "change with res); 1: grid lines on the nominal dimensions (16 cavities of 5 mm, 1.5 mm "
+        "walls, floor and base layer, 14.5 mm proximal block) at every res, mirror-symmetric "
+        "about y = 10"}}};
   return {info, kFingerMinRes, kFingerMaxRes, &MakePneumaticFinger};
 }
 

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <array>
 #include <map>
 
 namespace softkin {
@@ -290,6 +291,45 @@ TEST(RobotParams, UnknownOrOutOfRangeParametersAreRejectedByName) {
   }
   EXPECT_THROW(MakeRobot("three_chamber", 3, {{"gain", 1}}), std::invalid_argument);
   EXPECT_THROW(MakeRobot("finger_manipulator", 7), std::invalid_argument);  // odd res
+}
+
+}  // namespace
+}  // namespace softkin
+
+namespace softkin {
+namespace {
+
+// pneumatic_finger with design_grid = 1: the grid lines sit on the nominal dimensions, so the
+// chambers' rest volume is the design's at every resolution (16 cavities of 5 x 17 x 10.5 mm),
+// odd resolutions included, and the mesh is mirror-symmetric about y = 10, so a bend stays in
+// that plane.
+TEST(RobotGrid, PneumaticFingerDesignGridKeepsItsDimensionsAndSymmetry) {
+  const double nominal = 16 * 5.0 * 17.0 * 10.5;
+  for (int res : {5, 6, 7, 9}) {
+    const Scene s = MakeRobot("pneumatic_finger", res, {{"design_grid", 1.0}});
+    const Model m(s);
+    EXPECT_NEAR(m.actuator_rest_measure(0), nominal, 1e-6 * nominal) << "res " << res;
+    // Every vertex has its mirror image in y = 10.
+    std::map<std::array<long, 3>, int> at;
+    auto key = [](double x, double y, double z) {
+      return std::array<long, 3>{std::lround(x * 1e6), std::lround(y * 1e6), std::lround(z * 1e6)};
+    };
+    for (int v = 0; v < s.mesh.num_vertices(); ++v)
+      at[key(s.mesh.vertices(v, 0), s.mesh.vertices(v, 1), s.mesh.vertices(v, 2))] = v;
+    int unmatched = 0;
+    for (int v = 0; v < s.mesh.num_vertices(); ++v)
+      unmatched += !at.count(
+          key(s.mesh.vertices(v, 0), 20.0 - s.mesh.vertices(v, 1), s.mesh.vertices(v, 2)));
+    EXPECT_EQ(unmatched, 0) << "res " << res;
+  }
+  const Scene s = MakeRobot("pneumatic_finger", 7, {{"design_grid", 1.0}});
+  auto model = std::make_shared<const Model>(s);
+  const FkResult r = MakeFkSolver(model, FkOptions{})->Solve(Eigen::VectorXd::Constant(1, 2.0));
+  ASSERT_EQ(r.status, FkStatus::Converged) << r.message;
+  const Eigen::RowVector3d tip = s.marker_positions(r.positions).row(s.marker_index("tip"));
+  EXPECT_NEAR(tip.y(), 10.0, 1e-4);  // odd res: the snapped grid drifts sideways
+  EXPECT_LT(tip.z(), 0.0);
+  EXPECT_THROW(MakeRobot("pneumatic_finger", 7, {{"design_grid", 0.5}}), std::invalid_argument);
 }
 
 }  // namespace
