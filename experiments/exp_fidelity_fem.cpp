@@ -85,6 +85,8 @@ FidelityParams ReadFidelityParams(const Config& cfg) {
     if (fc.label.empty()) cfg.Fail(key + ".label", "a name for the case");
     if (fc.robot.empty() == fc.scene.empty()) cfg.Fail(key, "exactly one of robot and scene");
     if (fc.pressure.empty()) cfg.Fail(key + ".pressure", "one pressure (MPa) per actuator");
+    if (std::all_of(fc.pressure.begin(), fc.pressure.end(), [](double x) { return x == 0.0; }))
+      cfg.Fail(key + ".pressure", "at least one non-zero pressure (MPa)");
     p.cases.push_back(fc);
   }
   p.fem.law = cfg.String("fem_law", "neo-hooke");
@@ -136,23 +138,6 @@ Scene CaseScene(const Config& cfg, const FidelityCase& c) {
   return LoadSceneJson(f.string());
 }
 
-/// Outer-surface vertices of the whole scene mesh (faces that occur once).
-std::vector<int> SurfaceVertices(const Mesh& mesh) {
-  const auto faces = SortedMeshFaces(mesh);
-  std::vector<bool> on(mesh.num_vertices(), false);
-  for (size_t q = 0; q < faces.size(); ++q) {
-    const bool shared = (q > 0 && faces[q - 1].key == faces[q].key) ||
-                        (q + 1 < faces.size() && faces[q + 1].key == faces[q].key);
-    if (shared) continue;
-    for (int v : faces[q].key)
-      if (v >= 0 && v < mesh.num_vertices()) on[v] = true;
-  }
-  std::vector<int> out;
-  for (int v = 0; v < mesh.num_vertices(); ++v)
-    if (on[v]) out.push_back(v);
-  return out;
-}
-
 /// Centre line: the mean deformed position of the surface vertices in each of `n` slices of the
 /// rest shape along axis `axis` (NaN rows for slices with no vertex).
 Eigen::MatrixX3d CentreLine(const Mesh& mesh, const std::vector<int>& surf,
@@ -174,7 +159,6 @@ Eigen::MatrixX3d CentreLine(const Mesh& mesh, const std::vector<int>& surf,
 struct Matched {
   FkResult r;
   Eigen::VectorXd c;
-  int solves = 0;
   bool matched = false;
 };
 
@@ -191,7 +175,6 @@ Matched SolveAtVolume(FkSolver* solver, const Scene& scene, const std::vector<do
   Eigen::MatrixX3d start = warm ? *warm : scene.mesh.vertices;
   for (int it = 0; it < 12; ++it) {
     m.r = solver->Solve(c, &start);
-    ++m.solves;
     m.c = c;
     if (m.r.status != FkStatus::Converged) return m;
     start = m.r.positions;
@@ -256,9 +239,10 @@ struct Compared {
   double tip_error = 0, rms = 0, worst = 0, bend = kNaN;
 };
 
-std::vector<Compared> Compare(const CaseData& d, const SoftKinParams& q, const FidelityParams& p) {
-  const Scene scene = WithParams(d.scene, q);
-  auto model = std::make_shared<const Model>(scene);
+/// SoftKin with parameters q on case d: `model` is built from WithParams(d.scene, q).
+std::vector<Compared> Compare(const CaseData& d, const std::shared_ptr<const Model>& model,
+                              const FidelityParams& p) {
+  const Scene& scene = model->scene();
   auto solver = MakeFkSolver(model, p.opts);
   std::unique_ptr<BendAngle> bend;
   if (d.has_bend) bend = std::make_unique<BendAngle>(scene);
@@ -294,7 +278,7 @@ std::vector<Compared> Compare(const CaseData& d, const SoftKinParams& q, const F
 /// a large error so that the search leaves such parameters.
 double MeanTipError(const CaseData& d, const SoftKinParams& q, const FidelityParams& p) {
   double sum = 0;
-  const auto rows = Compare(d, q, p);
+  const auto rows = Compare(d, std::make_shared<const Model>(WithParams(d.scene, q)), p);
   for (const auto& c : rows)
     sum +=
         c.m.r.status == FkStatus::Converged && c.m.matched ? 100.0 * c.tip_error / d.length : 1e3;
@@ -365,9 +349,7 @@ CaseData RunCase(const Config& cfg, const FidelityCase& fc, Scene scene, const F
     d.loaded[a] = pressure[a] != 0.0;
     if (d.loaded[a] && d.lead < 0) d.lead = a;
   }
-  if (d.lead < 0) cfg.Fail("cases", "case '" + fc.label + "': at least one non-zero pressure");
   d.tip = s.marker_index("tip");
-  if (d.tip < 0) cfg.Fail("cases", "case '" + fc.label + "': a scene with a 'tip' marker");
   if (verbose)
     std::fprintf(stderr, "  %s: FEM (%s, %s) on %d tets ...\n", fc.label.c_str(), p.fem.law.c_str(),
                  p.fem.element.c_str(), s.mesh.num_elements());
@@ -392,7 +374,7 @@ CaseData RunCase(const Config& cfg, const FidelityCase& fc, Scene scene, const F
   const Eigen::RowVector3d ext =
       s.mesh.vertices.colwise().maxCoeff() - s.mesh.vertices.colwise().minCoeff();
   d.length = ext.maxCoeff(&d.axis);
-  d.surf = SurfaceVertices(s.mesh);
+  d.surf = BoundaryVertices(s.mesh);
   const double end_load = d.fem.increments.back().load;
   for (double f : p.fractions) {
     size_t k = 0;
@@ -414,11 +396,20 @@ nlohmann::json NullIfNaN(double v) {
 nlohmann::json RunFidelityFem(const Config& cfg, const std::string& dir, bool verbose) {
   const FidelityParams p = ReadFidelityParams(cfg);
   std::vector<Scene> scenes;
-  for (const auto& c : p.cases) {
-    scenes.push_back(CaseScene(cfg, c));
-    if (static_cast<int>(c.pressure.size()) != scenes.back().num_actuators())
-      cfg.Fail("cases", "case '" + c.label + "': one pressure per actuator (" +
-                            std::to_string(scenes.back().num_actuators()) + ")");
+  for (size_t i = 0; i < p.cases.size(); ++i) {
+    const std::string key = "cases[" + std::to_string(i) + "]";
+    scenes.push_back(CaseScene(cfg, p.cases[i]));
+    if (static_cast<int>(p.cases[i].pressure.size()) != scenes.back().num_actuators())
+      cfg.Fail(key + ".pressure", "one pressure per actuator of '" + scenes.back().name + "' (" +
+                                      std::to_string(scenes.back().num_actuators()) + ")");
+    // Before any FEM runs: the case's scene must have a tip marker and be one the FEM can mesh.
+    if (scenes.back().marker_index("tip") < 0)
+      cfg.Fail(key, "a robot or scene with a 'tip' marker");
+    try {
+      BuildPressureFemMesh(Model(scenes.back()), p.fem.element);
+    } catch (const std::invalid_argument& e) {
+      cfg.Fail(key, std::string("a scene the pressure FEM can mesh: ") + e.what());
+    }
   }
   if (cfg.check_only()) return {};
   std::vector<CaseData> data;
@@ -474,9 +465,9 @@ nlohmann::json RunFidelityFem(const Config& cfg, const std::string& dir, bool ve
       entry["role"] = d.fc->label == p.calibrate_on ? "calibration" : "hold-out";
     for (size_t vi = 0; vi < variants.size(); ++vi) {
       const auto& [vname, q] = variants[vi];
-      const std::vector<Compared> rows = Compare(d, q, p);
-      const Scene scene = WithParams(d.scene, q);
-      auto cold_solver = MakeFkSolver(std::make_shared<const Model>(scene), p.opts);
+      const auto model = std::make_shared<const Model>(WithParams(d.scene, q));
+      const std::vector<Compared> rows = Compare(d, model, p);
+      auto cold_solver = MakeFkSolver(model, p.opts);  // a fresh solver: nothing kept from above
       nlohmann::json jrows = nlohmann::json::array();
       double mean = 0;
       for (const Compared& c : rows) {

@@ -27,37 +27,36 @@ double Seconds(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double>(b - a).count();
 }
 
-std::string Num(double v) {
+}  // namespace
+
+std::string InpNumber(double v) {
   char buf[40];
   std::snprintf(buf, sizeof(buf), "%.12g", v);
   return buf;
 }
 
-/// Writes a list of integers, at most 8 per line (the .inp line-length convention).
-void WriteIds(std::ostream& o, const std::vector<int>& ids) {
+void WriteInpIds(std::ostream& o, const std::vector<int>& ids) {
   for (size_t q = 0; q < ids.size(); ++q) {
     o << ids[q] + 1;
     o << ((q + 1) % 8 == 0 || q + 1 == ids.size() ? "\n" : ", ");
   }
 }
 
-}  // namespace
-
 void WriteCalculixMaterial(std::ostream& o, const std::string& name, const std::string& law,
                            double E, double nu, const Material* mr) {
   o << "*MATERIAL, NAME=" << name << "\n";
   if (law == "linear") {
-    o << "*ELASTIC\n" << Num(E) << ", " << Num(nu) << "\n";
+    o << "*ELASTIC\n" << InpNumber(E) << ", " << InpNumber(nu) << "\n";
   } else if (mr) {
     // A Mooney-Rivlin body region keeps its c1 : c2 ratio, scaled to the small-strain modulus E.
     const double sc = E / (6.0 * (mr->c1 + mr->c2));
     const double d1 = 6.0 * (1.0 - 2.0 * nu) / E;
     o << "*HYPERELASTIC, MOONEY-RIVLIN\n"
-      << Num(sc * mr->c1) << ", " << Num(sc * mr->c2) << ", " << Num(d1) << "\n";
+      << InpNumber(sc * mr->c1) << ", " << InpNumber(sc * mr->c2) << ", " << InpNumber(d1) << "\n";
   } else {
     const double c10 = E / (4.0 * (1.0 + nu));
     const double d1 = 6.0 * (1.0 - 2.0 * nu) / E;
-    o << "*HYPERELASTIC, NEO HOOKE\n" << Num(c10) << ", " << Num(d1) << "\n";
+    o << "*HYPERELASTIC, NEO HOOKE\n" << InpNumber(c10) << ", " << InpNumber(d1) << "\n";
   }
 }
 
@@ -92,8 +91,8 @@ void WriteCalculixInput(const Model& model, const Eigen::Ref<const Eigen::Vector
     << "' exported for CalculiX (solver/baselines/calculix.hpp)\n";
   o << "*NODE, NSET=NALL\n";
   for (int v = 0; v < mesh.num_vertices(); ++v)
-    o << v + 1 << ", " << Num(mesh.vertices(v, 0)) << ", " << Num(mesh.vertices(v, 1)) << ", "
-      << Num(mesh.vertices(v, 2)) << "\n";
+    o << v + 1 << ", " << InpNumber(mesh.vertices(v, 0)) << ", " << InpNumber(mesh.vertices(v, 1))
+      << ", " << InpNumber(mesh.vertices(v, 2)) << "\n";
 
   // Element sets: one per body region, one per actuation group.
   std::map<std::string, std::vector<int>> sets;
@@ -116,14 +115,14 @@ void WriteCalculixInput(const Model& model, const Eigen::Ref<const Eigen::Vector
   // Boundary conditions.
   if (!s.fixed.empty()) {
     o << "*NSET, NSET=FIXED\n";
-    WriteIds(o, s.fixed);
+    WriteInpIds(o, s.fixed);
     o << "*BOUNDARY\nFIXED, 1, 3, 0.\n";
   }
   for (int d = 0; d < 3; ++d) {
     if (s.fixed_axis[d].empty()) continue;
     o << "*NSET, NSET=HELD"
       << "XYZ"[d] << "\n";
-    WriteIds(o, s.fixed_axis[d]);
+    WriteInpIds(o, s.fixed_axis[d]);
     o << "*BOUNDARY\nHELD"
       << "XYZ"[d] << ", " << d + 1 << ", " << d + 1 << ", 0.\n";
   }
@@ -134,7 +133,7 @@ void WriteCalculixInput(const Model& model, const Eigen::Ref<const Eigen::Vector
   // Materials and sections.
   auto material = [&](const std::string& name, double E, double expansion, const Material* mr) {
     WriteCalculixMaterial(o, name, opt.law, E, opt.poisson, mr);
-    o << "*EXPANSION\n" << Num(expansion) << "\n";
+    o << "*EXPANSION\n" << InpNumber(expansion) << "\n";
   };
   for (const auto& [name, ids] : sets) {
     double E = opt.young, a = 0.0;
@@ -161,7 +160,8 @@ void WriteCalculixInput(const Model& model, const Eigen::Ref<const Eigen::Vector
   const double dt = 1.0 / opt.increments;
   o << "*INITIAL CONDITIONS, TYPE=TEMPERATURE\nNALL, 0.\n";
   o << "*STEP, NLGEOM, INC=" << 100 * opt.increments << "\n";
-  o << "*STATIC\n" << Num(dt) << ", 1., " << Num(1e-4 * dt) << ", " << Num(dt) << "\n";
+  o << "*STATIC\n"
+    << InpNumber(dt) << ", 1., " << InpNumber(1e-4 * dt) << ", " << InpNumber(dt) << "\n";
   o << "*TEMPERATURE\nNALL, 1.\n";
   o << "*NODE PRINT, NSET=NALL\nU\n";
   o << "*END STEP\n";

@@ -41,6 +41,12 @@ struct CalculixOptions {
   bool keep_files = false;     ///< keep the work folder (otherwise removed after parsing)
 };
 
+/// A number as written in .inp decks (%.12g).
+std::string InpNumber(double v);
+
+/// Writes 0-based ids 1-based, at most 8 per line (the .inp line-length convention).
+void WriteInpIds(std::ostream& o, const std::vector<int>& ids);
+
 /// Writes a *MATERIAL card `name` for `law` ("linear": *ELASTIC E, nu; otherwise a hyperelastic
 /// law with small-strain modulus E and Poisson ratio nu: NEO HOOKE with C10 = E / (4 (1 + nu)),
 /// or, for a Mooney-Rivlin region `mr`, MOONEY-RIVLIN with its c1 : c2 ratio; D1 = 6 (1 - 2 nu) /

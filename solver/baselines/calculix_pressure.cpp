@@ -2,6 +2,7 @@
 
 #include "softkin/solver/baselines/calculix.hpp"
 #include "softkin/solver/baselines/ccx_run.hpp"
+#include "softkin/solver/mesh/element_faces.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -17,36 +18,20 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string Num(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof(buf), "%.12g", v);
-  return buf;
-}
-
-/// Writes 0-based ids 1-based, at most 8 per line.
-void WriteIds(std::ostream& o, const std::vector<int>& ids) {
-  for (size_t q = 0; q < ids.size(); ++q) {
-    o << ids[q] + 1;
-    o << ((q + 1) % 8 == 0 || q + 1 == ids.size() ? "\n" : ", ");
-  }
-}
-
-using FaceKey = std::array<int, 3>;
-FaceKey Key(int a, int b, int c) {
-  FaceKey k{a, b, c};
-  std::sort(k.begin(), k.end());
-  return k;
-}
-
-/// CalculiX's face number (1..4) of the tet face that leaves out local corner `missing`
-/// (faces 1-2-3, 1-4-2, 2-4-3, 3-4-1 leave out corners 4, 3, 1, 2).
-int FaceNumber(int missing) {
-  static const int kFace[4] = {3, 4, 2, 1};
-  return kFace[missing];
-}
-
 /// Local edge-midpoint slots of C3D10 (nodes 5..10 on edges 12, 23, 31, 14, 24, 34).
 const int kEdges[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
+
+/// The nodes the deck prints and the reader expects: every corner node (the scene's vertices)
+/// and the cavities' edge-midpoint nodes (for their volume).
+std::vector<bool> PrintedNodes(const PressureFemMesh& fem) {
+  std::vector<bool> printed(fem.rest.rows(), false);
+  for (int n = 0; n < fem.rest.rows(); ++n) printed[n] = fem.node_vertex[n] >= 0;
+  for (const auto& cav : fem.cavities)
+    for (const auto& f : cav)
+      for (int m : f.mids)
+        if (m >= 0) printed[m] = true;
+  return printed;
+}
 
 double Seconds(std::chrono::steady_clock::time_point a, std::chrono::steady_clock::time_point b) {
   return std::chrono::duration<double>(b - a).count();
@@ -115,74 +100,54 @@ PressureFemMesh BuildPressureFemMesh(const Model& model, const std::string& elem
         0.5 * (fem.rest.row(mid_ends[q].first) + fem.rest.row(mid_ends[q].second));
   fem.node_vertex.resize(fem.rest.rows(), -1);
 
-  // Face map: each tet face -> the elements that have it.
-  std::map<FaceKey, std::vector<std::pair<int, int>>> faces;  // (element, missing local corner)
-  for (int i = 0; i < mesh.num_elements(); ++i) {
-    const auto& v = mesh.elements[i].v;
-    for (int m = 0; m < 4; ++m) {
-      int f[3], q = 0;
-      for (int j = 0; j < 4; ++j)
-        if (j != m) f[q++] = v[j];
-      faces[Key(f[0], f[1], f[2])].push_back({i, m});
-    }
-  }
-  // Cavities: the faces of each group's elements that are not shared within the group.
+  // Cavities: the faces a group's elements share with body elements. SortedMeshFaces puts the
+  // two elements of an interior face side by side; a chamber face found once is on the outside.
   fem.cavities.assign(model.num_groups(), {});
   fem.cavity_rest_volume.assign(model.num_groups(), 0.0);
+  auto chamber = [&](int g) {
+    const int side = model.group_side(g);
+    return s.actuators[model.group_actuator(g)].name + (side > 0   ? " (positive side)"
+                                                        : side < 0 ? " (negative side)"
+                                                                   : "");
+  };
+  const std::vector<MeshFace> faces = SortedMeshFaces(mesh);
+  for (size_t q = 0; q < faces.size(); ++q) {
+    const int i = faces[q].element, g = els[i].group;
+    if (g < 0) continue;
+    const bool next_same = q + 1 < faces.size() && faces[q + 1].key == faces[q].key;
+    const bool prev_same = q > 0 && faces[q - 1].key == faces[q].key;
+    if (!next_same && !prev_same)
+      throw std::invalid_argument("calculix-pressure: chamber '" + chamber(g) +
+                                  "' is open to the outside at a face of element " +
+                                  std::to_string(i) + "; the pressure FEM needs closed cavities");
+    const MeshFace& wall = faces[next_same ? q + 1 : q - 1];
+    const int gw = els[wall.element].group;
+    if (gw == g) continue;  // inside the chamber
+    if (gw >= 0)
+      throw std::invalid_argument("calculix-pressure: chamber '" + chamber(g) +
+                                  "' touches chamber '" + chamber(gw) +
+                                  "' at the face of elements " + std::to_string(i) + " and " +
+                                  std::to_string(wall.element) +
+                                  " with no wall between them; the pressure FEM needs a body wall "
+                                  "around each chamber");
+    // The chamber element's face in its outward order points out of the cavity, into the wall.
+    // The wall element's LocalFaces index 0..3 is CalculiX's tet face 1..4 (1-2-3, 1-4-2, 2-4-3,
+    // 3-4-1: the same vertex sets).
+    const LocalFace& lf = kTetFaces[faces[q].local];
+    const auto& v = mesh.elements[i].v;
+    CavityFace cf;
+    cf.element = fem_of_scene[wall.element];
+    cf.face = wall.local + 1;
+    cf.corners = {fem.vertex_node[v[lf.a]], fem.vertex_node[v[lf.b]], fem.vertex_node[v[lf.c]]};
+    if (element_type == "C3D10")
+      for (int e = 0; e < 3; ++e)
+        cf.mids[e] = mid.at(std::minmax(cf.corners[e], cf.corners[(e + 1) % 3]));
+    fem.cavities[g].push_back(cf);
+  }
   for (int g = 0; g < model.num_groups(); ++g) {
-    const std::string chamber =
-        s.actuators[model.group_actuator(g)].name + (model.group_side(g) > 0   ? " (positive side)"
-                                                     : model.group_side(g) < 0 ? " (negative side)"
-                                                                               : "");
-    for (int i : model.group_elements(g)) {
-      const auto& v = mesh.elements[i].v;
-      for (int m = 0; m < 4; ++m) {
-        int f[3], q = 0;
-        for (int j = 0; j < 4; ++j)
-          if (j != m) f[q++] = v[j];
-        const auto& share = faces.at(Key(f[0], f[1], f[2]));
-        int wall = -1, wall_missing = -1;
-        for (const auto& [k, km] : share) {
-          if (k == i) continue;
-          if (els[k].group == g) {
-            wall = -2;  // inside the chamber
-            break;
-          }
-          if (els[k].group >= 0)
-            throw std::invalid_argument(
-                "calculix-pressure: chamber '" + chamber +
-                "' touches another chamber at the face "
-                "of elements " +
-                std::to_string(i) + " and " + std::to_string(k) +
-                " with no wall between them; the pressure FEM needs a body wall around each "
-                "chamber");
-          wall = k;
-          wall_missing = km;
-        }
-        if (wall == -2) continue;
-        if (wall < 0)
-          throw std::invalid_argument("calculix-pressure: chamber '" + chamber +
-                                      "' is open to the outside at a face of "
-                                      "element " +
-                                      std::to_string(i) +
-                                      "; the pressure FEM needs closed cavities");
-        // Orient the face out of the cavity: away from the chamber element's fourth corner.
-        std::array<int, 3> n{fem.vertex_node[f[0]], fem.vertex_node[f[1]], fem.vertex_node[f[2]]};
-        const Eigen::Vector3d a = fem.rest.row(n[0]), b = fem.rest.row(n[1]),
-                              c = fem.rest.row(n[2]);
-        const Eigen::Vector3d d = mesh.vertices.row(v[m]);
-        if ((b - a).cross(c - a).dot(d - a) > 0) std::swap(n[1], n[2]);
-        CavityFace cf;
-        cf.element = fem_of_scene[wall];
-        cf.face = FaceNumber(wall_missing);
-        cf.corners = n;
-        if (element_type == "C3D10")
-          for (int e = 0; e < 3; ++e) cf.mids[e] = mid.at(std::minmax(n[e], n[(e + 1) % 3]));
-        fem.cavities[g].push_back(cf);
-      }
-    }
     if (fem.cavities[g].empty())
-      throw std::invalid_argument("calculix-pressure: chamber '" + chamber + "' has no elements");
+      throw std::invalid_argument("calculix-pressure: chamber '" + chamber(g) +
+                                  "' has no elements");
     fem.cavity_rest_volume[g] = CavityVolume(fem.cavities[g], fem.rest);
   }
   return fem;
@@ -242,8 +207,8 @@ void WritePressureFemInput(const Model& model, const PressureFemMesh& fem,
     << "', hollow chambers under pressure (solver/baselines/calculix_pressure.hpp)\n";
   o << "*NODE, NSET=NALL\n";
   for (int n = 0; n < fem.rest.rows(); ++n)
-    o << n + 1 << ", " << Num(fem.rest(n, 0)) << ", " << Num(fem.rest(n, 1)) << ", "
-      << Num(fem.rest(n, 2)) << "\n";
+    o << n + 1 << ", " << InpNumber(fem.rest(n, 0)) << ", " << InpNumber(fem.rest(n, 1)) << ", "
+      << InpNumber(fem.rest(n, 2)) << "\n";
   std::map<int, std::vector<int>> by_region;
   for (size_t e = 0; e < fem.connectivity.size(); ++e)
     by_region[fem.element_region[e]].push_back(static_cast<int>(e));
@@ -270,7 +235,7 @@ void WritePressureFemInput(const Model& model, const PressureFemMesh& fem,
                                 "' holds no vertex of the body; the FEM has no support");
   if (!fixed.empty()) {
     o << "*NSET, NSET=FIXED\n";
-    WriteIds(o, fixed);
+    WriteInpIds(o, fixed);
     o << "*BOUNDARY\nFIXED, 1, 3, 0.\n";
   }
   for (int d = 0; d < 3; ++d) {
@@ -278,7 +243,7 @@ void WritePressureFemInput(const Model& model, const PressureFemMesh& fem,
     if (held.empty()) continue;
     o << "*NSET, NSET=HELD"
       << "XYZ"[d] << "\n";
-    WriteIds(o, held);
+    WriteInpIds(o, held);
     o << "*BOUNDARY\nHELD"
       << "XYZ"[d] << ", " << d + 1 << ", " << d + 1 << ", 0.\n";
   }
@@ -289,22 +254,16 @@ void WritePressureFemInput(const Model& model, const PressureFemMesh& fem,
                           opt.poisson, mat.hyperelastic() ? &mat : nullptr);
     o << "*SOLID SECTION, ELSET=R" << region << ", MATERIAL=MR" << region << "\n";
   }
-  // Printed nodes: every corner node (the scene's vertices) and the cavities' midpoint nodes.
-  std::vector<bool> printed(fem.rest.rows(), false);
-  for (int n = 0; n < fem.rest.rows(); ++n) printed[n] = fem.node_vertex[n] >= 0;
-  for (const auto& cav : fem.cavities)
-    for (const auto& f : cav)
-      for (int m : f.mids)
-        if (m >= 0) printed[m] = true;
+  const std::vector<bool> printed = PrintedNodes(fem);
   std::vector<int> out_nodes;
   for (int n = 0; n < fem.rest.rows(); ++n)
     if (printed[n]) out_nodes.push_back(n);
   o << "*NSET, NSET=NOUT\n";
-  WriteIds(o, out_nodes);
+  WriteInpIds(o, out_nodes);
   o << "*STEP, NLGEOM, INC=" << opt.max_increments << "\n";
   o << "*STATIC\n"
-    << Num(opt.max_increment) << ", 1., " << Num(opt.min_increment) << ", "
-    << Num(opt.max_increment) << "\n";
+    << InpNumber(opt.max_increment) << ", 1., " << InpNumber(opt.min_increment) << ", "
+    << InpNumber(opt.max_increment) << "\n";
   const std::vector<double> gp = GroupPressures(model, p);
   bool any = false;
   for (int g = 0; g < model.num_groups(); ++g) {
@@ -314,7 +273,7 @@ void WritePressureFemInput(const Model& model, const PressureFemMesh& fem,
     o << "** chamber group " << g << " (actuator '" << s.actuators[model.group_actuator(g)].name
       << "')\n";
     for (const auto& f : fem.cavities[g])
-      o << f.element + 1 << ", P" << f.face << ", " << Num(gp[g]) << "\n";
+      o << f.element + 1 << ", P" << f.face << ", " << InpNumber(gp[g]) << "\n";
   }
   o << "*NODE PRINT, NSET=NOUT\nU\n";
   o << "*END STEP\n";
@@ -331,27 +290,23 @@ PressureFemRun RunPressureFem(const Model& model, const Eigen::Ref<const Eigen::
     return run;
   };
   PressureFemMesh fem;
+  std::string ccx_path;
   const CcxWorkFolder folder(opt.keep_files);
   try {
     fem = BuildPressureFemMesh(model, opt.element);
     run.nodes = static_cast<int>(fem.rest.rows());
     run.elements = static_cast<int>(fem.connectivity.size());
-    const std::string ccx = FindCcx();
-    if (ccx.empty()) return done(CcxMissingMessage());
+    ccx_path = FindCcx();
+    if (ccx_path.empty()) return done(CcxMissingMessage());
     if (folder.path().empty()) return done("cannot create a temporary folder");
     WritePressureFemInput(model, fem, p, opt, (folder.path() / "job.inp").string());
   } catch (const std::exception& e) {
     return done(e.what());
   }
   const fs::path& work = folder.path();
-  const CcxRun ccx = RunCcxJob(FindCcx(), work, opt.time_limit_s, t0);
+  const CcxRun ccx = RunCcxJob(ccx_path, work, opt.time_limit_s, t0);
   if (!ccx.started) return done(ccx.last_error);
-  std::vector<bool> printed(fem.rest.rows(), false);
-  for (int n = 0; n < fem.rest.rows(); ++n) printed[n] = fem.node_vertex[n] >= 0;
-  for (const auto& cav : fem.cavities)
-    for (const auto& f : cav)
-      for (int m : f.mids)
-        if (m >= 0) printed[m] = true;
+  const std::vector<bool> printed = PrintedNodes(fem);
   std::vector<std::pair<double, Eigen::MatrixX3d>> blocks;
   try {
     blocks = ReadCalculixDisplacements((work / "job.dat").string(),
@@ -391,8 +346,8 @@ PressureFemRun RunPressureFem(const Model& model, const Eigen::Ref<const Eigen::
   char buf[96];
   std::snprintf(buf, sizeof(buf), "ccx stopped at load %.4g of the pressure ramp",
                 run.increments.empty() ? 0.0 : run.increments.back().load);
-  std::string why =
-      ccx.timed_out ? "time limit of " + Num(opt.time_limit_s) + " s reached" : ccx.last_error;
+  std::string why = ccx.timed_out ? "time limit of " + InpNumber(opt.time_limit_s) + " s reached"
+                                  : ccx.last_error;
   return done(std::string(buf) + (why.empty() ? "" : ": " + why));
 }
 

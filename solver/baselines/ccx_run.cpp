@@ -133,7 +133,6 @@ CcxRun RunCcxJob(const std::string& ccx, const fs::path& work, double time_limit
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
-  if (!run.timed_out && WIFEXITED(wstatus)) run.exit_code = WEXITSTATUS(wstatus);
   run.last_error = LastErrorLine(log);
   return run;
 }

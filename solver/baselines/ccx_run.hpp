@@ -41,7 +41,6 @@ class CcxWorkFolder {
 struct CcxRun {
   bool started = false;    ///< the process was created
   bool timed_out = false;  ///< killed at the wall-clock limit
-  int exit_code = -1;      ///< ccx's exit status (-1 if killed or not started)
   /// Seconds since `t0` at which each converged increment appeared in job.sta, in order.
   std::vector<double> increment_wall_s;
   std::string last_error;  ///< the last line of ccx's output that mentions an error ("" if none)

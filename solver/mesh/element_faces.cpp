@@ -37,4 +37,20 @@ std::vector<MeshFace> SortedMeshFaces(const Mesh& mesh) {
   return faces;
 }
 
+std::vector<int> BoundaryVertices(const Mesh& mesh) {
+  const std::vector<MeshFace> faces = SortedMeshFaces(mesh);
+  std::vector<bool> on(mesh.num_vertices(), false);
+  for (size_t q = 0; q < faces.size(); ++q) {
+    if ((q > 0 && faces[q - 1].key == faces[q].key) ||
+        (q + 1 < faces.size() && faces[q + 1].key == faces[q].key))
+      continue;  // shared by two elements
+    for (int v : faces[q].key)
+      if (v >= 0 && v < mesh.num_vertices()) on[v] = true;  // skips a triangle's INT_MAX pad
+  }
+  std::vector<int> out;
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    if (on[v]) out.push_back(v);
+  return out;
+}
+
 }  // namespace softkin

@@ -39,4 +39,7 @@ struct MeshFace {
 /// twice in a row, a boundary face once.
 std::vector<MeshFace> SortedMeshFaces(const Mesh& mesh);
 
+/// The vertices on the mesh's outer surface (of faces that belong to one element), sorted.
+std::vector<int> BoundaryVertices(const Mesh& mesh);
+
 }  // namespace softkin

@@ -1,6 +1,7 @@
 // Tests of the mesh-input checks every reader shares (ValidateAndOrient, solver/mesh/mesh.hpp):
 // unused vertices dropped with a map to file positions, duplicate elements, 1-based .tet files,
-// cracks, folds versus all-reversed meshes, and second-order elements read by their corners.
+// cracks, folds versus all-reversed meshes, and second-order elements read by their corners;
+// and the boundary vertices of a mesh (element_faces.hpp).
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -14,7 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "softkin/solver/mesh/element_faces.hpp"
 #include "softkin/solver/mesh/io/mesh_io.hpp"
+#include "softkin/solver/mesh/mesh_gen.hpp"
 #include "softkin/solver/mesh/mesh.hpp"
 #include "tests/solver/mesh/mesh_io_test_util.hpp"
 
@@ -245,6 +248,33 @@ TEST_F(MeshTopology, TetGenO2AndVtkQuadraticTetAreReadByTheirCorners) {
   EXPECT_NEAR(SignedVolume(m.elements[0], m.vertices), 1.0 / 6, 1e-15);
   EXPECT_TRUE(AnyHas(r.notes, "higher-order elements by their corner nodes"));
   EXPECT_EQ(r.unused_vertices, 6);
+}
+
+}  // namespace
+}  // namespace softkin
+
+namespace softkin {
+namespace {
+
+// BoundaryVertices (element_faces.hpp): on a 3 x 3 x 3 grid of cells (4^3 vertices) every vertex
+// but the 2^3 inner ones is on the surface; on a grid of prisms, every vertex of a one-layer slab.
+TEST(BoundaryVertices, GridInteriorVerticesAreLeftOut) {
+  const Mesh m = VoxelTetMesh(Eigen::Vector3d::Zero(), 1.0, Eigen::Vector3i(3, 3, 3),
+                              [](const Eigen::Vector3d&, const Eigen::Vector3i&) { return 0; });
+  const std::vector<int> b = BoundaryVertices(m);
+  EXPECT_EQ(b.size(), 64u - 8u);
+  for (int v : b) {
+    const Eigen::RowVector3d x = m.vertices.row(v);
+    EXPECT_TRUE((x.array() == 0.0).any() || (x.array() == 3.0).any()) << x;
+  }
+  Mesh slab;
+  slab.vertices.resize(6, 3);
+  slab.vertices << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 0, 1, 1;
+  Element e;
+  e.type = ElementType::Prism;
+  e.v = {{0, 1, 2, 3, 4, 5}};
+  slab.elements.push_back(e);
+  EXPECT_EQ(BoundaryVertices(slab).size(), 6u);
 }
 
 }  // namespace
