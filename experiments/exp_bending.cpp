@@ -1,10 +1,12 @@
 // Fig. 2.11 / Table 2.2: bend the pneumatic finger through its range, warm-started along the sweep.
+#include "softkin/experiments/fem_trajectory.hpp"
 #include "softkin/experiments/measure.hpp"
 #include "softkin/experiments/results.hpp"
 #include "softkin/experiments/runner.hpp"
 #include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/mesh/io/mesh_io.hpp"
+#include "softkin/solver/baselines/calculix_pressure.hpp"
 #include "softkin/solver/robots/robots.hpp"
 
 #include <chrono>
@@ -40,6 +42,11 @@ struct BendingParams {
   double vmax = 0;
   bool has_bend = false;  ///< the robot has tip_top / tip_bottom markers
   int tip = -1;
+  // The pressure FEM beside the sweep (Fig. 2.11's FEM 1 / FEM 2): one ramp per law in
+  // "fem_laws" (none by default) to "fem_pressure_mpa" on the swept chambers.
+  std::vector<std::string> fem_laws;
+  double fem_pressure = 0;
+  PressureFemOptions fem;
 };
 
 /// The swept actuators, checked to share their rest value and range.
@@ -84,6 +91,11 @@ BendingParams ReadBendingParams(const Config& cfg) {
   p.robot_build_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t_build0).count();
   p.opts = cfg.Solver(p.scene.solver);
+  p.fem_laws = cfg.StringList("fem_laws", {});
+  if (!p.fem_laws.empty()) {
+    p.fem = ReadPressureFemOptions(cfg, 0.05, 0.0);
+    p.fem_pressure = cfg.Number("fem_pressure_mpa", 0.0);
+  }
   cfg.CheckNoUnknownKeys();
   if (p.steps < 1) cfg.Fail("steps", "an integer >= 1");
   if (p.spacing != "linear" && p.spacing != "geometric") cfg.Fail("spacing", "linear or geometric");
@@ -105,6 +117,18 @@ BendingParams ReadBendingParams(const Config& cfg) {
   if (p.tip < 0) throw std::invalid_argument("robot '" + p.robot + "' has no 'tip' marker");
   if (p.spacing == "geometric" && !(act.rest > 0))
     cfg.Fail("spacing", "linear (geometric spacing needs a positive rest value)");
+  if (!p.fem_laws.empty()) {
+    for (size_t i = 0; i < p.fem_laws.size(); ++i)
+      CheckFemLaw(cfg, "fem_laws[" + std::to_string(i) + "]", p.fem_laws[i]);
+    if (!(p.fem_pressure > 0)) cfg.Fail("fem_pressure_mpa", "the FEM's end pressure, MPa > 0");
+    if (act.type != ActuatorType::Pneumatic || act.is_signed())
+      cfg.Fail("fem_laws", "no FEM: the swept actuators are not unsigned pneumatic chambers");
+    try {
+      (void)BuildPressureFemMesh(Model(p.scene), p.fem.element);
+    } catch (const std::invalid_argument& e) {
+      cfg.Fail("fem_laws", std::string("no FEM for this robot: ") + e.what());
+    }
+  }
   return p;
 }
 
@@ -183,6 +207,36 @@ BendingSweep Sweep(const BendingParams& p, const std::shared_ptr<const Model>& m
   return b;
 }
 
+/// The pressure FEM's ramps, one per law, beside the sweep (fem_trajectory.csv); null if none
+/// was asked for. A FEM that cannot run (no ccx) is reported with its message, not fatal.
+nlohmann::json RunFem(const BendingParams& p, const Model& model, const std::string& dir,
+                      bool verbose) {
+  if (p.fem_laws.empty()) return nullptr;
+  CsvWriter csv(dir + "/fem_trajectory.csv", FemTrajectoryColumns());
+  Eigen::VectorXd pressure = Eigen::VectorXd::Zero(p.scene.num_actuators());
+  for (int i : p.swept) pressure[i] = p.fem_pressure;
+  nlohmann::json j = {{"element", p.fem.element},
+                      {"young_mpa", p.fem.young},
+                      {"poisson", p.fem.poisson},
+                      {"pressure_mpa", p.fem_pressure},
+                      {"max_increment", p.fem.max_increment}};
+  for (const std::string& law : p.fem_laws) {
+    PressureFemOptions o = p.fem;
+    o.law = law;
+    if (verbose)
+      std::fprintf(stderr, "  FEM (%s, %s, pressure ramp to %g MPa) ...\n", law.c_str(),
+                   o.element.c_str(), p.fem_pressure);
+    const FemTrajectory t = RunFemTrajectory(p.scene, model, pressure, p.swept[0], o);
+    AppendFemRows(t, &csv);
+    j[law] = FemTrajectorySummary(t, p.milestones);
+    if (verbose)
+      std::fprintf(stderr, "  FEM (%s): %zu increments, %.1f s, bend %.1f deg%s%s\n", law.c_str(),
+                   t.run.increments.size(), t.run.time_s, t.max_bend_deg,
+                   t.run.message.empty() ? "" : "; ", t.run.message.c_str());
+  }
+  return j;
+}
+
 }  // namespace
 
 nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bool verbose) {
@@ -195,6 +249,7 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
       p.robot_build_s +
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t_model0).count();
   const BendingSweep b = Sweep(p, model, dir, verbose);
+  const nlohmann::json fem = RunFem(p, *model, dir, verbose);
 
   nlohmann::json j;
   j["robot"] = p.robot;
@@ -223,6 +278,7 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
   }
   j["tips"] = b.tips;
   j["step_times_s"] = b.step_times;
+  if (!fem.is_null()) j["fem"] = fem;
   if (p.robot == "pneumatic_finger")
     j["thesis_table_2_2"] = {
         {"t90_s", 8.5}, {"t180_s", 15.2}, {"t240_s", 23.2}, {"elements", 45802}};

@@ -7,6 +7,7 @@
 // per actuator), and the two shapes are compared: tip distance, bend angle, RMS and largest
 // distance over the outer-surface vertices, and centre lines (surface vertices averaged in slices
 // along the robot's long axis) for the plot.
+#include "softkin/experiments/fem_trajectory.hpp"
 #include "softkin/experiments/measure.hpp"
 #include "softkin/experiments/results.hpp"
 #include "softkin/experiments/runner.hpp"
@@ -89,12 +90,9 @@ FidelityParams ReadFidelityParams(const Config& cfg) {
       cfg.Fail(key + ".pressure", "at least one non-zero pressure (MPa)");
     p.cases.push_back(fc);
   }
+  p.fem = ReadPressureFemOptions(cfg, 0.02, 0.0);
   p.fem.law = cfg.String("fem_law", "neo-hooke");
-  p.fem.element = cfg.String("fem_element", "C3D10");
-  p.fem.young = cfg.Number("young_mpa", 1.0);
-  p.fem.poisson = cfg.Number("poisson", 0.45);
-  p.fem.max_increment = cfg.Number("max_increment", 0.02);
-  p.fem.time_limit_s = cfg.Number("fem_time_limit_s", 0.0);
+  CheckFemLaw(cfg, "fem_law", p.fem.law);
   p.fractions = cfg.NumberList("fractions", {0.25, 0.5, 0.75, 1.0});
   p.slices = cfg.Int("slices", 24);
   p.opts = cfg.Solver(FkOptions{});
@@ -115,12 +113,6 @@ FidelityParams ReadFidelityParams(const Config& cfg) {
   for (double f : p.fractions)
     if (!(f > 0 && f <= 1)) cfg.Fail("fractions", "fractions of the FEM ramp in (0, 1]");
   if (p.slices < 2) cfg.Fail("slices", "an integer >= 2");
-  if (p.fem.law != "linear" && p.fem.law != "neo-hooke") cfg.Fail("fem_law", "linear or neo-hooke");
-  if (p.fem.element != "C3D10" && p.fem.element != "C3D4") cfg.Fail("fem_element", "C3D10 or C3D4");
-  if (!(p.fem.young > 0)) cfg.Fail("young_mpa", "a positive Young's modulus (MPa)");
-  if (!(p.fem.poisson >= 0 && p.fem.poisson < 0.5)) cfg.Fail("poisson", "a value in [0, 0.5)");
-  if (!(p.fem.max_increment > 0 && p.fem.max_increment <= 1))
-    cfg.Fail("max_increment", "a fraction of the ramp in (0, 1]");
   return p;
 }
 

@@ -2,10 +2,12 @@
 // warm-started along the sweep exactly like fig2_11 (secant predictor), with the same stopping
 // rule. Times to 90 / 180 / 240 degrees, iterations, final energy and its gap to the lowest,
 // status, distance to the lg-aa shape and the tip trajectory of every method.
+#include "softkin/experiments/fem_trajectory.hpp"
 #include "softkin/experiments/measure.hpp"
 #include "softkin/experiments/results.hpp"
 #include "softkin/experiments/runner.hpp"
 #include "softkin/solver/baselines/calculix.hpp"
+#include "softkin/solver/baselines/ccx_run.hpp"
 #include "softkin/solver/common/enum_names.hpp"
 #include "softkin/solver/fk/energy.hpp"
 #include "softkin/solver/factory/fk_factory.hpp"
@@ -29,6 +31,14 @@ const std::map<std::string, std::string> kNotRun = {
     {"sofa", "SOFA is not available on this machine (no Debian package); no row is filled in"},
 };
 
+/// The pressure-driven FEM rows (calculix_pressure.hpp: hollow chambers, cavity pressure ramped
+/// under NLGEOM), by method name: their material law. They are not FK solvers: their actuation is
+/// a pressure, and each increment is reported at the cavity volume ratio it reached.
+const std::map<std::string, std::string> kPressureFem = {
+    {"calculix-pressure-linear", "linear"},
+    {"calculix-pressure-nonlinear", "neo-hooke"},
+};
+
 std::string Key(std::string name) {
   std::replace(name.begin(), name.end(), '-', '_');
   return name;
@@ -44,9 +54,11 @@ struct SolverComparisonParams {
   // status time_limit and the milestones it reached.
   double budget = 600.0;
   Scene scene;
-  FkOptions base;   ///< the robot's solver options with the config's
-  double vmax = 0;  ///< the first actuator's end value
-  int tip = -1;     ///< the tip marker
+  FkOptions base;           ///< the robot's solver options with the config's
+  double vmax = 0;          ///< the first actuator's end value
+  int tip = -1;             ///< the tip marker
+  PressureFemOptions fem;   ///< the pressure FEM rows' options (law set per row)
+  double fem_pressure = 0;  ///< their end pressure on the first actuator, MPa
 };
 
 SolverComparisonParams ReadSolverComparisonParams(const Config& cfg) {
@@ -60,18 +72,26 @@ SolverComparisonParams ReadSolverComparisonParams(const Config& cfg) {
   p.budget = cfg.Number("time_limit_s", 600.0);
   p.scene = ConfigRobot(cfg, p.robot, res);
   p.base = cfg.Solver(p.scene.solver);
+  const bool pressure_rows =
+      std::any_of(p.methods.begin(), p.methods.end(),
+                  [](const std::string& m) { return kPressureFem.count(m); });
+  if (pressure_rows) {
+    p.fem = ReadPressureFemOptions(cfg, 0.05, p.budget);
+    p.fem_pressure = cfg.Number("fem_pressure_mpa", 0.0);
+  }
   cfg.CheckNoUnknownKeys();
   if (p.steps < 1) cfg.Fail("steps", "an integer >= 1");
   if (!(p.budget > 0)) cfg.Fail("time_limit_s", "a number of seconds > 0");
   if (p.methods.empty() || p.methods[0] != "lg-aa")
     cfg.Fail("methods", "a list of FK solver names starting with lg-aa (the reference shape)");
   for (const auto& m : p.methods) {
-    if (kNotRun.count(m)) continue;
+    if (kNotRun.count(m) || kPressureFem.count(m)) continue;
     try {
       (void)FkSolverTypeFromString(m);
     } catch (const std::invalid_argument&) {
       std::vector<std::string> names = FkSolverTypeNames();
       for (const auto& [n, why] : kNotRun) names.push_back(n);
+      for (const auto& [n, law] : kPressureFem) names.push_back(n);
       cfg.Fail("methods", "FK solver names (" + NameList(names) + ")");
     }
   }
@@ -85,6 +105,20 @@ SolverComparisonParams ReadSolverComparisonParams(const Config& cfg) {
       cfg.Fail("methods",
                "no calculix-* method unless the first actuator is an unsigned pneumatic "
                "chamber (the FEM increments are read back as its volume ratio)");
+  const bool any_ccx = std::any_of(p.methods.begin(), p.methods.end(), [](const std::string& m) {
+    return m.rfind("calculix", 0) == 0;
+  });
+  if (any_ccx && FindCcx().empty())
+    cfg.Fail("methods", "no calculix-* method on this machine: " + CcxMissingMessage());
+  if (pressure_rows) {
+    if (!(p.fem_pressure > 0))
+      cfg.Fail("fem_pressure_mpa", "the pressure FEM's end pressure, MPa > 0");
+    try {
+      (void)BuildPressureFemMesh(Model(p.scene), p.fem.element);
+    } catch (const std::invalid_argument& e) {
+      cfg.Fail("methods", std::string("no calculix-pressure-* method for this robot: ") + e.what());
+    }
+  }
   p.tip = p.scene.marker_index("tip");
   if (p.tip < 0 || p.scene.marker_index("tip_top") < 0 || p.scene.marker_index("tip_bottom") < 0)
     cfg.Fail("robot", "a robot with tip, tip_top and tip_bottom markers (e.g. pneumatic_finger)");
@@ -100,6 +134,8 @@ struct Totals {
   std::map<std::string, int> steps_done;
   /// (bend angle, elapsed s) of every converged step or FEM increment, in order.
   std::map<std::string, std::vector<std::pair<double, double>>> bends;
+  /// (bend angle, actuation value) of lg-aa's converged steps, in order.
+  std::vector<std::pair<double, double>> aa_curve;
 };
 
 /// One method's sweep: its state as it goes, and the rows it writes.
@@ -121,6 +157,7 @@ struct MethodSweep {
               double elapsed, bool converged) {
     const double ang = bend(Xs);
     if (converged) bends->emplace_back(ang, elapsed);
+    if (converged) curve.emplace_back(ang, value);
     for (size_t q = 0; q < p.milestones.size(); ++q)
       if (reach[q] < 0 && ang >= p.milestones[q] && converged) reach[q] = elapsed;
     const int tip = p.tip;
@@ -129,7 +166,8 @@ struct MethodSweep {
     csv->RowStrings({name, std::to_string(s), std::to_string(value), std::to_string(ang),
                      std::to_string(P(tip, 0)), std::to_string(P(tip, 1)),
                      std::to_string(P(tip, 2)), std::to_string(rs.iterations),
-                     std::to_string(step_s), std::to_string(elapsed), std::to_string(rs.energy),
+                     std::to_string(step_s), std::to_string(elapsed),
+                     std::isfinite(rs.energy) ? std::to_string(rs.energy) : std::string(),
                      std::to_string(rs.gradient_ratio), FkStatusToString(rs.status)});
     if (verbose)
       std::fprintf(stderr, "  %s [%d] %s = %.3f  bend %.1f deg  %.2f s\n", name.c_str(), s,
@@ -144,8 +182,9 @@ struct MethodSweep {
   BendAngle bend;
   std::vector<double> reach;  ///< elapsed s at each milestone, -1: not reached
   nlohmann::json tips = nlohmann::json::array();
-  Eigen::MatrixX3d X;  ///< the last shape
-  FkResult r;          ///< the last solve
+  std::vector<std::pair<double, double>> curve;  ///< (bend angle, actuation) of converged rows
+  Eigen::MatrixX3d X;                            ///< the last shape
+  FkResult r;                                    ///< the last solve
   double cumulative = 0;
   int iterations = 0;
   int done = 0;  ///< steps completed
@@ -185,6 +224,41 @@ void SweepCalculix(const std::shared_ptr<const Model>& model, FkOptions o, Metho
   m->iterations = m->r.iterations;
   m->status = FkStatusToString(m->r.status);
   m->done = m->r.status == FkStatus::Converged ? p.steps : 0;
+}
+
+/// The pressure FEM: one CalculiX ramp of the first actuator's cavity pressure from rest to
+/// fem_pressure_mpa, as far as it converges within the budget. A row per converged increment at
+/// the cavity volume ratio it reached (no energy: Eq. 2.10 needs the chambers, which the FEM
+/// leaves hollow); its time to an angle is the wall-clock time at which that increment converged.
+void SweepPressureFem(const Model& model, const std::string& law, MethodSweep* m,
+                      nlohmann::json* extra) {
+  const SolverComparisonParams& p = m->p;
+  PressureFemOptions o = p.fem;
+  o.law = law;
+  Eigen::VectorXd pressure = Eigen::VectorXd::Zero(p.scene.num_actuators());
+  pressure[0] = p.fem_pressure;
+  const FemTrajectory t = RunFemTrajectory(p.scene, model, pressure, 0, o);
+  if (!t.run.ok) throw std::runtime_error(m->name + ": " + t.run.message);
+  double prev = 0;
+  for (size_t k = 0; k < t.run.increments.size(); ++k) {
+    const PressureFemIncrement& inc = t.run.increments[k];
+    FkResult rk;
+    rk.iterations = 1;
+    rk.status = FkStatus::Converged;
+    rk.energy = std::numeric_limits<double>::quiet_NaN();
+    m->Record(static_cast<int>(k) + 1, inc.cavity_ratio[0], inc.positions, rk, inc.wall_s - prev,
+              inc.wall_s, true);
+    prev = inc.wall_s;
+    m->X = inc.positions;
+  }
+  m->r = FkResult{};
+  m->r.energy = std::numeric_limits<double>::quiet_NaN();
+  m->r.message = t.run.message;
+  m->cumulative = t.run.time_s;
+  m->iterations = static_cast<int>(t.run.increments.size());
+  m->status = t.run.reached_end ? "reached_end" : "stopped";
+  m->done = 0;  // its end state is a pressure, not the sweep's end value
+  *extra = FemTrajectorySummary(t, p.milestones);
 }
 
 /// The iterative solvers: `steps` warm-started steps (secant predictor) within the budget.
@@ -227,10 +301,14 @@ void RunMethod(const SolverComparisonParams& p, const std::shared_ptr<const Mode
     return;
   }
   FkOptions o = p.base;
-  o.solver = FkSolverTypeFromString(name);
+  if (!kPressureFem.count(name)) o.solver = FkSolverTypeFromString(name);
   o.continuation_steps = 1;
   MethodSweep m(p, name, csv, &t->bends[name], verbose);
-  if (o.solver == FkSolverType::kCalculixLinear || o.solver == FkSolverType::kCalculixNonlinear)
+  nlohmann::json fem;
+  if (kPressureFem.count(name))
+    SweepPressureFem(*model, kPressureFem.at(name), &m, &fem);
+  else if (o.solver == FkSolverType::kCalculixLinear ||
+           o.solver == FkSolverType::kCalculixNonlinear)
     SweepCalculix(model, o, &m);
   else
     SweepIterative(model, o, &m);
@@ -241,18 +319,22 @@ void RunMethod(const SolverComparisonParams& p, const std::shared_ptr<const Mode
     mj[k] = m.reach[q] >= 0 ? nlohmann::json(m.reach[q]) : nlohmann::json(nullptr);
   }
   mj["iterations"] = m.iterations;
-  mj["energy"] = m.r.energy;
+  mj["energy"] = std::isfinite(m.r.energy) ? nlohmann::json(m.r.energy) : nlohmann::json(nullptr);
   mj["status"] = m.status;
   mj["message"] = m.r.message;  // the last solve's (why a method stopped)
   mj["steps_done"] = m.done;
   mj["total_s"] = m.cumulative;
   mj["final_bend_deg"] = m.bend(m.X);
   mj["tips"] = m.tips;
+  if (!fem.is_null())
+    for (const char* k : {"law", "nodes", "elements", "end_pressure_mpa", "end_cavity_ratio"})
+      mj[k] = fem[k];
   t->methods[key] = mj;
   if (m.done == p.steps) {
     t->finals[name] = m.X;
     t->final_energy[name] = m.r.energy;
   }
+  if (name == "lg-aa") t->aa_curve = m.curve;
   t->total_time[name] = m.cumulative;
   t->steps_done[name] = m.done;
   t->all_converged[name] = m.status == "converged" && m.done == p.steps;
@@ -331,12 +413,43 @@ void AddSpeedupVsBestNlp(const SolverComparisonParams& p, Totals* t, nlohmann::j
   (*j)["speedup_vs_best_nlp_excluded"] = excluded;
 }
 
-// Headline 2: lg-aa against calculix-nonlinear: time to the largest milestone both reached (the
-// thesis: 240 degrees). If the FEM reached none, time to the largest bend the FEM did reach,
-// against lg-aa's time to its first step at or beyond that bend (basis "fem_max_bend").
-void AddSpeedupVsCalculix(const SolverComparisonParams& p, Totals* t, nlohmann::json* j) {
-  (*j)["speedup_vs_calculix_nonlinear"] = nullptr;
-  const auto& fem = t->bends["calculix-nonlinear"];
+// lg-aa's time to bend the robot by `deg` from rest: one cold solve at the actuation where its
+// sweep's bend curve (linearly interpolated from rest) reaches `deg`; -1 if the sweep never did.
+double AaColdTimeToBend(const SolverComparisonParams& p, const std::shared_ptr<const Model>& model,
+                        const Totals& t, double deg, nlohmann::json* info) {
+  const Actuator& act = p.scene.actuators.at(0);
+  double a0 = 0, v0 = act.rest;
+  for (const auto& [a1, v1] : t.aa_curve) {
+    if (a1 >= deg) {
+      const double v = v0 + (v1 - v0) * (deg - a0) / std::max(a1 - a0, 1e-12);
+      FkOptions o = p.base;
+      o.solver = FkSolverType::kLgAa;
+      o.continuation_steps = 1;
+      Eigen::VectorXd c = p.scene.rest_actuation();
+      c[0] = v;
+      const FkResult r = MakeFkSolver(model, o)->Solve(c);
+      BendAngle bend(p.scene);
+      (*info)["actuation"] = v;
+      (*info)["bend_deg"] = bend(r.positions);
+      (*info)["status"] = FkStatusToString(r.status);
+      (*info)["time_s"] = r.time_s;
+      return r.status == FkStatus::Converged ? r.time_s : -1.0;
+    }
+    a0 = a1;
+    v0 = v1;
+  }
+  return -1.0;
+}
+
+// Headline 2: lg-aa against a FEM row (`fem`): time to the largest milestone both reached (the
+// thesis: 240 degrees). If the FEM reached none, the FEM's time to the largest bend it did reach
+// against one cold lg-aa solve from rest to that bend (basis "fem_max_bend", AaColdTimeToBend).
+void AddSpeedupVsFem(const SolverComparisonParams& p, const std::shared_ptr<const Model>& model,
+                     const std::string& fem_name, Totals* t, nlohmann::json* j) {
+  const std::string key = "speedup_vs_" + Key(fem_name);
+  if (std::find(p.methods.begin(), p.methods.end(), fem_name) == p.methods.end()) return;
+  (*j)[key] = nullptr;
+  const auto& fem = t->bends[fem_name];
   const auto& aa = t->bends["lg-aa"];
   auto first_at = [](const std::vector<std::pair<double, double>>& v, double deg) {
     for (const auto& [ang, time] : v)
@@ -346,22 +459,24 @@ void AddSpeedupVsCalculix(const SolverComparisonParams& p, Totals* t, nlohmann::
   if (fem.empty() || aa.empty()) return;
   const std::vector<double>& milestones = p.milestones;
   double at = -1;
-  std::string basis = "milestone";
   for (size_t q = milestones.size(); q-- > 0 && at < 0;)
     if (first_at(fem, milestones[q]) > 0 && first_at(aa, milestones[q]) > 0) at = milestones[q];
   if (at < 0) {
     double fem_max = 0;
     for (const auto& [ang, time] : fem) fem_max = std::max(fem_max, ang);
-    if (first_at(aa, fem_max) > 0) {
-      at = fem_max;
-      basis = "fem_max_bend";
+    nlohmann::json cold;
+    const double aa_s = fem_max > 0 ? AaColdTimeToBend(p, model, *t, fem_max, &cold) : -1.0;
+    if (aa_s > 0) {
+      (*j)[key] = first_at(fem, fem_max) / aa_s;
+      (*j)[key + "_at_deg"] = fem_max;
+      (*j)[key + "_basis"] = "fem_max_bend";
+      (*j)[key + "_lg_aa_cold_solve"] = cold;
     }
+    return;
   }
-  if (at >= 0) {
-    (*j)["speedup_vs_calculix_nonlinear"] = first_at(fem, at) / first_at(aa, at);
-    (*j)["speedup_vs_calculix_nonlinear_at_deg"] = at;
-    (*j)["speedup_vs_calculix_nonlinear_basis"] = basis;
-  }
+  (*j)[key] = first_at(fem, at) / first_at(aa, at);
+  (*j)[key + "_at_deg"] = at;
+  (*j)[key + "_basis"] = "milestone";
 }
 
 }  // namespace
@@ -379,7 +494,9 @@ nlohmann::json RunSolverComparison(const Config& cfg, const std::string& dir, bo
   const double lowest = AddEnergyGaps(p, &t);
   nlohmann::json j;
   AddSpeedupVsBestNlp(p, &t, &j);
-  AddSpeedupVsCalculix(p, &t, &j);
+  for (const char* fem :
+       {"calculix-nonlinear", "calculix-pressure-linear", "calculix-pressure-nonlinear"})
+    AddSpeedupVsFem(p, model, fem, &t, &j);
   j["methods"] = t.methods;
   j["robot"] = p.robot;
   j["n_tets"] = p.scene.mesh.num_tets();

@@ -7,7 +7,11 @@ Reads RESULTS_DIR/trajectory.csv (written by `softkin run experiments/configs/fi
 and, if present, RESULTS_DIR/summary.json. Writes RESULTS_DIR/fig2_11_pneumatic_bending.png:
   left:  tip path in the x-z plane (mm, equal aspect), coloured by actuation, with markers where
          the bend angle first crosses 90, 180 and 240 degrees;
-  right: bend angle against actuation (volume ratio of the chamber).
+  right: bend angle against the chamber volume ratio the solve achieved.
+If RESULTS_DIR/fem_trajectory.csv is there (config key fem_laws), the pressure-driven FEM's ramps
+(FEM 1 linear, FEM 2 neo-Hookean; solver/baselines/calculix_pressure.hpp) are drawn beside
+SoftKin's: tip paths on the left, bend angle against the FEM's cavity volume ratio on the right,
+each ending where the FEM stopped (summary.json says why).
 Exit status 2 with a message on stderr if the CSV is missing or malformed.
 """
 import os
@@ -18,6 +22,10 @@ import figlib
 NAME = "fig2_11_pneumatic_bending"
 COLUMNS = ["step", "actuation", "bend_deg", "tip_x", "tip_y", "tip_z", "iterations", "time_s",
            "cumulative_s", "energy", "volume_ratio", "residual_ratio", "converged"]
+FEM_COLUMNS = ["law", "increment", "load", "pressure_mpa", "cavity_ratio", "bend_deg", "tip_x",
+               "tip_y", "tip_z", "wall_s"]
+FEM_STYLE = {"linear": ("FEM 1 (linear, pressure)", "tab:purple", "--"),
+             "neo-hooke": ("FEM 2 (neo-Hookean, pressure)", "tab:brown", "-.")}
 MILESTONES = (90.0, 180.0, 240.0)
 
 
@@ -43,11 +51,24 @@ def crossings(rows):
             if a["bend_deg"] < m <= b["bend_deg"]:
                 t = (m - a["bend_deg"]) / (b["bend_deg"] - a["bend_deg"])
                 out[m] = tuple(a[k] + t * (b[k] - a[k])
-                               for k in ("tip_x", "tip_z", "actuation", "cumulative_s"))
+                               for k in ("tip_x", "tip_z", "volume_ratio", "cumulative_s"))
                 break
         if out[m] is None and rows[0]["bend_deg"] >= m:
             r = rows[0]
-            out[m] = (r["tip_x"], r["tip_z"], r["actuation"], r["cumulative_s"])
+            out[m] = (r["tip_x"], r["tip_z"], r["volume_ratio"], r["cumulative_s"])
+    return out
+
+
+def read_fem(results):
+    """FEM rows by law, in file order; {} if the run had no FEM."""
+    path = os.path.join(results, "fem_trajectory.csv")
+    if not os.path.isfile(path):
+        return {}
+    numeric = [c for c in FEM_COLUMNS if c != "law"]
+    rows = figlib.read_table(NAME, path, FEM_COLUMNS, numeric=numeric, min_rows=0)
+    out = {}
+    for r in rows:
+        out.setdefault(r["law"], []).append(r)
     return out
 
 
@@ -59,6 +80,8 @@ def main(argv):
     results = figlib.results_dir(NAME, argv, __doc__)
     rows = read_table(os.path.join(results, "trajectory.csv"), COLUMNS)
     summary = read_summary(os.path.join(results, "summary.json"))
+    fem = read_fem(results)
+    fem_info = summary.get("fem", {}) if isinstance(summary, dict) else {}
 
     import matplotlib
     matplotlib.use("Agg")
@@ -69,6 +92,7 @@ def main(argv):
     x = [r["tip_x"] for r in rows]
     z = [r["tip_z"] for r in rows]
     act = [r["actuation"] for r in rows]
+    vol = [r["volume_ratio"] for r in rows]
     bend = [r["bend_deg"] for r in rows]
     bad = [i for i, r in enumerate(rows) if r["converged"] < 0.5]
     cross = crossings(rows)
@@ -92,6 +116,10 @@ def main(argv):
         if c is not None:
             ax0.plot(c[0], c[1], marker="*", ms=15, ls="none", color=colors[m], mec="k",
                      zorder=6, label=f"bend crosses {m:.0f}\N{DEGREE SIGN}")
+    for law, frows in fem.items():
+        label, color, ls = FEM_STYLE.get(law, (f"FEM ({law})", "0.4", ":"))
+        ax0.plot([r["tip_x"] for r in frows], [r["tip_z"] for r in frows], ls=ls, color=color,
+                 lw=2.0, marker="o", ms=2.5, zorder=4, label=label)
     ax0.set_aspect("equal", adjustable="datalim")
     ax0.autoscale_view()
     ax0.set_xlabel("tip x (mm)")
@@ -102,17 +130,27 @@ def main(argv):
     cb = fig.colorbar(sc, ax=ax0, shrink=0.85)
     cb.set_label("actuation (chamber volume ratio)")
 
-    # Right: bend angle against actuation.
+    # Right: bend angle against the chamber volume ratio reached.
     solver = summary.get("solver", "local-global")
-    ax1.plot(act, bend, "-o", ms=3, color="tab:blue", label=f"SoftKin ({solver})")
+    ax1.plot(vol, bend, "-o", ms=3, color="tab:blue", label=f"SoftKin ({solver})")
+    for law, frows in fem.items():
+        label, color, ls = FEM_STYLE.get(law, (f"FEM ({law})", "0.4", ":"))
+        info = fem_info.get(law, {})
+        end = f", to {info['end_pressure_mpa']:.3g} MPa" if "end_pressure_mpa" in info else ""
+        ax1.plot([r["cavity_ratio"] for r in frows], [r["bend_deg"] for r in frows], ls=ls,
+                 color=color, lw=2.0, marker="o", ms=2.5, label=label + end)
+        if info.get("status") == "stopped":
+            last = frows[-1]
+            ax1.annotate("stopped", (last["cavity_ratio"], last["bend_deg"]), fontsize=7,
+                         color=color, xytext=(4, -10), textcoords="offset points")
     for m in MILESTONES:
         ax1.axhline(m, color=colors[m], ls="--", lw=0.9)
         c = cross[m]
         if c is not None:
             ax1.plot(c[2], m, marker="*", ms=13, color=colors[m], mec="k", zorder=5)
-    ax1.set_xlabel("actuation (chamber volume ratio)")
+    ax1.set_xlabel("chamber volume ratio reached (FEM: cavity volume ratio)")
     ax1.set_ylabel("bend angle (deg)")
-    ax1.set_title("Bend angle vs actuation")
+    ax1.set_title("Bend angle vs chamber volume")
     ax1.grid(True, alpha=0.3)
 
     # Timing box: measured times (from the summary, else from the CSV) next to Table 2.2.
@@ -129,6 +167,12 @@ def main(argv):
         lines.append(f"{m:>3.0f}\N{DEGREE SIGN}: {fmt_s(measured)} | {ref_s}")
     if "n_tets" in summary:
         lines.append(f"{summary['n_tets']} tets")
+    for law in fem:
+        info = fem_info.get(law, {})
+        if "time_s" in info:
+            lines.append(f"{FEM_STYLE.get(law, (law,))[0].split(' (')[0]} ({fem_info.get('element', '')}): "
+                         f"{info['max_bend_deg']:.0f}\N{DEGREE SIGN} in {info['time_s']:.0f} s, "
+                         f"{info.get('status', '')}")
     ax1.text(0.03, 0.97, "\n".join(lines), transform=ax1.transAxes, va="top", ha="left",
              fontsize=8, family="monospace",
              bbox=dict(boxstyle="round", fc="white", ec="0.7", alpha=0.9))

@@ -3,6 +3,7 @@
 #include "softkin/experiments/cli_dataset.hpp"
 #include "softkin/experiments/cli_fk.hpp"
 #include "softkin/experiments/cli_ik.hpp"
+#include "softkin/solver/baselines/ccx_run.hpp"
 #include "softkin/solver/scene/solver_options_json.hpp"
 #include "tests/solver/fk/fk_test_util.hpp"
 #include "tests/solver/scene/scene_json_test_util.hpp"
@@ -440,6 +441,71 @@ void WriteBoxObj(const std::string& path, double lo, double hi) {
                         {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
   for (const auto& tri : t)
     f << "f " << tri[0] + 1 << " " << tri[1] + 1 << " " << tri[2] + 1 << "\n";
+}
+
+// Fig. 2.11 and Table 2.2 carry the pressure-driven FEM (calculix_pressure.hpp) beside SoftKin:
+// its keys are checked before any work, and a tiny ramp is measured as a bending trajectory that
+// inflates the cavity and bends the finger the way SoftKin does.
+TEST(Cli, BendingAndSolverComparisonRunThePressureFem) {
+  const std::string dir = TempDir("pressure_fem");
+  const std::string cfg = dir + "/bend.json";
+  const std::string bend_base =
+      R"("name": "tiny_fem", "experiment": "pneumatic_bending", "seed": 1,
+         "robot": "pneumatic_finger", "res": 5, "steps": 2, "end_value": 1.4)";
+  std::ofstream(cfg) << "{" << bend_base << R"(, "fem_laws": ["rubber"],
+    "fem_pressure_mpa": 0.02})";
+  CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("fem_laws[0]"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("neo-hooke"), std::string::npos) << r.out;
+  std::ofstream(cfg) << "{" << bend_base << R"(, "fem_laws": ["linear"]})";
+  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("fem_pressure_mpa"), std::string::npos) << r.out;
+  std::ofstream(cfg) << "{" << bend_base << R"(, "fem_laws": ["linear"],
+    "fem_pressure_mpa": 0.02, "fem_element": "C3D8"})";
+  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("fem_element"), std::string::npos) << r.out;
+  if (softkin::FindCcx().empty()) GTEST_SKIP() << softkin::CcxMissingMessage();
+
+  std::ofstream(cfg) << "{" << bend_base << R"(, "fem_laws": ["neo-hooke"],
+    "fem_pressure_mpa": 0.03, "fem_element": "C3D4", "max_increment": 0.5})";
+  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  {
+    std::ifstream f(dir + "/tiny_fem/summary.json");
+    const auto j = nlohmann::json::parse(f);
+    const auto& fem = j["fem"]["neo-hooke"];
+    ASSERT_GE(fem["increments"].get<int>(), 1) << fem.dump();
+    EXPECT_GT(fem["end_cavity_ratio"].get<double>(), 1.0);
+    // Inflating the chamber bends the finger the same way as SoftKin's sweep (positive angle).
+    EXPECT_GT(fem["max_bend_deg"].get<double>(), 0.1);
+    EXPECT_GT(j["max_bend_deg"].get<double>(), 0.1);
+    EXPECT_EQ(j["fem"]["element"], "C3D4");
+    std::ifstream csv(dir + "/tiny_fem/fem_trajectory.csv");
+    std::string header, row;
+    std::getline(csv, header);
+    EXPECT_EQ(header.rfind("law,increment,load,pressure_mpa,cavity_ratio,bend_deg", 0), 0u);
+    int rows = 0;
+    while (std::getline(csv, row)) rows += !row.empty();
+    EXPECT_EQ(rows, fem["increments"].get<int>() + 1);  // the rest state, then each increment
+  }
+
+  std::ofstream(cfg) << R"({"name": "tiny_table", "experiment": "solver_comparison", "seed": 1,
+    "robot": "pneumatic_finger", "res": 5, "steps": 2, "end_value": 1.4, "time_limit_s": 60,
+    "methods": ["lg-aa", "calculix-pressure-nonlinear"], "fem_pressure_mpa": 0.03,
+    "fem_element": "C3D4", "max_increment": 0.5})";
+  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::ifstream f(dir + "/tiny_table/summary.json");
+  const auto j = nlohmann::json::parse(f);
+  const auto& row = j["methods"]["calculix_pressure_nonlinear"];
+  EXPECT_TRUE(row["status"] == "reached_end" || row["status"] == "stopped") << row.dump();
+  EXPECT_GE(row["iterations"].get<int>(), 1);
+  EXPECT_GT(row["end_cavity_ratio"].get<double>(), 1.0);
+  EXPECT_TRUE(row["energy"].is_null());  // the FEM's chambers are hollow: no Eq. 2.10 energy
+  EXPECT_TRUE(j.contains("speedup_vs_calculix_pressure_nonlinear"));
 }
 
 TEST(Cli, TessellateMeshesABoxChamberInABoxBody) {
