@@ -11,7 +11,7 @@
 //   per_vertex          wall time per vertex
 // Compare solvers as the ratio of their times within one run (the machine is shared):
 //   build/bin/bench_newton --benchmark_filter='Strip'
-// Cases: bilayer_strip res 1 and 2 (3k and 24k tets) at alpha 1.1 and 1.5; pneumatic_finger
+// Cases: bilayer_strip res 1 and 2 (3.6k and 24k tets) at alpha 1.1 and 1.5; pneumatic_finger
 // res 8 at alpha 5; three_chamber res 5 at (1.5, 1, 1).
 #include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/robots/robots.hpp"

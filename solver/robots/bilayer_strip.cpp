@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -21,20 +22,30 @@ namespace {
 // single actuator "top" (region 1, weight 1, volume ratio alpha in [1, 2]). The face x = 0 is
 // clamped. Inflating the top layer lengthens it, so the strip curls towards -z. Both layers are
 // solid: the strip is a bending beam whose curvature grows with alpha (a bimetal).
-// Resolution: cells across one layer (cell size t / res); res 1 gives 6 * 50 * 5 * 2 = 3,000
-// tets at the defaults, res 2 24,000, res 3 81,000 and res 4 192,000. Markers: tip (the x = L
-// face), tip_top / tip_bottom (its top and bottom quarters in z).
+// Resolution: cells across one layer (cell size t / res in x and z). Across the width the cell
+// count is the even number nearest W / h (cells of W / ny, up to h / (W / h) from cubic), so the
+// mesh is mirror-symmetric about y = W / 2 and a curl stays in that plane: the voxel split is
+// mirrored cell by cell, which is symmetric only over an even count. res 1 gives
+// 6 * 50 * 6 * 2 = 3,600 tets at the defaults, res 2 24,000, res 3 86,400 and res 4 192,000.
+// Markers: tip (the x = L face), tip_top / tip_bottom (its top and bottom quarters in z).
 // ================================================================================================
 
 constexpr int kStripMinRes = 1, kStripMaxRes = 8, kStripDefaultRes = 2;
 
 Scene MakeBilayerStrip(int res, const RobotParams& P) {
   const double t = P.at("layer"), h = t / res;
-  const int nx = Cells(P.at("length"), h), ny = Cells(P.at("width"), h), nz = 2 * res;
+  const double width = P.at("width");
+  const int nx = Cells(P.at("length"), h), nz = 2 * res;
+  const int ny = 2 * std::max(1, static_cast<int>(std::lround(width / (2 * h))));
+  auto lines = [](int n, double step) {
+    std::vector<double> v(n + 1);
+    for (int i = 0; i <= n; ++i) v[i] = i * step;
+    return v;
+  };
   Scene s;
   s.name = "bilayer_strip";
-  s.mesh = VoxelTetMesh(
-      Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz),
+  s.mesh = RectilinearTetMesh(
+      lines(nx, h), lines(ny, width / ny), lines(nz, h),
       [res](const Eigen::Vector3d&, const Eigen::Vector3i& c) { return c[2] < res ? 0 : 1; });
   s.body[0] = Material{"body", 1.0, 1.0};
   Actuator a;
@@ -62,8 +73,8 @@ RobotEntry BilayerStripEntry() {
       "(region 0, R_omega 1), the top layer the pneumatic actuator 'top' (region 1, alpha in "
       "[1, 2]), so inflation curls the strip towards -z. Markers: tip, tip_top, tip_bottom.",
       kStripDefaultRes,
-      "cells across one layer (cell size layer/res mm), integer in [1, 8]; res 1: 3,000 tets, "
-      "res 2: 24,000",
+      "cells across one layer (cell size layer/res mm; an even count across the width, so "
+      "the mesh is mirror-symmetric), integer in [1, 8]; res 1: 3,600 tets, res 2: 24,000",
       {{"length", 100.0, 10.0, 500.0, "strip length, mm"},
        {"width", 10.0, 1.0, 100.0, "strip width, mm"},
        {"layer", 2.0, 0.25, 20.0, "thickness of each layer, mm"}}};

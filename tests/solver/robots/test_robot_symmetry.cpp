@@ -1,0 +1,87 @@
+// Symmetric designs stay symmetric: every embedded robot whose design is mirror-symmetric about a
+// plane y = const has a mirror-symmetric mesh there, and an actuation that is itself symmetric
+// (every actuator spans both sides of the plane) keeps its markers on the plane. The voxel split
+// is mirrored cell by cell (mesh_gen.hpp), which is symmetric over an even number of cells
+// across the plane; the snapped robots are listed at resolutions where that holds (at odd ones
+// their walls snap to one side; pneumatic_finger's design_grid = 1 is symmetric at every
+// resolution, test_robots_grid.cpp).
+#include "softkin/solver/factory/fk_factory.hpp"
+#include "softkin/solver/fk/fk_solver.hpp"
+#include "softkin/solver/fk/model.hpp"
+#include "softkin/solver/robots/robots.hpp"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace softkin {
+namespace {
+
+struct MirrorCase {
+  std::string robot;
+  int res;
+  double plane_y;                 ///< the design's mirror plane y = plane_y (mm)
+  std::vector<double> actuation;  ///< a symmetric actuation with a clear bend
+};
+
+/// Vertices without a mirror image about y = plane_y (to 1e-6 mm).
+int UnmatchedMirrorVertices(const Mesh& mesh, double plane_y) {
+  auto key = [](double x, double y, double z) {
+    return std::array<long, 3>{std::lround(x * 1e6), std::lround(y * 1e6), std::lround(z * 1e6)};
+  };
+  std::map<std::array<long, 3>, int> at;
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    at[key(mesh.vertices(v, 0), mesh.vertices(v, 1), mesh.vertices(v, 2))] = v;
+  int unmatched = 0;
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    unmatched +=
+        !at.count(key(mesh.vertices(v, 0), 2 * plane_y - mesh.vertices(v, 1), mesh.vertices(v, 2)));
+  return unmatched;
+}
+
+TEST(RobotSymmetry, MirrorSymmetricDesignsBendInTheirPlane) {
+  const std::vector<MirrorCase> cases = {
+      {"pneumatic_finger", 6, 10.0, {3.0}},
+      {"cable_finger", 6, 12.5, {0.8, 0.8, 0.8}},
+      {"multi_segment_gripper", 6, 10.0, {3.0, 3.0, 3.0}},
+      {"cable_gripper", 6, 10.0, {0.8}},
+      {"dea_crawler", 8, 10.0, {0.85}},
+      {"bilayer_strip", 1, 5.0, {1.1}},
+  };
+  for (const MirrorCase& c : cases) {
+    SCOPED_TRACE(c.robot + " res " + std::to_string(c.res));
+    const Scene s = MakeRobot(c.robot, c.res);
+    EXPECT_EQ(UnmatchedMirrorVertices(s.mesh, c.plane_y), 0);
+    auto model = std::make_shared<const Model>(s);
+    const Eigen::VectorXd a =
+        Eigen::Map<const Eigen::VectorXd>(c.actuation.data(), c.actuation.size());
+    const FkResult r = MakeFkSolver(model, s.solver)->Solve(a);
+    ASSERT_EQ(r.status, FkStatus::Converged) << r.message;
+    const Eigen::MatrixX3d P0 = s.marker_positions(s.mesh.vertices);
+    const Eigen::MatrixX3d P = s.marker_positions(r.positions);
+    const double size = s.mesh.size();
+    // Markers on the plane stay on it (to 1e-4 of the robot's size, above the stopping rule),
+    // and the robot did bend: some marker moved by more than 1 % of its size.
+    double moved = 0;
+    int on_plane = 0;
+    for (int m = 0; m < P.rows(); ++m) {
+      moved = std::max(moved, (P.row(m) - P0.row(m)).norm());
+      if (std::abs(P0(m, 1) - c.plane_y) < 1e-6 * size) {
+        ++on_plane;
+        EXPECT_NEAR(P(m, 1), c.plane_y, 1e-4 * size) << "marker " << s.markers[m].name;
+      }
+    }
+    EXPECT_GT(on_plane, 0);
+    EXPECT_GT(moved, 0.01 * size);
+  }
+  // The strip at res 3 (W / h = 15 cubic cells) is cut into an even 16 across its width.
+  EXPECT_EQ(UnmatchedMirrorVertices(MakeRobot("bilayer_strip", 3).mesh, 5.0), 0);
+}
+
+}  // namespace
+}  // namespace softkin
