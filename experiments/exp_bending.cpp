@@ -123,11 +123,7 @@ BendingParams ReadBendingParams(const Config& cfg) {
     if (!(p.fem_pressure > 0)) cfg.Fail("fem_pressure_mpa", "the FEM's end pressure, MPa > 0");
     if (act.type != ActuatorType::Pneumatic || act.is_signed())
       cfg.Fail("fem_laws", "no FEM: the swept actuators are not unsigned pneumatic chambers");
-    try {
-      (void)BuildPressureFemMesh(Model(p.scene), p.fem.element);
-    } catch (const std::invalid_argument& e) {
-      cfg.Fail("fem_laws", std::string("no FEM for this robot: ") + e.what());
-    }
+    CheckPressureFemCanRun(cfg, "fem_laws", p.scene, p.fem.element);
   }
   return p;
 }

@@ -113,11 +113,7 @@ SolverComparisonParams ReadSolverComparisonParams(const Config& cfg) {
   if (pressure_rows) {
     if (!(p.fem_pressure > 0))
       cfg.Fail("fem_pressure_mpa", "the pressure FEM's end pressure, MPa > 0");
-    try {
-      (void)BuildPressureFemMesh(Model(p.scene), p.fem.element);
-    } catch (const std::invalid_argument& e) {
-      cfg.Fail("methods", std::string("no calculix-pressure-* method for this robot: ") + e.what());
-    }
+    CheckPressureFemCanRun(cfg, "methods", p.scene, p.fem.element);
   }
   p.tip = p.scene.marker_index("tip");
   if (p.tip < 0 || p.scene.marker_index("tip_top") < 0 || p.scene.marker_index("tip_bottom") < 0)

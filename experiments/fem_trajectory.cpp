@@ -1,6 +1,7 @@
 #include "softkin/experiments/fem_trajectory.hpp"
 
 #include "softkin/experiments/measure.hpp"
+#include "softkin/solver/baselines/ccx_run.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -30,6 +31,16 @@ PressureFemOptions ReadPressureFemOptions(const Config& cfg, double default_max_
 void CheckFemLaw(const Config& cfg, const std::string& key, const std::string& law) {
   if (law != "linear" && law != "neo-hooke")
     cfg.Fail(key, "linear (FEM 1) or neo-hooke (FEM 2), not '" + law + "'");
+}
+
+void CheckPressureFemCanRun(const Config& cfg, const std::string& key, const Scene& scene,
+                            const std::string& element) {
+  if (FindCcx().empty()) cfg.Fail(key, "a machine with CalculiX: " + CcxMissingMessage());
+  try {
+    (void)BuildPressureFemMesh(Model(scene), element);
+  } catch (const std::invalid_argument& e) {
+    cfg.Fail(key, std::string("a robot the pressure FEM can mesh: ") + e.what());
+  }
 }
 
 FemTrajectory RunFemTrajectory(const Scene& scene, const Model& model,

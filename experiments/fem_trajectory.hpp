@@ -28,6 +28,11 @@ PressureFemOptions ReadPressureFemOptions(const Config& cfg, double default_max_
 /// Fails on `key` unless law is "linear" or "neo-hooke".
 void CheckFemLaw(const Config& cfg, const std::string& key, const std::string& law);
 
+/// Fails on `key`, before any work, if ccx is missing (with the install hint) or the FEM cannot
+/// mesh the scene with `element` (naming the chamber or actuator).
+void CheckPressureFemCanRun(const Config& cfg, const std::string& key, const Scene& scene,
+                            const std::string& element);
+
 /// One converged FEM increment, measured.
 struct FemTrajectoryPoint {
   double load = 0;          ///< fraction of the pressure ramp
