@@ -18,7 +18,7 @@ Options are passed to \`softkin run\` unchanged, for example:
   --no-plot         skip the paper_figs plot script
   --results DIR     results root (default: results)
 
-Output: results/$NAME/{summary.json, config.json, run.json, trajectory.csv}
+Output: results/$NAME/{summary.json, config.json, run.json, trajectory.csv, fem_trajectory.csv}
         and results/$NAME/$NAME.png
 USAGE
 }
@@ -49,7 +49,7 @@ echo "[main] running: $BUILD_DIR/bin/softkin run $CONFIG $*"
 
 OUT="$RESULTS_ROOT/$NAME"
 [[ "$OUT" = /* ]] || OUT="$ROOT/$OUT"
-echo "[main] results: $OUT/ (summary.json, trajectory.csv, config.json, run.json)"
+echo "[main] results: $OUT/ (summary.json, trajectory.csv, fem_trajectory.csv, config.json, run.json)"
 if [[ -f "$OUT/$NAME.png" ]]; then
   echo "[main] figure:  $OUT/$NAME.png"
 else
