@@ -3,8 +3,8 @@
 #include "softkin/experiments/cli_dataset.hpp"
 #include "softkin/experiments/cli_fk.hpp"
 #include "softkin/experiments/cli_ik.hpp"
-#include "softkin/solver/baselines/ccx_run.hpp"
 #include "softkin/solver/scene/solver_options_json.hpp"
+#include "tests/experiments/cli_test_util.hpp"
 #include "tests/solver/fk/fk_test_util.hpp"
 #include "tests/solver/scene/scene_json_test_util.hpp"
 
@@ -20,36 +20,9 @@
 #include <string>
 #include <vector>
 
+using namespace softkin::cli_test;  // NOLINT: the helpers of every test here
+
 namespace {
-
-struct CliRun {
-  int code;
-  std::string out;
-};
-
-CliRun Cli(const std::string& args) {
-  const std::string cmd = std::string(SOFTKIN_BIN) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf{};
-  while (p && fgets(buf.data(), buf.size(), p)) out += buf.data();
-  const int status = p ? pclose(p) : -1;
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
-
-std::string TempDir(const std::string& name) {
-  auto d = std::filesystem::temp_directory_path() / ("softkin_cli_" + name);
-  std::filesystem::remove_all(d);
-  std::filesystem::create_directories(d);
-  return d.string();
-}
-
-std::string ReadAll(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::ostringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
 
 // An output that is also an input (or another output), or that cannot be written, is refused
 // before any solve, and the input is left as it was; a failed write is an error, not exit 0.
@@ -359,79 +332,6 @@ TEST(Cli, SceneCheckBuildsTheModelAsFkDoes) {
       << r.out;
 }
 
-TEST(Cli, RunWritesSummaryWithConfigCommitAndMachine) {
-  const std::string dir = TempDir("run");
-  const std::string cfg = dir + "/tiny.json";
-  std::ofstream(cfg) << R"({"name": "tiny_bend", "experiment": "pneumatic_bending", "seed": 3,
-    "robot": "three_chamber", "res": 3, "actuator": "c1", "steps": 3,
-    "milestones_deg": [5], "end_value": 1.6})";
-  // three_chamber has no tip_top/tip_bottom: the bending experiment must say so.
-  CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
-  EXPECT_NE(r.code, 0);
-  EXPECT_NE(r.out.find("tip_top"), std::string::npos) << r.out;
-
-  // actuation_paths (Fig. 2.12): a group naming an unknown actuator is rejected with the key.
-  std::ofstream(cfg) << R"({"name": "tiny_paths", "experiment": "actuation_paths", "seed": 3,
-    "robot": "three_chamber", "res": 3, "paths": ["c1", "c1+c9"], "steps": 2})";
-  r = Cli("run " + cfg + " --no-plot --results " + dir);
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.out.find("paths"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("c1+c9"), std::string::npos) << r.out;
-  std::ofstream(cfg) << R"({"name": "tiny_paths", "experiment": "actuation_paths", "seed": 3,
-    "robot": "three_chamber", "res": 3, "paths": ["c1", "c1+c2+c3"], "steps": 2, "end_value": 1.5})";
-  r = Cli("run " + cfg + " --no-plot --results " + dir);
-  ASSERT_EQ(r.code, 0) << r.out;
-  {
-    std::ifstream pf(dir + "/tiny_paths/summary.json");
-    const auto pj = nlohmann::json::parse(pf);
-    ASSERT_EQ(pj["paths"].size(), 2u);
-    EXPECT_EQ(pj["non_converged_steps"], 0);
-    // Equal inflation of all three chambers keeps the tip on the axis (x = z = 0).
-    const auto& tip = pj["paths"][1]["tips"][1];
-    EXPECT_NEAR(tip[0].get<double>(), 0.0, 1e-6);
-    EXPECT_NEAR(tip[2].get<double>(), 0.0, 1e-6);
-  }
-
-  std::ofstream(cfg) << R"({"name": "tiny_aa", "experiment": "aa_ablation", "seed": 3,
-    "robots": ["three_chamber"], "resolutions": [3], "levels": [0.5, 1.0], "solvers": ["newton"]})";
-  r = Cli("run " + cfg + " --no-plot --results " + dir);
-  ASSERT_EQ(r.code, 0) << r.out;
-  std::ifstream f(dir + "/tiny_aa/summary.json");
-  const auto j = nlohmann::json::parse(f);
-  EXPECT_EQ(j["seed"], 3);
-  // The whole other solver runs beside the Anderson variants, compared by time.
-  const auto& full = j["cases"][1];
-  EXPECT_EQ(full["newton"]["status"], "converged");
-  EXPECT_GT(full["newton"]["linear_iterations"].get<int>(), 0);
-  EXPECT_FALSE(full["newton"].contains("aa_accepted"));
-  EXPECT_NEAR(full["newton"]["energy"].get<double>(),
-              full["lg-aa m=6 hybrid"]["energy"].get<double>(),
-              1e-4 * full["lg-aa m=6 hybrid"]["energy"].get<double>());
-  EXPECT_GT(j["time_ratio_full_actuation_by_solver"]["newton"]["min"].get<double>(), 0.0);
-  EXPECT_TRUE(j.contains("git_commit"));
-  EXPECT_TRUE(j["machine"].contains("hardware_threads"));
-  EXPECT_EQ(j["config"]["robots"][0], "three_chamber");
-  EXPECT_TRUE(std::filesystem::exists(dir + "/tiny_aa/aa_ablation.csv"));
-
-  std::ofstream(cfg)
-      << R"({"name": "tiny_aa", "experiment": "aa_ablation", "seed": 3, "robts": []})";
-  r = Cli("run " + cfg + " --no-plot --results " + dir);
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.out.find("robts"), std::string::npos) << r.out;
-  for (const char* bad : {R"(["lg-aa"])", R"(["newtn"])"}) {
-    std::ofstream(cfg) << R"({"name": "tiny_aa", "experiment": "aa_ablation", "seed": 3,
-      "solvers": )" << bad
-                       << "}";
-    r = Cli("run " + cfg + " --no-plot --results " + dir);
-    EXPECT_EQ(r.code, 2) << bad;
-    EXPECT_NE(r.out.find("solvers"), std::string::npos) << r.out;
-  }
-  std::ofstream(cfg) << R"({"name": "x", "experiment": "aa_ablation"})";
-  r = Cli("run " + cfg + " --no-plot --results " + dir);
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.out.find("seed"), std::string::npos) << r.out;
-}
-
 /// An axis-aligned box [lo, hi]^3 as a Wavefront OBJ (outward triangles).
 void WriteBoxObj(const std::string& path, double lo, double hi) {
   std::ofstream f(path);
@@ -441,71 +341,6 @@ void WriteBoxObj(const std::string& path, double lo, double hi) {
                         {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
   for (const auto& tri : t)
     f << "f " << tri[0] + 1 << " " << tri[1] + 1 << " " << tri[2] + 1 << "\n";
-}
-
-// Fig. 2.11 and Table 2.2 carry the pressure-driven FEM (calculix_pressure.hpp) beside SoftKin:
-// its keys are checked before any work, and a tiny ramp is measured as a bending trajectory that
-// inflates the cavity and bends the finger the way SoftKin does.
-TEST(Cli, BendingAndSolverComparisonRunThePressureFem) {
-  const std::string dir = TempDir("pressure_fem");
-  const std::string cfg = dir + "/bend.json";
-  const std::string bend_base =
-      R"("name": "tiny_fem", "experiment": "pneumatic_bending", "seed": 1,
-         "robot": "pneumatic_finger", "res": 5, "steps": 2, "end_value": 1.4)";
-  std::ofstream(cfg) << "{" << bend_base << R"(, "fem_laws": ["rubber"],
-    "fem_pressure_mpa": 0.02})";
-  CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
-  EXPECT_EQ(r.code, 2) << r.out;
-  EXPECT_NE(r.out.find("fem_laws[0]"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("neo-hooke"), std::string::npos) << r.out;
-  std::ofstream(cfg) << "{" << bend_base << R"(, "fem_laws": ["linear"]})";
-  r = Cli("run " + cfg + " --no-plot --results " + dir);
-  EXPECT_EQ(r.code, 2) << r.out;
-  EXPECT_NE(r.out.find("fem_pressure_mpa"), std::string::npos) << r.out;
-  std::ofstream(cfg) << "{" << bend_base << R"(, "fem_laws": ["linear"],
-    "fem_pressure_mpa": 0.02, "fem_element": "C3D8"})";
-  r = Cli("run " + cfg + " --no-plot --results " + dir);
-  EXPECT_EQ(r.code, 2) << r.out;
-  EXPECT_NE(r.out.find("fem_element"), std::string::npos) << r.out;
-  if (softkin::FindCcx().empty()) GTEST_SKIP() << softkin::CcxMissingMessage();
-
-  std::ofstream(cfg) << "{" << bend_base << R"(, "fem_laws": ["neo-hooke"],
-    "fem_pressure_mpa": 0.03, "fem_element": "C3D4", "max_increment": 0.5})";
-  r = Cli("run " + cfg + " --no-plot --results " + dir);
-  ASSERT_EQ(r.code, 0) << r.out;
-  {
-    std::ifstream f(dir + "/tiny_fem/summary.json");
-    const auto j = nlohmann::json::parse(f);
-    const auto& fem = j["fem"]["neo-hooke"];
-    ASSERT_GE(fem["increments"].get<int>(), 1) << fem.dump();
-    EXPECT_GT(fem["end_cavity_ratio"].get<double>(), 1.0);
-    // Inflating the chamber bends the finger the same way as SoftKin's sweep (positive angle).
-    EXPECT_GT(fem["max_bend_deg"].get<double>(), 0.1);
-    EXPECT_GT(j["max_bend_deg"].get<double>(), 0.1);
-    EXPECT_EQ(j["fem"]["element"], "C3D4");
-    std::ifstream csv(dir + "/tiny_fem/fem_trajectory.csv");
-    std::string header, row;
-    std::getline(csv, header);
-    EXPECT_EQ(header.rfind("law,increment,load,pressure_mpa,cavity_ratio,bend_deg", 0), 0u);
-    int rows = 0;
-    while (std::getline(csv, row)) rows += !row.empty();
-    EXPECT_EQ(rows, fem["increments"].get<int>() + 1);  // the rest state, then each increment
-  }
-
-  std::ofstream(cfg) << R"({"name": "tiny_table", "experiment": "solver_comparison", "seed": 1,
-    "robot": "pneumatic_finger", "res": 5, "steps": 2, "end_value": 1.4, "time_limit_s": 60,
-    "methods": ["lg-aa", "calculix-pressure-nonlinear"], "fem_pressure_mpa": 0.03,
-    "fem_element": "C3D4", "max_increment": 0.5})";
-  r = Cli("run " + cfg + " --no-plot --results " + dir);
-  ASSERT_EQ(r.code, 0) << r.out;
-  std::ifstream f(dir + "/tiny_table/summary.json");
-  const auto j = nlohmann::json::parse(f);
-  const auto& row = j["methods"]["calculix_pressure_nonlinear"];
-  EXPECT_TRUE(row["status"] == "reached_end" || row["status"] == "stopped") << row.dump();
-  EXPECT_GE(row["iterations"].get<int>(), 1);
-  EXPECT_GT(row["end_cavity_ratio"].get<double>(), 1.0);
-  EXPECT_TRUE(row["energy"].is_null());  // the FEM's chambers are hollow: no Eq. 2.10 energy
-  EXPECT_TRUE(j.contains("speedup_vs_calculix_pressure_nonlinear"));
 }
 
 TEST(Cli, TessellateMeshesABoxChamberInABoxBody) {
@@ -556,16 +391,6 @@ TEST(Cli, TessellateMeshesABoxChamberInABoxBody) {
 }  // namespace
 
 // ---- softkin ik ----------------------------------------------------------------------------
-
-namespace {
-
-int CountLines(const std::string& text) {
-  int n = 0;
-  for (char c : text) n += c == '\n';
-  return n;
-}
-
-}  // namespace
 
 TEST(Cli, IkHelpDocumentsEveryOption) {
   const CliRun r = Cli("ik --help");
@@ -677,101 +502,6 @@ TEST(Cli, IkReachesAForwardSolvedTargetAndResumesATrajectory) {
           dir + "/path.csv --resume");
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("path.csv:2"), std::string::npos) << r.out;
-}
-
-// Table 3.1's cost experiment checks every robot's keys before it runs the first, including the
-// progressive remeshing object of a robot driven as Algorithm 2 does.
-TEST(Cli, CollisionCostsRejectsABadRemeshKeyBeforeRunningAny) {
-  const std::string dir = TempDir("collision_costs_bad_remesh");
-  const std::string cfg = dir + "/bad.json";
-  for (const auto& [remesh, message] : std::vector<std::pair<std::string, std::string>>{
-           {R"({"alpha_max": "four"})", "robots[1].remesh.alpha_max: expected a finite number"},
-           {R"({"alpha": 4})", "robots[1].remesh.alpha: expected one of alpha_max, d_max, method"},
-           {R"({"method": "all"})", "robots[1].remesh.method: expected auto, chamber or whole"},
-           {R"({"chamber_rest": "deformed"})",
-            "robots[1].remesh.chamber_rest: expected remeshed or original"},
-           {R"({"d_max": 0.5})", "robots[1].remesh.d_max: expected"},
-           {R"([4])", "robots[1].remesh: expected an object"}}) {
-    SCOPED_TRACE(remesh);
-    std::ofstream(cfg) << R"({"name": "bad_costs", "experiment": "collision_costs", "seed": 1,
-      "robots": [{"robot": "selfcollision_finger", "res": 5, "steps": 1, "actuation": {"chamber": 1.5}},
-                 {"robot": "twisting_robot", "res": 1, "steps": 2, "actuation": {"chamber": 3.0},
-                  "remesh": )"
-                       << remesh << "}]}";
-    const CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
-    EXPECT_NE(r.code, 0);
-    EXPECT_NE(r.out.find(cfg + ": " + message), std::string::npos) << r.out;
-    EXPECT_EQ(r.out.find("[selfcollision_finger 1/1]"), std::string::npos)
-        << r.out;  // robot 0 never ran
-  }
-  // A robot's own collision options are checked up front too.
-  std::ofstream(cfg) << R"({"name": "bad_costs", "experiment": "collision_costs", "seed": 1,
-    "robots": [{"robot": "selfcollision_finger", "res": 5, "steps": 1, "actuation": {"chamber": 1.5}},
-               {"robot": "membrane", "res": 10, "steps": 1, "actuation": {"c1": 1.5},
-                "collision": {"stiffness": "soft"}}]})";
-  const CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
-  EXPECT_NE(r.code, 0);
-  EXPECT_NE(
-      r.out.find(cfg + ": robots[1].collision.stiffness: expected a number > 0, got \"soft\""),
-      std::string::npos)
-      << r.out;
-  EXPECT_EQ(r.out.find("[selfcollision_finger 1/1]"), std::string::npos) << r.out;
-}
-
-// A collision sweep reads every variant before it runs the first: a bad key in the last one
-// fails at once, naming the file and the key, and no variant's output is written.
-TEST(Cli, CollisionSweepRejectsABadVariantBeforeRunningAny) {
-  const std::string dir = TempDir("collision_bad_variant");
-  const std::string cfg = dir + "/bad.json";
-  std::ofstream(cfg) << R"({"name": "bad_sweep", "experiment": "collision_sweep", "seed": 1,
-    "robot": "selfcollision_finger", "res": 5, "steps": 1, "actuation": {"chamber": 1.5},
-    "variants": [{"name": "ok", "collision": {"self": true}},
-                 {"name": "bad", "collision": {"self": true, "self_spring": "glue"}}]})";
-  const CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
-  EXPECT_NE(r.code, 0);
-  EXPECT_NE(
-      r.out.find(
-          cfg + ": variants[1].collision.self_spring: expected one of: target, pair, got \"glue\""),
-      std::string::npos)
-      << r.out;
-  EXPECT_EQ(r.out.find("[ok 1/1]"), std::string::npos) << r.out;  // variant 0 never ran
-  EXPECT_FALSE(std::filesystem::exists(dir + "/bad_sweep/steps.csv"));
-}
-
-// A solver scaling study reads every case before it solves: a bad solver name in the last case
-// fails at once with the key. A tiny valid one writes one converged row per (res, solver) and the
-// growth of the iteration count per solver.
-TEST(Cli, SolverScalingChecksEveryCaseAndReportsTheGrowth) {
-  const std::string dir = TempDir("solver_scaling");
-  const std::string bad = dir + "/bad.json";
-  std::ofstream(bad) << R"({"name": "bad_scaling", "experiment": "solver_scaling", "seed": 1,
-    "cases": [{"robot": "three_chamber", "resolutions": [3], "actuation": [1.2, 1, 1],
-               "solvers": ["newton"]},
-              {"robot": "three_chamber", "resolutions": [3], "actuation": [1.2, 1, 1],
-               "solvers": ["newtonn"]}]})";
-  CliRun r = Cli("run " + bad + " --no-plot --results " + dir);
-  EXPECT_NE(r.code, 0);
-  EXPECT_NE(r.out.find(bad + ": cases[1].solvers: expected FK solver names"), std::string::npos)
-      << r.out;
-  EXPECT_EQ(r.out.find("res 3 ("), std::string::npos) << r.out;  // nothing was solved
-  const std::string good = dir + "/good.json";
-  std::ofstream(good) << R"({"name": "tiny_scaling", "experiment": "solver_scaling", "seed": 1,
-    "cases": [{"robot": "three_chamber", "resolutions": [3, 4], "actuation": [1.2, 1, 1],
-               "solvers": ["newton", "lg-aa"]}]})";
-  r = Cli("run " + good + " --no-plot --results " + dir);
-  ASSERT_EQ(r.code, 0) << r.out;
-  const std::string csv = ReadAll(dir + "/tiny_scaling/scaling.csv");
-  EXPECT_EQ(CountLines(csv), 5) << csv;  // header + 2 res x 2 solvers
-  const auto j = nlohmann::json::parse(ReadAll(dir + "/tiny_scaling/summary.json"));
-  for (const char* solver : {"newton", "lg-aa"}) {
-    const auto& g = j["growth"]["three_chamber"][solver];
-    EXPECT_TRUE(g["all_converged"].get<bool>()) << g;
-    EXPECT_GT(g["iteration_growth"].get<double>(), 0.0) << g;
-  }
-  for (const auto& row : j["rows"]) {
-    EXPECT_EQ(row["status"], "converged") << row;
-    EXPECT_LT(row["residual_ratio"].get<double>(), 1e-6) << row;
-  }
 }
 
 TEST(Cli, IkExperimentsRunTinyConfigsAndRejectBadPaths) {
