@@ -130,9 +130,9 @@ BendingParams ReadBendingParams(const Config& cfg) {
 
 /// What the sweep measured.
 struct BendingSweep {
-  double cumulative = 0.0, max_bend = 0.0;
-  int total_iters = 0, failures = 0;
-  std::vector<double> reach;  ///< solve time to each milestone, -1: not reached
+  double cumulative = 0.0, max_bend = 0.0;          ///< max_bend: over the converged steps
+  int total_iters = 0, failures = 0, inverted = 0;  ///< inverted: steps ended `inverted`
+  std::vector<double> reach;  ///< solve time to each milestone (at a converged step), -1: none
   nlohmann::json tips = nlohmann::json::array(), step_times = nlohmann::json::array();
 };
 
@@ -147,12 +147,13 @@ BendingSweep Sweep(const BendingParams& p, const std::shared_ptr<const Model>& m
   if (p.has_bend) bend = std::make_unique<BendAngle>(scene);
   CsvWriter csv(dir + "/trajectory.csv",
                 {"step", "actuation", "bend_deg", "tip_x", "tip_y", "tip_z", "iterations", "time_s",
-                 "cumulative_s", "energy", "volume_ratio", "residual_ratio", "converged"});
+                 "cumulative_s", "energy", "volume_ratio", "residual_ratio", "converged",
+                 "inverted_elements"});
   std::vector<std::pair<double, std::string>> frames;
   if (p.vtu_every > 0) std::filesystem::create_directories(dir + "/frames");
   const Eigen::MatrixX3d rest_tip = scene.marker_positions(scene.mesh.vertices);
   csv.Row({0, act.rest, 0.0, rest_tip(tip, 0), rest_tip(tip, 1), rest_tip(tip, 2), 0, 0, 0, 0, 1.0,
-           0, 1});
+           0, 1, 0});
 
   Eigen::VectorXd c = scene.rest_actuation();
   Eigen::MatrixX3d X = scene.mesh.vertices, X_prev = X, guess;
@@ -176,15 +177,18 @@ BendingSweep Sweep(const BendingParams& p, const std::shared_ptr<const Model>& m
     b.total_iters += r.iterations;
     const bool ok = r.status == FkStatus::Converged;
     if (!ok) ++b.failures;
+    b.inverted += r.status == FkStatus::Inverted;
     const double ang = p.has_bend ? (*bend)(X) : 0.0;
-    b.max_bend = std::max(b.max_bend, ang);
+    if (ok) b.max_bend = std::max(b.max_bend, ang);  // of the converged steps
+    // A milestone counts at a converged step only (not at one with inverted elements).
     for (size_t m = 0; m < p.milestones.size(); ++m)
-      if (b.reach[m] < 0 && ang >= p.milestones[m]) b.reach[m] = b.cumulative;
+      if (ok && b.reach[m] < 0 && ang >= p.milestones[m]) b.reach[m] = b.cumulative;
     const Eigen::MatrixX3d P = scene.marker_positions(X);
     b.tips.push_back({P(tip, 0), P(tip, 1), P(tip, 2)});
     b.step_times.push_back(r.time_s);
     csv.Row({double(s), c[a], ang, P(tip, 0), P(tip, 1), P(tip, 2), double(r.iterations), r.time_s,
-             b.cumulative, r.energy, r.volume_ratios[a], r.gradient_ratio, ok ? 1.0 : 0.0});
+             b.cumulative, r.energy, r.volume_ratios[a], r.gradient_ratio, ok ? 1.0 : 0.0,
+             double(r.inverted_elements)});
     if (p.vtu_every > 0 && (s % p.vtu_every == 0 || s == steps)) {
       char name[64];
       std::snprintf(name, sizeof(name), "frames/step_%04d.vtu", s);
@@ -263,6 +267,7 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
   j["model_build_s"] = build_s;
   j["factor_s"] = model->factor_time_s();
   j["non_converged_steps"] = b.failures;
+  j["inverted_steps"] = b.inverted;
   j["solver"] = ToString(p.opts.solver);
   j["anderson_window"] = p.opts.anderson_window;
   j["predictor"] = p.predictor;

@@ -211,7 +211,9 @@ std::string SimulatorKinematics::Solve(const Eigen::VectorXd& c, const Eigen::Ma
     if (from_rest) *from_rest = true;
     run(*solver_, nullptr, "rest retry");
   }
-  if (r->status == FkStatus::Converged) return "";
+  // An inverted state is the solver's fixed point: IK sees it and reports its inverted elements
+  // (KinematicsEval::inverted_elements), so that no waypoint counts it as reached.
+  if (r->status == FkStatus::Converged || r->status == FkStatus::Inverted) return "";
   std::ostringstream s;
   s << "forward solve at c = (" << c.transpose() << ") ended with status "
     << FkStatusToString(r->status) << (r->message.empty() ? "" : ": ") << r->message;

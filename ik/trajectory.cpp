@@ -302,7 +302,8 @@ TrajectoryResult FollowTrajectory(Kinematics& kin,
       wr.reached = ik.p.row(k).transpose();
       wr.error_mm = (wr.reached - wr.target).norm();
       wr.objective = ik.objective;
-      wr.converged = ik.summary.converged();
+      // A reached point in a state with inverted body elements is not a physical answer.
+      wr.converged = ik.summary.converged() && ik.inverted_elements == 0;
       wr.inverted_elements = ik.inverted_elements;
       wr.min_volume_ratio = ik.min_volume_ratio;
     } else {  // not even c_prev could be evaluated: no point to report

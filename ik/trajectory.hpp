@@ -89,9 +89,9 @@ struct WaypointResult {
   /// evaluated (the kinematics failed there; `message` says why).
   double error_mm = 0.0;
   double objective = 0.0;  ///< error_mm^2 (-1 as error_mm)
-  bool converged = false;  ///< objective <= lambda
+  bool converged = false;  ///< objective <= lambda, in a state with no inverted body element
   /// Body elements inverted in the simulated state at c (IkResult): > 0 flags a reached point
-  /// that is not a physical answer (converged counts the objective only).
+  /// that is not a physical answer (such a waypoint is never `converged`).
   int inverted_elements = 0;
   double min_volume_ratio = 1.0;
   IkTermination termination = IkTermination::kConverged;

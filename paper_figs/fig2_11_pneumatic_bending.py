@@ -21,7 +21,8 @@ import figlib
 
 NAME = "fig2_11_pneumatic_bending"
 COLUMNS = ["step", "actuation", "bend_deg", "tip_x", "tip_y", "tip_z", "iterations", "time_s",
-           "cumulative_s", "energy", "volume_ratio", "residual_ratio", "converged"]
+           "cumulative_s", "energy", "volume_ratio", "residual_ratio", "converged",
+           "inverted_elements"]
 FEM_COLUMNS = ["law", "increment", "load", "pressure_mpa", "cavity_ratio", "bend_deg", "tip_x",
                "tip_y", "tip_z", "wall_s"]
 FEM_STYLE = {"linear": ("FEM 1 (linear, pressure)", "tab:purple", "--"),
@@ -111,7 +112,9 @@ def main(argv):
     ax0.plot(x[0], z[0], "ks", ms=7, zorder=4, label="rest")
     if bad:
         ax0.scatter([x[i] for i in bad], [z[i] for i in bad], s=60, facecolors="none",
-                    edgecolors="red", zorder=5, label="not converged")
+                    edgecolors="red", zorder=5,
+                    label="not converged (inverted elements)"
+                    if any(rows[i]["inverted_elements"] > 0 for i in bad) else "not converged")
     for m, c in cross.items():
         if c is not None:
             ax0.plot(c[0], c[1], marker="*", ms=15, ls="none", color=colors[m], mec="k",
@@ -133,6 +136,9 @@ def main(argv):
     # Right: bend angle against the chamber volume ratio reached.
     solver = summary.get("solver", "local-global")
     ax1.plot(vol, bend, "-o", ms=3, color="tab:blue", label=f"SoftKin ({solver})")
+    if bad:
+        ax1.scatter([vol[i] for i in bad], [bend[i] for i in bad], s=60, facecolors="none",
+                    edgecolors="red", zorder=5)
     for law, frows in fem.items():
         label, color, ls = FEM_STYLE.get(law, (f"FEM ({law})", "0.4", ":"))
         info = fem_info.get(law, {})
@@ -180,9 +186,11 @@ def main(argv):
 
     robot = summary.get("robot", "pneumatic_finger")
     quick = " (quick run)" if summary.get("quick") else ""
-    max_bend = max(bend)
+    good = [b for i, b in enumerate(bend) if i not in bad]
+    max_bend = max(good) if good else 0.0
+    flagged = f", {len(bad)} step(s) not converged" if bad else ""
     fig.suptitle(f"Thesis Fig. 2.11 / Table 2.2: {robot} under pneumatic actuation{quick}; "
-                 f"max bend {max_bend:.0f}\N{DEGREE SIGN}")
+                 f"max bend {max_bend:.0f}\N{DEGREE SIGN} (converged steps){flagged}")
     figlib.save_figure(fig, results, NAME)
     return 0
 

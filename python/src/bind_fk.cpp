@@ -190,7 +190,8 @@ void BindFk(py::module_& m) {
           "Marker name -> position (3,), mm.")
       .def_property_readonly(
           "status", [](const PyFkResult& p) { return std::string(FkStatusToString(p.r.status)); },
-          "converged, iteration_cap, diverged, invalid_input or time_limit.")
+          "converged, iteration_cap, diverged, invalid_input, time_limit or inverted (met the "
+          "tolerance at a state with inverted body elements).")
       .def_property_readonly("converged",
                              [](const PyFkResult& p) { return p.r.status == FkStatus::Converged; })
       .def_property_readonly("message", [](const PyFkResult& p) { return p.r.message; })

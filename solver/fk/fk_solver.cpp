@@ -23,13 +23,15 @@ const char* FkStatusToString(FkStatus s) {
       return "invalid_input";
     case FkStatus::TimeLimit:
       return "time_limit";
+    case FkStatus::Inverted:
+      return "inverted";
   }
   return "unknown";
 }
 
 bool FkStatusFromString(const std::string& s, FkStatus* out) {
   for (FkStatus v : {FkStatus::Converged, FkStatus::IterationCap, FkStatus::Diverged,
-                     FkStatus::InvalidInput, FkStatus::TimeLimit})
+                     FkStatus::InvalidInput, FkStatus::TimeLimit, FkStatus::Inverted})
     if (s == FkStatusToString(v)) {
       *out = v;
       return true;
@@ -70,6 +72,15 @@ FkResult FkSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
                          const Eigen::MatrixX3d* warm_start) {
   FkResult r = SolveImpl(c, warm_start);
   ReportInvertedElements(*model_, &r);
+  if (r.status == FkStatus::Converged && r.inverted_elements > 0) {
+    char buf[160];
+    std::snprintf(buf, sizeof(buf),
+                  "met the tolerance, but %d body element(s) are inverted (smallest volume ratio "
+                  "%.3g): not a state a material takes",
+                  r.inverted_elements, r.min_volume_ratio);
+    r.status = FkStatus::Inverted;
+    r.message = r.message.empty() ? buf : r.message + "; " + buf;
+  }
   return r;
 }
 

@@ -14,8 +14,11 @@
 
 namespace softkin {
 
-/// TimeLimit: FkOptions::time_limit_s ran out (the positions are the last checked iterate).
-enum class FkStatus { Converged, IterationCap, Diverged, InvalidInput, TimeLimit };
+/// How a solve ended. TimeLimit: FkOptions::time_limit_s ran out (the positions are the last
+/// checked iterate). Inverted: the iteration met its tolerance, but body elements of the state
+/// are inverted (signed volume <= 0), a state no material takes; it is never reported as
+/// converged (FkSolver::Solve).
+enum class FkStatus { Converged, IterationCap, Diverged, InvalidInput, TimeLimit, Inverted };
 const char* FkStatusToString(FkStatus s);
 bool FkStatusFromString(const std::string& s, FkStatus* out);
 

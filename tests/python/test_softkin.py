@@ -108,6 +108,13 @@ def test_newton_and_lg_aa_agree_through_python(finger):
     assert np.abs(a.positions - b.positions).max() < 1e-2
 
 
+def test_a_state_with_inverted_elements_is_not_converged():
+    bar = softkin.robot("bimaterial_bar", res=4)
+    r = softkin.FkSolver(bar, solver="lg-aa", threads=1).solve([180.0, 40.0])
+    assert r.status == "inverted" and not r.converged
+    assert r.inverted_elements > 0 and "are inverted" in r.message
+
+
 def test_options_are_the_scene_json_keys_with_its_messages(finger):
     solver = softkin.FkSolver(finger, solver="lg", max_iterations=50, threads=1)
     assert solver.options["solver"] == "lg" and solver.options["max_iterations"] == 50
