@@ -22,6 +22,11 @@
 ///    and always before stopping); the spring targets join the right-hand side and their k the
 ///    matrix, whose factor follows the spring set by CHOLMOD update/downdate. A change of the
 ///    spring set restarts the Anderson history (the map G changed).
+///    A cold solve with contacts ramps the actuation (continuation_steps stages) and cuts a stage
+///    in half, from its start, when the contact response tangles: at a check, the inverted body
+///    elements have grown by more than max(16, 0.5 % of the elements) since the stage began while
+///    the residual is above its reference (a step that crossed thin gaps before the first check,
+///    whose springs then push the wrong way). Up to kMaxCutBacks halvings per solve.
 ///  - stop when every vertex moves less than tolerance * size in one iteration AND the residual
 ///    ||2 (A X - B)|| has dropped below gradient_tolerance times its reference (the larger of its
 ///    value at the warm start and at the rest shape for the same actuation).
@@ -50,7 +55,10 @@ class LocalGlobalSolver : public FkSolver {
 
  private:
   /// One continuation stage: iterate from X towards the solution for c; accumulates into r.
-  void SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X, FkResult* r);
+  /// With detect_tangle, returns false (status diverged) when the contact response tangled
+  /// (above); otherwise true.
+  bool SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X, FkResult* r, bool detect_tangle);
+  static constexpr int kMaxCutBacks = 6;
   FkOptions options_;
   ContactTermFactory contacts_;
   std::unique_ptr<ContactTerm> response_;  // springs of Eq. 3.5-3.9, when active

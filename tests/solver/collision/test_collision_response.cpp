@@ -596,6 +596,32 @@ TEST(CollisionResponse, SelfCollidingFingerBendsCollisionFreeWithBalancedForces)
   EXPECT_GT(target.reaction_sum, 10 * pair.reaction_sum);
 }
 
+// From rest straight to alpha = 2, the first global step pushes the fingers' segments across
+// their 0.2 mm slits before any contact check; the springs then pull the wrong way and the state
+// tangles. lg-aa sees the tangle, restarts the stage with half the load step, and ends where an
+// explicit two-stage continuation ends.
+TEST(CollisionResponse, ColdSelfContactSolveCutsTheLoadStepBackWhenItTangles) {
+  const Scene scene = MakeRobot("selfcollision_finger", 6, {});
+  ASSERT_EQ(scene.solver.continuation_steps, 1);
+  auto model = std::make_shared<const Model>(scene);
+  Eigen::VectorXd c(1);
+  c << 2.0;
+  const FkResult cold = MakeFkSolver(model, scene.solver)->Solve(c);
+  ASSERT_EQ(cold.status, FkStatus::Converged) << cold.BriefReport();
+  EXPECT_NE(cold.message.find("cut the load step back 1 time(s)"), std::string::npos)
+      << cold.message;
+  EXPECT_TRUE(cold.collision.collision_free()) << cold.BriefReport();
+  EXPECT_EQ(cold.inverted_elements, 0);
+  FkOptions two = scene.solver;
+  two.continuation_steps = 2;
+  const FkResult staged = MakeFkSolver(model, two)->Solve(c);
+  ASSERT_EQ(staged.status, FkStatus::Converged) << staged.BriefReport();
+  EXPECT_EQ(staged.message.find("cut the load step"), std::string::npos) << staged.message;
+  // Same fixed point to the stopping rule (tolerance 1e-5 of the size per iteration).
+  EXPECT_LT((cold.positions - staged.positions).rowwise().norm().maxCoeff(), 1e-3 * model->size());
+  EXPECT_NEAR(cold.energy, staged.energy, 1e-4 * staged.energy);
+}
+
 TEST(CollisionResponse, BlockPressedIntoAnObstacleStaysOut) {
   // One block, its top face pressed 3 mm down onto a box obstacle under it. The moved top face is
   // held in every coordinate; nothing else is fixed.
