@@ -340,8 +340,11 @@ FkResult LocalGlobalSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c
       discarded.stiffenings += st.stiffenings;
       discarded.check_s += st.check_s;
       discarded.response_s += st.response_s;
-      // A fresh contact term: Reset() after a tangled state left the next stage 3x slower
-      // (selfcollision_finger: 2,633 iterations against 812).
+      // A fresh contact term, so that the retry is the solve a new solver with that load step
+      // makes (the contact events, and so the iteration count, are sensitive to round-off: a
+      // Reset() term, whose factor went through CHOLMOD updates and downdates, took 3,952
+      // iterations here against 1,821 on selfcollision_finger res 8, and 1,065 against 1,199
+      // at res 6; refactoring it on Reset() changed nothing).
       response_ = contacts_(*model_, options_.collision);
       response_->Reset();
       h = 0.5 * (t_next - t);
