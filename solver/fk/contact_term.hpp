@@ -45,6 +45,8 @@ struct CollisionStats {
   int stiffenings = 0;    ///< times k was raised (CollisionResponse::Stiffen)
   double check_s = 0;     ///< detection (self + obstacles)
   double response_s = 0;  ///< targets, release rule and the factor update
+  /// Adds the counts and times of `o` (max_springs: the larger of the two).
+  void Add(const CollisionStats& o);
 };
 
 /// Contact handling inside the local-global iteration (Algorithm 1 with Eq. 3.9). Free-coordinate

@@ -84,10 +84,8 @@ FkResult FkSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
   return r;
 }
 
-void ReportInvertedElements(const Model& model, FkResult* r) {
-  const Eigen::MatrixX3d& X = r->positions;
-  if (X.rows() != model.num_vertices() || !X.allFinite()) return;
-  int body = 0, actuation = 0;
+InvertedCount CountInverted(const Model& model, const Eigen::MatrixX3d& X) {
+  InvertedCount n;
   double worst = std::numeric_limits<double>::infinity();
   ElemRows P = ElemRows::Zero();
   for (const ModelElement& e : model.elements()) {
@@ -95,14 +93,22 @@ void ReportInvertedElements(const Model& model, FkResult* r) {
     const double ratio = RowsVolume(P, e.k) / e.rest_volume;
     if (e.role == ElementRole::Body) {
       worst = std::min(worst, ratio);
-      body += ratio <= 0.0;
+      n.body += ratio <= 0.0;
     } else {
-      actuation += ratio <= 0.0;
+      n.actuation += ratio <= 0.0;
     }
   }
-  r->inverted_elements = body;
-  r->inverted_actuation_elements = actuation;
-  r->min_volume_ratio = std::isfinite(worst) ? worst : 1.0;  // 1: no body elements
+  if (std::isfinite(worst)) n.min_body_ratio = worst;
+  return n;
+}
+
+void ReportInvertedElements(const Model& model, FkResult* r) {
+  const Eigen::MatrixX3d& X = r->positions;
+  if (X.rows() != model.num_vertices() || !X.allFinite()) return;
+  const InvertedCount n = CountInverted(model, X);
+  r->inverted_elements = n.body;
+  r->inverted_actuation_elements = n.actuation;
+  r->min_volume_ratio = n.min_body_ratio;
 }
 
 std::string SolveInputError(const Model& m, const Eigen::Ref<const Eigen::VectorXd>& c,

@@ -79,6 +79,15 @@ class FkSolver {
   std::shared_ptr<const Model> model_;
 };
 
+/// Elements of a model whose signed volume is not positive, body and actuation elements apart,
+/// and the smallest signed / rest volume ratio of a body element (1 if it has none).
+struct InvertedCount {
+  int body = 0, actuation = 0;
+  double min_body_ratio = 1.0;
+};
+/// InvertedCount of `model` at positions X (#V x 3, finite).
+InvertedCount CountInverted(const Model& model, const Eigen::MatrixX3d& X);
+
 /// Counts the elements of `model` whose signed volume at r->positions is not positive (body and
 /// actuation elements apart) and the smallest signed / rest volume ratio of a body element, into
 /// r->inverted_elements, inverted_actuation_elements and min_volume_ratio. Positions that are

@@ -3,7 +3,6 @@
 #include "softkin/solver/fk/anderson.hpp"
 #include "softkin/solver/fk/energy.hpp"
 #include "softkin/solver/fk/targets.hpp"
-#include "softkin/solver/mesh/element_geometry.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -104,20 +103,6 @@ struct StageEvaluation {
 };
 }  // namespace
 
-namespace {
-/// Body elements whose signed volume at X is not positive.
-int CountInvertedBody(const Model& m, const Eigen::MatrixX3d& X) {
-  int n = 0;
-  ElemRows P = ElemRows::Zero();
-  for (const ModelElement& e : m.elements()) {
-    if (e.role != ElementRole::Body) continue;
-    for (int j = 0; j < e.k; ++j) P.row(j) = X.row(e.v[j]);
-    n += RowsVolume(P, e.k) <= 0.0;
-  }
-  return n;
-}
-}  // namespace
-
 LocalGlobalSolver::LocalGlobalSolver(std::shared_ptr<const Model> model, const FkOptions& options,
                                      ContactTermFactory contacts)
     : FkSolver(std::move(model)), options_(options), contacts_(std::move(contacts)) {
@@ -177,7 +162,7 @@ bool LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
       return true;
     }
     if (resp && detect_tangle && it % interval == 0) {
-      const int inverted = CountInvertedBody(m, X);
+      const int inverted = CountInverted(m, X).body;
       if (it == 0) inverted_at_start = inverted;
       if (inverted - inverted_at_start > tangle_limit && r->gradient_ratio > 1.0) {
         X = X_good;
@@ -331,15 +316,7 @@ FkResult LocalGlobalSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c
       if (cuts++ == 0) first_tangle = r.message;
       r.positions = start;
       r.message.clear();
-      const CollisionStats st = response_->stats();
-      discarded.checks += st.checks;
-      discarded.springs_added += st.springs_added;
-      discarded.springs_released += st.springs_released;
-      discarded.max_springs = std::max(discarded.max_springs, st.max_springs);
-      discarded.unresolved += st.unresolved;
-      discarded.stiffenings += st.stiffenings;
-      discarded.check_s += st.check_s;
-      discarded.response_s += st.response_s;
+      discarded.Add(response_->stats());
       // A fresh contact term, so that the retry is the solve a new solver with that load step
       // makes (the contact events, and so the iteration count, are sensitive to round-off: a
       // Reset() term, whose factor went through CHOLMOD updates and downdates, took 3,952
@@ -366,15 +343,7 @@ FkResult LocalGlobalSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c
     r.collision_active = true;
     r.springs = response_->num_springs();
     r.collision_stats = response_->stats();
-    CollisionStats& cs = r.collision_stats;
-    cs.checks += discarded.checks;
-    cs.springs_added += discarded.springs_added;
-    cs.springs_released += discarded.springs_released;
-    cs.max_springs = std::max(cs.max_springs, discarded.max_springs);
-    cs.unresolved += discarded.unresolved;
-    cs.stiffenings += discarded.stiffenings;
-    cs.check_s += discarded.check_s;
-    cs.response_s += discarded.response_s;
+    r.collision_stats.Add(discarded);
     const auto tc = Clock::now();
     r.collision = response_->Check(r.positions);  // the exact check of the final state
     r.collision_stats.check_s += Seconds(tc, Clock::now());

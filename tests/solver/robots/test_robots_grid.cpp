@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <functional>
 #include <array>
+#include <iostream>
 #include <map>
 #include <string>
 
@@ -27,12 +28,6 @@ struct GridOutcome {
 
 /// Points that failed or ended inverted (for robots whose range inverts nothing).
 int FailedOrInverted(const GridOutcome& g) { return g.failed + g.inverted; }
-
-std::string Join(const Eigen::VectorXd& c) {
-  std::string t;
-  for (int i = 0; i < c.size(); ++i) t += (i ? " " : "") + std::to_string(c[i]);
-  return t;
-}
 
 /// Solves every point of the grid values[0] x values[1] x ... (one list per actuator) in
 /// serpentine order, each warm-started from the previous solution (as a sweep or a dataset
@@ -60,8 +55,9 @@ GridOutcome SolveGrid(
       EXPECT_EQ(r.status == FkStatus::Inverted, r.inverted_elements > 0);
       out.inverted += r.status == FkStatus::Inverted;
       if (r.status == FkStatus::Inverted)
-        std::printf("  %s at (%s): %d inverted body elements, smallest volume ratio %.3g\n",
-                    s.name.c_str(), Join(c).c_str(), r.inverted_elements, r.min_volume_ratio);
+        std::cout << "  " << s.name << " at (" << c.transpose() << "): " << r.inverted_elements
+                  << " inverted body elements, smallest volume ratio " << r.min_volume_ratio
+                  << "\n";
       X = r.positions;
       if (check) check(c, r);
     }
