@@ -100,6 +100,10 @@ class NewtonSolver : public FkSolver {
   /// false with *why if the linearisation or the preconditioner cannot be set up.
   bool Direction(const Eigen::VectorXd& c, const State& s, double eta, Eigen::VectorXd* d,
                  FkResult* r, std::string* why);
+  /// kSmoothingSteps local-global steps from s (re-evaluated at each): applied to every trial
+  /// point of the line search, they remove the stretch a straight-line step leaves in rotating
+  /// elements (newton_solver.cpp).
+  void Smooth(const Eigen::VectorXd& c, State* s);
   /// The geodesic acceleration of the Newton direction d at s: *acc (#V x 3) = a / 2 with
   /// H a = -g''[d, d], the second derivative of g along d by differences (h = 0.1); zero when it
   /// is not finite or |a| >= 1.5 |d|. *probe is scratch. Uses the linearisation and factor that

@@ -194,22 +194,26 @@ TEST(NewtonSolver, MooneyRivlinBodiesAreLeftToLgAaWithAReason) {
   EXPECT_NE(nw.message.find("lg-aa"), std::string::npos) << nw.message;
 }
 
-// Where the projected Hessian is no preconditioner for H (multi_segment_gripper with every chamber
-// at volume ratio 8, where GMRES makes no progress), Newton gives up early and lg-aa reaches the
-// same state as lg-aa alone, with the reason in the message. That state flattens 4 body elements
-// of the first segment, so both report it `inverted`, not converged.
+// Where the projected Hessian is no preconditioner for H (multi_segment_gripper res 7 with every
+// chamber at volume ratio 8, where GMRES makes no progress), Newton gives up early, with the
+// reason in the message, and lg-aa continues from the rest shape: the same iterations as lg-aa
+// alone (compared after 300 of them; lg-aa needs about 6,600 to converge here). At res 6 Newton
+// solves this case itself since it smooths its trial points.
 TEST(NewtonSolver, StalledKrylovSolvesHandOverToLgAa) {
-  auto model = std::make_shared<const Model>(MakeRobot("multi_segment_gripper", 6));
+  auto model = std::make_shared<const Model>(MakeRobot("multi_segment_gripper", 7));
   const Eigen::VectorXd c = Eigen::Vector3d(8.0, 8.0, 8.0);
-  const FkResult nw = MakeFkSolver(model, Options("newton", 1e-5, 1e-6))->Solve(c);
-  const FkResult lg = MakeFkSolver(model, Options("lg-aa", 1e-5, 1e-6))->Solve(c);
-  ASSERT_EQ(lg.status, FkStatus::Inverted) << lg.BriefReport();
-  EXPECT_EQ(nw.status, FkStatus::Inverted) << nw.BriefReport();
-  EXPECT_EQ(nw.inverted_elements, lg.inverted_elements);
+  FkOptions on = Options("newton", 1e-5, 1e-6), ol = Options("lg-aa", 1e-5, 1e-6);
+  on.max_iterations = ol.max_iterations = 300;
+  const FkResult nw = MakeFkSolver(model, on)->Solve(c);
+  const FkResult lg = MakeFkSolver(model, ol)->Solve(c);
+  ASSERT_EQ(lg.status, FkStatus::IterationCap) << lg.BriefReport();
+  EXPECT_EQ(nw.status, FkStatus::IterationCap) << nw.BriefReport();
   EXPECT_NE(nw.message.find("stalled"), std::string::npos) << nw.message;
-  EXPECT_NE(nw.message.find("continued with lg-aa"), std::string::npos) << nw.message;
-  EXPECT_LT((nw.positions - lg.positions).rowwise().norm().maxCoeff(), 1e-3 * model->size());
-  EXPECT_NEAR(nw.energy, lg.energy, 1e-6 * lg.energy);
+  EXPECT_NE(nw.message.find("continued with lg-aa from the rest shape"), std::string::npos)
+      << nw.message;
+  EXPECT_GT(nw.linear_iterations, 0);
+  EXPECT_LT((nw.positions - lg.positions).rowwise().norm().maxCoeff(), 1e-9 * model->size());
+  EXPECT_NEAR(nw.energy, lg.energy, 1e-12 * lg.energy);
 }
 
 TEST(NewtonSolver, UnknownSolverNameListsNewton) {
