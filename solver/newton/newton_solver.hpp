@@ -16,11 +16,13 @@
 ///    with their eigenvalues made positive (the projected-Newton Hessian of the rotation-free
 ///    energy; EquilibriumJacobianWorkspace::Factor). P drops only the groups' rank-one coupling
 ///    and the skew part of K, so GMRES needs few products;
-///  - globalisation: a backtracking line search on the merit |g| (Armijo, halving), so no accepted
-///    step raises the residual; an intermediate load step ends at |g| <= 1e-3 of its start, the
-///    last one by the local-global test (FkOptions::tolerance and gradient_tolerance: the
-///    local-global step's largest vertex move and the residual ratio against the same reference);
-///    the final state takes that local-global step, as lg-aa's does;
+///  - globalisation: a backtracking line search (halving) along the Newton direction, bent by its
+///    geodesic acceleration, that accepts a point lowering the frozen-ratio energy (Armijo) or the
+///    residual |g|; every trial point is first smoothed by local-global steps, which re-fit the
+///    rotations a straight-line step distorts (Smooth); an intermediate load step ends at |g| <=
+///    1e-3 of its start, the last one by the local-global test (FkOptions::tolerance and
+///    gradient_tolerance: the local-global step's largest vertex move and the residual ratio
+///    against the same reference); the final state takes that local-global step, as lg-aa's does;
 ///  - adaptive load stepping: from the rest shape the actuation is applied in one step first;
 ///    a load step whose Newton iteration fails (no decrease along the Newton direction, a
 ///    degenerate element, or 30 iterations) is halved; the next step doubles after one that took
