@@ -29,13 +29,10 @@ constexpr int kMaxKrylov = 300;
 constexpr double kMaxForcing = 0.1;
 /// An intermediate load step ends when |g| has dropped by this factor.
 constexpr double kStepReduction = 1e-3;
-/// GMRES is stopped as stalled when its relative residual is still above kStall after
-/// kStallProducts products (no progress: on multi_segment_gripper at its full range it stays at
-/// 1.0; where the factor works it falls below 0.1 within 2-35 products on the embedded robots,
-/// and below 0.5 within 50 on bilayer_strip). kMaxStalls stalls with a fresh factor end Newton
-/// for one Solve.
-constexpr int kStallProducts = 50;
-constexpr double kStall = 0.9;
+/// GMRES is stopped as stalled when its relative residual is still above Limits::stall_residual
+/// (0.9) after Limits::stall_products (50) products. On the embedded robots and bilayer_strip a
+/// fresh factor brings it below 0.1 well within 50 products. kMaxStalls stalls with a fresh
+/// factor end Newton for one Solve.
 constexpr int kMaxStalls = 2;
 /// Geodesic acceleration (Acceleration): the difference step h along the Newton direction, the
 /// largest |a| / |d| it is used at, and its GMRES forcing term and product budget.
@@ -116,13 +113,15 @@ bool NewtonSolver::Direction(const Eigen::VectorXd& c, const State& s, double et
     // with d = P^-1 u. (Left preconditioning bounds |P^-1 (H d + g)|, which on bilayer_strip
     // was up to 50 times smaller than the true residual: the steps were not Newton steps.)
     GmresColumn gm(-s.g, Eigen::VectorXd::Zero(s.g.size()), budget, budget, eta);
-    while (!gm.done() && !(gm.products() >= kStallProducts && gm.rel() > kStall))
+    while (!gm.done() &&
+           !(gm.products() >= limits_.stall_products && gm.estimate() > limits_.stall_residual))
       gm.Consume(op.Apply(op.Precondition(gm.Request())).col(0));
+    gm.Stop();  // a stalled solve keeps what it has
     r->linear_iterations += gm.products();
     *d = op.Precondition(gm.y()).col(0);
     const double digits = std::max(0.5, -std::log10(std::max(gm.rel(), 1e-16)));
     const bool ok = d->allFinite() && gm.rel() <= eta;
-    stalled = gm.rel() > kStall;
+    stalled = gm.rel() > limits_.stall_residual;
     return std::make_pair(ok, gm.products() / digits);
   };
   auto factor = [&]() {
@@ -149,9 +148,8 @@ bool NewtonSolver::Direction(const Eigen::VectorXd& c, const State& s, double et
   fresh_rate_ = rate;
   // A direction short of eta is still used (the line search guards it), but GMRES that stalls
   // with a fresh factor means P is far from H here (H strongly indefinite or non-normal): after
-  // kMaxStalls of those Newton gives up and lg-aa takes over (LoadSteps, Solve). (Failing only
-  // the load step instead, and halving it, took 5.7 s on multi_segment_gripper at its full range
-  // against 2.1 s, and still ended in lg-aa on bilayer_strip res 2 at 1.5.)
+  // kMaxStalls of those Newton gives up and lg-aa takes over (LoadSteps, Solve), since smaller
+  // load steps do not make the linear systems easier.
   if (!ok && stalled && ++stalls_ >= kMaxStalls) {
     *why = "GMRES with a fresh preconditioner stalled " + std::to_string(stalls_) +
            " times (the Newton systems are far from their projected Hessian here)";
@@ -203,8 +201,10 @@ bool NewtonSolver::Acceleration(const Eigen::VectorXd& c, const State& s, const 
   op.SetPreconditioner(workspace_.factor());
   GmresColumn gm(-second, Eigen::VectorXd::Zero(second.size()), kAccelerationProducts,
                  kAccelerationProducts, kAccelerationForcing);
-  while (!gm.done() && !(gm.products() >= kStallProducts && gm.rel() > kStall))
+  while (!gm.done() &&
+         !(gm.products() >= limits_.stall_products && gm.estimate() > limits_.stall_residual))
     gm.Consume(op.Apply(op.Precondition(gm.Request())).col(0));
+  gm.Stop();
   r->linear_iterations += gm.products() + 1;
   const Eigen::VectorXd a = op.Precondition(gm.y()).col(0);
   const bool used = a.allFinite() && gm.rel() < 1.0 && a.norm() < kMaxAccelerationRatio * d.norm();

@@ -73,6 +73,11 @@ class NewtonSolver : public FkSolver {
     int step_iterations = 30;
     /// The smallest load step, as a fraction of the actuation range of one call.
     double min_load_step = 1.0 / 1024.0;
+    /// A GMRES solve is stopped as stalled when its relative residual is still above
+    /// stall_residual after stall_products products; two such solves with a fresh
+    /// preconditioner hand the solve over to lg-aa.
+    int stall_products = 50;
+    double stall_residual = 0.9;
   };
   void set_limits(const Limits& limits) { limits_ = limits; }
 

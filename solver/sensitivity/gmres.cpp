@@ -91,6 +91,24 @@ void GmresColumn::Consume(const Eigen::VectorXd& w) {
     return;
   }
   want_residual_ = true;  // recompute the residual from scratch (next product)
+  folded_ = true;
+}
+
+double GmresColumn::estimate() const {
+  if (done_ || j_ == 0 || (want_residual_ && !folded_)) return rel_;
+  return std::abs(g_(j_)) / beta0_;
+}
+
+void GmresColumn::Stop() {
+  if (done_) return;
+  if (j_ > 0 && !want_residual_) {
+    const Eigen::VectorXd z =
+        Hh_.topLeftCorner(j_, j_).triangularView<Eigen::Upper>().solve(g_.head(j_));
+    y_.noalias() += V_.leftCols(j_) * z;
+  }
+  if (j_ > 0 && (!want_residual_ || folded_)) rel_ = std::abs(g_(j_)) / beta0_;
+  if (!y_.allFinite()) rel_ = std::numeric_limits<double>::infinity();
+  done_ = true;
 }
 
 void GmresColumn::Grow(int cols) {
@@ -100,6 +118,7 @@ void GmresColumn::Grow(int cols) {
 }
 
 void GmresColumn::StartCycle(const Eigen::VectorXd& r) {
+  folded_ = false;
   const double beta = r.norm();
   rel_ = beta / beta0_;
   if (rel_ <= tol_ || products_ >= max_it_ || !(beta > 0.0)) {

@@ -20,8 +20,15 @@ class GmresColumn {
   bool done() const { return done_; }
   /// Operator products consumed so far.
   int products() const { return products_; }
-  /// ||b - M^-1 A y|| / ||b|| of the current y (the last recomputed or estimated value).
+  /// ||b - M^-1 A y|| / ||b|| of the current y (the last recomputed or estimated value). Within
+  /// a cycle y (and rel) stay at the cycle's start: see estimate() and Stop().
   double rel() const { return rel_; }
+  /// GMRES's running estimate of the relative residual after the products so far (the Givens
+  /// residual of the current cycle; rel() before the first product of a cycle).
+  double estimate() const;
+  /// Ends the solve after the products so far: y takes the current cycle's correction and rel()
+  /// its estimate. For a caller that gives up early (a stall test).
+  void Stop();
   const Eigen::VectorXd& y() const { return y_; }
   /// The vector the next product is applied to.
   const Eigen::VectorXd& Request();
@@ -39,6 +46,7 @@ class GmresColumn {
   Eigen::VectorXd g_, cs_, sn_;
   int j_ = 0, products_ = 0;
   bool done_ = false, want_residual_ = false;
+  bool folded_ = false;  ///< y_ holds the current cycle's correction (awaiting its residual)
 };
 
 }  // namespace softkin
