@@ -31,8 +31,8 @@
 ///    solved with the same operator and factor). A warm start is tried at the full actuation
 ///    first, then from the rest shape;
 ///  - fallback: when the step falls below 1/1024 of the range, or GMRES stalls twice with a
-///    fresh factor of P (P far from H: strongly indefinite or non-normal systems, as on
-///    multi_segment_gripper near its full range), the remaining actuation is left to lg-aa from
+///    fresh factor of P (P far from H: strongly indefinite or non-normal systems; Limits), the
+///    remaining actuation is left to lg-aa from
 ///    the last converged state, and the message says so. Scenes Newton does not cover
 ///    (Mooney-Rivlin bodies, active collision response: EquilibriumJacobianUnsupported and
 ///    ContactHandlingActive) are solved by lg-aa outright, with a message.
