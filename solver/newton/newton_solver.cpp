@@ -45,10 +45,10 @@ constexpr int kAccelerationProducts = 50;
 constexpr double kGoodStep = 0.5;
 /// Local-global steps applied to every trial point of the line search (Smooth). Measured on
 /// bilayer_strip res 2 at alpha = 1.1 (Newton iterations / s, one run each): 0 steps 13 / 3.3,
-/// 1: 11 / 3.0, 2: 8 / 2.6, 4: 8 / 2.4, 8: 7 / 2.7, 16: 6 / 2.8; at alpha = 1.5 only 8 of
-/// these converged without lg-aa (23 iterations, 11.8 s; with 4, GMRES stalled twice and lg-aa
-/// took over). Stopping the steps once the residual falls by less than 0.5 or 0.8 per step
-/// changed the times by under 10 %. docs/newton.md.
+/// 1: 11 / 3.0, 2: 8 / 2.6, 4: 8 / 2.4, 8: 7 / 2.7, 16: 6 / 2.8; at alpha = 1.5: 0 steps 274 /
+/// 155 s, 4 steps not converged in 300 s, 8 steps 20 / 8.7 s. Stopping the steps once the
+/// residual falls by less than 0.5 or 0.8 per step changed the times by under 10 %.
+/// docs/newton.md.
 constexpr int kSmoothingSteps = 8;
 /// Armijo constant and the halvings of the line search.
 constexpr double kArmijo = 1e-4;
