@@ -32,8 +32,8 @@
 ///    first, then from the rest shape;
 ///  - fallback: when the step falls below 1/1024 of the range, or GMRES stalls twice with a
 ///    fresh factor of P (P far from H: strongly indefinite or non-normal systems; Limits), the
-///    remaining actuation is left to lg-aa from
-///    the last converged state, and the message says so. Scenes Newton does not cover
+///    remaining actuation is left to lg-aa from the last converged state, and the message says
+///    so. Scenes Newton does not cover
 ///    (Mooney-Rivlin bodies, active collision response: EquilibriumJacobianUnsupported and
 ///    ContactHandlingActive) are solved by lg-aa outright, with a message.
 /// FkResult::iterations counts Newton iterations (plus the fallback's local-global ones),
