@@ -63,6 +63,21 @@ NewtonSolver::NewtonSolver(std::shared_ptr<const Model> model, const FkOptions& 
   for (const auto& e : model_->elements()) total_weight_ += e.wv;
 }
 
+void NewtonSolver::set_limits(const Limits& l) {
+  auto bad = [](const std::string& field, const std::string& expected, double got) {
+    std::ostringstream os;
+    os << "newton limits: " << field << " must be " << expected << ", got " << got;
+    throw std::invalid_argument(os.str());
+  };
+  if (l.step_iterations < 1) bad("step_iterations", "an integer >= 1", l.step_iterations);
+  if (!(l.min_load_step > 0.0 && l.min_load_step <= 1.0))
+    bad("min_load_step", "in (0, 1]", l.min_load_step);
+  if (l.stall_products < 1) bad("stall_products", "an integer >= 1", l.stall_products);
+  if (!(l.stall_residual >= 0.0 && l.stall_residual <= 1.0))
+    bad("stall_residual", "in [0, 1]", l.stall_residual);
+  limits_ = l;
+}
+
 bool NewtonSolver::TimeUp() const { return deadline_ && Clock::now() > *deadline_; }
 
 void NewtonSolver::Evaluate(const Eigen::VectorXd& c, State* s) {

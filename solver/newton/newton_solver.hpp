@@ -79,7 +79,8 @@ class NewtonSolver : public FkSolver {
     int stall_products = 50;
     double stall_residual = 0.9;
   };
-  void set_limits(const Limits& limits) { limits_ = limits; }
+  /// Throws std::invalid_argument naming the field and its valid range for a bad value.
+  void set_limits(const Limits& limits);
 
   /// The residual 2 |g| before each Newton iteration of the last load step of the last Solve(),
   /// and at its end (for convergence studies).

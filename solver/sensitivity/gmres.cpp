@@ -76,9 +76,7 @@ void GmresColumn::Consume(const Eigen::VectorXd& w) {
   const bool end = std::abs(g_(j + 1)) <= tol_ * beta0_ || breakdown || !(den > 0.0) || j_ >= m_ ||
                    products_ >= max_it_;
   if (!end) return;
-  const Eigen::VectorXd z =
-      Hh_.topLeftCorner(j_, j_).triangularView<Eigen::Upper>().solve(g_.head(j_));
-  y_.noalias() += V_.leftCols(j_) * z;
+  FoldCycle();
   if (!y_.allFinite()) {
     done_ = true;
     rel_ = std::numeric_limits<double>::infinity();
@@ -91,22 +89,23 @@ void GmresColumn::Consume(const Eigen::VectorXd& w) {
     return;
   }
   want_residual_ = true;  // recompute the residual from scratch (next product)
+}
+
+void GmresColumn::FoldCycle() {
+  const Eigen::VectorXd z =
+      Hh_.topLeftCorner(j_, j_).triangularView<Eigen::Upper>().solve(g_.head(j_));
+  y_.noalias() += V_.leftCols(j_) * z;
   folded_ = true;
 }
 
-double GmresColumn::estimate() const {
-  if (done_ || j_ == 0 || (want_residual_ && !folded_)) return rel_;
-  return std::abs(g_(j_)) / beta0_;
-}
+double GmresColumn::estimate() const { return done_ || j_ == 0 ? rel_ : std::abs(g_(j_)) / beta0_; }
 
 void GmresColumn::Stop() {
   if (done_) return;
-  if (j_ > 0 && !want_residual_) {
-    const Eigen::VectorXd z =
-        Hh_.topLeftCorner(j_, j_).triangularView<Eigen::Upper>().solve(g_.head(j_));
-    y_.noalias() += V_.leftCols(j_) * z;
+  if (j_ > 0) {
+    if (!folded_) FoldCycle();
+    rel_ = std::abs(g_(j_)) / beta0_;
   }
-  if (j_ > 0 && (!want_residual_ || folded_)) rel_ = std::abs(g_(j_)) / beta0_;
   if (!y_.allFinite()) rel_ = std::numeric_limits<double>::infinity();
   done_ = true;
 }

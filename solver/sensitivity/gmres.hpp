@@ -38,6 +38,8 @@ class GmresColumn {
  private:
   void Grow(int cols);
   void StartCycle(const Eigen::VectorXd& r);
+  /// y += the correction of the current cycle's j_ basis vectors (its small triangular solve).
+  void FoldCycle();
 
   Eigen::VectorXd b_, y_, next_;
   int m_, max_it_;

@@ -220,6 +220,34 @@ TEST(NewtonSolver, StalledKrylovSolvesHandOverToLgAa) {
   EXPECT_NEAR(nw.energy, lg.energy, 1e-12 * lg.energy);
 }
 
+TEST(NewtonSolver, BadLimitsNameTheFieldAndTheRange) {
+  auto model = std::make_shared<const Model>(MakeRobot("bilayer_strip", 1));
+  NewtonSolver solver(model, Options("newton", 1e-5, 1e-6));
+  auto error = [&](const NewtonSolver::Limits& l) {
+    try {
+      solver.set_limits(l);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  NewtonSolver::Limits l;
+  l.stall_products = 0;
+  EXPECT_NE(error(l).find("stall_products must be an integer >= 1, got 0"), std::string::npos)
+      << error(l);
+  l = {};
+  l.stall_residual = std::nan("");
+  EXPECT_NE(error(l).find("stall_residual must be in [0, 1]"), std::string::npos) << error(l);
+  l = {};
+  l.min_load_step = 0.0;
+  EXPECT_NE(error(l).find("min_load_step must be in (0, 1]"), std::string::npos) << error(l);
+  l = {};
+  l.step_iterations = -3;
+  EXPECT_NE(error(l).find("step_iterations must be an integer >= 1, got -3"), std::string::npos)
+      << error(l);
+  EXPECT_EQ(error({}), "");  // the defaults are valid
+}
+
 TEST(NewtonSolver, UnknownSolverNameListsNewton) {
   std::string why;
   try {
