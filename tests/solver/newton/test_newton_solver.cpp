@@ -162,6 +162,31 @@ TEST(NewtonSolver, ResidualFallsSuperlinearlyNearTheSolution) {
   EXPECT_LE(r.iterations, 12) << trace;
 }
 
+// From rest straight to the far end of the finger's range, newton reaches the state lg-aa reaches
+// (with its few inverted elements: the walls between the chambers buckle at alpha 10), not a
+// tangled equilibrium: the load step's tangent predictor, over the whole range, used to drive the
+// walls through each other (426 inverted elements, 11 % more energy).
+TEST(NewtonSolver, FarActuationFromRestReachesLgAasState) {
+  const Scene s = MakeRobot("pneumatic_finger", 8);
+  auto model = std::make_shared<const Model>(s);
+  Eigen::VectorXd c(1);
+  c << 10.0;
+  FkOptions o = Options("newton", 1e-5, 1e-6);
+  o.threads = 2;
+  const FkResult nw = MakeFkSolver(model, o)->Solve(c);
+  EXPECT_EQ(nw.message.find("lg-aa"), std::string::npos) << nw.message;
+  o.solver = FkSolverType::kLgAa;
+  const FkResult ref = MakeFkSolver(model, o)->Solve(c);
+  // Both meet the tolerance at a state with inverted elements, and say so.
+  EXPECT_EQ(ref.status, FkStatus::Inverted) << ref.BriefReport();
+  EXPECT_EQ(nw.status, ref.status) << nw.BriefReport();
+  EXPECT_EQ(nw.inverted_elements, ref.inverted_elements);
+  EXPECT_NEAR(nw.energy, ref.energy, 1e-4 * ref.energy);
+  EXPECT_LT((nw.positions - ref.positions).rowwise().norm().maxCoeff(), 1e-3 * model->size())
+      << nw.BriefReport() << " vs " << ref.BriefReport();
+  EXPECT_LE(nw.iterations, 15) << nw.BriefReport();
+}
+
 // A Newton solve that fails (here: at most one iteration per load step, and no step below a half)
 // continues with lg-aa from its best state, says so, and converges to lg-aa's answer.
 TEST(NewtonSolver, FailureContinuesWithLgAaAndSaysSo) {
