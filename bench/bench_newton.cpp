@@ -8,11 +8,15 @@
 //   krylov              GMRES products (newton)
 //   load_steps          converged load steps (newton)
 //   residual_ratio      the final residual ratio (both must be below 1e-6)
+//   inverted            inverted body elements of the answer (status inverted: the tolerance is
+//                       met, at a state whose walls buckle through each other, the same for both)
 //   per_vertex          wall time per vertex
 // Compare solvers as the ratio of their times within one run (the machine is shared):
 //   build/bin/bench_newton --benchmark_filter='Strip'
-// Cases: bilayer_strip res 1 and 2 (3.6k and 24k tets) at alpha 1.1 and 1.5; pneumatic_finger
-// res 8 at alpha 5; three_chamber res 5 at (1.5, 1, 1).
+// Cases: bilayer_strip res 1 and 2 (3.6k and 24k tets) and the 12k-tet strip of issue #33 (res 2
+// with 2 mm cells along the length) at alpha 1.1 and 1.5; pneumatic_finger res 8 at alpha 5, and
+// res 12 (46.7k tets) from rest to the end of its range, alpha 10; three_chamber res 5 at
+// (1.5, 1, 1).
 #include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/robots/robots.hpp"
 
@@ -21,22 +25,24 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace softkin {
 namespace {
 
-/// One model per (robot, res), built once.
-std::shared_ptr<const Model> CachedModel(const std::string& robot, int res) {
-  static std::map<std::pair<std::string, int>, std::shared_ptr<const Model>> cache;
-  auto& m = cache[{robot, res}];
-  if (!m) m = std::make_shared<const Model>(MakeRobot(robot, res));
+/// One model per (robot, res, params), built once.
+std::shared_ptr<const Model> CachedModel(const std::string& robot, int res,
+                                         const RobotParams& params) {
+  static std::map<std::tuple<std::string, int, RobotParams>, std::shared_ptr<const Model>> cache;
+  auto& m = cache[{robot, res, params}];
+  if (!m) m = std::make_shared<const Model>(MakeRobot(robot, res, params));
   return m;
 }
 
 void Solve(benchmark::State& state, const std::string& robot, int res, const std::string& solver,
-           const Eigen::VectorXd& c) {
-  auto model = CachedModel(robot, res);
+           const Eigen::VectorXd& c, const RobotParams& params = {}) {
+  auto model = CachedModel(robot, res, params);
   FkOptions o;
   o.solver = FkSolverTypeFromString(solver);
   o.max_iterations = 1000000;
@@ -44,7 +50,8 @@ void Solve(benchmark::State& state, const std::string& robot, int res, const std
   for (auto _ : state) {
     auto s = MakeFkSolver(model, o);  // a fresh solver: no factor or reference kept between runs
     r = s->Solve(c);
-    if (r.status != FkStatus::Converged) state.SkipWithError(r.BriefReport().c_str());
+    if (r.status != FkStatus::Converged && r.status != FkStatus::Inverted)
+      state.SkipWithError(r.BriefReport().c_str());
   }
   state.counters["tets"] = model->mesh().num_elements();
   state.counters["vertices"] = model->num_vertices();
@@ -52,6 +59,7 @@ void Solve(benchmark::State& state, const std::string& robot, int res, const std
   state.counters["krylov"] = r.linear_iterations;
   state.counters["load_steps"] = r.load_steps;
   state.counters["residual_ratio"] = r.gradient_ratio;
+  state.counters["inverted"] = r.inverted_elements;
   state.counters["per_vertex"] =
       benchmark::Counter(model->num_vertices(), benchmark::Counter::kIsIterationInvariantRate |
                                                     benchmark::Counter::kInvert);
@@ -62,8 +70,14 @@ Eigen::VectorXd One(double v) { return Eigen::VectorXd::Constant(1, v); }
 void BM_Strip(benchmark::State& state, int res, double alpha, const char* solver) {
   Solve(state, "bilayer_strip", res, solver, One(alpha));
 }
+void BM_Strip12k(benchmark::State& state, double alpha, const char* solver) {
+  Solve(state, "bilayer_strip", 2, solver, One(alpha), {{"cell_length", 2.0}});
+}
 void BM_Finger(benchmark::State& state, const char* solver) {
   Solve(state, "pneumatic_finger", 8, solver, One(5.0));
+}
+void BM_FingerRes12Alpha10(benchmark::State& state, const char* solver) {
+  Solve(state, "pneumatic_finger", 12, solver, One(10.0));
 }
 void BM_ThreeChamber(benchmark::State& state, const char* solver) {
   Solve(state, "three_chamber", 5, solver, Eigen::Vector3d(1.5, 1.0, 1.0));
@@ -73,6 +87,8 @@ void BM_Strip_r1_a1_1(benchmark::State& s, const char* solver) { BM_Strip(s, 1, 
 void BM_Strip_r1_a1_5(benchmark::State& s, const char* solver) { BM_Strip(s, 1, 1.5, solver); }
 void BM_Strip_r2_a1_1(benchmark::State& s, const char* solver) { BM_Strip(s, 2, 1.1, solver); }
 void BM_Strip_r2_a1_5(benchmark::State& s, const char* solver) { BM_Strip(s, 2, 1.5, solver); }
+void BM_Strip12k_a1_1(benchmark::State& s, const char* solver) { BM_Strip12k(s, 1.1, solver); }
+void BM_Strip12k_a1_5(benchmark::State& s, const char* solver) { BM_Strip12k(s, 1.5, solver); }
 
 BENCHMARK_CAPTURE(BM_Strip_r1_a1_1, newton, "newton")
     ->Unit(benchmark::kMillisecond)
@@ -106,11 +122,35 @@ BENCHMARK_CAPTURE(BM_Strip_r2_a1_5, lg_aa, "lg-aa")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip12k_a1_1, newton, "newton")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip12k_a1_1, lg_aa, "lg-aa")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip12k_a1_5, newton, "newton")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip12k_a1_5, lg_aa, "lg-aa")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
 BENCHMARK_CAPTURE(BM_Finger, newton, "newton")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);
 BENCHMARK_CAPTURE(BM_Finger, lg_aa, "lg-aa")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_FingerRes12Alpha10, newton, "newton")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_FingerRes12Alpha10, lg_aa, "lg-aa")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);

@@ -27,6 +27,8 @@ namespace {
 // mesh is mirror-symmetric about y = W / 2 and a curl stays in that plane: the voxel split is
 // mirrored cell by cell, which is symmetric only over an even count. res 1 gives
 // 6 * 50 * 6 * 2 = 3,600 tets at the defaults, res 2 24,000, res 3 86,400 and res 4 192,000.
+// cell_length > 0 sets the cells' length along x instead (rounded to a whole number of cells):
+// res 2 with cell_length 2 is the 50 x 10 x 4-cell, 12,000-tet strip of issue #33.
 // Markers: tip (the x = L face), tip_top / tip_bottom (its top and bottom quarters in z).
 // ================================================================================================
 
@@ -35,7 +37,9 @@ constexpr int kStripMinRes = 1, kStripMaxRes = 8, kStripDefaultRes = 2;
 Scene MakeBilayerStrip(int res, const RobotParams& P) {
   const double t = P.at("layer"), h = t / res;
   const double width = P.at("width");
-  const int nx = Cells(P.at("length"), h), nz = 2 * res;
+  const double hx = P.at("cell_length") > 0.0 ? P.at("cell_length") : h;
+  const int nx = Cells(P.at("length"), hx), nz = 2 * res;
+  const double dx = P.at("length") / nx;
   const int ny = 2 * std::max(1, static_cast<int>(std::lround(width / (2 * h))));
   auto lines = [](int n, double step) {
     std::vector<double> v(n + 1);
@@ -45,7 +49,7 @@ Scene MakeBilayerStrip(int res, const RobotParams& P) {
   Scene s;
   s.name = "bilayer_strip";
   s.mesh = RectilinearTetMesh(
-      lines(nx, h), lines(ny, width / ny), lines(nz, h),
+      lines(nx, dx), lines(ny, width / ny), lines(nz, h),
       [res](const Eigen::Vector3d&, const Eigen::Vector3i& c) { return c[2] < res ? 0 : 1; });
   s.body[0] = Material{"body", 1.0, 1.0};
   Actuator a;
@@ -58,7 +62,7 @@ Scene MakeBilayerStrip(int res, const RobotParams& P) {
   s.actuators.push_back(a);
   const double eps = 1e-6 * h;
   s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
-  AddDistalFaceMarkers(nx * h, nz * h, eps, &s);
+  AddDistalFaceMarkers(nx * dx, nz * h, eps, &s);
   s.validate();
   return s;
 }
@@ -77,7 +81,10 @@ RobotEntry BilayerStripEntry() {
       "the mesh is mirror-symmetric), integer in [1, 8]; res 1: 3,600 tets, res 2: 24,000",
       {{"length", 100.0, 10.0, 500.0, "strip length, mm"},
        {"width", 10.0, 1.0, 100.0, "strip width, mm"},
-       {"layer", 2.0, 0.25, 20.0, "thickness of each layer, mm"}}};
+       {"layer", 2.0, 0.25, 20.0, "thickness of each layer, mm"},
+       {"cell_length", 0.0, 0.0, 50.0,
+        "cell size along the length, mm (0: layer/res, cubic cells); res 2 with cell_length 2 "
+        "gives 12,000 tets"}}};
   return {info, kStripMinRes, kStripMaxRes, &MakeBilayerStrip};
 }
 

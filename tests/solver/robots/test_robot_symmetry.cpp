@@ -81,6 +81,12 @@ TEST(RobotSymmetry, MirrorSymmetricDesignsBendInTheirPlane) {
   }
   // The strip at res 3 (W / h = 15 cubic cells) is cut into an even 16 across its width.
   EXPECT_EQ(UnmatchedMirrorVertices(MakeRobot("bilayer_strip", 3).mesh, 5.0), 0);
+  // The 12,000-tet strip of the benchmarks: 50 x 10 x 4 cells of 2 x 1 x 1 mm, same outline.
+  const Scene strip12k = MakeRobot("bilayer_strip", 2, {{"cell_length", 2.0}});
+  EXPECT_EQ(strip12k.mesh.num_elements(), 12000);
+  EXPECT_EQ(UnmatchedMirrorVertices(strip12k.mesh, 5.0), 0);
+  const Eigen::RowVector3d hi = strip12k.mesh.vertices.colwise().maxCoeff();
+  EXPECT_LT((hi - Eigen::RowVector3d(100, 10, 4)).norm(), 1e-9);
 }
 
 }  // namespace
