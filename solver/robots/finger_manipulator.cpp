@@ -47,7 +47,121 @@ constexpr double kManipWidth = 20.0, kManipThick = 12.0, kManipBase = 6.0, kMani
                  kManipJoint = 6.0, kManipCap = 3.0, kManipWall = 1.5, kManipCavity = 4.0,
                  kManipSpine = 3.0, kManipGain = 4.0, kManipRange = 3.0, kManipChamberWeight = 20.0;
 
+/// The scene around a manipulator mesh (regions as in the layout above): materials, the three
+/// signed actuators, the fixed base face and the markers (tip; j1, j2 at x = joint_end[q]).
+Scene FinishManipulator(const RobotParams& P, Mesh mesh, const double joint_end[2]) {
+  Scene s;
+  s.name = "finger_manipulator";
+  s.mesh = std::move(mesh);
+  s.body[0] = Material{"body", P.at("body_r_omega"), 1.0};
+  s.body[7] = Material{"spine", 1.0, P.at("spine_weight")};
+  s.body[8] = Material{"joint", 1.0, 20.0};
+  const double gain = P.at("gain");
+  for (int q = 0; q < 3; ++q) {
+    Actuator a;
+    a.name = "s" + std::to_string(q + 1);
+    a.type = ActuatorType::Pneumatic;
+    a.regions = {1 + 2 * q};
+    a.negative_regions = {2 + 2 * q};
+    a.gain = gain;
+    a.weight = P.at("chamber_weight");
+    a.rest = 0.0;
+    a.min = -kManipRange;
+    a.max = kManipRange;
+    s.actuators.push_back(a);
+  }
+  const double xmax = s.mesh.vertices.col(0).maxCoeff(), eps = 1e-9 * xmax;
+  s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
+  s.markers.push_back(
+      {"tip", VerticesOnPlane(s.mesh, Eigen::Vector3d(xmax, 0, 0), Eigen::Vector3d::UnitX(), eps)});
+  for (int q = 0; q < 2; ++q)
+    s.markers.push_back(
+        {"j" + std::to_string(q + 1), VerticesOnPlane(s.mesh, Eigen::Vector3d(joint_end[q], 0, 0),
+                                                      Eigen::Vector3d::UnitX(), eps)});
+  s.validate();
+  return s;
+}
+
+/// The design's dimensions along x (mm): the base block, then per section its solid proximal part
+/// and chamber row, then the connector; the cap. Section q spans [x0[q], x0[q] + 40); its row
+/// holds as many 4 mm cavities between 1.5 mm walls as fit after a solid part of one wall, ending
+/// in a wall (6 cavities, from x0 + 5.5), as MakeChamberRow does in cells.
+struct ManipDesign {
+  double x0[3], first[3], joint1[2];
+  int chambers = 0;
+  double length = 0.0;
+};
+ManipDesign MakeManipDesign() {
+  ManipDesign d;
+  const double pitch = kManipWall + kManipCavity;
+  d.chambers = static_cast<int>(std::floor((kManipSection - 2 * kManipWall) / pitch + 1e-9));
+  double x = kManipBase;
+  for (int q = 0; q < 3; ++q) {
+    d.x0[q] = x;
+    d.first[q] = x + kManipSection - d.chambers * pitch - kManipWall;
+    x += kManipSection;
+    if (q < 2) {
+      x += kManipJoint;
+      d.joint1[q] = x;
+    }
+  }
+  d.length = x + kManipCap;
+  return d;
+}
+
+/// The manipulator with its nominal dimensions at every resolution (grid lines on each of them,
+/// parts cut into cells of about 20 / res mm; an even count across the spine, so y = 10 is a
+/// grid line and the mesh is mirror-symmetric about it): 1.5 mm walls, floor and roof, 4 mm
+/// cavities, 7 mm wide chamber rows beside a 3 mm spine.
+Mesh DesignGridManipulatorMesh(int res, const ManipDesign& d) {
+  const double h = kManipWidth / res, pitch = kManipWall + kManipCavity;
+  const double side = 0.5 * (kManipWidth - 2 * kManipWall - kManipSpine);
+  const double y1 = kManipWall, y2 = kManipWall + side, y3 = y2 + kManipSpine, y4 = y3 + side;
+  std::vector<double> bx = {0.0};
+  for (int q = 0; q < 3; ++q) {
+    bx.push_back(d.x0[q]);
+    for (int c = 0; c < d.chambers; ++c) {
+      bx.push_back(d.first[q] + c * pitch);
+      bx.push_back(d.first[q] + c * pitch + kManipWall);
+    }
+    bx.push_back(d.first[q] + d.chambers * pitch);
+    bx.push_back(d.x0[q] + kManipSection);
+  }
+  bx.push_back(d.length);
+  bx.erase(
+      std::unique(bx.begin(), bx.end(), [](double a, double b) { return std::abs(a - b) < 1e-9; }),
+      bx.end());
+  const auto xs = DesignLines(bx, h);
+  const auto ys = DesignLines({0.0, y1, y2, y3, y4, kManipWidth}, h, {false, false, true});
+  const auto zs = DesignLines({0.0, kManipWall, kManipThick - kManipWall, kManipThick}, h);
+  return RectilinearTetMesh(xs, ys, zs, [&](const Eigen::Vector3d& c, const Eigen::Vector3i&) {
+    for (int q = 0; q < 2; ++q)
+      if (c.x() > d.joint1[q] - kManipJoint && c.x() < d.joint1[q]) return 8;
+    for (int q = 0; q < 3; ++q) {
+      if (c.x() < d.x0[q] || c.x() > d.x0[q] + kManipSection) continue;
+      const double u = c.x() - d.first[q];
+      const bool cavity = u > 0 && u < d.chambers * pitch && std::fmod(u, pitch) > kManipWall &&
+                          c.z() > kManipWall && c.z() < kManipThick - kManipWall;
+      if (cavity && c.y() > y1 && c.y() < y2) return 2 + 2 * q;  // -y side
+      if (cavity && c.y() > y3 && c.y() < y4) return 1 + 2 * q;  // +y side
+      if (c.y() > y2 && c.y() < y3 && u > 0) return 7;           // spine
+      return 0;
+    }
+    return 0;
+  });
+}
+
 Scene MakeFingerManipulator(int res, const RobotParams& P) {
+  const double design = P.at("design_grid");
+  if (design != 0.0 && design != 1.0)
+    throw std::invalid_argument(
+        "finger_manipulator: design_grid must be 0 (snap to cells) or 1 (grid lines on the "
+        "design's dimensions), got " +
+        std::to_string(design));
+  if (design == 1.0) {
+    const ManipDesign d = MakeManipDesign();
+    return FinishManipulator(P, DesignGridManipulatorMesh(res, d), d.joint1);
+  }
   if (res % 2 != 0)
     throw std::invalid_argument(
         "finger_manipulator: --res must be even (mirror symmetry about "
@@ -90,36 +204,9 @@ Scene MakeFingerManipulator(int res, const RobotParams& P) {
     }
     return 0;
   };
-  Scene s;
-  s.name = "finger_manipulator";
-  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz), cell);
-  s.body[0] = Material{"body", P.at("body_r_omega"), 1.0};
-  s.body[7] = Material{"spine", 1.0, P.at("spine_weight")};
-  s.body[8] = Material{"joint", 1.0, 20.0};
-  const double gain = P.at("gain");
-  for (int q = 0; q < 3; ++q) {
-    Actuator a;
-    a.name = "s" + std::to_string(q + 1);
-    a.type = ActuatorType::Pneumatic;
-    a.regions = {1 + 2 * q};
-    a.negative_regions = {2 + 2 * q};
-    a.gain = gain;
-    a.weight = P.at("chamber_weight");
-    a.rest = 0.0;
-    a.min = -kManipRange;
-    a.max = kManipRange;
-    s.actuators.push_back(a);
-  }
-  const double eps = 1e-6 * h, xmax = nx * h;
-  s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
-  s.markers.push_back(
-      {"tip", VerticesOnPlane(s.mesh, Eigen::Vector3d(xmax, 0, 0), Eigen::Vector3d::UnitX(), eps)});
-  for (int q = 0; q < 2; ++q)
-    s.markers.push_back({"j" + std::to_string(q + 1),
-                         VerticesOnPlane(s.mesh, Eigen::Vector3d(joints[q].second * h, 0, 0),
-                                         Eigen::Vector3d::UnitX(), eps)});
-  s.validate();
-  return s;
+  const double joint_end[2] = {joints[0].second * h, joints[1].second * h};
+  return FinishManipulator(
+      P, VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz), cell), joint_end);
 }
 
 }  // namespace
@@ -140,7 +227,11 @@ RobotEntry FingerManipulatorEntry() {
        {"spine_weight", 20.0, 0.01, 100.0, "element weight of the central spine"},
        {"chamber_weight", kManipChamberWeight, 0.01, 100.0,
         "element weight of the chambers' actuation elements"},
-       {"body_r_omega", 1.0, 0.0, 1.0, "R_omega of the body material (walls, floor, roof)"}}};
+       {"body_r_omega", 1.0, 0.0, 1.0, "R_omega of the body material (walls, floor, roof)"},
+       {"design_grid", 0.0, 0.0, 1.0,
+        "0: features snap to whole cells of 20/res mm (walls and cavities change with res, res "
+        "even); 1: grid lines on the nominal dimensions (1.5 mm walls, floor and roof, six 4 mm "
+        "cavities per section, 3 mm spine) at every res, mirror-symmetric about y = 10"}}};
   return {info, kManipMinRes, kManipMaxRes, &MakeFingerManipulator};
 }
 

@@ -86,19 +86,6 @@ int FingerCell(const FingerLayout& L, int i, int j, int k) {
   return cavity ? 1 : 0;
 }
 
-/// Grid lines through the breakpoints `b` (increasing), each interval cut into about
-/// len / h cells (at least 1; an even number where `even` says so).
-std::vector<double> DesignLines(const std::vector<double>& b, double h,
-                                const std::vector<bool>& even = {}) {
-  std::vector<double> lines = {b[0]};
-  for (size_t q = 0; q + 1 < b.size(); ++q) {
-    int n = std::max(1, static_cast<int>(std::lround((b[q + 1] - b[q]) / h)));
-    if (q < even.size() && even[q] && n % 2) ++n;
-    for (int i = 1; i <= n; ++i) lines.push_back(b[q] + (b[q + 1] - b[q]) * i / n);
-  }
-  return lines;
-}
-
 /// The finger with its nominal dimensions whatever the resolution: 16 cavities of 5 mm between
 /// 1.5 mm walls (the count at the default res 12), 1.5 mm side walls, roof, floor and base layer,
 /// and a 14.5 mm proximal block; grid lines on every one of these dimensions, each part cut into

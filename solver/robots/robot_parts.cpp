@@ -34,6 +34,17 @@ ChamberRow MakeChamberRow(int x0, int x1, int wall, int cavity, int min_solid) {
   return r;
 }
 
+std::vector<double> DesignLines(const std::vector<double>& b, double h,
+                                const std::vector<bool>& even) {
+  std::vector<double> lines = {b[0]};
+  for (size_t q = 0; q + 1 < b.size(); ++q) {
+    int n = std::max(1, static_cast<int>(std::lround((b[q + 1] - b[q]) / h)));
+    if (q < even.size() && even[q] && n % 2) ++n;
+    for (int i = 1; i <= n; ++i) lines.push_back(b[q] + (b[q + 1] - b[q]) * i / n);
+  }
+  return lines;
+}
+
 bool InCavity(const ChamberRow& r, int i) {
   const int u = i - r.first;
   if (u < 0 || u >= r.chambers * (r.wall + r.cavity)) return false;

@@ -12,6 +12,7 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <vector>
 
 namespace softkin {
 namespace robots_detail {
@@ -53,6 +54,12 @@ constexpr double kFingerLayerWeight = 20.0;
 
 /// The number of cells of size h (mm) closest to a length of `mm`, at least one.
 int Cells(double mm, double h);
+
+/// Grid lines through the breakpoints `b` (increasing: a design's dimensions along one axis),
+/// each interval cut into about len / h cells (at least 1; an even number where `even` says so).
+/// Meshes on these lines keep the design's dimensions at every resolution.
+std::vector<double> DesignLines(const std::vector<double>& b, double h,
+                                const std::vector<bool>& even = {});
 
 /// Markers of a finger whose distal face is the plane x = xmax: "tip" (the face's centroid),
 /// "tip_top" / "tip_bottom" (its top and bottom quarters in z, used for the bend angle).

@@ -372,3 +372,48 @@ TEST(RobotGrid, PneumaticFingerDesignGridKeepsItsDimensionsAndSymmetry) {
 
 }  // namespace
 }  // namespace softkin
+
+namespace softkin {
+namespace {
+
+// finger_manipulator with design_grid = 1: its walls, cavities and spine keep their nominal size
+// at every resolution, odd ones included (each side of each section: 6 cavities of 4 x 7 x 9 mm),
+// the mesh is mirror-symmetric about y = 10 (the +y chambers of a section mirror its -y ones),
+// and the snapped default is still the robot without the parameter.
+TEST(RobotGrid, FingerManipulatorDesignGridKeepsItsDimensionsAndSymmetry) {
+  const double nominal = 6 * 4.0 * 7.0 * 9.0;
+  for (int res : {6, 7, 9, 12}) {
+    SCOPED_TRACE("res " + std::to_string(res));
+    const Scene s = MakeRobot("finger_manipulator", res, {{"design_grid", 1.0}});
+    std::map<int, double> volume;
+    for (const Element& e : s.mesh.elements) {
+      const Eigen::RowVector3d a = s.mesh.vertices.row(e.v[0]), b = s.mesh.vertices.row(e.v[1]),
+                               c = s.mesh.vertices.row(e.v[2]), d = s.mesh.vertices.row(e.v[3]);
+      volume[e.region] += (b - a).cross(c - a).dot(d - a) / 6.0;
+    }
+    for (int region = 1; region <= 6; ++region)
+      EXPECT_NEAR(volume[region], nominal, 1e-9 * nominal) << "region " << region;
+    // The spine: 3 mm wide through the full 12 mm thickness, along each section's chamber row
+    // (6 x 5.5 + 1.5 = 34.5 mm).
+    EXPECT_NEAR(volume[7], 3 * 3.0 * 12.0 * 34.5, 1e-9 * 3 * 3.0 * 12.0 * 34.5);
+    const Eigen::RowVector3d hi = s.mesh.vertices.colwise().maxCoeff();
+    EXPECT_LT((hi - Eigen::RowVector3d(141, 20, 12)).norm(), 1e-9);
+    std::map<std::array<long, 3>, int> at;
+    auto key = [](double x, double y, double z) {
+      return std::array<long, 3>{std::lround(x * 1e6), std::lround(y * 1e6), std::lround(z * 1e6)};
+    };
+    for (int v = 0; v < s.mesh.num_vertices(); ++v)
+      at[key(s.mesh.vertices(v, 0), s.mesh.vertices(v, 1), s.mesh.vertices(v, 2))] = v;
+    int unmatched = 0;
+    for (int v = 0; v < s.mesh.num_vertices(); ++v)
+      unmatched += !at.count(
+          key(s.mesh.vertices(v, 0), 20.0 - s.mesh.vertices(v, 1), s.mesh.vertices(v, 2)));
+    EXPECT_EQ(unmatched, 0);
+    EXPECT_EQ(s.markers.size(), 3u);
+  }
+  EXPECT_EQ(MakeRobot("finger_manipulator", 8).mesh.num_elements(), 13200);
+  EXPECT_THROW(MakeRobot("finger_manipulator", 8, {{"design_grid", 0.5}}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace softkin
