@@ -221,7 +221,8 @@ RobotEntry FingerManipulatorEntry() {
       "v > 0 inflates the +y chambers to volume ratio 1 + gain v (bending towards -y), v < 0 the "
       "-y chambers. Redundant: m = 3, n = 2. Markers: tip, j1, j2 (ends of sections 1 and 2).",
       kManipDefaultRes,
-      "cells across the 20 mm width (cell size 20/res mm), even integer in [6, 24]",
+      "cells across the 20 mm width (cell size 20/res mm), integer in [6, 24], even unless "
+      "design_grid = 1",
       {{"gain", kManipGain, 0.1, 10.0,
         "volume ratio per unit of actuation: a chamber side reaches 1 + gain |v|"},
        {"spine_weight", 20.0, 0.01, 100.0, "element weight of the central spine"},
