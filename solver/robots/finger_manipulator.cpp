@@ -40,6 +40,9 @@ namespace {
 // PneuNet-style variant with gaps between the chamber boxes did not bend more (50). The mesh is
 // mirror-symmetric about y = 10 (res is even), so v and -v give mirror images. Markers: tip (distal
 // face x = L), j1, j2 (the connectors' distal faces: the ends of sections 1 and 2).
+// With design_grid = 1 the grid lines sit on the nominal dimensions instead, at any res
+// (DesignGridManipulatorMesh; docs/fidelity.md has what it changes, and that it still does not
+// converge under refinement).
 // ================================================================================================
 
 constexpr int kManipMinRes = 6, kManipMaxRes = 24, kManipDefaultRes = 8;
@@ -87,7 +90,7 @@ Scene FinishManipulator(const RobotParams& P, Mesh mesh, const double joint_end[
 /// holds as many 4 mm cavities between 1.5 mm walls as fit after a solid part of one wall, ending
 /// in a wall (6 cavities, from x0 + 5.5), as MakeChamberRow does in cells.
 struct ManipDesign {
-  double x0[3], first[3], joint1[2];
+  double x0[3], first[3], joint_end[2];  // mm; joint_end: the connectors' distal faces
   int chambers = 0;
   double length = 0.0;
 };
@@ -102,7 +105,7 @@ ManipDesign MakeManipDesign() {
     x += kManipSection;
     if (q < 2) {
       x += kManipJoint;
-      d.joint1[q] = x;
+      d.joint_end[q] = x;
     }
   }
   d.length = x + kManipCap;
@@ -136,7 +139,7 @@ Mesh DesignGridManipulatorMesh(int res, const ManipDesign& d) {
   const auto zs = DesignLines({0.0, kManipWall, kManipThick - kManipWall, kManipThick}, h);
   return RectilinearTetMesh(xs, ys, zs, [&](const Eigen::Vector3d& c, const Eigen::Vector3i&) {
     for (int q = 0; q < 2; ++q)
-      if (c.x() > d.joint1[q] - kManipJoint && c.x() < d.joint1[q]) return 8;
+      if (c.x() > d.joint_end[q] - kManipJoint && c.x() < d.joint_end[q]) return 8;
     for (int q = 0; q < 3; ++q) {
       if (c.x() < d.x0[q] || c.x() > d.x0[q] + kManipSection) continue;
       const double u = c.x() - d.first[q];
@@ -160,7 +163,7 @@ Scene MakeFingerManipulator(int res, const RobotParams& P) {
         std::to_string(design));
   if (design == 1.0) {
     const ManipDesign d = MakeManipDesign();
-    return FinishManipulator(P, DesignGridManipulatorMesh(res, d), d.joint1);
+    return FinishManipulator(P, DesignGridManipulatorMesh(res, d), d.joint_end);
   }
   if (res % 2 != 0)
     throw std::invalid_argument(
