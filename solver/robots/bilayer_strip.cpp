@@ -3,12 +3,15 @@
 /// hard case of the FK benchmarks: long, thin and bending-dominated.
 #include "softkin/solver/robots/robot_parts.hpp"
 
+#include "softkin/solver/common/text_format.hpp"
 #include "softkin/solver/mesh/mesh_gen.hpp"
 
 #include <Eigen/Core>
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace softkin {
@@ -33,13 +36,19 @@ namespace {
 // ================================================================================================
 
 constexpr int kStripMinRes = 1, kStripMaxRes = 8, kStripDefaultRes = 2;
+constexpr double kStripMinCellLength = 0.25;  // mm: the cubic cells of the thinnest layers at res 1
 
 Scene MakeBilayerStrip(int res, const RobotParams& P) {
   const double t = P.at("layer"), h = t / res;
   const double width = P.at("width");
-  const double hx = P.at("cell_length") > 0.0 ? P.at("cell_length") : h;
-  const int nx = Cells(P.at("length"), hx), nz = 2 * res;
-  const double dx = P.at("length") / nx;
+  const double cell_length = P.at("cell_length"), length = P.at("length");
+  // Shorter cells than the thinnest layer's cubic ones would give millions of tets.
+  if (cell_length != 0.0 && cell_length < kStripMinCellLength)
+    throw std::invalid_argument("bilayer_strip: cell_length must be 0 (cubic cells) or at least " +
+                                FormatNumber(kStripMinCellLength) + " mm, got " +
+                                FormatNumber(cell_length));
+  const int nx = Cells(length, cell_length > 0.0 ? cell_length : h), nz = 2 * res;
+  const double dx = length / nx;
   const int ny = 2 * std::max(1, static_cast<int>(std::lround(width / (2 * h))));
   auto lines = [](int n, double step) {
     std::vector<double> v(n + 1);
@@ -87,8 +96,8 @@ RobotEntry BilayerStripEntry() {
        {"width", 10.0, 1.0, 100.0, "strip width, mm"},
        {"layer", 2.0, 0.25, 20.0, "thickness of each layer, mm"},
        {"cell_length", 0.0, 0.0, 50.0,
-        "cell size along the length, mm (0: layer/res, cubic cells); res 2 with cell_length 2 "
-        "gives 12,000 tets"}}};
+        "cell size along the length, mm (0: layer/res, cubic cells; else at least 0.25); res 2 "
+        "with cell_length 2 gives 12,000 tets"}}};
   return {info, kStripMinRes, kStripMaxRes, &MakeBilayerStrip};
 }
 

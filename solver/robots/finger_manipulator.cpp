@@ -155,13 +155,7 @@ Mesh DesignGridManipulatorMesh(int res, const ManipDesign& d) {
 }
 
 Scene MakeFingerManipulator(int res, const RobotParams& P) {
-  const double design = P.at("design_grid");
-  if (design != 0.0 && design != 1.0)
-    throw std::invalid_argument(
-        "finger_manipulator: design_grid must be 0 (snap to cells) or 1 (grid lines on the "
-        "design's dimensions), got " +
-        std::to_string(design));
-  if (design == 1.0) {
+  if (DesignGridFlag("finger_manipulator", P)) {
     const ManipDesign d = MakeManipDesign();
     return FinishManipulator(P, DesignGridManipulatorMesh(res, d), d.joint_end);
   }

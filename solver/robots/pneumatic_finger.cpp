@@ -120,15 +120,9 @@ Mesh DesignGridFingerMesh(int res) {
 
 Scene MakePneumaticFinger(int res, const RobotParams& P) {
   const FingerLayout L = MakeFingerLayout(res);
-  const double design = P.at("design_grid");
-  if (design != 0.0 && design != 1.0)
-    throw std::invalid_argument(
-        "pneumatic_finger: design_grid must be 0 (snap to cells) or 1 "
-        "(grid lines on the design's dimensions), got " +
-        std::to_string(design));
   Scene s;
   s.name = "pneumatic_finger";
-  s.mesh = design == 1.0
+  s.mesh = DesignGridFlag("pneumatic_finger", P)
                ? DesignGridFingerMesh(res)
                : VoxelTetMesh(Eigen::Vector3d::Zero(), L.h, Eigen::Vector3i(L.nx, L.ny, L.nz),
                               [&L](const Eigen::Vector3d&, const Eigen::Vector3i& c) {

@@ -2,11 +2,13 @@
 /// The helpers the robot generators share (robot_parts.hpp).
 #include "softkin/solver/robots/robot_parts.hpp"
 
+#include "softkin/solver/common/text_format.hpp"
 #include "softkin/solver/materials/hyperelastic.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace softkin {
@@ -43,6 +45,16 @@ std::vector<double> DesignLines(const std::vector<double>& b, double h,
     for (int i = 1; i <= n; ++i) lines.push_back(b[q] + (b[q + 1] - b[q]) * i / n);
   }
   return lines;
+}
+
+bool DesignGridFlag(const std::string& robot, const RobotParams& P) {
+  const double design = P.at("design_grid");
+  if (design != 0.0 && design != 1.0)
+    throw std::invalid_argument(robot +
+                                ": design_grid must be 0 (snap to cells) or 1 (grid lines on the "
+                                "design's dimensions), got " +
+                                FormatNumber(design));
+  return design == 1.0;
 }
 
 bool InCavity(const ChamberRow& r, int i) {

@@ -61,6 +61,11 @@ int Cells(double mm, double h);
 std::vector<double> DesignLines(const std::vector<double>& b, double h,
                                 const std::vector<bool>& even = {});
 
+/// The robot parameter design_grid of `robot` as a flag: 0 snaps the features to whole cells, 1
+/// puts grid lines on the design's dimensions (DesignLines). Any other value throws
+/// std::invalid_argument naming the robot, the key and the accepted values.
+bool DesignGridFlag(const std::string& robot, const RobotParams& P);
+
 /// Markers of a finger whose distal face is the plane x = xmax: "tip" (the face's centroid),
 /// "tip_top" / "tip_bottom" (its top and bottom quarters in z, used for the bend angle).
 void AddDistalFaceMarkers(double xmax, double zmax, double eps, Scene* s);

@@ -9,12 +9,11 @@
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/fk/model.hpp"
 #include "softkin/solver/robots/robots.hpp"
+#include "tests/solver/robots/mirror_test_util.hpp"
 
 #include <gtest/gtest.h>
 
-#include <array>
 #include <cmath>
-#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -29,20 +28,7 @@ struct MirrorCase {
   std::vector<double> actuation;  ///< a symmetric actuation with a clear bend
 };
 
-/// Vertices without a mirror image about y = plane_y (to 1e-6 mm).
-int UnmatchedMirrorVertices(const Mesh& mesh, double plane_y) {
-  auto key = [](double x, double y, double z) {
-    return std::array<long, 3>{std::lround(x * 1e6), std::lround(y * 1e6), std::lround(z * 1e6)};
-  };
-  std::map<std::array<long, 3>, int> at;
-  for (int v = 0; v < mesh.num_vertices(); ++v)
-    at[key(mesh.vertices(v, 0), mesh.vertices(v, 1), mesh.vertices(v, 2))] = v;
-  int unmatched = 0;
-  for (int v = 0; v < mesh.num_vertices(); ++v)
-    unmatched +=
-        !at.count(key(mesh.vertices(v, 0), 2 * plane_y - mesh.vertices(v, 1), mesh.vertices(v, 2)));
-  return unmatched;
-}
+using test::UnmatchedMirrorVertices;
 
 TEST(RobotSymmetry, MirrorSymmetricDesignsBendInTheirPlane) {
   const std::vector<MirrorCase> cases = {

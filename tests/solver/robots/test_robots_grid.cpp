@@ -5,14 +5,15 @@
 #include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/fk/model.hpp"
+#include "softkin/solver/mesh/element_geometry.hpp"
 #include "softkin/solver/robots/robots.hpp"
+#include "tests/solver/robots/mirror_test_util.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <functional>
-#include <array>
 #include <iostream>
 #include <map>
 #include <string>
@@ -327,6 +328,14 @@ TEST(RobotParams, UnknownOrOutOfRangeParametersAreRejectedByName) {
               std::string::npos)
         << e.what();
   }
+  try {
+    MakeRobot("bilayer_strip", 1, {{"cell_length", 0.01}});  // would be 10,000 cells long
+    ADD_FAILURE() << "no throw";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("cell_length must be 0 (cubic cells) or at least 0.25"),
+              std::string::npos)
+        << e.what();
+  }
   EXPECT_THROW(MakeRobot("three_chamber", 3, {{"gain", 1}}), std::invalid_argument);
   EXPECT_THROW(MakeRobot("finger_manipulator", 7), std::invalid_argument);  // odd res
 }
@@ -348,17 +357,7 @@ TEST(RobotGrid, PneumaticFingerDesignGridKeepsItsDimensionsAndSymmetry) {
     const Model m(s);
     EXPECT_NEAR(m.actuator_rest_measure(0), nominal, 1e-6 * nominal) << "res " << res;
     // Every vertex has its mirror image in y = 10.
-    std::map<std::array<long, 3>, int> at;
-    auto key = [](double x, double y, double z) {
-      return std::array<long, 3>{std::lround(x * 1e6), std::lround(y * 1e6), std::lround(z * 1e6)};
-    };
-    for (int v = 0; v < s.mesh.num_vertices(); ++v)
-      at[key(s.mesh.vertices(v, 0), s.mesh.vertices(v, 1), s.mesh.vertices(v, 2))] = v;
-    int unmatched = 0;
-    for (int v = 0; v < s.mesh.num_vertices(); ++v)
-      unmatched += !at.count(
-          key(s.mesh.vertices(v, 0), 20.0 - s.mesh.vertices(v, 1), s.mesh.vertices(v, 2)));
-    EXPECT_EQ(unmatched, 0) << "res " << res;
+    EXPECT_EQ(test::UnmatchedMirrorVertices(s.mesh, 10.0), 0) << "res " << res;
   }
   const Scene s = MakeRobot("pneumatic_finger", 7, {{"design_grid", 1.0}});
   auto model = std::make_shared<const Model>(s);
@@ -386,11 +385,10 @@ TEST(RobotGrid, FingerManipulatorDesignGridKeepsItsDimensionsAndSymmetry) {
     SCOPED_TRACE("res " + std::to_string(res));
     const Scene s = MakeRobot("finger_manipulator", res, {{"design_grid", 1.0}});
     std::map<int, double> volume;
-    for (const Element& e : s.mesh.elements) {
-      const Eigen::RowVector3d a = s.mesh.vertices.row(e.v[0]), b = s.mesh.vertices.row(e.v[1]),
-                               c = s.mesh.vertices.row(e.v[2]), d = s.mesh.vertices.row(e.v[3]);
-      volume[e.region] += (b - a).cross(c - a).dot(d - a) / 6.0;
-    }
+    for (const Element& e : s.mesh.elements)
+      volume[e.region] += TetVolume6(s.mesh.vertices.row(e.v[0]), s.mesh.vertices.row(e.v[1]),
+                                     s.mesh.vertices.row(e.v[2]), s.mesh.vertices.row(e.v[3])) /
+                          6.0;
     for (int region = 1; region <= 6; ++region)
       EXPECT_NEAR(volume[region], nominal, 1e-9 * nominal) << "region " << region;
     // The spine: 3 mm wide through the full 12 mm thickness, along each section's chamber row
@@ -398,17 +396,7 @@ TEST(RobotGrid, FingerManipulatorDesignGridKeepsItsDimensionsAndSymmetry) {
     EXPECT_NEAR(volume[7], 3 * 3.0 * 12.0 * 34.5, 1e-9 * 3 * 3.0 * 12.0 * 34.5);
     const Eigen::RowVector3d hi = s.mesh.vertices.colwise().maxCoeff();
     EXPECT_LT((hi - Eigen::RowVector3d(141, 20, 12)).norm(), 1e-9);
-    std::map<std::array<long, 3>, int> at;
-    auto key = [](double x, double y, double z) {
-      return std::array<long, 3>{std::lround(x * 1e6), std::lround(y * 1e6), std::lround(z * 1e6)};
-    };
-    for (int v = 0; v < s.mesh.num_vertices(); ++v)
-      at[key(s.mesh.vertices(v, 0), s.mesh.vertices(v, 1), s.mesh.vertices(v, 2))] = v;
-    int unmatched = 0;
-    for (int v = 0; v < s.mesh.num_vertices(); ++v)
-      unmatched += !at.count(
-          key(s.mesh.vertices(v, 0), 20.0 - s.mesh.vertices(v, 1), s.mesh.vertices(v, 2)));
-    EXPECT_EQ(unmatched, 0);
+    EXPECT_EQ(test::UnmatchedMirrorVertices(s.mesh, 10.0), 0);
     EXPECT_EQ(s.markers.size(), 3u);
   }
   EXPECT_EQ(MakeRobot("finger_manipulator", 8).mesh.num_elements(), 13200);
