@@ -14,11 +14,13 @@
 // Compare solvers as the ratio of their times within one run (the machine is shared):
 //   build/bin/bench_newton --benchmark_filter='Strip'
 // Cases: bilayer_strip res 1 and 2 (3.6k and 24k tets) and the 12k-tet strip of issue #33 (res 2
-// with 2 mm cells along the length) at alpha 1.1 and 1.5; pneumatic_finger res 8 at alpha 5, and
-// res 12 (46.7k tets) from rest to the end of its range, alpha 10; three_chamber res 5 at
-// (1.5, 1, 1).
+// with 2 mm cells along the length) and the unstructured Gmsh strip of the same size
+// (scenes/bilayer_strip_gmsh.json, 12,397 tets, data/strip/) at alpha 1.1 and 1.5; pneumatic_finger
+// res 8 at alpha 5, and res 12 (46.7k tets) from rest to the end of its range, alpha 10;
+// three_chamber res 5 at (1.5, 1, 1).
 #include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/robots/robots.hpp"
+#include "softkin/solver/scene/scene_json.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -40,9 +42,17 @@ std::shared_ptr<const Model> CachedModel(const std::string& robot, int res,
   return m;
 }
 
-void Solve(benchmark::State& state, const std::string& robot, int res, const std::string& solver,
-           const Eigen::VectorXd& c, const RobotParams& params = {}) {
-  auto model = CachedModel(robot, res, params);
+/// The scene file's model (relative to the source tree), built once.
+std::shared_ptr<const Model> CachedSceneModel(const std::string& scene) {
+  static std::map<std::string, std::shared_ptr<const Model>> cache;
+  auto& m = cache[scene];
+  if (!m)
+    m = std::make_shared<const Model>(LoadSceneJson(std::string(SOFTKIN_SOURCE_DIR) + "/" + scene));
+  return m;
+}
+
+void Solve(benchmark::State& state, const std::shared_ptr<const Model>& model,
+           const std::string& solver, const Eigen::VectorXd& c) {
   FkOptions o;
   o.solver = FkSolverTypeFromString(solver);
   o.max_iterations = 1000000;
@@ -65,6 +75,11 @@ void Solve(benchmark::State& state, const std::string& robot, int res, const std
                                                     benchmark::Counter::kInvert);
 }
 
+void Solve(benchmark::State& state, const std::string& robot, int res, const std::string& solver,
+           const Eigen::VectorXd& c, const RobotParams& params = {}) {
+  Solve(state, CachedModel(robot, res, params), solver, c);
+}
+
 Eigen::VectorXd One(double v) { return Eigen::VectorXd::Constant(1, v); }
 
 void BM_Strip(benchmark::State& state, int res, double alpha, const char* solver) {
@@ -72,6 +87,9 @@ void BM_Strip(benchmark::State& state, int res, double alpha, const char* solver
 }
 void BM_Strip12k(benchmark::State& state, double alpha, const char* solver) {
   Solve(state, "bilayer_strip", 2, solver, One(alpha), {{"cell_length", 2.0}});
+}
+void BM_GmshStrip(benchmark::State& state, double alpha, const char* solver) {
+  Solve(state, CachedSceneModel("scenes/bilayer_strip_gmsh.json"), solver, One(alpha));
 }
 void BM_Finger(benchmark::State& state, const char* solver) {
   Solve(state, "pneumatic_finger", 8, solver, One(5.0));
@@ -89,6 +107,8 @@ void BM_Strip_r2_a1_1(benchmark::State& s, const char* solver) { BM_Strip(s, 2, 
 void BM_Strip_r2_a1_5(benchmark::State& s, const char* solver) { BM_Strip(s, 2, 1.5, solver); }
 void BM_Strip12k_a1_1(benchmark::State& s, const char* solver) { BM_Strip12k(s, 1.1, solver); }
 void BM_Strip12k_a1_5(benchmark::State& s, const char* solver) { BM_Strip12k(s, 1.5, solver); }
+void BM_GmshStrip_a1_1(benchmark::State& s, const char* solver) { BM_GmshStrip(s, 1.1, solver); }
+void BM_GmshStrip_a1_5(benchmark::State& s, const char* solver) { BM_GmshStrip(s, 1.5, solver); }
 
 BENCHMARK_CAPTURE(BM_Strip_r1_a1_1, newton, "newton")
     ->Unit(benchmark::kMillisecond)
@@ -135,6 +155,22 @@ BENCHMARK_CAPTURE(BM_Strip12k_a1_5, newton, "newton")
     ->UseRealTime()
     ->Iterations(1);
 BENCHMARK_CAPTURE(BM_Strip12k_a1_5, lg_aa, "lg-aa")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_GmshStrip_a1_1, newton, "newton")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_GmshStrip_a1_1, lg_aa, "lg-aa")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_GmshStrip_a1_5, newton, "newton")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_GmshStrip_a1_5, lg_aa, "lg-aa")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);

@@ -6,6 +6,7 @@
 #include "softkin/solver/fk/targets.hpp"
 #include "softkin/solver/newton/newton_solver.hpp"
 #include "softkin/solver/robots/robots.hpp"
+#include "softkin/solver/scene/scene_json.hpp"
 #include "softkin/solver/sensitivity/free_operator.hpp"
 #include "tests/solver/fk/fk_test_util.hpp"
 
@@ -137,6 +138,42 @@ TEST(NewtonSolver, SameStateAsLgAaOnEveryEmbeddedRobot) {
   }
   EXPECT_GE(newton_solved, 7);
   EXPECT_GE(compared, 6);
+}
+
+// The unstructured Gmsh strip of issue #33 (scenes/bilayer_strip_gmsh.json, data/strip/): the
+// scene reads as a clamped 100 x 10 x 4 mm bilayer whose top layer is the actuator, newton
+// solves it in a few iterations to a fixed point of lg-aa (lg-aa needs about 4,100 iterations
+// from rest at this actuation), and the strip curls towards -z.
+TEST(NewtonSolver, GmshStripSceneIsAFixedPointOfLgAa) {
+  const Scene s =
+      LoadSceneJson(std::string(SOFTKIN_SOURCE_DIR) + "/scenes/bilayer_strip_gmsh.json");
+  ASSERT_EQ(s.mesh.num_elements(), 12397);
+  ASSERT_EQ(s.num_actuators(), 1);
+  EXPECT_EQ(s.solver.solver, FkSolverType::kNewton);
+  const Eigen::RowVector3d lo = s.mesh.vertices.colwise().minCoeff();
+  const Eigen::RowVector3d hi = s.mesh.vertices.colwise().maxCoeff();
+  EXPECT_LT((lo - Eigen::RowVector3d::Zero()).norm(), 1e-9);
+  EXPECT_LT((hi - Eigen::RowVector3d(100, 10, 4)).norm(), 1e-9);
+  // Top layer actuated, bottom layer body; the layers meet at z = 2.
+  for (const auto& e : s.mesh.elements) {
+    double z = 0.0;
+    for (int k = 0; k < 4; ++k) z += 0.25 * s.mesh.vertices(e.v[k], 2);
+    EXPECT_EQ(e.region, z > 2.0 ? 1 : 0);
+  }
+  ASSERT_GT(s.fixed.size(), 20u);
+  for (int v : s.fixed) EXPECT_LT(std::abs(s.mesh.vertices(v, 0)), 1e-9);
+
+  auto model = std::make_shared<const Model>(s);
+  const Eigen::VectorXd c = Eigen::VectorXd::Constant(1, 1.1);
+  const FkResult nw = MakeFkSolver(model, Options("newton", 1e-8, 1e-8))->Solve(c);
+  ASSERT_EQ(nw.status, FkStatus::Converged) << nw.BriefReport();
+  EXPECT_LE(nw.iterations, 12) << nw.BriefReport();
+  EXPECT_EQ(nw.message.find("lg-aa"), std::string::npos) << nw.message;
+  const FkResult again = MakeFkSolver(model, Options("lg-aa", 1e-6, 1e-6))->Solve(c, &nw.positions);
+  EXPECT_LE(again.iterations, 2) << again.BriefReport();
+  EXPECT_LT((again.positions - nw.positions).rowwise().norm().maxCoeff(), 1e-6 * model->size());
+  const Eigen::MatrixX3d tip = s.marker_positions(nw.positions);
+  EXPECT_LT(tip(s.marker_index("tip"), 2), -30.0);
 }
 
 // Near the solution each Newton iteration divides the residual by more than the one before.
