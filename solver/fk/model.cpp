@@ -139,6 +139,9 @@ Model::Model(const Scene& scene) : scene_(scene) {
       }
       // Cable elements get their direction and length share below, per cable.
     }
+    // "strain" (scene.hpp, ElementEnergy): the term per unit of strain, not of vertex motion.
+    if (scene_.element_energy == ElementEnergy::kStrain)
+      me.wv /= P.topRows(me.k).squaredNorm() / 3.0;
   }
   for (int g = 0; g < num_groups(); ++g) {
     const Actuator& act = scene_.actuators[groups_[g].actuator];

@@ -30,11 +30,22 @@ const std::vector<RobotEntry>& Registry() {
   return kRobots;
 }
 
+/// The parameter every robot takes: the scene's element_energy (scene.hpp, ElementEnergy).
+RobotParam ElementEnergyParam() {
+  return {"element_energy", 0.0, 0.0, 1.0,
+          "0: element energy terms as Eq. 2.10 writes them (shape; for the same strain a term "
+          "grows with its element's size squared); 1: divided by each element's rest size "
+          "(strain; small and large elements equally stiff)"};
+}
+
 }  // namespace
 
 std::vector<RobotInfo> ListRobots() {
   std::vector<RobotInfo> out;
-  for (const auto& r : Registry()) out.push_back(r.info);
+  for (const auto& r : Registry()) {
+    out.push_back(r.info);
+    out.back().params.push_back(ElementEnergyParam());
+  }
   return out;
 }
 
@@ -46,14 +57,16 @@ Scene MakeRobot(const std::string& name, int res, const RobotParams& params) {
       throw std::invalid_argument(name + ": --res must be an integer in [" +
                                   std::to_string(r.min_res) + ", " + std::to_string(r.max_res) +
                                   "], got " + std::to_string(res));
+    std::vector<RobotParam> accepted = r.info.params;
+    accepted.push_back(ElementEnergyParam());
     RobotParams full;
-    for (const auto& p : r.info.params) full[p.name] = p.def;
+    for (const auto& p : accepted) full[p.name] = p.def;
     for (const auto& [key, value] : params) {
-      auto it = std::find_if(r.info.params.begin(), r.info.params.end(),
+      auto it = std::find_if(accepted.begin(), accepted.end(),
                              [&](const RobotParam& p) { return p.name == key; });
-      if (it == r.info.params.end()) {
+      if (it == accepted.end()) {
         std::string known;
-        for (const auto& p : r.info.params) known += (known.empty() ? "" : ", ") + p.name;
+        for (const auto& p : accepted) known += (known.empty() ? "" : ", ") + p.name;
         throw std::invalid_argument(name + ": unknown parameter '" + key + "'; its parameters: " +
                                     (known.empty() ? std::string("none") : known));
       }
@@ -63,7 +76,16 @@ Scene MakeRobot(const std::string& name, int res, const RobotParams& params) {
                                     FormatNumber(value));
       full[key] = value;
     }
-    return r.make(res, full);
+    const double energy = full.at("element_energy");
+    if (energy != 0.0 && energy != 1.0)
+      throw std::invalid_argument(name +
+                                  ": parameter 'element_energy' must be 0 (shape, Eq. 2.10) "
+                                  "or 1 (strain), got " +
+                                  FormatNumber(energy));
+    full.erase("element_energy");
+    Scene scene = r.make(res, full);
+    scene.element_energy = energy == 1.0 ? ElementEnergy::kStrain : ElementEnergy::kShape;
+    return scene;
   }
   std::string known;
   for (const auto& r : Registry()) known += (known.empty() ? "" : ", ") + r.info.name;

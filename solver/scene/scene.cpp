@@ -17,6 +17,10 @@ constexpr EnumName<MaterialLaw> kLawNames[] = {
     {MaterialLaw::kBlend, "blend"},
     {MaterialLaw::kMooneyRivlin, "mooney-rivlin"},
 };
+constexpr EnumName<ElementEnergy> kElementEnergyNames[] = {
+    {ElementEnergy::kShape, "shape"},
+    {ElementEnergy::kStrain, "strain"},
+};
 }  // namespace
 
 std::string ToString(MaterialLaw law) { return EnumToString(kLawNames, law); }
@@ -24,6 +28,12 @@ MaterialLaw MaterialLawFromString(const std::string& s) {
   return EnumFromString(kLawNames, s, "material law");
 }
 std::vector<std::string> MaterialLawNames() { return EnumNames(kLawNames); }
+
+std::string ToString(ElementEnergy e) { return EnumToString(kElementEnergyNames, e); }
+ElementEnergy ElementEnergyFromString(const std::string& s) {
+  return EnumFromString(kElementEnergyNames, s, "element energy");
+}
+std::vector<std::string> ElementEnergyNames() { return EnumNames(kElementEnergyNames); }
 
 const char* ActuatorTypeToString(ActuatorType t) {
   switch (t) {

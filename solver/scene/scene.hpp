@@ -31,6 +31,23 @@ std::string ToString(MaterialLaw law);
 MaterialLaw MaterialLawFromString(const std::string& s);
 std::vector<std::string> MaterialLawNames();
 
+/// How an element's term of the FK energy is weighted (Scene::element_energy; Eq. 2.10).
+/// kShape, "shape": w_i Vol_i |N V^d - R N V^t|^2 as the thesis writes it. The norm compares
+/// vertex positions, so for the same strain an element's term grows with its size squared: a
+/// mesh with elements of different sizes (graded, or a grid with thin walls) makes its small
+/// elements softer, and the energy of a refined mesh falls as h^2.
+/// kStrain, "strain": the same term divided by the element's rest size |N V^t|^2 / 3, which for
+/// an element without a preferred direction is w_i Vol_i |F - R|^2 to first order: a strain
+/// energy, the same for small and large elements. On a mesh whose elements all have the same size
+/// and shape both give the same state (the energy differs by a constant factor).
+enum class ElementEnergy {
+  kShape,   ///< "shape"
+  kStrain,  ///< "strain"
+};
+std::string ToString(ElementEnergy e);
+ElementEnergy ElementEnergyFromString(const std::string& s);
+std::vector<std::string> ElementEnergyNames();
+
 struct Material {
   std::string name = "default";
   double r_omega = 1.0;
@@ -125,6 +142,9 @@ struct Scene {
   /// the local-global solvers respond to them with springs (FkOptions::collision).
   std::vector<TriangleSurface> obstacles;
   FkOptions solver;  ///< default solver options for this scene
+  /// The weighting of the elements' energy terms (ElementEnergy): "shape" (Eq. 2.10, default) or
+  /// "strain" (each term divided by its element's rest size squared).
+  ElementEnergy element_energy = ElementEnergy::kShape;
   /// Rest positions for the elements of some regions when they differ from mesh.vertices.
   /// Progressive remeshing (remesh.hpp, thesis Algorithm 2) gives a re-tessellated chamber the
   /// shape it was meshed in as its rest shape, while the body tets sharing its interface vertices

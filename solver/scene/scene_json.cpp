@@ -163,6 +163,8 @@ Scene SceneParser::Build(const json& given_root, const Mesh* given,
   } else {
     ReadMeshSection(root.at("mesh"), &scene);
   }
+  scene.element_energy =
+      ElementEnergyFromString(Get(root, "", "element_energy").get<std::string>());
   ReadRegions(root.at("regions"), &scene);
   ReadFixed(root.at("fixed"), &scene);
   ReadMotions(Get(root, "", "motions"), &scene);

@@ -70,6 +70,14 @@ void AddMeshKeys(std::vector<KeySpec>* t) {
 void AddRegionKeys(std::vector<KeySpec>* t) {
   const Material mat;
   const Actuator act;
+  t->push_back(Key("element_energy", S, Opt,
+                   "How each element's energy term is weighted. shape: w Vol |N V^d - R N V^t|^2 "
+                   "as Eq. 2.10 writes it, which for the same strain grows with the element's "
+                   "size squared (small elements are softer); strain: the same divided by the "
+                   "element's rest size |N V^t|^2 / 3, about w Vol |F - R|^2, the same for small "
+                   "and large elements. Both give the same state on a mesh of equal elements.")
+                   .Def("shape")
+                   .Choices(ElementEnergyNames()));
   t->push_back(Key("regions", A, R,
                    "Role of each region tag; every tag that has elements needs exactly one "
                    "entry."));
