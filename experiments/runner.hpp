@@ -44,6 +44,8 @@ Scene ConfigRobot(const Config& cfg, const std::string& robot, int res);
 // Experiments (each in its own file).
 nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunResolutionSweep(const Config& cfg, const std::string& dir, bool verbose);
+/// Convergence under refinement, robot by robot (exp_refinement.cpp).
+nlohmann::json RunRefinement(const Config& cfg, const std::string& dir, bool verbose);
 /// SoftKin against the pressure-driven CalculiX FEM at equal chamber volume (exp_fidelity_fem.cpp).
 nlohmann::json RunFidelityFem(const Config& cfg, const std::string& dir, bool verbose);
 nlohmann::json RunSolverScaling(const Config& cfg, const std::string& dir, bool verbose);

@@ -51,7 +51,79 @@ std::vector<int> VerticesInXRange(const Mesh& m, double x0, double x1, double zm
   return VerticesInBox(m, Eigen::Vector3d(x0, -kInf, -kInf), Eigen::Vector3d(x1, kInf, zmax_incl));
 }
 
-Scene MakeMultiSegmentGripper(int res, const RobotParams&) {
+/// Materials, actuators, the fixed face and the markers of a gripper mesh: P0 is the plane
+/// x = p0_x, grip_layer the layer (z <= layer_z) of the third segment, x in [grip_x0, xmax].
+void FinishGripper(int res, double p0_x, double grip_x0, double xmax, double layer_z, Scene* s) {
+  s->name = "multi_segment_gripper";
+  s->body[0] = Material{"body", 1.0, 1.0};
+  s->body[4] = Material{"inextensible", 1.0, 20.0};
+  s->body[5] = Material{"connector", 1.0, 20.0};
+  for (int k = 0; k < 3; ++k)
+    s->actuators.push_back(PneumaticActuator("c" + std::to_string(k + 1), {k + 1}, kGripMaxAlpha));
+  const double eps = 1e-6 * kGripWidth / res, zmax = s->mesh.vertices.col(2).maxCoeff();
+  s->fixed = VerticesOnPlane(s->mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
+  AddDistalFaceMarkers(xmax, zmax, eps, s);
+  s->markers.push_back(
+      {"P0", VerticesOnPlane(s->mesh, Eigen::Vector3d(p0_x, 0, 0), Eigen::Vector3d::UnitX(), eps)});
+  s->markers.push_back(
+      {"grip_layer", VerticesInXRange(s->mesh, grip_x0 - eps, xmax + eps, layer_z + eps)});
+  s->validate();
+}
+
+/// Chambers per segment with design_grid = 1 (the count the snapped grid has at res 12).
+constexpr int kGripDesignChambers = 7;
+
+/// The gripper's x breakpoints and the cell classifier with its nominal dimensions whatever the
+/// resolution (design_grid = 1): the 8 mm base block; per segment a 2 mm solid proximal part and
+/// 7 cavities of 5 mm between 1.5 mm walls, the last wall closing the segment at 50 mm; 5 mm
+/// connectors. Grid lines on every one of these, each part cut into cells of about 20 / res mm,
+/// an even number across the cavities' width (mirror-symmetric about y = 10).
+Mesh DesignGridGripperMesh(int res, double* p0_x, double* grip_x0) {
+  const double h = kGripWidth / res, pitch = kGripWall + kGripCavity;
+  const double solid = kGripSegment - kGripDesignChambers * pitch - kGripWall;
+  std::vector<double> bx = {0.0}, first;
+  for (int k = 0; k < 3; ++k) {
+    const double x0 = kGripBase + k * (kGripSegment + kGripJoint);
+    bx.push_back(x0);
+    first.push_back(x0 + solid);
+    for (int c = 0; c < kGripDesignChambers; ++c) {
+      bx.push_back(first.back() + c * pitch);
+      bx.push_back(first.back() + c * pitch + kGripWall);
+    }
+    bx.push_back(first.back() + kGripDesignChambers * pitch);  // the closing wall
+    bx.push_back(x0 + kGripSegment);
+  }
+  *p0_x = kGripBase + 2 * (kGripSegment + kGripJoint);
+  *grip_x0 = *p0_x;
+  const double z0 = kGripLayer + kGripWall, z1 = kGripHeight - kGripWall;
+  const auto xs = DesignLines(bx, h);
+  const auto ys =
+      DesignLines({0.0, kGripWall, kGripWidth - kGripWall, kGripWidth}, h, {false, true, false});
+  const auto zs = DesignLines({0.0, kGripLayer, z0, z1, kGripHeight}, h);
+  return RectilinearTetMesh(xs, ys, zs, [&](const Eigen::Vector3d& c, const Eigen::Vector3i&) {
+    if (c.z() < kGripLayer) return 4;
+    for (int k = 0; k < 3; ++k) {
+      const double x0 = kGripBase + k * (kGripSegment + kGripJoint), x1 = x0 + kGripSegment;
+      if (c.x() > x1 && c.x() < x1 + kGripJoint) return 5;
+      if (c.x() < x0 || c.x() > x1) continue;
+      const double u = c.x() - first[k];
+      const bool cavity = u > 0 && u < kGripDesignChambers * pitch &&
+                          std::fmod(u, pitch) > kGripWall && c.y() > kGripWall &&
+                          c.y() < kGripWidth - kGripWall && c.z() > z0 && c.z() < z1;
+      return cavity ? k + 1 : 0;
+    }
+    return 0;
+  });
+}
+
+Scene MakeMultiSegmentGripper(int res, const RobotParams& P) {
+  if (DesignGridFlag("multi_segment_gripper", P)) {
+    Scene s;
+    double p0_x = 0.0, grip_x0 = 0.0;
+    s.mesh = DesignGridGripperMesh(res, &p0_x, &grip_x0);
+    FinishGripper(res, p0_x, grip_x0, s.mesh.vertices.col(0).maxCoeff(), kGripLayer, &s);
+    return s;
+  }
   const double h = kGripWidth / res;
   const int ny = res, nz = static_cast<int>(std::lround(kGripHeight / h));
   const int wall = Cells(kGripWall, h), cav = Cells(kGripCavity, h), layer = Cells(kGripLayer, h);
@@ -86,21 +158,8 @@ Scene MakeMultiSegmentGripper(int res, const RobotParams&) {
     return 0;
   };
   Scene s;
-  s.name = "multi_segment_gripper";
   s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz), cell);
-  s.body[0] = Material{"body", 1.0, 1.0};
-  s.body[4] = Material{"inextensible", 1.0, 20.0};
-  s.body[5] = Material{"connector", 1.0, 20.0};
-  for (int k = 0; k < 3; ++k)
-    s.actuators.push_back(PneumaticActuator("c" + std::to_string(k + 1), {k + 1}, kGripMaxAlpha));
-  const double eps = 1e-6 * h, xmax = nx * h, zmax = nz * h;
-  s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
-  AddDistalFaceMarkers(xmax, zmax, eps, &s);
-  s.markers.push_back({"P0", VerticesOnPlane(s.mesh, Eigen::Vector3d(joints[1].second * h, 0, 0),
-                                             Eigen::Vector3d::UnitX(), eps)});
-  s.markers.push_back({"grip_layer", VerticesInXRange(s.mesh, rows[2].x0 * h - eps,
-                                                      rows[2].x1 * h + eps, layer * h + eps)});
-  s.validate();
+  FinishGripper(res, joints[1].second * h, rows[2].x0 * h, nx * h, layer * h, &s);
   return s;
 }
 
@@ -116,8 +175,13 @@ RobotEntry MultiSegmentGripperEntry() {
       "tip_top, tip_bottom, P0 (end of the second segment), grip_layer (the third segment's "
       "inextensible layer).",
       kGripDefaultRes,
-      "cells across the 20 mm width (cell size 20/res mm), integer in [6, 24]",
-      {}};
+      "cells across the 20 mm width (cell size 20/res mm), integer in [6, 24]; features snap to "
+      "whole cells unless design_grid = 1",
+      {{"design_grid", 0.0, 0.0, 1.0,
+        "0: features snap to whole cells of 20/res mm (walls, cavities and their count change "
+        "with res: 4, 6, 5, 7 chambers per segment at res 6, 8, 10, 12); 1: grid lines on the "
+        "nominal dimensions (7 cavities of 5 mm per segment between 1.5 mm walls, 1.5 mm floor, "
+        "side walls, roof and layer) at every res, mirror-symmetric about y = 10"}}};
   return {info, kGripMinRes, kGripMaxRes, &MakeMultiSegmentGripper};
 }
 

@@ -403,5 +403,40 @@ TEST(RobotGrid, FingerManipulatorDesignGridKeepsItsDimensionsAndSymmetry) {
   EXPECT_THROW(MakeRobot("finger_manipulator", 8, {{"design_grid", 0.5}}), std::invalid_argument);
 }
 
+// multi_segment_gripper with design_grid = 1: seven 5 x 17 x 10.5 mm cavities per segment at
+// every resolution (the snapped grid has 4, 6, 5 and 7 at res 6, 8, 10 and 12), the 168 x 20 x 15
+// mm outline, the connectors' volume, the markers, mirror symmetry about y = 10; the snapped
+// default is unchanged.
+TEST(RobotGrid, MultiSegmentGripperDesignGridKeepsItsDimensionsAndSymmetry) {
+  const double nominal = 7 * 5.0 * 17.0 * 10.5;
+  for (int res : {6, 7, 9}) {
+    SCOPED_TRACE("res " + std::to_string(res));
+    const Scene s = MakeRobot("multi_segment_gripper", res, {{"design_grid", 1.0}});
+    std::map<int, double> volume;
+    for (const Element& e : s.mesh.elements)
+      volume[e.region] += TetVolume6(s.mesh.vertices.row(e.v[0]), s.mesh.vertices.row(e.v[1]),
+                                     s.mesh.vertices.row(e.v[2]), s.mesh.vertices.row(e.v[3])) /
+                          6.0;
+    for (int region = 1; region <= 3; ++region)
+      EXPECT_NEAR(volume[region], nominal, 1e-9 * nominal) << "region " << region;
+    // Two connectors of 5 mm above the 1.5 mm layer.
+    EXPECT_NEAR(volume[5], 2 * 5.0 * 20.0 * 13.5, 1e-9 * 2700.0);
+    const Eigen::RowVector3d hi = s.mesh.vertices.colwise().maxCoeff();
+    EXPECT_LT((hi - Eigen::RowVector3d(168, 20, 15)).norm(), 1e-9);
+    EXPECT_EQ(test::UnmatchedMirrorVertices(s.mesh, 10.0), 0);
+    const Eigen::MatrixX3d P = s.marker_positions(s.mesh.vertices);
+    EXPECT_NEAR(P(s.marker_index("P0"), 0), 118.0, 1e-9);
+    EXPECT_NEAR(P(s.marker_index("tip"), 0), 168.0, 1e-9);
+    for (int v : s.markers[s.marker_index("grip_layer")].vertices) {
+      EXPECT_GE(s.mesh.vertices(v, 0), 118.0 - 1e-9);
+      EXPECT_LE(s.mesh.vertices(v, 2), 1.5 + 1e-9);
+    }
+  }
+  EXPECT_EQ(MakeRobot("multi_segment_gripper", 8).mesh.num_elements(), 19296);
+  EXPECT_EQ(MakeRobot("multi_segment_gripper", 8).mesh.num_vertices(), 4284);
+  EXPECT_THROW(MakeRobot("multi_segment_gripper", 8, {{"design_grid", 2.0}}),
+               std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace softkin

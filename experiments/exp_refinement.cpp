@@ -1,0 +1,206 @@
+// Convergence under mesh refinement, robot by robot (issue #35): each case is an embedded robot
+// with its design parameters and one actuation, solved at four or more resolutions; the tip's
+// change from one resolution to the next says whether the answer converges. (The tracked point
+// is the marker `tip` unless the case names another.)
+#include "softkin/experiments/results.hpp"
+#include "softkin/experiments/runner.hpp"
+#include "softkin/solver/factory/fk_factory.hpp"
+#include "softkin/solver/fk/fk_solver.hpp"
+#include "softkin/solver/robots/robots.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace softkin {
+
+namespace {
+
+struct RefinementCase {
+  std::string label, robot, marker = "tip";
+  RobotParams params;
+  std::vector<double> actuation;  ///< one value per actuator
+  std::vector<int> resolutions;   ///< increasing, at least 4
+  std::string solver;             ///< "": the config's solver.solver
+};
+
+std::string CaseKeys() {
+  return "label (string), robot (string), solver (a solver name, instead of the config's), marker "
+         "(the tracked marker's name; default tip), "
+         "robot_params (object of numbers), actuation (array of "
+         "numbers, one per actuator), resolutions (array of at least 4 increasing integers)";
+}
+
+RefinementCase ReadCase(const Config& cfg, const nlohmann::json& c, const std::string& key) {
+  if (!c.is_object()) cfg.Fail(key, "an object with " + CaseKeys());
+  RefinementCase rc;
+  for (const auto& [k, v] : c.items()) {
+    if (k == "label" && v.is_string()) {
+      rc.label = v.get<std::string>();
+    } else if (k == "robot" && v.is_string()) {
+      rc.robot = v.get<std::string>();
+    } else if (k == "solver" && v.is_string()) {
+      rc.solver = v.get<std::string>();
+      try {
+        FkSolverTypeFromString(rc.solver);
+      } catch (const std::invalid_argument& e) {
+        cfg.Fail(key + ".solver", e.what());
+      }
+    } else if (k == "marker" && v.is_string()) {
+      rc.marker = v.get<std::string>();
+    } else if (k == "robot_params" && v.is_object()) {
+      for (const auto& [pk, pv] : v.items()) {
+        if (!pv.is_number()) cfg.Fail(key + ".robot_params." + pk, "a number");
+        rc.params[pk] = pv.get<double>();
+      }
+    } else if (k == "actuation" && v.is_array() && !v.empty()) {
+      for (const auto& x : v) {
+        if (!x.is_number()) cfg.Fail(key + ".actuation", "an array of numbers");
+        rc.actuation.push_back(x.get<double>());
+      }
+    } else if (k == "resolutions" && v.is_array()) {
+      for (const auto& x : v) {
+        if (!x.is_number_integer() || x.get<int>() < 1)
+          cfg.Fail(key + ".resolutions", "an array of positive integers");
+        rc.resolutions.push_back(x.get<int>());
+      }
+    } else {
+      cfg.Fail(key + "." + k, "one of " + CaseKeys());
+    }
+  }
+  if (rc.label.empty() || rc.label.find_first_of(",\"\n\r") != std::string::npos)
+    cfg.Fail(key + ".label",
+             "a name for the case without commas, quotes or line breaks (it is "
+             "a field of refinement.csv)");
+  if (rc.robot.empty()) cfg.Fail(key + ".robot", "an embedded robot's name (softkin robots)");
+  if (rc.actuation.empty()) cfg.Fail(key + ".actuation", "one value per actuator");
+  if (rc.resolutions.size() < 4)
+    cfg.Fail(key + ".resolutions", "at least 4 resolutions (convergence needs three changes)");
+  for (size_t i = 1; i < rc.resolutions.size(); ++i)
+    if (rc.resolutions[i] <= rc.resolutions[i - 1])
+      cfg.Fail(key + ".resolutions", "strictly increasing resolutions");
+  return rc;
+}
+
+std::vector<RefinementCase> ReadCases(const Config& cfg) {
+  const nlohmann::json cases = cfg.Raw("cases");
+  if (!cases.is_array() || cases.empty())
+    cfg.Fail("cases", "a non-empty array of objects with " + CaseKeys());
+  std::vector<RefinementCase> out;
+  for (size_t i = 0; i < cases.size(); ++i) {
+    out.push_back(ReadCase(cfg, cases[i], "cases[" + std::to_string(i) + "]"));
+    for (size_t j = 0; j + 1 < out.size(); ++j)
+      if (out[j].label == out.back().label)
+        cfg.Fail("cases[" + std::to_string(i) + "].label", "a label no other case has");
+  }
+  return out;
+}
+
+/// The robot at `res` with the case's parameters; errors name the case.
+Scene CaseRobot(const Config& cfg, const RefinementCase& rc, int res) {
+  try {
+    return MakeRobot(rc.robot, res, rc.params);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(cfg.path() + ": cases '" + rc.label + "': " + e.what());
+  }
+}
+
+double Distance(const Eigen::RowVector3d& a, const Eigen::RowVector3d& b) { return (a - b).norm(); }
+
+/// One case: every resolution, a row each; the summary entry with the changes of the tip.
+nlohmann::json RunCase(const Config& cfg, const RefinementCase& rc, FkOptions opts, CsvWriter* csv,
+                       bool verbose) {
+  if (!rc.solver.empty()) opts.solver = FkSolverTypeFromString(rc.solver);
+  std::vector<Eigen::RowVector3d> tips;
+  std::vector<nlohmann::json> rows;
+  double length = 0.0;
+  for (int res : rc.resolutions) {
+    const Scene scene = CaseRobot(cfg, rc, res);
+    if (static_cast<Eigen::Index>(rc.actuation.size()) != scene.num_actuators())
+      cfg.Fail("cases '" + rc.label + "'.actuation", std::to_string(scene.num_actuators()) +
+                                                         " value(s), one per actuator of '" +
+                                                         rc.robot + "'");
+    const int tip = scene.marker_index(rc.marker);
+    if (tip < 0)
+      cfg.Fail("cases '" + rc.label + "'.marker",
+               "a marker of '" + rc.robot + "' (softkin robots)");
+    const Eigen::RowVector3d lo = scene.mesh.vertices.colwise().minCoeff();
+    const Eigen::RowVector3d hi = scene.mesh.vertices.colwise().maxCoeff();
+    length = (hi - lo).maxCoeff();
+    auto model = std::make_shared<const Model>(scene);
+    const Eigen::VectorXd c =
+        Eigen::Map<const Eigen::VectorXd>(rc.actuation.data(), rc.actuation.size());
+    const FkResult r = MakeFkSolver(model, opts)->Solve(c);
+    if (r.status == FkStatus::InvalidInput)
+      throw std::invalid_argument(cfg.path() + ": cases '" + rc.label + "': " + r.message);
+    tips.push_back(scene.marker_positions(r.positions).row(tip));
+    nlohmann::json row = {{"case", rc.label},
+                          {"res", res},
+                          {"n_vertices", scene.mesh.num_vertices()},
+                          {"n_elements", scene.mesh.num_elements()},
+                          {"tip_x", tips.back()[0]},
+                          {"tip_y", tips.back()[1]},
+                          {"tip_z", tips.back()[2]},
+                          {"energy", r.energy},
+                          {"iterations", r.iterations},
+                          {"solve_s", r.time_s},
+                          {"inverted", r.inverted_elements},
+                          {"status", FkStatusToString(r.status)}};
+    // The change from the previous resolution (left empty on the first).
+    if (tips.size() > 1) row["change_mm"] = Distance(tips.back(), tips[tips.size() - 2]);
+    if (verbose)
+      std::fprintf(stderr, "  %s res %d: %d elements, %s\n", rc.label.c_str(), res,
+                   scene.mesh.num_elements(), r.BriefReport().c_str());
+    rows.push_back(row);
+  }
+  // The changes between successive resolutions, and the distance of each tip to the finest.
+  nlohmann::json changes = nlohmann::json::array(), to_finest = nlohmann::json::array();
+  bool shrink = true;
+  for (size_t i = 0; i < tips.size(); ++i) {
+    to_finest.push_back(Distance(tips[i], tips.back()));
+    if (i == 0) continue;
+    changes.push_back(Distance(tips[i], tips[i - 1]));
+    if (i >= 2 && changes[i - 1].get<double>() > changes[i - 2].get<double>()) shrink = false;
+  }
+  for (auto& row : rows) {
+    row["to_finest_mm"] = to_finest[&row - &rows[0]];
+    csv->RowJson(row);
+  }
+  bool all_converged = true;
+  for (const auto& row : rows) all_converged &= row["status"] == "converged";
+  return {{"label", rc.label},
+          {"robot", rc.robot},
+          {"robot_params", rc.params},
+          {"marker", rc.marker},
+          {"solver", ToString(opts.solver)},
+          {"actuation", rc.actuation},
+          {"resolutions", rc.resolutions},
+          {"length_mm", length},
+          {"tip_changes_mm", changes},
+          {"tip_to_finest_mm", to_finest},
+          {"last_change_percent_of_length", 100.0 * changes.back().get<double>() / length},
+          {"changes_shrink", shrink},
+          {"all_converged", all_converged}};
+}
+
+}  // namespace
+
+nlohmann::json RunRefinement(const Config& cfg, const std::string& dir, bool verbose) {
+  const std::vector<RefinementCase> cases = ReadCases(cfg);
+  const FkOptions opts = cfg.Solver(FkOptions{});
+  cfg.CheckNoUnknownKeys();
+  if (cfg.check_only()) return {};
+  CsvWriter csv(dir + "/refinement.csv",
+                {"case", "res", "n_vertices", "n_elements", "tip_x", "tip_y", "tip_z", "change_mm",
+                 "to_finest_mm", "energy", "iterations", "solve_s", "inverted", "status"});
+  nlohmann::json out = nlohmann::json::array();
+  int shrinking = 0;
+  for (const auto& rc : cases) {
+    out.push_back(RunCase(cfg, rc, opts, &csv, verbose));
+    shrinking += out.back()["changes_shrink"].get<bool>();
+  }
+  return {{"cases", out}, {"cases_whose_changes_shrink", shrinking}, {"n_cases", cases.size()}};
+}
+
+}  // namespace softkin
