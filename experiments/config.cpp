@@ -186,9 +186,13 @@ nlohmann::json Config::Raw(const std::string& key) const {
 
 std::map<std::string, double> Config::NumberMap(const std::string& key) const {
   used_.insert(key);
+  if (!j_.contains(key)) return {};
+  return NumberObject(j_[key], key);
+}
+
+std::map<std::string, double> Config::NumberObject(const nlohmann::json& v,
+                                                   const std::string& key) const {
   std::map<std::string, double> out;
-  if (!j_.contains(key)) return out;
-  const auto& v = j_[key];
   if (!v.is_object()) Fail(key, "an object of numbers, e.g. {\"name\": 1.5}");
   for (const auto& [k, x] : v.items()) {
     if (!x.is_number()) Fail(key, "a number for every entry (entry '" + k + "' is not)");

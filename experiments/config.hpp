@@ -49,6 +49,9 @@ class Config {
   nlohmann::json Raw(const std::string& key) const;
   /// An object of numbers, e.g. "robot_params": {"interface": 0.3}.
   std::map<std::string, double> NumberMap(const std::string& key) const;
+  /// The same check for a value found inside a structured key (e.g. cases[2].robot_params);
+  /// errors name `key`.
+  std::map<std::string, double> NumberObject(const nlohmann::json& v, const std::string& key) const;
   /// Solver options from the "solver" object on top of `base`.
   FkOptions Solver(const FkOptions& base) const;
   /// Throws if the config has keys that no getter asked for.

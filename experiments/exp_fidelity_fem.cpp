@@ -67,11 +67,8 @@ FidelityParams ReadFidelityParams(const Config& cfg) {
         fc.scene = v.get<std::string>();
       } else if (k == "res" && v.is_number_integer() && v.get<int>() > 0) {
         fc.res = v.get<int>();
-      } else if (k == "robot_params" && v.is_object()) {
-        for (const auto& [pk, pv] : v.items()) {
-          if (!pv.is_number()) cfg.Fail(key + ".robot_params." + pk, "a number");
-          fc.params[pk] = pv.get<double>();
-        }
+      } else if (k == "robot_params") {
+        fc.params = cfg.NumberObject(v, key + ".robot_params");
       } else if (k == "pressure" && v.is_array() && !v.empty()) {
         for (const auto& x : v) {
           if (!x.is_number()) cfg.Fail(key + ".pressure", "an array of pressures (MPa)");

@@ -8,6 +8,7 @@
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/robots/robots.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -18,6 +19,7 @@ namespace softkin {
 namespace {
 
 struct RefinementCase {
+  std::string key;  ///< its place in the config, cases[i], for errors
   std::string label, robot, marker = "tip";
   RobotParams params;
   std::vector<double> actuation;  ///< one value per actuator
@@ -35,6 +37,7 @@ std::string CaseKeys() {
 RefinementCase ReadCase(const Config& cfg, const nlohmann::json& c, const std::string& key) {
   if (!c.is_object()) cfg.Fail(key, "an object with " + CaseKeys());
   RefinementCase rc;
+  rc.key = key;
   for (const auto& [k, v] : c.items()) {
     if (k == "label" && v.is_string()) {
       rc.label = v.get<std::string>();
@@ -42,18 +45,16 @@ RefinementCase ReadCase(const Config& cfg, const nlohmann::json& c, const std::s
       rc.robot = v.get<std::string>();
     } else if (k == "solver" && v.is_string()) {
       rc.solver = v.get<std::string>();
-      try {
-        FkSolverTypeFromString(rc.solver);
-      } catch (const std::invalid_argument& e) {
-        cfg.Fail(key + ".solver", e.what());
+      const auto names = FkSolverTypeNames();
+      if (std::find(names.begin(), names.end(), rc.solver) == names.end()) {
+        std::string list;
+        for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+        cfg.Fail(key + ".solver", "one of " + list);
       }
     } else if (k == "marker" && v.is_string()) {
       rc.marker = v.get<std::string>();
-    } else if (k == "robot_params" && v.is_object()) {
-      for (const auto& [pk, pv] : v.items()) {
-        if (!pv.is_number()) cfg.Fail(key + ".robot_params." + pk, "a number");
-        rc.params[pk] = pv.get<double>();
-      }
+    } else if (k == "robot_params") {
+      rc.params = cfg.NumberObject(v, key + ".robot_params");
     } else if (k == "actuation" && v.is_array() && !v.empty()) {
       for (const auto& x : v) {
         if (!x.is_number()) cfg.Fail(key + ".actuation", "an array of numbers");
@@ -102,11 +103,20 @@ Scene CaseRobot(const Config& cfg, const RefinementCase& rc, int res) {
   try {
     return MakeRobot(rc.robot, res, rc.params);
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(cfg.path() + ": cases '" + rc.label + "': " + e.what());
+    throw std::invalid_argument(cfg.path() + ": " + rc.key + " ('" + rc.label + "'): " + e.what());
   }
 }
 
-double Distance(const Eigen::RowVector3d& a, const Eigen::RowVector3d& b) { return (a - b).norm(); }
+/// The case's robot at its first resolution takes its actuation and has its marker (checked
+/// for every case before any runs).
+void CheckCase(const Config& cfg, const RefinementCase& rc) {
+  const Scene scene = CaseRobot(cfg, rc, rc.resolutions.front());
+  if (static_cast<Eigen::Index>(rc.actuation.size()) != scene.num_actuators())
+    cfg.Fail(rc.key + ".actuation", std::to_string(scene.num_actuators()) +
+                                        " value(s), one per actuator of '" + rc.robot + "'");
+  if (scene.marker_index(rc.marker) < 0)
+    cfg.Fail(rc.key + ".marker", "a marker of '" + rc.robot + "' (softkin robots)");
+}
 
 /// One case: every resolution, a row each; the summary entry with the changes of the tip.
 nlohmann::json RunCase(const Config& cfg, const RefinementCase& rc, FkOptions opts, CsvWriter* csv,
@@ -117,14 +127,7 @@ nlohmann::json RunCase(const Config& cfg, const RefinementCase& rc, FkOptions op
   double length = 0.0;
   for (int res : rc.resolutions) {
     const Scene scene = CaseRobot(cfg, rc, res);
-    if (static_cast<Eigen::Index>(rc.actuation.size()) != scene.num_actuators())
-      cfg.Fail("cases '" + rc.label + "'.actuation", std::to_string(scene.num_actuators()) +
-                                                         " value(s), one per actuator of '" +
-                                                         rc.robot + "'");
     const int tip = scene.marker_index(rc.marker);
-    if (tip < 0)
-      cfg.Fail("cases '" + rc.label + "'.marker",
-               "a marker of '" + rc.robot + "' (softkin robots)");
     const Eigen::RowVector3d lo = scene.mesh.vertices.colwise().minCoeff();
     const Eigen::RowVector3d hi = scene.mesh.vertices.colwise().maxCoeff();
     length = (hi - lo).maxCoeff();
@@ -133,7 +136,8 @@ nlohmann::json RunCase(const Config& cfg, const RefinementCase& rc, FkOptions op
         Eigen::Map<const Eigen::VectorXd>(rc.actuation.data(), rc.actuation.size());
     const FkResult r = MakeFkSolver(model, opts)->Solve(c);
     if (r.status == FkStatus::InvalidInput)
-      throw std::invalid_argument(cfg.path() + ": cases '" + rc.label + "': " + r.message);
+      throw std::invalid_argument(cfg.path() + ": " + rc.key + " ('" + rc.label +
+                                  "'): " + r.message);
     tips.push_back(scene.marker_positions(r.positions).row(tip));
     nlohmann::json row = {{"case", rc.label},
                           {"res", res},
@@ -147,28 +151,26 @@ nlohmann::json RunCase(const Config& cfg, const RefinementCase& rc, FkOptions op
                           {"solve_s", r.time_s},
                           {"inverted", r.inverted_elements},
                           {"status", FkStatusToString(r.status)}};
-    // The change from the previous resolution (left empty on the first).
-    if (tips.size() > 1) row["change_mm"] = Distance(tips.back(), tips[tips.size() - 2]);
     if (verbose)
       std::fprintf(stderr, "  %s res %d: %d elements, %s\n", rc.label.c_str(), res,
                    scene.mesh.num_elements(), r.BriefReport().c_str());
     rows.push_back(row);
   }
-  // The changes between successive resolutions, and the distance of each tip to the finest.
-  nlohmann::json changes = nlohmann::json::array(), to_finest = nlohmann::json::array();
-  bool shrink = true;
-  for (size_t i = 0; i < tips.size(); ++i) {
-    to_finest.push_back(Distance(tips[i], tips.back()));
-    if (i == 0) continue;
-    changes.push_back(Distance(tips[i], tips[i - 1]));
-    if (i >= 2 && changes[i - 1].get<double>() > changes[i - 2].get<double>()) shrink = false;
+  // The change from the previous resolution (left empty on the first) and the distance to the
+  // finest mesh's point, per row; whether the changes shrink.
+  std::vector<double> changes, to_finest;
+  bool shrink = true, all_converged = true;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    to_finest.push_back((tips[i] - tips.back()).norm());
+    rows[i]["to_finest_mm"] = to_finest.back();
+    if (i > 0) {
+      changes.push_back((tips[i] - tips[i - 1]).norm());
+      rows[i]["change_mm"] = changes.back();
+      shrink &= changes.size() < 2 || changes.back() <= changes[changes.size() - 2];
+    }
+    all_converged &= rows[i]["status"] == "converged";
+    csv->RowJson(rows[i]);
   }
-  for (auto& row : rows) {
-    row["to_finest_mm"] = to_finest[&row - &rows[0]];
-    csv->RowJson(row);
-  }
-  bool all_converged = true;
-  for (const auto& row : rows) all_converged &= row["status"] == "converged";
   return {{"label", rc.label},
           {"robot", rc.robot},
           {"robot_params", rc.params},
@@ -179,7 +181,7 @@ nlohmann::json RunCase(const Config& cfg, const RefinementCase& rc, FkOptions op
           {"length_mm", length},
           {"tip_changes_mm", changes},
           {"tip_to_finest_mm", to_finest},
-          {"last_change_percent_of_length", 100.0 * changes.back().get<double>() / length},
+          {"last_change_percent_of_length", 100.0 * changes.back() / length},
           {"changes_shrink", shrink},
           {"all_converged", all_converged}};
 }
@@ -190,6 +192,7 @@ nlohmann::json RunRefinement(const Config& cfg, const std::string& dir, bool ver
   const std::vector<RefinementCase> cases = ReadCases(cfg);
   const FkOptions opts = cfg.Solver(FkOptions{});
   cfg.CheckNoUnknownKeys();
+  for (const auto& rc : cases) CheckCase(cfg, rc);
   if (cfg.check_only()) return {};
   CsvWriter csv(dir + "/refinement.csv",
                 {"case", "res", "n_vertices", "n_elements", "tip_x", "tip_y", "tip_z", "change_mm",

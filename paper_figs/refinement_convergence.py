@@ -11,6 +11,7 @@ Writes RESULTS_DIR/refinement_convergence.png:
   right: its distance to the finest mesh's, as a percentage of the robot's length.
 Exit status 2 with a message on stderr if a file is missing or malformed.
 """
+import os
 import sys
 
 import figlib
@@ -23,10 +24,12 @@ NUMERIC = ["res", "n_elements", "tip_x", "tip_y", "tip_z", "to_finest_mm"]
 
 def main(argv):
     results = figlib.results_dir(NAME, argv, __doc__)
-    import os
     rows = figlib.read_table(NAME, os.path.join(results, "refinement.csv"), COLUMNS, NUMERIC)
     summary = figlib.read_summary(NAME, os.path.join(results, "summary.json"))
     lengths = {c["label"]: c["length_mm"] for c in summary.get("cases", [])}
+    # Dashed: the strain form of the element energy (robot parameter element_energy = 1).
+    strain = {c["label"] for c in summary.get("cases", [])
+              if c.get("robot_params", {}).get("element_energy") == 1}
 
     import matplotlib
     matplotlib.use("Agg")
@@ -41,7 +44,7 @@ def main(argv):
     for i, label in enumerate(cases):
         mine = sorted((r for r in rows if r["case"] == label), key=lambda r: r["res"])
         color = cmap(i % 20)
-        style = "--" if "strain" in label else "-"
+        style = "--" if label in strain else "-"
         pts = []
         for r in mine[1:]:
             try:

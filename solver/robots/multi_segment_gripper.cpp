@@ -51,9 +51,10 @@ std::vector<int> VerticesInXRange(const Mesh& m, double x0, double x1, double zm
   return VerticesInBox(m, Eigen::Vector3d(x0, -kInf, -kInf), Eigen::Vector3d(x1, kInf, zmax_incl));
 }
 
-/// Materials, actuators, the fixed face and the markers of a gripper mesh: P0 is the plane
-/// x = p0_x, grip_layer the layer (z <= layer_z) of the third segment, x in [grip_x0, xmax].
-void FinishGripper(int res, double p0_x, double grip_x0, double xmax, double layer_z, Scene* s) {
+/// Materials, actuators, the fixed face and the markers of a gripper mesh whose third segment
+/// (the gripper) starts at x = third_x0: P0 is that plane, grip_layer the layer (z <= layer_z)
+/// of the segment, x in [third_x0, xmax].
+void FinishGripper(int res, double third_x0, double xmax, double layer_z, Scene* s) {
   s->name = "multi_segment_gripper";
   s->body[0] = Material{"body", 1.0, 1.0};
   s->body[4] = Material{"inextensible", 1.0, 20.0};
@@ -63,10 +64,10 @@ void FinishGripper(int res, double p0_x, double grip_x0, double xmax, double lay
   const double eps = 1e-6 * kGripWidth / res, zmax = s->mesh.vertices.col(2).maxCoeff();
   s->fixed = VerticesOnPlane(s->mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
   AddDistalFaceMarkers(xmax, zmax, eps, s);
+  s->markers.push_back({"P0", VerticesOnPlane(s->mesh, Eigen::Vector3d(third_x0, 0, 0),
+                                              Eigen::Vector3d::UnitX(), eps)});
   s->markers.push_back(
-      {"P0", VerticesOnPlane(s->mesh, Eigen::Vector3d(p0_x, 0, 0), Eigen::Vector3d::UnitX(), eps)});
-  s->markers.push_back(
-      {"grip_layer", VerticesInXRange(s->mesh, grip_x0 - eps, xmax + eps, layer_z + eps)});
+      {"grip_layer", VerticesInXRange(s->mesh, third_x0 - eps, xmax + eps, layer_z + eps)});
   s->validate();
 }
 
@@ -78,7 +79,7 @@ constexpr int kGripDesignChambers = 7;
 /// 7 cavities of 5 mm between 1.5 mm walls, the last wall closing the segment at 50 mm; 5 mm
 /// connectors. Grid lines on every one of these, each part cut into cells of about 20 / res mm,
 /// an even number across the cavities' width (mirror-symmetric about y = 10).
-Mesh DesignGridGripperMesh(int res, double* p0_x, double* grip_x0) {
+Mesh DesignGridGripperMesh(int res) {
   const double h = kGripWidth / res, pitch = kGripWall + kGripCavity;
   const double solid = kGripSegment - kGripDesignChambers * pitch - kGripWall;
   std::vector<double> bx = {0.0}, first;
@@ -93,8 +94,6 @@ Mesh DesignGridGripperMesh(int res, double* p0_x, double* grip_x0) {
     bx.push_back(first.back() + kGripDesignChambers * pitch);  // the closing wall
     bx.push_back(x0 + kGripSegment);
   }
-  *p0_x = kGripBase + 2 * (kGripSegment + kGripJoint);
-  *grip_x0 = *p0_x;
   const double z0 = kGripLayer + kGripWall, z1 = kGripHeight - kGripWall;
   const auto xs = DesignLines(bx, h);
   const auto ys =
@@ -118,10 +117,11 @@ Mesh DesignGridGripperMesh(int res, double* p0_x, double* grip_x0) {
 
 Scene MakeMultiSegmentGripper(int res, const RobotParams& P) {
   if (DesignGridFlag("multi_segment_gripper", P)) {
+    // The third segment (the gripper) starts after two segments and their connectors.
+    const double third = kGripBase + 2 * (kGripSegment + kGripJoint);
     Scene s;
-    double p0_x = 0.0, grip_x0 = 0.0;
-    s.mesh = DesignGridGripperMesh(res, &p0_x, &grip_x0);
-    FinishGripper(res, p0_x, grip_x0, s.mesh.vertices.col(0).maxCoeff(), kGripLayer, &s);
+    s.mesh = DesignGridGripperMesh(res);
+    FinishGripper(res, third, s.mesh.vertices.col(0).maxCoeff(), kGripLayer, &s);
     return s;
   }
   const double h = kGripWidth / res;
@@ -159,7 +159,7 @@ Scene MakeMultiSegmentGripper(int res, const RobotParams& P) {
   };
   Scene s;
   s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz), cell);
-  FinishGripper(res, joints[1].second * h, rows[2].x0 * h, nx * h, layer * h, &s);
+  FinishGripper(res, rows[2].x0 * h, nx * h, layer * h, &s);
   return s;
 }
 

@@ -47,14 +47,18 @@ std::vector<double> DesignLines(const std::vector<double>& b, double h,
   return lines;
 }
 
+bool FlagParam(const std::string& robot, const RobotParams& P, const std::string& key,
+               const std::string& off, const std::string& on) {
+  const double v = P.at(key);
+  if (v != 0.0 && v != 1.0)
+    throw std::invalid_argument(robot + ": parameter '" + key + "' must be 0 (" + off + ") or 1 (" +
+                                on + "), got " + FormatNumber(v));
+  return v == 1.0;
+}
+
 bool DesignGridFlag(const std::string& robot, const RobotParams& P) {
-  const double design = P.at("design_grid");
-  if (design != 0.0 && design != 1.0)
-    throw std::invalid_argument(robot +
-                                ": design_grid must be 0 (snap to cells) or 1 (grid lines on the "
-                                "design's dimensions), got " +
-                                FormatNumber(design));
-  return design == 1.0;
+  return FlagParam(robot, P, "design_grid", "snap to cells",
+                   "grid lines on the design's dimensions");
 }
 
 bool InCavity(const ChamberRow& r, int i) {

@@ -61,6 +61,11 @@ int Cells(double mm, double h);
 std::vector<double> DesignLines(const std::vector<double>& b, double h,
                                 const std::vector<bool>& even = {});
 
+/// A 0/1 robot parameter `key` of `robot` as a flag; any other value throws
+/// std::invalid_argument naming the robot, the key and what 0 (`off`) and 1 (`on`) mean.
+bool FlagParam(const std::string& robot, const RobotParams& P, const std::string& key,
+               const std::string& off, const std::string& on);
+
 /// The robot parameter design_grid of `robot` as a flag: 0 snaps the features to whole cells, 1
 /// puts grid lines on the design's dimensions (DesignLines). Any other value throws
 /// std::invalid_argument naming the robot, the key and the accepted values.

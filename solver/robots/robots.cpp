@@ -76,15 +76,11 @@ Scene MakeRobot(const std::string& name, int res, const RobotParams& params) {
                                     FormatNumber(value));
       full[key] = value;
     }
-    const double energy = full.at("element_energy");
-    if (energy != 0.0 && energy != 1.0)
-      throw std::invalid_argument(name +
-                                  ": parameter 'element_energy' must be 0 (shape, Eq. 2.10) "
-                                  "or 1 (strain), got " +
-                                  FormatNumber(energy));
+    const bool strain =
+        robots_detail::FlagParam(name, full, "element_energy", "shape, Eq. 2.10", "strain");
     full.erase("element_energy");
     Scene scene = r.make(res, full);
-    scene.element_energy = energy == 1.0 ? ElementEnergy::kStrain : ElementEnergy::kShape;
+    scene.element_energy = strain ? ElementEnergy::kStrain : ElementEnergy::kShape;
     return scene;
   }
   std::string known;

@@ -5,7 +5,7 @@
 #include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/fk/model.hpp"
-#include "softkin/solver/mesh/element_geometry.hpp"
+#include "softkin/solver/remesh/remesh.hpp"
 #include "softkin/solver/robots/robots.hpp"
 #include "tests/solver/robots/mirror_test_util.hpp"
 
@@ -384,16 +384,12 @@ TEST(RobotGrid, FingerManipulatorDesignGridKeepsItsDimensionsAndSymmetry) {
   for (int res : {6, 7, 9, 12}) {
     SCOPED_TRACE("res " + std::to_string(res));
     const Scene s = MakeRobot("finger_manipulator", res, {{"design_grid", 1.0}});
-    std::map<int, double> volume;
-    for (const Element& e : s.mesh.elements)
-      volume[e.region] += TetVolume6(s.mesh.vertices.row(e.v[0]), s.mesh.vertices.row(e.v[1]),
-                                     s.mesh.vertices.row(e.v[2]), s.mesh.vertices.row(e.v[3])) /
-                          6.0;
+    auto volume = [&](int region) { return RegionVolume(s.mesh, s.mesh.vertices, {region}); };
     for (int region = 1; region <= 6; ++region)
-      EXPECT_NEAR(volume[region], nominal, 1e-9 * nominal) << "region " << region;
+      EXPECT_NEAR(volume(region), nominal, 1e-9 * nominal) << "region " << region;
     // The spine: 3 mm wide through the full 12 mm thickness, along each section's chamber row
     // (6 x 5.5 + 1.5 = 34.5 mm).
-    EXPECT_NEAR(volume[7], 3 * 3.0 * 12.0 * 34.5, 1e-9 * 3 * 3.0 * 12.0 * 34.5);
+    EXPECT_NEAR(volume(7), 3 * 3.0 * 12.0 * 34.5, 1e-9 * 3 * 3.0 * 12.0 * 34.5);
     const Eigen::RowVector3d hi = s.mesh.vertices.colwise().maxCoeff();
     EXPECT_LT((hi - Eigen::RowVector3d(141, 20, 12)).norm(), 1e-9);
     EXPECT_EQ(test::UnmatchedMirrorVertices(s.mesh, 10.0), 0);
@@ -412,15 +408,11 @@ TEST(RobotGrid, MultiSegmentGripperDesignGridKeepsItsDimensionsAndSymmetry) {
   for (int res : {6, 7, 9}) {
     SCOPED_TRACE("res " + std::to_string(res));
     const Scene s = MakeRobot("multi_segment_gripper", res, {{"design_grid", 1.0}});
-    std::map<int, double> volume;
-    for (const Element& e : s.mesh.elements)
-      volume[e.region] += TetVolume6(s.mesh.vertices.row(e.v[0]), s.mesh.vertices.row(e.v[1]),
-                                     s.mesh.vertices.row(e.v[2]), s.mesh.vertices.row(e.v[3])) /
-                          6.0;
+    auto volume = [&](int region) { return RegionVolume(s.mesh, s.mesh.vertices, {region}); };
     for (int region = 1; region <= 3; ++region)
-      EXPECT_NEAR(volume[region], nominal, 1e-9 * nominal) << "region " << region;
+      EXPECT_NEAR(volume(region), nominal, 1e-9 * nominal) << "region " << region;
     // Two connectors of 5 mm above the 1.5 mm layer.
-    EXPECT_NEAR(volume[5], 2 * 5.0 * 20.0 * 13.5, 1e-9 * 2700.0);
+    EXPECT_NEAR(volume(5), 2 * 5.0 * 20.0 * 13.5, 1e-9 * 2700.0);
     const Eigen::RowVector3d hi = s.mesh.vertices.colwise().maxCoeff();
     EXPECT_LT((hi - Eigen::RowVector3d(168, 20, 15)).norm(), 1e-9);
     EXPECT_EQ(test::UnmatchedMirrorVertices(s.mesh, 10.0), 0);
