@@ -432,3 +432,63 @@ TEST(RobotGrid, MultiSegmentGripperDesignGridKeepsItsDimensionsAndSymmetry) {
 
 }  // namespace
 }  // namespace softkin
+
+namespace softkin {
+namespace {
+
+// selfcollision_finger with design_grid = 1: its walls keep the thickness asked for at every
+// resolution (the snapped grid rounds wall = 3.34 mm to 3.33 mm at res 12 and 2.86 mm at res 14),
+// with the chambers that fit after the 8 mm proximal block (14 of 5 x 17 x 10.5 mm for 1.5 mm
+// walls, 9 of 5 x 13.32 x 8.66 mm for 3.34 mm walls); a 0.2 mm slit between each pair of
+// neighbouring chambers; the 120 x 20 x 15 mm outline; mirror symmetry about y = 10 (so a bend
+// stays in that plane, odd res included); and the snapped default is unchanged.
+TEST(RobotGrid, SelfCollisionFingerDesignGridKeepsItsWallsAndSlits) {
+  struct Design {
+    double wall;
+    int chambers;
+  };
+  for (const Design d : {Design{1.5, 14}, Design{3.34, 9}}) {
+    const double pitch = 2 * d.wall + 5.0, proximal = 120.0 - d.chambers * pitch;
+    const double cavity = 5.0 * (20.0 - 2 * d.wall) * (15.0 - d.wall - 3.0);
+    for (int res : {6, 7, 9}) {
+      SCOPED_TRACE("wall " + std::to_string(d.wall) + ", res " + std::to_string(res));
+      const Scene s =
+          MakeRobot("selfcollision_finger", res, {{"wall", d.wall}, {"design_grid", 1.0}});
+      EXPECT_NEAR(RegionVolume(s.mesh, s.mesh.vertices, {1}), d.chambers * cavity,
+                  1e-9 * d.chambers * cavity);
+      const Eigen::RowVector3d lo = s.mesh.vertices.colwise().minCoeff(),
+                               hi = s.mesh.vertices.colwise().maxCoeff();
+      EXPECT_LT(lo.norm(), 1e-12);
+      EXPECT_LT((hi - Eigen::RowVector3d(120, 20, 15)).norm(), 1e-9);
+      EXPECT_EQ(test::UnmatchedMirrorVertices(s.mesh, 10.0), 0);
+      // Each slit plane x = xs has its doubled vertices 0.2 mm beyond it, above the floor only.
+      for (int q = 1; q < d.chambers; ++q) {
+        const double xs = proximal + q * pitch;
+        int moved = 0, below_floor = 0;
+        for (int v = 0; v < s.mesh.num_vertices(); ++v)
+          if (std::abs(s.mesh.vertices(v, 0) - (xs + 0.2)) < 1e-9) {
+            ++moved;
+            if (s.mesh.vertices(v, 2) < 3.0 + 1e-9) ++below_floor;
+          }
+        EXPECT_GT(moved, 0) << "slit " << q;
+        EXPECT_EQ(below_floor, 0) << "slit " << q;
+      }
+    }
+  }
+  const Scene snapped = MakeRobot("selfcollision_finger", 8);
+  EXPECT_EQ(snapped.mesh.num_elements(), 13824);
+  EXPECT_EQ(snapped.mesh.num_vertices(), 3447);
+  EXPECT_THROW(MakeRobot("selfcollision_finger", 8, {{"design_grid", 0.5}}), std::invalid_argument);
+
+  // An odd resolution bends in the mirror plane, and the response keeps the state collision-free.
+  const Scene s = MakeRobot("selfcollision_finger", 7, {{"wall", 3.34}, {"design_grid", 1.0}});
+  auto model = std::make_shared<const Model>(s);
+  const FkResult r = MakeFkSolver(model, s.solver)->Solve(Eigen::VectorXd::Constant(1, 2.0));
+  ASSERT_EQ(r.status, FkStatus::Converged) << r.message;
+  const Eigen::RowVector3d tip = s.marker_positions(r.positions).row(s.marker_index("tip"));
+  EXPECT_NEAR(tip.y(), 10.0, 1e-3);
+  EXPECT_LT(tip.z(), -5.0);
+}
+
+}  // namespace
+}  // namespace softkin
