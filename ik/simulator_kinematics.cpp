@@ -453,7 +453,10 @@ KinematicsEval SimulatorKinematics::Evaluate(const Eigen::Ref<const Eigen::Vecto
   if (!smooth.empty()) {
     const bool guess = options_.jacobian_initial_guess && jac_columns_ == smooth &&
                        jac_dXdc_.rows() == 3 * X.rows();
-    last_implicit_ = ComputeEquilibriumJacobian(*model_, X, c, smooth, options_.implicit,
+    EquilibriumJacobianOptions jo = options_.implicit;
+    if (options_.implicit_tolerance_follows_fk)
+      jo.tolerance = std::max(jo.tolerance, std::min(1e-2 * fk_.gradient_tolerance, 1e-4));
+    last_implicit_ = ComputeEquilibriumJacobian(*model_, X, c, smooth, jo,
                                                 guess ? &jac_dXdc_ : nullptr, workspace_.get());
     if (!last_implicit_.ok && !options_.implicit_fallback) {
       ev.message = last_implicit_.message;

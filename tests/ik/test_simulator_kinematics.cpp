@@ -239,6 +239,39 @@ TEST(Kinematics, PredictedStartsKeepPAndJ) {
   EXPECT_LT(pa, pb);
 }
 
+// The implicit Jacobian's Krylov tolerance follows the forward solves': at gradient ratio 1e-5 the
+// state is only that close to the equilibrium, so its Jacobian solved to 1e-7 is as close to the
+// exact one (a state converged to 1e-11) as solved to 1e-8, in fewer rounds. At the default
+// gradient ratio 1e-6 the tolerance stays 1e-8: the same bits.
+TEST(Kinematics, ImplicitToleranceFollowsTheForwardSolves) {
+  const Scene s = MakeRobot("three_chamber", 3);
+  auto model = std::make_shared<const Model>(s);
+  const Eigen::VectorXd c = Vec({1.8, 1.3, 1.0});
+  SimulatorKinematicsOptions follow = Mode(JacobianMode::kImplicit), fixed = follow;
+  fixed.implicit_tolerance_follows_fk = false;
+  const FkOptions exact_fk = Fk(1e-10, 1e-11);
+  SimulatorKinematics exact(model, fixed, &exact_fk);
+  const KinematicsEval ref = exact.Evaluate(c, true);
+  ASSERT_TRUE(ref.ok) << ref.message;
+
+  const FkOptions loose = Fk(1e-5, 1e-5);
+  SimulatorKinematics a(model, follow, &loose), b(model, fixed, &loose);
+  const KinematicsEval ea = a.Evaluate(c, true), eb = b.Evaluate(c, true);
+  ASSERT_TRUE(ea.ok) << ea.message;
+  ASSERT_TRUE(eb.ok) << eb.message;
+  EXPECT_EQ(ea.p, eb.p);
+  EXPECT_LT(a.last_implicit().rounds, b.last_implicit().rounds);
+  const double state_error = RelErr(eb.J, ref.J);  // the state's own share
+  EXPECT_GT(state_error, 1e-7);
+  EXPECT_LT(RelErr(ea.J, ref.J), 1.2 * state_error);
+
+  const FkOptions standard = Fk(1e-5, 1e-6);
+  SimulatorKinematics d(model, follow, &standard), e(model, fixed, &standard);
+  const KinematicsEval ed = d.Evaluate(c, true), ee = e.Evaluate(c, true);
+  ASSERT_TRUE(ed.ok && ee.ok);
+  EXPECT_EQ(ed.J, ee.J);
+}
+
 // With no new Jacobian along a path (IK's broyden), dX/dc is secant-updated after each solve so
 // predictions stay first-order. That only moves where solves start: p agrees with a kinematics
 // that predicts nothing, every predicted start converges, and a Jacobian taken afterwards (its
