@@ -76,18 +76,7 @@ IkResult SolveGaussNewton(Kinematics& kin, const Objective& objective,
   double mu = -1.0;
 
   while (true) {
-    if (cur.value <= options.lambda) {
-      S.termination = IkTermination::kConverged;
-      std::ostringstream m;
-      m << "O = " << cur.value << " <= lambda = " << options.lambda;
-      S.message = m.str();
-      break;
-    }
-    if (S.iterations >= options.max_iterations) {
-      S.termination = IkTermination::kMaxIterations;
-      S.message = "reached i_max = " + std::to_string(options.max_iterations);
-      break;
-    }
+    if (P.Finished(cur.value, S.iterations, &S)) break;
     const Eigen::MatrixXd A = dr_dc * range.asDiagonal();
     const Eigen::VectorXd g = A.transpose() * r;
     const Eigen::MatrixXd H = A.transpose() * A;

@@ -35,6 +35,22 @@ bool IkProblem::Stalled(double o_prev, double o_now, double step, IkSummary* sum
   return false;
 }
 
+bool IkProblem::Finished(double value, int iterations, IkSummary* summary) const {
+  if (value <= options_.lambda) {
+    summary->termination = IkTermination::kConverged;
+    std::ostringstream m;
+    m << "O = " << value << " <= lambda = " << options_.lambda;
+    summary->message = m.str();
+    return true;
+  }
+  if (iterations >= options_.max_iterations) {
+    summary->termination = IkTermination::kMaxIterations;
+    summary->message = "reached i_max = " + std::to_string(options_.max_iterations);
+    return true;
+  }
+  return false;
+}
+
 bool IkProblem::OutOfBudget(IkTermination* why, std::string* message) const {
   std::ostringstream s;
   if (evaluations_ >= options_.max_evaluations) {

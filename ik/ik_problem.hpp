@@ -51,6 +51,10 @@ class IkProblem {
   /// fraction of the range) was below parameter_tolerance. Sets termination kNoProgress and the
   /// message in *summary and returns true when it applies.
   bool Stalled(double o_prev, double o_now, double step, IkSummary* summary) const;
+  /// The descent methods' stop at the top of an iteration: O = value <= lambda (kConverged), or
+  /// `iterations` reached max_iterations (kMaxIterations). Sets the termination and message in
+  /// *summary and returns true when one applies.
+  bool Finished(double value, int iterations, IkSummary* summary) const;
 
   int evaluations() const { return evaluations_; }
   int jacobian_evaluations() const { return jacobian_evaluations_; }

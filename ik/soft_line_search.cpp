@@ -41,18 +41,7 @@ IkResult SolveSoftLineSearch(Kinematics& kin, const Objective& objective,
   };
 
   while (true) {
-    if (cur.value <= options.lambda) {
-      S.termination = IkTermination::kConverged;
-      std::ostringstream m;
-      m << "O = " << cur.value << " <= lambda = " << options.lambda;
-      S.message = m.str();
-      break;
-    }
-    if (S.iterations >= options.max_iterations) {
-      S.termination = IkTermination::kMaxIterations;
-      S.message = "reached i_max = " + std::to_string(options.max_iterations);
-      break;
-    }
+    if (P.Finished(cur.value, S.iterations, &S)) break;
     // Descent direction, blocked components removed.
     Eigen::VectorXd d = -scale.cwiseProduct(cur.grad);
     for (int a = 0; a < n; ++a)
