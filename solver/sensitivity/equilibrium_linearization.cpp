@@ -80,6 +80,9 @@ bool EquilibriumLinearization::Setup(const Model& model,
   if (static_cast<int>(measure_grad_.size()) != ne) measure_grad_.resize(ne);
   if (static_cast<int>(rows_.size()) != ne) rows_.resize(ne);
   if (static_cast<int>(vol_grad_.size()) != ne) vol_grad_.resize(ne);
+  rotation_only_.assign(ne, 0);
+  if (static_cast<int>(rotated_rest_.size()) != ne) rotated_rest_.resize(ne);
+  if (static_cast<int>(rotated_sinv_.size()) != ne) rotated_sinv_.resize(ne);
 
   // Groups: current measures and the normalisation of ComputeLocalRatios.
   groups_.assign(model.num_groups(), GroupCache());
@@ -133,6 +136,12 @@ bool EquilibriumLinearization::Setup(const Model& model,
 #pragma omp critical
       bad = std::max(bad, i);
       continue;
+    }
+    if ((e.role == ElementRole::Body && e.r_omega >= 1.0) || e.role == ElementRole::Pneumatic) {
+      rotation_only_[i] = 1;
+      rotated_rest_[i].setZero();
+      rotated_rest_[i].topRows(e.k).noalias() = P * ec.R.transpose();
+      rotated_sinv_[i].noalias() = ec.R * ec.Sinv * ec.R.transpose();
     }
     if (e.role != ElementRole::Body || e.r_omega < 1.0) rows_[i] = D;
     if (e.role == ElementRole::Body && e.r_omega < 1.0) {
@@ -325,6 +334,33 @@ void EquilibriumLinearization::ApplyRhsDerivativeBatch(const Eigen::Ref<const Ei
     if (!vented && (e.role == ElementRole::Cable || e.role == ElementRole::Dea)) {
       Ps.noalias() = P * ActuationShape(e, r).transpose();
       dPs0.noalias() = P * ActuationShapeDerivative(e, r).transpose();
+    }
+    if (rotation_only_[i] && !vented) {
+      // The closed form of ElementTargetDerivative for these elements. With the rows t_q = R P_q
+      // of the rotated rest shape (centred, as P is), R^T dR = [w]_x, and w' = R w:
+      //   w' = R (tr(S) I - S)^-1 R^T sum_q t_q x dD_q,   d(R P_q) = w' x t_q,
+      // the first since axial(R^T dD^T P) = R^T sum_q t_q x dD_q (the rows need no centring:
+      // sum_q t_q = 0). Bodies: dT_q = R_omega w' x t_q; pneumatic (T = q P R^T, q = cbrt(r)):
+      // dT_q = dq t_q + q w' x t_q.
+      const ElemRows& t = rotated_rest_[i];
+      const Eigen::Matrix3d& Sr = rotated_sinv_[i];
+      const bool pneumatic = e.role == ElementRole::Pneumatic;
+      const double q = pneumatic ? std::cbrt(r) : e.r_omega;
+      for (int j = 0; j < m; ++j) {
+        Eigen::Vector3d b = Eigen::Vector3d::Zero();
+        for (int v = 0; v < e.k; ++v) {
+          const Eigen::Vector3d d(dX(e.v[v], 3 * j), dX(e.v[v], 3 * j + 1), dX(e.v[v], 3 * j + 2));
+          b += t.row(v).transpose().cross(d);
+        }
+        const Eigen::Vector3d w = Sr * b;
+        const double dq = pneumatic ? q * dratio_[static_cast<size_t>(i) * m + j] / (3.0 * r) : 0.0;
+        ElemRows& out = weighted_[static_cast<size_t>(i) * m + j];
+        for (int v = 0; v < e.k; ++v) {
+          const Eigen::Vector3d tv = t.row(v).transpose();
+          out.row(v) = (e.wv * (q * w.cross(tv) + dq * tv)).transpose();
+        }
+      }
+      continue;
     }
     for (int j = 0; j < m; ++j) {
       ElemRows dD, dT;
