@@ -225,7 +225,9 @@ TEST(EquilibriumJacobian, InitialGuessSavesProductsNotAccuracy) {
 // K_local (the per-element blocks of K) is K itself where no group couples elements: on the
 // bimaterial bar (blended bodies, motion actuators, no actuation groups) K_local v equals the
 // matrix-free derivative of B along v. On three_chamber the two differ only by the groups'
-// rank-one terms, so along a direction that moves no chamber element they agree too.
+// rank-one terms, so along a direction that moves no chamber element they agree too. There the
+// matrix-free product takes the closed form of rigid bodies and K_local the general one
+// (ElementTargetDerivative), so this also checks the one against the other.
 TEST(EquilibriumJacobian, LocalStiffnessIsKWithoutTheGroupCoupling) {
   std::mt19937 rng(11);
   std::normal_distribution<double> nd;
