@@ -190,10 +190,9 @@ class EquilibriumLinearization {
   std::vector<ElementCache> cache_;
   std::vector<GroupCache> groups_;
   std::vector<ElemRows> rows_;  ///< centred current rows D (blended bodies, cable, DEA)
-  /// Rigid bodies (R_omega = 1) and loaded pneumatic elements, whose target derivative has the
-  /// closed form of ApplyRhsDerivativeBatch: the rows R P_q of the rotated rest shape, and
-  /// R (tr(S) I - S)^-1 R^T. Empty for other elements.
-  std::vector<char> rotation_only_;
+  /// Rigid bodies (R_omega = 1) and loaded pneumatic elements (HasClosedFormDerivative), whose
+  /// target derivative has the closed form of ApplyRhsDerivativeBatch: the rows R P_q of the
+  /// rotated rest shape, and R (tr(S) I - S)^-1 R^T. Unset for other elements.
   std::vector<ElemRows> rotated_rest_;
   std::vector<Eigen::Matrix3d> rotated_sinv_;
   std::vector<ElemRows> vol_grad_;      ///< d Vol / dD of blended bodies with an active scale

@@ -57,6 +57,13 @@ inline Eigen::Matrix3d PolarDerivativeW(const Eigen::Matrix3d& R, const Eigen::M
   return Skew(Sinv * AxialOfSkewPart(R.transpose() * dM));
 }
 
+/// Whether element e's target derivative takes the closed form of ApplyRhsDerivativeBatch: a
+/// rigid body (R_omega = 1), or a pneumatic element that is not vented (its ratio r).
+inline bool HasClosedFormDerivative(const ModelElement& e, double r) {
+  return (e.role == ElementRole::Body && e.r_omega >= 1.0) ||
+         (e.role == ElementRole::Pneumatic && r != kVented);
+}
+
 }  // namespace
 
 bool EquilibriumLinearization::Setup(const Model& model,
@@ -80,7 +87,6 @@ bool EquilibriumLinearization::Setup(const Model& model,
   if (static_cast<int>(measure_grad_.size()) != ne) measure_grad_.resize(ne);
   if (static_cast<int>(rows_.size()) != ne) rows_.resize(ne);
   if (static_cast<int>(vol_grad_.size()) != ne) vol_grad_.resize(ne);
-  rotation_only_.assign(ne, 0);
   if (static_cast<int>(rotated_rest_.size()) != ne) rotated_rest_.resize(ne);
   if (static_cast<int>(rotated_sinv_.size()) != ne) rotated_sinv_.resize(ne);
 
@@ -137,8 +143,7 @@ bool EquilibriumLinearization::Setup(const Model& model,
       bad = std::max(bad, i);
       continue;
     }
-    if ((e.role == ElementRole::Body && e.r_omega >= 1.0) || e.role == ElementRole::Pneumatic) {
-      rotation_only_[i] = 1;
+    if (HasClosedFormDerivative(e, r)) {
       rotated_rest_[i].setZero();
       rotated_rest_[i].topRows(e.k).noalias() = P * ec.R.transpose();
       rotated_sinv_[i].noalias() = ec.R * ec.Sinv * ec.R.transpose();
@@ -335,7 +340,7 @@ void EquilibriumLinearization::ApplyRhsDerivativeBatch(const Eigen::Ref<const Ei
       Ps.noalias() = P * ActuationShape(e, r).transpose();
       dPs0.noalias() = P * ActuationShapeDerivative(e, r).transpose();
     }
-    if (rotation_only_[i] && !vented) {
+    if (HasClosedFormDerivative(e, r)) {
       // The closed form of ElementTargetDerivative for these elements. With the rows t_q = R P_q
       // of the rotated rest shape (centred, as P is), R^T dR = [w]_x, and w' = R w:
       //   w' = R (tr(S) I - S)^-1 R^T sum_q t_q x dD_q,   d(R P_q) = w' x t_q,

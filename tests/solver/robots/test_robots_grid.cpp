@@ -430,12 +430,6 @@ TEST(RobotGrid, MultiSegmentGripperDesignGridKeepsItsDimensionsAndSymmetry) {
                std::invalid_argument);
 }
 
-}  // namespace
-}  // namespace softkin
-
-namespace softkin {
-namespace {
-
 // selfcollision_finger with design_grid = 1: its walls keep the thickness asked for at every
 // resolution (the snapped grid rounds wall = 3.34 mm to 3.33 mm at res 12 and 2.86 mm at res 14),
 // with the chambers that fit after the 8 mm proximal block (14 of 5 x 17 x 10.5 mm for 1.5 mm
