@@ -4,19 +4,28 @@
 // (3 -> 35 -> 35 -> n_out, h = 2, b = 35, §5.3.4); data come from the analytical PCC finger
 // (3 actuators): n_out = 3 is N_fk (tip position), 9 the tip Jacobian (N_J), 27 the Jacobian of
 // three tracked points. Training sets have 4096 x 0.7 = 2867 samples (16^3 grid, 70 % split).
+// BM_DatasetShard times the simulator dataset those networks learn from (issue 33's target: the
+// 16^3 three_chamber res 4 grid with implicit Jacobians in <= 5 minutes).
 #include "softkin/ik/ik_solver.hpp"
 #include "softkin/ik/objectives.hpp"
 #include "softkin/ik/pcc_chamber_kinematics.hpp"
 #include "softkin/ik/pcc_kinematics.hpp"
+#include "softkin/ik/simulator_kinematics.hpp"
 #include "softkin/ik/trajectory.hpp"
 #include "softkin/learn/net_kinematics.hpp"
 #include "softkin/learn/train_nets.hpp"
 #include "softkin/learn/ceres_trainer.hpp"
+#include "softkin/learn/dataset.hpp"
 #include "softkin/learn/lm_trainer.hpp"
+
+#include "softkin/solver/robots/robots.hpp"
 
 #include <benchmark/benchmark.h>
 
+#include <cstdio>
+#include <filesystem>
 #include <random>
+#include <string>
 
 namespace softkin {
 namespace {
@@ -209,6 +218,52 @@ void BM_LearnedIkWaypoint(benchmark::State& state) {
   state.counters["err_mm"] = err;
 }
 BENCHMARK(BM_LearnedIkWaypoint)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// One shard of the thesis-size dataset, as `softkin dataset --robot three_chamber --res 4 --grid 16
+// --jacobian implicit --gradient-tolerance 1e-5 --shard 7/16` computes it: 256 samples (four
+// warm-start blocks of 64) from the middle of the serpentine order, each a forward solve and an
+// implicit Jacobian, one thread. Counters: ms_per_sample, and the whole 16^3 grid projected from
+// it, in one process (dataset_16cubed_s, 4096 samples) and as two MPI ranks on two cores
+// (dataset_16cubed_2ranks_s, half of it: the ranks share the samples; docs/cluster.md).
+void BM_DatasetShard(benchmark::State& state) {
+  const Scene scene = MakeRobot("three_chamber", 4);
+  FkOptions fk = scene.solver;
+  fk.gradient_tolerance = 1e-5;
+  fk.threads = 1;
+  SimulatorKinematicsOptions ko;
+  ko.jacobian = JacobianMode::kImplicit;
+  ko.implicit.threads = 1;
+  SimulatorKinematics kin(scene, ko, &fk);
+  DatasetSampling sampling;
+  sampling.grid = 16;
+  const std::string out =
+      (std::filesystem::temp_directory_path() / "softkin_bench_dataset_shard.csv").string();
+  DatasetRunOptions run;
+  run.out = out;
+  run.jacobian = true;
+  run.shard = 7;
+  run.shards = 16;
+  run.progress = false;
+  run.reset = [&kin] { kin.Reset(); };
+  DatasetRunSummary sum;
+  for (auto _ : state) {
+    std::remove(out.c_str());
+    std::remove((out + ".json").c_str());
+    sum = GenerateDataset(kin, sampling, run);
+  }
+  std::remove(out.c_str());
+  std::remove((out + ".json").c_str());
+  if (sum.written != sum.count || sum.failed > 0) {
+    state.SkipWithError("a sample failed or was not written");
+    return;
+  }
+  const double per_sample = sum.time_s / static_cast<double>(sum.count);
+  state.counters["samples"] = static_cast<double>(sum.count);
+  state.counters["ms_per_sample"] = 1e3 * per_sample;
+  state.counters["dataset_16cubed_s"] = 4096 * per_sample;
+  state.counters["dataset_16cubed_2ranks_s"] = 2048 * per_sample;
+}
+BENCHMARK(BM_DatasetShard)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 
 }  // namespace
 }  // namespace softkin
