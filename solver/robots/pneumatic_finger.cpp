@@ -137,6 +137,7 @@ Scene MakePneumaticFinger(int res, const RobotParams& P) {
   a.rest = 1.0;
   a.min = 1.0;
   a.max = kFingerMaxAlpha;
+  a.weight = P.at("chamber_weight");
   s.actuators.push_back(a);
 
   const double eps = 1e-6 * L.h;
@@ -166,7 +167,10 @@ RobotEntry PneumaticFingerEntry() {
         "0: features snap to whole cells of 20/res mm (walls, chamber count and proximal block "
         "change with res); 1: grid lines on the nominal dimensions (16 cavities of 5 mm, 1.5 mm "
         "walls, floor and base layer, 14.5 mm proximal block) at every res, mirror-symmetric "
-        "about y = 10"}}};
+        "about y = 10"},
+       {"chamber_weight", Actuator{}.weight, 0.01, 100.0,
+        "weight w_i of the chamber (actuation) elements in Eq. 2.10, against the body's 1 (default "
+        "5, Sec. 2.5); a soft chamber fill lags its target volume (docs/fidelity.md)"}}};
   return {info, kFingerMinRes, kFingerMaxRes, &MakePneumaticFinger};
 }
 

@@ -369,6 +369,33 @@ TEST(RobotGrid, PneumaticFingerDesignGridKeepsItsDimensionsAndSymmetry) {
   EXPECT_THROW(MakeRobot("pneumatic_finger", 7, {{"design_grid", 0.5}}), std::invalid_argument);
 }
 
+// chamber_weight is the chamber elements' w_i of Eq. 2.10: the default is the thesis's 5, and a
+// softer fill lags its target, so at the same alpha it reaches a smaller volume and bends less.
+TEST(RobotGrid, PneumaticFingerChamberWeightSoftensTheFill) {
+  EXPECT_EQ(MakeRobot("pneumatic_finger", 5).actuators[0].weight, 5.0);
+  auto solve = [](double weight) {
+    const Scene s =
+        MakeRobot("pneumatic_finger", 5, {{"design_grid", 1.0}, {"chamber_weight", weight}});
+    EXPECT_EQ(s.actuators[0].weight, weight);
+    auto model = std::make_shared<const Model>(s);
+    const FkResult r = MakeFkSolver(model, FkOptions{})->Solve(Eigen::VectorXd::Constant(1, 2.0));
+    EXPECT_EQ(r.status, FkStatus::Converged) << r.message;
+    const Eigen::RowVector3d tip = s.marker_positions(r.positions).row(s.marker_index("tip"));
+    return std::make_pair(r.volume_ratios[0], tip.z());
+  };
+  const auto [stiff_volume, stiff_z] = solve(5.0);
+  const auto [soft_volume, soft_z] = solve(0.5);
+  EXPECT_GT(stiff_volume, 1.7);
+  EXPECT_LT(soft_volume, stiff_volume - 0.1);
+  EXPECT_LT(stiff_z, soft_z - 5.0);  // the finger curls towards -z
+  try {
+    MakeRobot("pneumatic_finger", 5, {{"chamber_weight", 0.0}});
+    ADD_FAILURE() << "chamber_weight 0 was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("chamber_weight"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace softkin
 
