@@ -377,6 +377,8 @@ double AddEnergyGaps(const SolverComparisonParams& p, Totals* t) {
 void AddSpeedupVsBestNlp(const SolverComparisonParams& p, Totals* t, nlohmann::json* j) {
   const int steps = p.steps;
   const std::vector<double>& aa_cum = t->step_end["lg-aa"];  // lg-aa's time after each step
+  const char* const kExcluded =
+      "the Ceres / Ipopt methods that ran are excluded (another energy, or no time)";
   std::string reason = "no Ceres or Ipopt method (ceres, ipopt-lbfgs, ipopt-newton) ran";
   double best = std::numeric_limits<double>::infinity();
   bool best_is_bound = false;
@@ -401,7 +403,7 @@ void AddSpeedupVsBestNlp(const SolverComparisonParams& p, Totals* t, nlohmann::j
                             1e-6 * std::abs(t->final_energy["lg-aa"]);
       if (!same) {
         excluded.push_back(name);
-        reason = "the Ceres / Ipopt methods that ran are excluded (another energy, or no time)";
+        reason = kExcluded;
         continue;
       }
       ratio = t->total_time[name] / aa_cum.back();
@@ -410,7 +412,7 @@ void AddSpeedupVsBestNlp(const SolverComparisonParams& p, Totals* t, nlohmann::j
       bound = true;
     } else {
       excluded.push_back(name);
-      reason = "the Ceres / Ipopt methods that ran are excluded (another energy, or no time)";
+      reason = kExcluded;
       continue;
     }
     if (ratio < best) {
