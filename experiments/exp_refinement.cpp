@@ -1,7 +1,10 @@
 // Convergence under mesh refinement, robot by robot (issue #35): each case is an embedded robot
 // with its design parameters and one actuation, solved at four or more resolutions; the tip's
 // change from one resolution to the next says whether the answer converges. (The tracked point
-// is the marker `tip` unless the case names another.)
+// is the marker `tip` unless the case names another.) A pneumatic case may instead prescribe the
+// chambers' volume ratios: then each resolution is solved at the actuation that reaches them
+// (matched_volume.hpp), so that the robots are compared at equal chamber volume.
+#include "softkin/experiments/matched_volume.hpp"
 #include "softkin/experiments/results.hpp"
 #include "softkin/experiments/runner.hpp"
 #include "softkin/solver/factory/fk_factory.hpp"
@@ -9,6 +12,7 @@
 #include "softkin/solver/robots/robots.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -23,6 +27,7 @@ struct RefinementCase {
   std::string label, robot, marker = "tip";
   RobotParams params;
   std::vector<double> actuation;  ///< one value per actuator
+  std::vector<double> volume;     ///< instead of actuation: the chambers' volume ratios
   std::vector<int> resolutions;   ///< increasing, at least 4
   std::string solver;             ///< "": the config's solver.solver
 };
@@ -31,7 +36,10 @@ std::string CaseKeys() {
   return "label (string), robot (string), solver (a solver name, instead of the config's), marker "
          "(the tracked marker's name; default tip), "
          "robot_params (object of numbers), actuation (array of "
-         "numbers, one per actuator), resolutions (array of at least 4 increasing integers)";
+         "numbers, one per actuator) or volume_ratio (array of positive numbers, the chamber "
+         "volume ratios to reach, one per actuator, all pneumatic; 1 leaves a chamber at rest), "
+         "resolutions (array of at least "
+         "4 increasing integers)";
 }
 
 RefinementCase ReadCase(const Config& cfg, const nlohmann::json& c, const std::string& key) {
@@ -60,6 +68,12 @@ RefinementCase ReadCase(const Config& cfg, const nlohmann::json& c, const std::s
         if (!x.is_number()) cfg.Fail(key + ".actuation", "an array of numbers");
         rc.actuation.push_back(x.get<double>());
       }
+    } else if (k == "volume_ratio" && v.is_array() && !v.empty()) {
+      for (const auto& x : v) {
+        if (!x.is_number() || !(x.get<double>() > 0))
+          cfg.Fail(key + ".volume_ratio", "an array of positive numbers");
+        rc.volume.push_back(x.get<double>());
+      }
     } else if (k == "resolutions" && v.is_array()) {
       for (const auto& x : v) {
         if (!x.is_number_integer() || x.get<int>() < 1)
@@ -75,7 +89,9 @@ RefinementCase ReadCase(const Config& cfg, const nlohmann::json& c, const std::s
              "a name for the case without commas, quotes or line breaks (it is "
              "a field of refinement.csv)");
   if (rc.robot.empty()) cfg.Fail(key + ".robot", "an embedded robot's name (softkin robots)");
-  if (rc.actuation.empty()) cfg.Fail(key + ".actuation", "one value per actuator");
+  if (rc.actuation.empty() == rc.volume.empty())
+    cfg.Fail(key + ".actuation",
+             "either actuation or volume_ratio (one value per actuator), not both");
   if (rc.resolutions.size() < 4)
     cfg.Fail(key + ".resolutions", "at least 4 resolutions (convergence needs three changes)");
   for (size_t i = 1; i < rc.resolutions.size(); ++i)
@@ -111,11 +127,30 @@ Scene CaseRobot(const Config& cfg, const RefinementCase& rc, int res) {
 /// for every case before any runs).
 void CheckCase(const Config& cfg, const RefinementCase& rc) {
   const Scene scene = CaseRobot(cfg, rc, rc.resolutions.front());
-  if (static_cast<Eigen::Index>(rc.actuation.size()) != scene.num_actuators())
-    cfg.Fail(rc.key + ".actuation", std::to_string(scene.num_actuators()) +
-                                        " value(s), one per actuator of '" + rc.robot + "'");
+  const bool by_volume = !rc.volume.empty();
+  const std::string key = rc.key + (by_volume ? ".volume_ratio" : ".actuation");
+  const size_t n = by_volume ? rc.volume.size() : rc.actuation.size();
+  if (static_cast<Eigen::Index>(n) != scene.num_actuators())
+    cfg.Fail(key, std::to_string(scene.num_actuators()) + " value(s), one per actuator of '" +
+                      rc.robot + "'");
+  if (by_volume)
+    for (const auto& a : scene.actuators)
+      if (a.type != ActuatorType::Pneumatic)
+        cfg.Fail(key, "a robot whose actuators are all pneumatic ('" + rc.robot + "' has " +
+                          ActuatorTypeToString(a.type) + " actuator '" + a.name + "')");
   if (scene.marker_index(rc.marker) < 0)
     cfg.Fail(rc.key + ".marker", "a marker of '" + rc.robot + "' (softkin robots)");
+}
+
+/// The values joined by spaces (one CSV field).
+std::string Joined(const Eigen::VectorXd& v) {
+  std::string s;
+  char buf[32];
+  for (Eigen::Index i = 0; i < v.size(); ++i) {
+    std::snprintf(buf, sizeof buf, "%.6g", v[i]);
+    s += (i ? " " : "") + std::string(buf);
+  }
+  return s;
 }
 
 /// One case: every resolution, a row each; the summary entry with the changes of the tip.
@@ -132,12 +167,31 @@ nlohmann::json RunCase(const Config& cfg, const RefinementCase& rc, FkOptions op
     const Eigen::RowVector3d hi = scene.mesh.vertices.colwise().maxCoeff();
     length = (hi - lo).maxCoeff();
     auto model = std::make_shared<const Model>(scene);
-    const Eigen::VectorXd c =
-        Eigen::Map<const Eigen::VectorXd>(rc.actuation.data(), rc.actuation.size());
-    const FkResult r = MakeFkSolver(model, opts)->Solve(c);
+    auto solver = MakeFkSolver(model, opts);
+    FkResult r;
+    Eigen::VectorXd c;
+    bool matched = true;
+    const auto t0 = std::chrono::steady_clock::now();
+    if (rc.volume.empty()) {
+      c = Eigen::Map<const Eigen::VectorXd>(rc.actuation.data(), rc.actuation.size());
+      r = solver->Solve(c);
+    } else {
+      // A ratio of 1 leaves that chamber at rest (its volume then follows its neighbours').
+      std::vector<bool> loaded;
+      for (double v : rc.volume) loaded.push_back(v != 1.0);
+      MatchedVolume m = SolveAtVolume(solver.get(), scene, rc.volume, loaded);
+      r = std::move(m.r);
+      c = m.c;
+      matched = m.matched;
+    }
+    // Wall time to the answer (with a volume target, every secant solve).
+    const double solve_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (r.status == FkStatus::InvalidInput)
       throw std::invalid_argument(cfg.path() + ": " + rc.key + " ('" + rc.label +
                                   "'): " + r.message);
+    const Eigen::VectorXd ratios =
+        Eigen::Map<const Eigen::VectorXd>(r.volume_ratios.data(), r.volume_ratios.size());
     tips.push_back(scene.marker_positions(r.positions).row(tip));
     nlohmann::json row = {{"case", rc.label},
                           {"res", res},
@@ -148,9 +202,12 @@ nlohmann::json RunCase(const Config& cfg, const RefinementCase& rc, FkOptions op
                           {"tip_z", tips.back()[2]},
                           {"energy", r.energy},
                           {"iterations", r.iterations},
-                          {"solve_s", r.time_s},
+                          {"solve_s", solve_s},
                           {"inverted", r.inverted_elements},
-                          {"status", FkStatusToString(r.status)}};
+                          {"status", FkStatusToString(r.status)},
+                          {"actuation", Joined(c)},
+                          {"volume_ratio", Joined(ratios)},
+                          {"volume_matched", matched}};
     if (verbose)
       std::fprintf(stderr, "  %s res %d: %d elements, %s\n", rc.label.c_str(), res,
                    scene.mesh.num_elements(), r.BriefReport().c_str());
@@ -168,7 +225,7 @@ nlohmann::json RunCase(const Config& cfg, const RefinementCase& rc, FkOptions op
       rows[i]["change_mm"] = changes.back();
       shrink &= changes.size() < 2 || changes.back() <= changes[changes.size() - 2];
     }
-    all_converged &= rows[i]["status"] == "converged";
+    all_converged &= rows[i]["status"] == "converged" && rows[i]["volume_matched"].get<bool>();
     csv->RowJson(rows[i]);
   }
   return {{"label", rc.label},
@@ -177,6 +234,7 @@ nlohmann::json RunCase(const Config& cfg, const RefinementCase& rc, FkOptions op
           {"marker", rc.marker},
           {"solver", ToString(opts.solver)},
           {"actuation", rc.actuation},
+          {"volume_ratio", rc.volume},
           {"resolutions", rc.resolutions},
           {"length_mm", length},
           {"tip_changes_mm", changes},
@@ -196,7 +254,8 @@ nlohmann::json RunRefinement(const Config& cfg, const std::string& dir, bool ver
   if (cfg.check_only()) return {};
   CsvWriter csv(dir + "/refinement.csv",
                 {"case", "res", "n_vertices", "n_elements", "tip_x", "tip_y", "tip_z", "change_mm",
-                 "to_finest_mm", "energy", "iterations", "solve_s", "inverted", "status"});
+                 "to_finest_mm", "energy", "iterations", "solve_s", "inverted", "status",
+                 "actuation", "volume_ratio", "volume_matched"});
   nlohmann::json out = nlohmann::json::array();
   int shrinking = 0;
   for (const auto& rc : cases) {

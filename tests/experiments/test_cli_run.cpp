@@ -8,7 +8,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 using namespace softkin::cli_test;  // NOLINT: the helpers of every test here
 
@@ -268,4 +270,61 @@ TEST(Cli, SolverScalingChecksEveryCaseAndReportsTheGrowth) {
     EXPECT_EQ(row["status"], "converged") << row;
     EXPECT_LT(row["residual_ratio"].get<double>(), 1e-6) << row;
   }
+}
+
+TEST(Cli, RefinementCanCompareAtEqualChamberVolume) {
+  const std::string dir = TempDir("refinement_volume");
+  const std::string bad = dir + "/bad.json";
+  // A volume target needs pneumatic actuators; a case gives actuation or volume_ratio, not both.
+  std::ofstream(bad) << R"({"name": "bad_ref", "experiment": "refinement", "seed": 1,
+    "cases": [{"label": "c", "robot": "cable_finger", "volume_ratio": [1.1, 1.1, 1.1],
+               "resolutions": [5, 6, 7, 8]}]})";
+  CliRun r = Cli("run " + bad + " --no-plot --results " + dir);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find(bad + ": cases[0].volume_ratio: expected a robot whose actuators are all "
+                             "pneumatic"),
+            std::string::npos)
+      << r.out;
+  std::ofstream(bad) << R"({"name": "bad_ref", "experiment": "refinement", "seed": 1,
+    "cases": [{"label": "t", "robot": "three_chamber", "volume_ratio": [1.3, 1, 1],
+               "actuation": [1.3, 1, 1], "resolutions": [3, 4, 5, 6]}]})";
+  r = Cli("run " + bad + " --no-plot --results " + dir);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("cases[0].actuation: expected either actuation or volume_ratio"),
+            std::string::npos)
+      << r.out;
+
+  const std::string good = dir + "/good.json";
+  std::ofstream(good) << R"({"name": "tiny_ref", "experiment": "refinement", "seed": 1,
+    "cases": [{"label": "t", "robot": "three_chamber", "volume_ratio": [1.3, 1, 1],
+               "resolutions": [3, 4, 5, 6]}]})";
+  r = Cli("run " + good + " --no-plot --results " + dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto j = nlohmann::json::parse(ReadAll(dir + "/tiny_ref/summary.json"));
+  const auto& c = j["cases"][0];
+  EXPECT_TRUE(c["all_converged"].get<bool>()) << c;
+  EXPECT_EQ(c["tip_changes_mm"].size(), 3u);
+  // Every row reached the chamber volume, each at its own actuation (the body resists the
+  // chamber, so the actuation must exceed the volume ratio it reaches).
+  const std::string csv = ReadAll(dir + "/tiny_ref/refinement.csv");
+  std::istringstream lines(csv);
+  std::string line, header;
+  std::getline(lines, header);
+  EXPECT_NE(header.find(",actuation,volume_ratio,volume_matched"), std::string::npos) << header;
+  int rows = 0;
+  while (std::getline(lines, line)) {
+    ++rows;
+    std::vector<std::string> f;
+    std::stringstream ls(line);
+    for (std::string x; std::getline(ls, x, ',');) f.push_back(x);
+    ASSERT_EQ(f.size(), 17u) << line;
+    EXPECT_EQ(f[16], "true") << line;
+    std::istringstream ratios(f[15]), actuation(f[14]);
+    double v1 = 0, c1 = 0;
+    ratios >> v1;
+    actuation >> c1;
+    EXPECT_NEAR(v1, 1.3, 1.3e-3) << line;  // the others, at rest, follow their neighbour
+    EXPECT_GT(c1, 1.3 + 1e-3) << line;
+  }
+  EXPECT_EQ(rows, 4);
 }
