@@ -54,13 +54,16 @@ std::vector<int> VerticesInXRange(const Mesh& m, double x0, double x1, double zm
 /// Materials, actuators, the fixed face and the markers of a gripper mesh whose third segment
 /// (the gripper) starts at x = third_x0: P0 is that plane, grip_layer the layer (z <= layer_z)
 /// of the segment, x in [third_x0, xmax].
-void FinishGripper(int res, double third_x0, double xmax, double layer_z, Scene* s) {
+void FinishGripper(int res, double third_x0, double xmax, double layer_z, double chamber_weight,
+                   Scene* s) {
   s->name = "multi_segment_gripper";
   s->body[0] = Material{"body", 1.0, 1.0};
   s->body[4] = Material{"inextensible", 1.0, 20.0};
   s->body[5] = Material{"connector", 1.0, 20.0};
-  for (int k = 0; k < 3; ++k)
+  for (int k = 0; k < 3; ++k) {
     s->actuators.push_back(PneumaticActuator("c" + std::to_string(k + 1), {k + 1}, kGripMaxAlpha));
+    s->actuators.back().weight = chamber_weight;
+  }
   const double eps = 1e-6 * kGripWidth / res, zmax = s->mesh.vertices.col(2).maxCoeff();
   s->fixed = VerticesOnPlane(s->mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
   AddDistalFaceMarkers(xmax, zmax, eps, s);
@@ -121,7 +124,8 @@ Scene MakeMultiSegmentGripper(int res, const RobotParams& P) {
     const double third = kGripBase + 2 * (kGripSegment + kGripJoint);
     Scene s;
     s.mesh = DesignGridGripperMesh(res);
-    FinishGripper(res, third, s.mesh.vertices.col(0).maxCoeff(), kGripLayer, &s);
+    FinishGripper(res, third, s.mesh.vertices.col(0).maxCoeff(), kGripLayer, P.at("chamber_weight"),
+                  &s);
     return s;
   }
   const double h = kGripWidth / res;
@@ -159,7 +163,7 @@ Scene MakeMultiSegmentGripper(int res, const RobotParams& P) {
   };
   Scene s;
   s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz), cell);
-  FinishGripper(res, rows[2].x0 * h, nx * h, layer * h, &s);
+  FinishGripper(res, rows[2].x0 * h, nx * h, layer * h, P.at("chamber_weight"), &s);
   return s;
 }
 
@@ -181,7 +185,10 @@ RobotEntry MultiSegmentGripperEntry() {
         "0: features snap to whole cells of 20/res mm (walls, cavities and their count change "
         "with res: 4, 6, 5, 7 chambers per segment at res 6, 8, 10, 12); 1: grid lines on the "
         "nominal dimensions (7 cavities of 5 mm per segment between 1.5 mm walls, 1.5 mm floor, "
-        "side walls, roof and layer) at every res, mirror-symmetric about y = 10"}}};
+        "side walls, roof and layer) at every res, mirror-symmetric about y = 10"},
+       {"chamber_weight", Actuator{}.weight, 0.01, 100.0,
+        "weight w_i of the chambers' (actuation) elements in Eq. 2.10, against the body's 1 "
+        "(default 5, Sec. 2.5); a soft chamber fill lags its target volume (docs/fidelity.md)"}}};
   return {info, kGripMinRes, kGripMaxRes, &MakeMultiSegmentGripper};
 }
 

@@ -396,6 +396,37 @@ TEST(RobotGrid, PneumaticFingerChamberWeightSoftensTheFill) {
   }
 }
 
+// multi_segment_gripper takes the same parameter, for all three chambers, snapped or on the
+// design grid; a soft fill reaches less volume at the same actuation.
+TEST(RobotGrid, MultiSegmentGripperChamberWeightSoftensEveryChamber) {
+  for (const auto& a : MakeRobot("multi_segment_gripper", 6).actuators) EXPECT_EQ(a.weight, 5.0);
+  for (double grid : {0.0, 1.0})
+    for (const auto& a :
+         MakeRobot("multi_segment_gripper", 6, {{"design_grid", grid}, {"chamber_weight", 0.05}})
+             .actuators)
+      EXPECT_EQ(a.weight, 0.05);
+  auto volume = [](double weight) {
+    const Scene s =
+        MakeRobot("multi_segment_gripper", 6, {{"design_grid", 1.0}, {"chamber_weight", weight}});
+    FkOptions o;
+    o.solver = FkSolverType::kNewton;
+    const FkResult r =
+        MakeFkSolver(std::make_shared<const Model>(s), o)->Solve(Eigen::Vector3d(2.0, 1.0, 1.0));
+    EXPECT_EQ(r.status, FkStatus::Converged) << r.message;
+    return r.volume_ratios[0];
+  };
+  const double stiff = volume(5.0), soft = volume(0.05);
+  EXPECT_GT(stiff, 1.8);
+  EXPECT_LT(soft, stiff - 0.3);
+  EXPECT_GT(soft, 1.01);
+  try {
+    MakeRobot("multi_segment_gripper", 6, {{"chamber_weight", 101.0}});
+    ADD_FAILURE() << "chamber_weight 101 was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("chamber_weight"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace softkin
 
