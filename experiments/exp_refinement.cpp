@@ -37,7 +37,8 @@ std::string CaseKeys() {
          "(the tracked marker's name; default tip), "
          "robot_params (object of numbers), actuation (array of "
          "numbers, one per actuator) or volume_ratio (array of positive numbers, the chamber "
-         "volume ratios to reach, one per actuator, all pneumatic; 1 leaves a chamber at rest), "
+         "volume ratios to reach, one per actuator, all unsigned pneumatic; 1 leaves a chamber at "
+         "rest), "
          "resolutions (array of at least "
          "4 increasing integers)";
 }
@@ -133,10 +134,12 @@ void CheckCase(const Config& cfg, const RefinementCase& rc) {
   if (static_cast<Eigen::Index>(n) != scene.num_actuators())
     cfg.Fail(key, std::to_string(scene.num_actuators()) + " value(s), one per actuator of '" +
                       rc.robot + "'");
+  // A volume target is one chamber's ratio; a signed actuator drives two chambers.
   if (by_volume)
     for (const auto& a : scene.actuators)
-      if (a.type != ActuatorType::Pneumatic)
-        cfg.Fail(key, "a robot whose actuators are all pneumatic ('" + rc.robot + "' has " +
+      if (a.type != ActuatorType::Pneumatic || a.is_signed())
+        cfg.Fail(key, "a robot whose actuators are all unsigned pneumatic ones ('" + rc.robot +
+                          "' has " + (a.is_signed() ? "signed " : "") +
                           ActuatorTypeToString(a.type) + " actuator '" + a.name + "')");
   if (scene.marker_index(rc.marker) < 0)
     cfg.Fail(rc.key + ".marker", "a marker of '" + rc.robot + "' (softkin robots)");

@@ -282,7 +282,17 @@ TEST(Cli, RefinementCanCompareAtEqualChamberVolume) {
   CliRun r = Cli("run " + bad + " --no-plot --results " + dir);
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find(bad + ": cases[0].volume_ratio: expected a robot whose actuators are all "
-                             "pneumatic"),
+                             "unsigned pneumatic ones ('cable_finger' has cable actuator 't1')"),
+            std::string::npos)
+      << r.out;
+  // A signed actuator inflates one of two chambers: no single volume ratio to match.
+  std::ofstream(bad) << R"({"name": "bad_ref", "experiment": "refinement", "seed": 1,
+    "cases": [{"label": "m", "robot": "finger_manipulator", "volume_ratio": [1.5, 1, 1],
+               "resolutions": [6, 7, 8, 9]}]})";
+  r = Cli("run " + bad + " --no-plot --results " + dir);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("cases[0].volume_ratio: expected a robot whose actuators are all unsigned "
+                       "pneumatic ones ('finger_manipulator' has signed pneumatic actuator 's1')"),
             std::string::npos)
       << r.out;
   std::ofstream(bad) << R"({"name": "bad_ref", "experiment": "refinement", "seed": 1,
