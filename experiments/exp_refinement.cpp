@@ -160,6 +160,9 @@ std::string Joined(const Eigen::VectorXd& v) {
 nlohmann::json RunCase(const Config& cfg, const RefinementCase& rc, FkOptions opts, CsvWriter* csv,
                        bool verbose) {
   if (!rc.solver.empty()) opts.solver = FkSolverTypeFromString(rc.solver);
+  // A volume ratio of 1 leaves that chamber at rest (its volume then follows its neighbours').
+  std::vector<bool> loaded;
+  for (double v : rc.volume) loaded.push_back(v != 1.0);
   std::vector<Eigen::RowVector3d> tips;
   std::vector<nlohmann::json> rows;
   double length = 0.0;
@@ -179,9 +182,6 @@ nlohmann::json RunCase(const Config& cfg, const RefinementCase& rc, FkOptions op
       c = Eigen::Map<const Eigen::VectorXd>(rc.actuation.data(), rc.actuation.size());
       r = solver->Solve(c);
     } else {
-      // A ratio of 1 leaves that chamber at rest (its volume then follows its neighbours').
-      std::vector<bool> loaded;
-      for (double v : rc.volume) loaded.push_back(v != 1.0);
       MatchedVolume m = SolveAtVolume(solver.get(), scene, rc.volume, loaded);
       r = std::move(m.r);
       c = m.c;

@@ -37,13 +37,15 @@ constexpr double kGripWidth = 20.0, kGripHeight = 15.0, kGripBase = 8.0, kGripSe
                  kGripJoint = 5.0, kGripLayer = 1.5, kGripWall = 1.5, kGripCavity = 5.0,
                  kGripMaxAlpha = 8.0;
 
-Actuator PneumaticActuator(const std::string& name, std::vector<int> regions, double max) {
+Actuator PneumaticActuator(const std::string& name, std::vector<int> regions, double max,
+                           double weight) {
   Actuator a;
   a.name = name;
   a.type = ActuatorType::Pneumatic;
   a.regions = std::move(regions);
   a.rest = a.min = 1.0;
   a.max = max;
+  a.weight = weight;
   return a;
 }
 
@@ -60,10 +62,9 @@ void FinishGripper(int res, double third_x0, double xmax, double layer_z, double
   s->body[0] = Material{"body", 1.0, 1.0};
   s->body[4] = Material{"inextensible", 1.0, 20.0};
   s->body[5] = Material{"connector", 1.0, 20.0};
-  for (int k = 0; k < 3; ++k) {
-    s->actuators.push_back(PneumaticActuator("c" + std::to_string(k + 1), {k + 1}, kGripMaxAlpha));
-    s->actuators.back().weight = chamber_weight;
-  }
+  for (int k = 0; k < 3; ++k)
+    s->actuators.push_back(
+        PneumaticActuator("c" + std::to_string(k + 1), {k + 1}, kGripMaxAlpha, chamber_weight));
   const double eps = 1e-6 * kGripWidth / res, zmax = s->mesh.vertices.col(2).maxCoeff();
   s->fixed = VerticesOnPlane(s->mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
   AddDistalFaceMarkers(xmax, zmax, eps, s);
@@ -186,9 +187,7 @@ RobotEntry MultiSegmentGripperEntry() {
         "with res: 4, 6, 5, 7 chambers per segment at res 6, 8, 10, 12); 1: grid lines on the "
         "nominal dimensions (7 cavities of 5 mm per segment between 1.5 mm walls, 1.5 mm floor, "
         "side walls, roof and layer) at every res, mirror-symmetric about y = 10"},
-       {"chamber_weight", Actuator{}.weight, 0.01, 100.0,
-        "weight w_i of the chambers' (actuation) elements in Eq. 2.10, against the body's 1 "
-        "(default 5, Sec. 2.5); a soft chamber fill lags its target volume (docs/fidelity.md)"}}};
+       ChamberWeightParam()}};
   return {info, kGripMinRes, kGripMaxRes, &MakeMultiSegmentGripper};
 }
 

@@ -168,9 +168,7 @@ RobotEntry PneumaticFingerEntry() {
         "change with res); 1: grid lines on the nominal dimensions (16 cavities of 5 mm, 1.5 mm "
         "walls, floor and base layer, 14.5 mm proximal block) at every res, mirror-symmetric "
         "about y = 10"},
-       {"chamber_weight", Actuator{}.weight, 0.01, 100.0,
-        "weight w_i of the chamber (actuation) elements in Eq. 2.10, against the body's 1 (default "
-        "5, Sec. 2.5); a soft chamber fill lags its target volume (docs/fidelity.md)"}}};
+       ChamberWeightParam()}};
   return {info, kFingerMinRes, kFingerMaxRes, &MakePneumaticFinger};
 }
 

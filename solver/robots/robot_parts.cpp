@@ -61,6 +61,12 @@ bool DesignGridFlag(const std::string& robot, const RobotParams& P) {
                    "grid lines on the design's dimensions");
 }
 
+RobotParam ChamberWeightParam() {
+  return {"chamber_weight", Actuator{}.weight, 0.01, 100.0,
+          "weight w_i of the chamber (actuation) elements in Eq. 2.10, against the body's 1 "
+          "(default 5, Sec. 2.5); a soft chamber fill lags its target volume (docs/fidelity.md)"};
+}
+
 bool InCavity(const ChamberRow& r, int i) {
   const int u = i - r.first;
   if (u < 0 || u >= r.chambers * (r.wall + r.cavity)) return false;

@@ -71,6 +71,11 @@ bool FlagParam(const std::string& robot, const RobotParams& P, const std::string
 /// std::invalid_argument naming the robot, the key and the accepted values.
 bool DesignGridFlag(const std::string& robot, const RobotParams& P);
 
+/// The robot parameter chamber_weight of the pneumatic robots whose chamber fill can be
+/// softened (pneumatic_finger, multi_segment_gripper): the weight of the chamber elements in
+/// Eq. 2.10 against the body's 1; default Actuator{}.weight (5, Sec. 2.5), range [0.01, 100].
+RobotParam ChamberWeightParam();
+
 /// Markers of a finger whose distal face is the plane x = xmax: "tip" (the face's centroid),
 /// "tip_top" / "tip_bottom" (its top and bottom quarters in z, used for the bend angle).
 void AddDistalFaceMarkers(double xmax, double zmax, double eps, Scene* s);
