@@ -92,7 +92,7 @@ RefinementCase ReadCase(const Config& cfg, const nlohmann::json& c, const std::s
   if (rc.robot.empty()) cfg.Fail(key + ".robot", "an embedded robot's name (softkin robots)");
   if (rc.actuation.empty() == rc.volume.empty())
     cfg.Fail(key + ".actuation",
-             "either actuation or volume_ratio (one value per actuator), not both");
+             "exactly one of actuation and volume_ratio (one value per actuator each)");
   if (rc.resolutions.size() < 4)
     cfg.Fail(key + ".resolutions", "at least 4 resolutions (convergence needs three changes)");
   for (size_t i = 1; i < rc.resolutions.size(); ++i)

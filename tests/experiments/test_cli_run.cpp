@@ -300,7 +300,7 @@ TEST(Cli, RefinementCanCompareAtEqualChamberVolume) {
                "actuation": [1.3, 1, 1], "resolutions": [3, 4, 5, 6]}]})";
   r = Cli("run " + bad + " --no-plot --results " + dir);
   EXPECT_EQ(r.code, 2) << r.out;
-  EXPECT_NE(r.out.find("cases[0].actuation: expected either actuation or volume_ratio"),
+  EXPECT_NE(r.out.find("cases[0].actuation: expected exactly one of actuation and volume_ratio"),
             std::string::npos)
       << r.out;
 
