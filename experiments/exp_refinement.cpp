@@ -3,13 +3,17 @@
 // change from one resolution to the next says whether the answer converges. (The tracked point
 // is the marker `tip` unless the case names another.) A pneumatic case may instead prescribe the
 // chambers' volume ratios: then each resolution is solved at the actuation that reaches them
-// (matched_volume.hpp), so that the robots are compared at equal chamber volume.
+// (matched_volume.hpp), so that the robots are compared at equal chamber volume. Each
+// resolution of each case is a unit of a journaled sweep (sweep.hpp): rerun, a killed run solves
+// only what is missing, and under mpirun the ranks share the units.
 #include "softkin/experiments/matched_volume.hpp"
 #include "softkin/experiments/results.hpp"
 #include "softkin/experiments/runner.hpp"
+#include "softkin/experiments/sweep.hpp"
 #include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/robots/robots.hpp"
+#include "softkin/solver/scene/solver_options_json.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -156,86 +160,106 @@ std::string Joined(const Eigen::VectorXd& v) {
   return s;
 }
 
-/// One case: every resolution, a row each; the summary entry with the changes of the tip.
-nlohmann::json RunCase(const Config& cfg, const RefinementCase& rc, FkOptions opts, CsvWriter* csv,
-                       bool verbose) {
+/// The case's solver options: the config's, with the case's own solver if it names one.
+FkOptions CaseOptions(const RefinementCase& rc, FkOptions opts) {
   if (!rc.solver.empty()) opts.solver = FkSolverTypeFromString(rc.solver);
+  return opts;
+}
+
+/// The journal key of one resolution of a case: every setting that determines its row.
+nlohmann::json UnitKey(const RefinementCase& rc, const FkOptions& opts, int res) {
+  return {{"label", rc.label},
+          {"robot", rc.robot},
+          {"robot_params", rc.params},
+          {"marker", rc.marker},
+          {"actuation", rc.actuation},
+          {"volume_ratio", rc.volume},
+          {"res", res},
+          {"solver", SolverOptionsToJson(CaseOptions(rc, opts))}};
+}
+
+/// One resolution of a case, solved: its row (without the columns that compare resolutions).
+nlohmann::json SolveUnit(const Config& cfg, const RefinementCase& rc, const FkOptions& opts,
+                         int res, bool verbose) {
   // A volume ratio of 1 leaves that chamber at rest (its volume then follows its neighbours').
   std::vector<bool> loaded;
   for (double v : rc.volume) loaded.push_back(v != 1.0);
-  std::vector<Eigen::RowVector3d> tips;
-  std::vector<nlohmann::json> rows;
-  double length = 0.0;
-  for (int res : rc.resolutions) {
-    const Scene scene = CaseRobot(cfg, rc, res);
-    const int tip = scene.marker_index(rc.marker);
-    const Eigen::RowVector3d lo = scene.mesh.vertices.colwise().minCoeff();
-    const Eigen::RowVector3d hi = scene.mesh.vertices.colwise().maxCoeff();
-    length = (hi - lo).maxCoeff();
-    auto model = std::make_shared<const Model>(scene);
-    auto solver = MakeFkSolver(model, opts);
-    FkResult r;
-    Eigen::VectorXd c;
-    bool matched = true;
-    const auto t0 = std::chrono::steady_clock::now();
-    if (rc.volume.empty()) {
-      c = Eigen::Map<const Eigen::VectorXd>(rc.actuation.data(), rc.actuation.size());
-      r = solver->Solve(c);
-    } else {
-      MatchedVolume m = SolveAtVolume(solver.get(), scene, rc.volume, loaded);
-      r = std::move(m.r);
-      c = m.c;
-      matched = m.matched;
-    }
-    // Wall time to the answer (with a volume target, every secant solve).
-    const double solve_s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (r.status == FkStatus::InvalidInput)
-      throw std::invalid_argument(cfg.path() + ": " + rc.key + " ('" + rc.label +
-                                  "'): " + r.message);
-    const Eigen::VectorXd ratios =
-        Eigen::Map<const Eigen::VectorXd>(r.volume_ratios.data(), r.volume_ratios.size());
-    tips.push_back(scene.marker_positions(r.positions).row(tip));
-    nlohmann::json row = {{"case", rc.label},
-                          {"res", res},
-                          {"n_vertices", scene.mesh.num_vertices()},
-                          {"n_elements", scene.mesh.num_elements()},
-                          {"tip_x", tips.back()[0]},
-                          {"tip_y", tips.back()[1]},
-                          {"tip_z", tips.back()[2]},
-                          {"energy", r.energy},
-                          {"iterations", r.iterations},
-                          {"solve_s", solve_s},
-                          {"inverted", r.inverted_elements},
-                          {"status", FkStatusToString(r.status)},
-                          {"actuation", Joined(c)},
-                          {"volume_ratio", Joined(ratios)},
-                          {"volume_matched", matched}};
-    if (verbose)
-      std::fprintf(stderr, "  %s res %d: %d elements, %s\n", rc.label.c_str(), res,
-                   scene.mesh.num_elements(), r.BriefReport().c_str());
-    rows.push_back(row);
+  const Scene scene = CaseRobot(cfg, rc, res);
+  const int tip = scene.marker_index(rc.marker);
+  const Eigen::RowVector3d lo = scene.mesh.vertices.colwise().minCoeff();
+  const Eigen::RowVector3d hi = scene.mesh.vertices.colwise().maxCoeff();
+  auto model = std::make_shared<const Model>(scene);
+  auto solver = MakeFkSolver(model, CaseOptions(rc, opts));
+  FkResult r;
+  Eigen::VectorXd c;
+  bool matched = true;
+  const auto t0 = std::chrono::steady_clock::now();
+  if (rc.volume.empty()) {
+    c = Eigen::Map<const Eigen::VectorXd>(rc.actuation.data(), rc.actuation.size());
+    r = solver->Solve(c);
+  } else {
+    MatchedVolume m = SolveAtVolume(solver.get(), scene, rc.volume, loaded);
+    r = std::move(m.r);
+    c = m.c;
+    matched = m.matched;
   }
-  // The change from the previous resolution (left empty on the first) and the distance to the
-  // finest mesh's point, per row; whether the changes shrink.
+  // Wall time to the answer (with a volume target, every secant solve).
+  const double solve_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (r.status == FkStatus::InvalidInput)
+    throw std::invalid_argument(cfg.path() + ": " + rc.key + " ('" + rc.label + "'): " + r.message);
+  const Eigen::VectorXd ratios =
+      Eigen::Map<const Eigen::VectorXd>(r.volume_ratios.data(), r.volume_ratios.size());
+  const Eigen::RowVector3d p = scene.marker_positions(r.positions).row(tip);
+  if (verbose)
+    std::fprintf(stderr, "  %s res %d: %d elements, %s\n", rc.label.c_str(), res,
+                 scene.mesh.num_elements(), r.BriefReport().c_str());
+  return {{"case", rc.label},
+          {"res", res},
+          {"n_vertices", scene.mesh.num_vertices()},
+          {"n_elements", scene.mesh.num_elements()},
+          {"length_mm", (hi - lo).maxCoeff()},
+          {"tip_x", p[0]},
+          {"tip_y", p[1]},
+          {"tip_z", p[2]},
+          {"energy", r.energy},
+          {"iterations", r.iterations},
+          {"solve_s", solve_s},
+          {"inverted", r.inverted_elements},
+          {"status", FkStatusToString(r.status)},
+          {"actuation", Joined(c)},
+          {"volume_ratio", Joined(ratios)},
+          {"volume_matched", matched}};
+}
+
+/// One case from the rows of its resolutions, in order: the change from the previous resolution
+/// (left empty on the first) and the distance to the finest mesh's point, per row, written to
+/// the CSV; the summary entry, with whether the changes shrink.
+nlohmann::json FinishCase(const RefinementCase& rc, const FkOptions& opts,
+                          std::vector<nlohmann::json> rows, CsvWriter* csv) {
+  auto tip = [&](size_t i) {
+    return Eigen::Vector3d(rows[i]["tip_x"].get<double>(), rows[i]["tip_y"].get<double>(),
+                           rows[i]["tip_z"].get<double>());
+  };
   std::vector<double> changes, to_finest;
   bool shrink = true, all_converged = true;
   for (size_t i = 0; i < rows.size(); ++i) {
-    to_finest.push_back((tips[i] - tips.back()).norm());
+    to_finest.push_back((tip(i) - tip(rows.size() - 1)).norm());
     rows[i]["to_finest_mm"] = to_finest.back();
     if (i > 0) {
-      changes.push_back((tips[i] - tips[i - 1]).norm());
+      changes.push_back((tip(i) - tip(i - 1)).norm());
       rows[i]["change_mm"] = changes.back();
       shrink &= changes.size() < 2 || changes.back() <= changes[changes.size() - 2];
     }
     all_converged &= rows[i]["status"] == "converged" && rows[i]["volume_matched"].get<bool>();
     csv->RowJson(rows[i]);
   }
+  const double length = rows.back()["length_mm"].get<double>();
   return {{"label", rc.label},
           {"robot", rc.robot},
           {"robot_params", rc.params},
           {"marker", rc.marker},
-          {"solver", ToString(opts.solver)},
+          {"solver", ToString(CaseOptions(rc, opts).solver)},
           {"actuation", rc.actuation},
           {"volume_ratio", rc.volume},
           {"resolutions", rc.resolutions},
@@ -255,17 +279,42 @@ nlohmann::json RunRefinement(const Config& cfg, const std::string& dir, bool ver
   cfg.CheckNoUnknownKeys();
   for (const auto& rc : cases) CheckCase(cfg, rc);
   if (cfg.check_only()) return {};
+  // Each resolution of each case is a unit, journaled as it finishes: a killed run rerun with
+  // the same command solves only what is missing, and under mpirun the ranks share the units.
+  struct Unit {
+    size_t c;
+    int res;
+  };
+  std::vector<Unit> units;
+  std::vector<nlohmann::json> keys;
+  for (size_t c = 0; c < cases.size(); ++c)
+    for (int res : cases[c].resolutions) {
+      units.push_back({c, res});
+      keys.push_back(UnitKey(cases[c], opts, res));
+    }
+  Sweep sweep(dir + "/refinement.jsonl", "refinement_convergence", verbose);
+  sweep.Run(keys, [&](size_t i) {
+    return SolveUnit(cfg, cases[units[i].c], opts, units[i].res, verbose);
+  });
+  if (!Sweep::WritesResults()) return {};
   CsvWriter csv(dir + "/refinement.csv",
                 {"case", "res", "n_vertices", "n_elements", "tip_x", "tip_y", "tip_z", "change_mm",
                  "to_finest_mm", "energy", "iterations", "solve_s", "inverted", "status",
                  "actuation", "volume_ratio", "volume_matched"});
   nlohmann::json out = nlohmann::json::array();
   int shrinking = 0;
+  size_t next = 0;
   for (const auto& rc : cases) {
-    out.push_back(RunCase(cfg, rc, opts, &csv, verbose));
+    std::vector<nlohmann::json> rows(sweep.rows().begin() + next,
+                                     sweep.rows().begin() + next + rc.resolutions.size());
+    next += rc.resolutions.size();
+    out.push_back(FinishCase(rc, opts, std::move(rows), &csv));
     shrinking += out.back()["changes_shrink"].get<bool>();
   }
-  return {{"cases", out}, {"cases_whose_changes_shrink", shrinking}, {"n_cases", cases.size()}};
+  return {{"cases", out},
+          {"cases_whose_changes_shrink", shrinking},
+          {"n_cases", cases.size()},
+          {"resumed_rows", sweep.resumed()}};
 }
 
 }  // namespace softkin

@@ -30,7 +30,7 @@ struct Entry {
 const Entry kExperiments[] = {
     {"pneumatic_bending", &RunPneumaticBending},
     {"resolution_sweep", &RunResolutionSweep},
-    {"refinement", &RunRefinement},
+    {"refinement", &RunRefinement, true},
     {"fidelity_fem", &RunFidelityFem},
     {"solver_scaling", &RunSolverScaling},
     {"marker_sweep", &RunMarkerSweep},

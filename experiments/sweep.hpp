@@ -33,6 +33,8 @@ class Sweep {
   /// (CsvWriter::RowJson) and returns them as a JSON array.
   nlohmann::json WriteTable(const std::string& csv_path,
                             const std::vector<std::string>& header) const;
+  /// After Run: the rows, in the order of the keys.
+  const std::vector<nlohmann::json>& rows() const { return rows_; }
   /// Units whose rows were in the journal before this run (resumed).
   int resumed() const { return resumed_; }
   /// Whether this process writes the experiment's results: rank 0 of an MPI job, or the only one.
