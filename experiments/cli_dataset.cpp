@@ -118,7 +118,10 @@ DatasetSampling SamplingFromArgs(const DatasetCommandArgs& a) {
     if (a.random < 1)
       throw std::invalid_argument("--random: expected a number of samples >= 1, got " +
                                   std::to_string(a.random));
-    if (a.seed < 0) throw std::invalid_argument("--seed: required with --random (an integer >= 0)");
+    if (a.seed < 0)
+      throw std::invalid_argument(
+          "--seed: required with --random: expected an integer >= 0" +
+          (a.seed == -1 ? std::string() : ", got " + std::to_string(a.seed)));
     sampling.kind = DatasetSampling::Kind::kRandom;
     sampling.random = a.random;
     sampling.seed = static_cast<std::uint64_t>(a.seed);
@@ -261,6 +264,11 @@ int RunDatasetCommand(const DatasetCommandArgs& a) {
     run.shards = n;
   }
   const std::vector<std::string> points = SplitComma(a.points, "--points");
+  for (size_t i = 0; i < points.size(); ++i)
+    for (size_t j = 0; j < i; ++j)
+      if (points[i] == points[j])
+        throw std::invalid_argument("--points: expected each point once, got '" + points[i] +
+                                    "' twice");
   DatasetSource source =
       a.robot.empty() ? TwinSource(a, points, &run) : RobotSource(a, ko, points, &run);
   run.source = source.json;

@@ -581,6 +581,8 @@ int RunIkCommand(const IkCommandArgs& a) {
   // Before any work: no output overwrites an input or another output, and each can be written.
   std::vector<NamedPath> inputs = SceneInputs(a.scene);
   inputs.push_back({"--trajectory", a.trajectory});
+  if (!a.nets.empty())
+    for (const std::string& f : LearnedNets::Files(a.nets)) inputs.push_back({"--nets", f});
   CheckCommandPaths(inputs, {{"--out", a.out}, {"--cache", a.cache}});
   if (!a.nets.empty() || a.method == "learned" || a.method == "direct") return RunLearnedIk(a);
   return RunSimulatorIk(a);

@@ -90,15 +90,18 @@ int RunTessellateCommand(const TessellateCommandArgs& a) {
   CheckOption("--feature-angle", o.feature_angle >= 0 && o.feature_angle < 180,
               "an angle in [0, 180) degrees", o.feature_angle);
   const std::string ext = OutputExtension(a.out);
+  // A TetGen .node comes with its .ele, written beside it.
+  const std::string ele =
+      ext == ".node" ? a.out.substr(0, a.out.size() - ext.size()) + ".ele" : std::string();
   CheckCommandPaths({{"--body", a.body}, {"--chamber", a.chamber}},
-                    {{"--out", a.out}, {"--json", a.json_out}});
+                    {{"--out", a.out}, {"--out's .ele", ele}, {"--json", a.json_out}});
   const TriangleSurface body = ReadSurfaceMesh(a.body);
   const TriangleSurface chamber = ReadSurfaceMesh(a.chamber);
   const double tets = EstimateTessellationTets(chamber, body, o);
   CheckMemoryEstimate("--size " + FormatNumber(o.cell_size), tets * kTessellationBytesPerTet,
-                      "about " + std::to_string(std::llround(tets)) + " tets for these surfaces",
+                      "about " + FormatNumber(tets) + " tets for these surfaces",
                       "use a larger --size");
-  std::cerr << "softkin tessellate: meshing, about " << std::llround(tets)
+  std::cerr << "softkin tessellate: meshing, about " << FormatNumber(tets)
             << " tets expected (CGAL Mesh_3 reports nothing until it is done)\n";
   TessellationReport rep;
   const Mesh mesh = Tessellate(chamber, body, o, &rep);

@@ -183,6 +183,12 @@ NetsFromDatasetOptions NetsOptionsFromArgs(const TrainCommandArgs& a, const Data
 
 int RunTrainCommand(const TrainCommandArgs& a) {
   const LmOptions lm = LmFromArgs(a);
+  // Before any work: the networks written to --out never replace the data they are trained on.
+  const std::string data = a.s2r.empty() ? a.dataset : a.s2r;
+  const std::string flag = a.s2r.empty() ? "--dataset" : "--s2r";
+  std::vector<NamedPath> outputs;
+  for (const std::string& f : LearnedNets::Files(a.out)) outputs.push_back({"--out", f});
+  CheckDistinctPaths({{flag, data}, {flag + "'s sidecar", data + ".json"}}, outputs);
   if (!a.s2r.empty()) return TrainS2rCommand(a, lm);
 
   const Dataset d = LoadDataset(a.dataset);

@@ -28,6 +28,10 @@ namespace fs = std::filesystem;
 std::string ResultDir(const std::string& root, const std::string& name) {
   fs::path p = fs::path(root) / name;
   std::error_code ec;
+  if (fs::exists(root, ec) && !fs::is_directory(root, ec))
+    throw std::invalid_argument("--results '" + root +
+                                "' is a file; expected a folder for the "
+                                "results (created if missing)");
   fs::create_directories(p, ec);
   if (ec)
     throw std::runtime_error("cannot create result folder " + p.string() + ": " + ec.message());

@@ -4,6 +4,7 @@
 
 #include "softkin/experiments/mpi_job.hpp"
 #include "softkin/experiments/results.hpp"
+#include "softkin/solver/common/output_file.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -123,6 +124,9 @@ nlohmann::json RunExperiment(const std::string& config_path, const RunOptions& o
   const MpiPlace& job = MpiJob();
   const bool root = job.root();
   const std::string dir = ResultDir(opt.results_root, cfg.name());
+  // The run writes the config it used to RESULTS/<name>/config.json: never over the input.
+  CheckDistinctPaths({{"config", config_path}},
+                     {{"the run's copy of its config", dir + "/config.json"}});
   if (root) WriteJson(dir + "/config.json", cfg.json());
   nlohmann::json run;
   run["config_path"] = config_path;

@@ -1,10 +1,12 @@
 #include "softkin/ik/trajectory.hpp"
 
 #include "softkin/ik/objectives.hpp"
+#include "softkin/solver/common/output_file.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <iomanip>
 #include <map>
@@ -42,6 +44,7 @@ std::vector<std::pair<std::string, std::string>> CacheHeader(const Kinematics& k
 // Loads the cache; "" on success, else why it cannot be used.
 std::string LoadCache(const std::string& path,
                       const std::vector<std::pair<std::string, std::string>>& header, int n,
+                      const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
                       ConfigurationSamples* out) {
   std::ifstream in(path);
   if (!in) return "cannot read " + path;
@@ -71,6 +74,14 @@ std::string LoadCache(const std::string& path,
     if (static_cast<int>(row.size()) != n + 3)
       return path + ":" + std::to_string(lineno) + ": expected " + std::to_string(n + 3) +
              " columns, found " + std::to_string(row.size());
+    for (int a = 0; a < n; ++a)
+      if (row[a] < lower[a] || row[a] > upper[a]) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf,
+                      ": c%d = %.10g is outside the actuator's range [%.10g, %.10g]", a, row[a],
+                      lower[a], upper[a]);
+        return path + ":" + std::to_string(lineno) + buf;
+      }
     rows.push_back(std::move(row));
   }
   for (const auto& [k, v] : header) {
@@ -130,7 +141,7 @@ ConfigurationSamples SampleConfigurationSpace(Kinematics& kin, const std::string
   ConfigurationSamples out;
   std::string rejected;
   if (!options.cache_file.empty() && std::ifstream(options.cache_file).good()) {
-    rejected = LoadCache(options.cache_file, header, n, &out);
+    rejected = LoadCache(options.cache_file, header, n, kin.lower(), kin.upper(), &out);
     if (rejected.empty()) {
       out.cache_status = "loaded";
       out.time_s = Seconds(t0);
@@ -166,8 +177,8 @@ ConfigurationSamples SampleConfigurationSpace(Kinematics& kin, const std::string
   if (options.cache_file.empty()) {
     out.cache_status = "built";
   } else {
-    std::ofstream f(options.cache_file);
-    if (!f) throw std::runtime_error("cannot write the sample cache " + options.cache_file);
+    OutputFile file(options.cache_file);  // written whole or not at all
+    std::ostream& f = file.stream();
     for (const auto& [key, v] : header) f << "# " << key << "=" << v << "\n";
     f << "# failed=" << out.failed << "\n";
     for (int a = 0; a < n; ++a) f << "c" << a << ",";
@@ -176,7 +187,7 @@ ConfigurationSamples SampleConfigurationSpace(Kinematics& kin, const std::string
       for (int a = 0; a < n; ++a) f << out.c(i, a) << ",";
       f << out.p(i, 0) << "," << out.p(i, 1) << "," << out.p(i, 2) << "\n";
     }
-    if (!f) throw std::runtime_error("cannot write the sample cache " + options.cache_file);
+    file.Commit();
     out.cache_status = rejected.empty() ? "written" : "rebuilt: " + rejected;
   }
   out.time_s = Seconds(t0);

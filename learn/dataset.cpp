@@ -451,14 +451,23 @@ DatasetRunSummary GenerateDataset(Kinematics& kin, const DatasetSampling& sampli
 
   // One writer per file: a second process started on the same output (a duplicated job, two
   // shells) stops here instead of interleaving lines with the first.
+  const bool existed = fs::exists(opt.out);
   const WriterLock lock(opt.out);
   // Resume or start (an empty file without a sidecar, from a run killed right after creating it,
   // holds nothing).
   bool fresh = true;
   if (fs::exists(opt.out) && (fs::file_size(opt.out) > 0 || fs::exists(SidecarPath(opt.out)))) {
-    const nlohmann::json side = ReadSidecar(opt.out);
+    // A refusal leaves no empty file behind where the lock created one.
+    nlohmann::json side;
+    try {
+      side = ReadSidecar(opt.out);
+    } catch (...) {
+      if (!existed) fs::remove(opt.out);
+      throw;
+    }
     std::string d = KeyDifferences(config, side["config"], "config");
     if (d.empty()) d = KeyDifferences(shard, side["shard"], "shard");
+    if (!d.empty() && !existed) fs::remove(opt.out);
     if (!d.empty())
       throw std::invalid_argument(opt.out +
                                   " exists and was made with another configuration (its sidecar " +
@@ -469,6 +478,17 @@ DatasetRunSummary GenerateDataset(Kinematics& kin, const DatasetSampling& sampli
     if (static_cast<long long>(raw.lines.size()) > range.count)
       Bad(opt.out, static_cast<long long>(range.count) + 2,
           "more samples than the shard's " + std::to_string(range.count));
+    // A kept row must be the sample of its index: the actuation this run would write there.
+    for (size_t j = 0; j < raw.lines.size(); ++j) {
+      const long long idx = range.first + static_cast<long long>(j);
+      const std::vector<std::string> f = SplitFields(raw.lines[j]);
+      const Eigen::VectorXd c = DatasetActuation(sampling, lower, upper, idx);
+      for (int a = 0; a < m; ++a)
+        if (f[2 + a] != Num(c[a]))
+          Bad(opt.out, static_cast<long long>(j) + 2,
+              "c" + std::to_string(a) + " = " + f[2 + a] + ", expected " + Num(c[a]) + " (sample " +
+                  std::to_string(idx) + " of this dataset's sampling)");
+    }
     fs::resize_file(opt.out, raw.complete_bytes);  // drop a truncated last line
     sum.already = static_cast<long long>(raw.lines.size());
     fresh = raw.complete_bytes == 0;

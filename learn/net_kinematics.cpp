@@ -94,6 +94,13 @@ void LearnedNets::Save(const std::string& dir) const {
   WriteTextFile((fs::path(dir) / "nets.json").string(), j.dump(2) + "\n");
 }
 
+std::vector<std::string> LearnedNets::Files(const std::string& dir) {
+  std::vector<std::string> out = {(fs::path(dir) / "nets.json").string()};
+  for (const char* name : kNetNames)
+    out.push_back((fs::path(dir) / (name + std::string(".fnn"))).string());
+  return out;
+}
+
 LearnedNets LearnedNets::Load(const std::string& dir) {
   const std::string path = (fs::path(dir) / "nets.json").string();
   std::ifstream in(path);

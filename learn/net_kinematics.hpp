@@ -49,6 +49,8 @@ struct LearnedNets {
   /// Reads a directory written by Save. Throws std::runtime_error naming the file and the key (or
   /// the network file's own error) for a missing, corrupt or inconsistent directory.
   static LearnedNets Load(const std::string& dir);
+  /// The files Save writes and Load reads in `dir`: nets.json and the four networks' .fnn files.
+  static std::vector<std::string> Files(const std::string& dir);
 };
 
 /// Where the learned kinematics takes J^s from.

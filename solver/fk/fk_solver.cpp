@@ -41,9 +41,15 @@ bool FkStatusFromString(const std::string& s, FkStatus* out) {
 
 std::string FkResult::BriefReport() const {
   char buf[256];
-  std::snprintf(buf, sizeof(buf), "%s: %s, %d iterations, energy %.6g, residual ratio %.3g, %.3f s",
-                solver.c_str(), FkStatusToString(status), iterations, energy, gradient_ratio,
-                time_s);
+  // A diverged solve has no energy or residual to speak of: "n/a", never "nan".
+  auto num = [](double v, const char* fmt) {
+    char t[32];
+    std::snprintf(t, sizeof(t), fmt, v);
+    return std::isfinite(v) ? std::string(t) : std::string("n/a");
+  };
+  std::snprintf(buf, sizeof(buf), "%s: %s, %d iterations, energy %s, residual ratio %s, %.3f s",
+                solver.c_str(), FkStatusToString(status), iterations, num(energy, "%.6g").c_str(),
+                num(gradient_ratio, "%.3g").c_str(), time_s);
   std::string s = buf;
   if (!message.empty()) s += " (" + message + ")";
   if (inverted_elements > 0) {

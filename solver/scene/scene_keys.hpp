@@ -65,6 +65,10 @@ struct KeySpec {
     lo_open = true;
     return *this;
   }
+  KeySpec& AtMost(double v) {
+    hi = v;
+    return *this;
+  }
   KeySpec& In(double a, double b) {
     lo = a;
     hi = b;

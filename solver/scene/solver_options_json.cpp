@@ -61,6 +61,10 @@ struct Row {
     spec.Above(v);
     return *this;
   }
+  Row& AtMost(double v) {
+    spec.AtMost(v);
+    return *this;
+  }
   Row& In(double a, double b) {
     spec.In(a, b);
     return *this;
@@ -115,11 +119,13 @@ const std::vector<Row>& Rows() {
       Option("tolerance", &F::tolerance,
              "Converged when every vertex moves less than tolerance x model size in one "
              "iteration (and the gradient test of gradient_tolerance holds).")
-          .Above(0.0),
+          .Above(0.0)
+          .AtMost(0.01),
       Option("gradient_tolerance", &F::gradient_tolerance,
              "Converged when the energy gradient norm is below this fraction of its first value "
              "(and the move test of tolerance holds).")
-          .Above(0.0),
+          .Above(0.0)
+          .AtMost(0.1),
       Option("anderson_window", &F::anderson_window,
              "History length of Anderson acceleration (lg-aa).")
           .In(1, 50),

@@ -32,6 +32,8 @@ TEST(Cli, BadOutputsAndValuesAreRefusedBeforeAnyWork) {
   {
     std::ofstream(scene) << R"({"robot": {"name": "three_chamber", "res": 3}})";
     std::ofstream(path) << "0 0 50\n";
+    std::ofstream(dir + "/cfg.json") << R"({"name": "t", "experiment": "aa_ablation", "seed": 1,
+      "robots": ["three_chamber"], "resolutions": [3], "levels": [1.0]})";
   }
   const std::string scene_text = ReadAll(scene), path_text = ReadAll(path);
   struct Case {
@@ -61,7 +63,28 @@ TEST(Cli, BadOutputsAndValuesAreRefusedBeforeAnyWork) {
             "--grid: Value 0 not in range"},
            {"dataset --robot three_chamber --random 0 --seed 1 --out " + dir + "/d.csv",
             "--random: Value 0 not in range"},
-           {"calibrate --rm 2 --res 0", "--res: Value 0 not in range"}}) {
+           {"calibrate --rm 2 --res 0", "--res: Value 0 not in range"},
+           // Networks are inputs of ik and outputs of train; a TetGen .node brings its .ele.
+           {"ik --robot three_chamber --nets " + dir +
+                "/nets --method learned --target 10,136,0 "
+                "--out " +
+                dir + "/nets/fk.fnn",
+            "same file as the input --nets"},
+           {"train --dataset " + dir + "/nets/nets.json --out " + dir + "/nets",
+            "same file as the input --dataset"},
+           {"tessellate --body " + dir + "/b.obj --chamber " + dir + "/c.obj --out " + dir +
+                "/m.node --json " + dir + "/m.ele",
+            "same file as the output --out's .ele"},
+           // Stopping tests looser than their meaning (a fraction of the model size, of the
+           // first gradient) would call a far-off state converged.
+           {fk + "--tolerance 10", "solver.tolerance: expected a number in (0, 0.01], got 10"},
+           {fk + "--gradient-tolerance 0.5",
+            "solver.gradient_tolerance: expected a number in (0, 0.1], got 0.5"},
+           {"run " + dir + "/cfg.json --results " + path, "is a file; expected a folder"},
+           {"dataset --robot three_chamber --random 5 --seed -5 --out " + dir + "/d.csv",
+            "--seed: required with --random: expected an integer >= 0, got -5"},
+           {"dataset --robot three_chamber --grid 2 --points tip,tip --out " + dir + "/d.csv",
+            "--points: expected each point once, got 'tip' twice"}}) {
     const CliRun r = Cli(c.args);
     EXPECT_EQ(r.code, 2) << c.args << "\n" << r.out;
     EXPECT_NE(r.out.find(c.expect), std::string::npos) << c.args << "\n" << r.out;

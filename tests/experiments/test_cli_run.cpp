@@ -68,6 +68,14 @@ TEST(Cli, RunWritesSummaryWithConfigCommitAndMachine) {
   EXPECT_EQ(j["config"]["robots"][0], "three_chamber");
   EXPECT_TRUE(std::filesystem::exists(dir + "/tiny_aa/aa_ablation.csv"));
 
+  // Rerunning the copy a run wrote (RESULTS/<name>/config.json) into the same results would
+  // write over it (with the quick overrides resolved): refused, the file left as it was.
+  const std::string copy = dir + "/tiny_aa/config.json", copy_text = ReadAll(copy);
+  r = Cli("run " + copy + " --no-plot --results " + dir);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("is the same file as the input config"), std::string::npos) << r.out;
+  EXPECT_EQ(ReadAll(copy), copy_text);
+
   std::ofstream(cfg)
       << R"({"name": "tiny_aa", "experiment": "aa_ablation", "seed": 3, "robts": []})";
   r = Cli("run " + cfg + " --no-plot --results " + dir);

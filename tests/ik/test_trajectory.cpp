@@ -10,6 +10,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 #include <unistd.h>
 
 namespace softkin {
@@ -234,6 +235,20 @@ TEST(Trajectory, SampleCacheIsReusedAndRejectedWhenBuiltForSomethingElse) {
   so.cache_key = "pcc other";
   const ConfigurationSamples e = SampleConfigurationSpace(k, "backbone[3]", so);
   EXPECT_NE(e.cache_status.find("oops"), std::string::npos) << e.cache_status;
+  // A sample outside the actuators' range is not loaded (it would start IK out of range).
+  std::string text;
+  {
+    std::ifstream in(file);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    text = ss.str();
+  }
+  const size_t last = text.rfind('\n', text.size() - 2) + 1;
+  text.replace(last, text.find(',', last) - last, "99");
+  { std::ofstream(file, std::ios::trunc) << text; }
+  const ConfigurationSamples g = SampleConfigurationSpace(k, "backbone[3]", so);
+  EXPECT_NE(g.cache_status.find("c0 = 99 is outside the actuator's range"), std::string::npos)
+      << g.cache_status;
   std::remove(file.c_str());
 }
 

@@ -319,6 +319,28 @@ TEST_F(DatasetTest, AnotherConfigOnTheSameFileIsAnError) {
   o.out = Path("d.csv");
   Run(Grid(3, 4), o);
   const std::string before = Read(o.out);
+  // A row whose actuation is not its index's sample is not resumed over.
+  {
+    std::string edited = before;
+    const size_t row2 = edited.find('\n', edited.find('\n') + 1) + 1;  // line 3: sample 1
+    const size_t c0 = edited.find(',', edited.find(',', row2) + 1) + 1;
+    edited.replace(c0, edited.find(',', c0) - c0, "0.123");
+    Write(o.out, edited.substr(0, edited.find('\n', row2) + 1));
+    try {
+      Run(Grid(3, 4), o);
+      ADD_FAILURE() << "resumed over a row with another actuation";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(o.out + ":3: c0 = 0.123, expected "), std::string::npos)
+          << e.what();
+    }
+    Write(o.out, before);
+  }
+  // A sidecar of something else beside a new output: refused, and no empty CSV is left.
+  Write(Path("other.csv.json"), "{\"x\": 1}");
+  DatasetRunOptions other = o;
+  other.out = Path("other.csv");
+  EXPECT_THROW(Run(Grid(3, 4), other), std::invalid_argument);
+  EXPECT_FALSE(fs::exists(other.out));
   try {
     Run(Grid(4, 4), o);
     FAIL() << "a different grid overwrote the file";

@@ -844,7 +844,11 @@ TEST(SceneJsonErrors, SolverOptions) {
   ExpectSceneError(j, {"solver.anderson_window: expected an integer in [1, 50], got 0"});
   j = TinyScene();
   j["solver"]["tolerance"] = -1;
-  ExpectSceneError(j, {"solver.tolerance: expected a number > 0, got -1"});
+  ExpectSceneError(j, {"solver.tolerance: expected a number in (0, 0.01], got -1"});
+  // A stopping test looser than its meaning would call a far-off state converged.
+  j = TinyScene();
+  j["solver"]["gradient_tolerance"] = 2;
+  ExpectSceneError(j, {"solver.gradient_tolerance: expected a number in (0, 0.1], got 2"});
 }
 
 TEST(SceneJsonErrors, MeshReaderErrorPassesThrough) {
