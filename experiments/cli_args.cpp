@@ -52,7 +52,9 @@ RobotParams ParseRobotParams(const std::vector<std::string>& items) {
         end != value.c_str() + value.size() || !std::isfinite(v))
       throw std::invalid_argument("--param: expected NAME=VALUE with a finite number, got '" +
                                   text + "'");
-    params[text.substr(0, eq)] = v;
+    if (!params.emplace(text.substr(0, eq), v).second)
+      throw std::invalid_argument("--param: expected each parameter once, got '" +
+                                  text.substr(0, eq) + "' twice");
   }
   return params;
 }

@@ -13,6 +13,7 @@
 
 #include <iostream>
 #include <memory>
+#include <set>
 #include <stdexcept>
 
 namespace softkin {
@@ -51,13 +52,22 @@ namespace {
 
 /// The --set KEY=VALUE options over `opt`, read by the scene JSON's reader. VALUE is JSON (a
 /// number, true, false) or, if it does not parse as JSON, a string (CommandLineValue).
-FkOptions ApplySetOptions(const std::vector<std::string>& sets, const FkOptions& opt) {
+FkOptions ApplySetOptions(const std::vector<std::string>& sets, const FkOptions& opt,
+                          const FkOptionFlags& flags) {
   nlohmann::json j = nlohmann::json::object();
+  std::set<std::string> seen;
   for (const std::string& kv : sets) {
     const auto eq = kv.find('=');
     if (eq == std::string::npos || eq == 0)
       throw std::invalid_argument("--set '" + kv + "': expected KEY=VALUE");
     const std::string key = kv.substr(0, eq);
+    // One value per option: a second --set, or --set beside the option's own flag, is refused
+    // rather than one of them silently winning.
+    if (!seen.insert(key).second)
+      throw std::invalid_argument("--set: expected each option once, got '" + key + "' twice");
+    if (flags.given.count(key))
+      throw std::invalid_argument("--set " + key + ": the option is also given as " +
+                                  FkOptionFlagName(key) + "; expected one of the two");
     const nlohmann::json v = CommandLineValue(kv.substr(eq + 1));
     nlohmann::json* at = &j;
     std::string rest = key;
@@ -114,7 +124,7 @@ nlohmann::json FkResultJson(const Scene& scene, const Eigen::VectorXd& c, const 
 }  // namespace
 
 FkOptions FkOptionsFromArgs(const FkCommandArgs& a, const FkOptions& base) {
-  return ApplySetOptions(a.set, ApplyFkOptionFlags(a.options, base));
+  return ApplySetOptions(a.set, ApplyFkOptionFlags(a.options, base), a.options);
 }
 
 int RunFkCommand(const FkCommandArgs& a) {

@@ -84,7 +84,15 @@ TEST(Cli, BadOutputsAndValuesAreRefusedBeforeAnyWork) {
            {"dataset --robot three_chamber --random 5 --seed -5 --out " + dir + "/d.csv",
             "--seed: required with --random: expected an integer >= 0, got -5"},
            {"dataset --robot three_chamber --grid 2 --points tip,tip --out " + dir + "/d.csv",
-            "--points: expected each point once, got 'tip' twice"}}) {
+            "--points: expected each point once, got 'tip' twice"},
+           // One value per option: no repeat silently wins.
+           {fk + "--set tolerance=1e-3 --tolerance 1e-5",
+            "--set tolerance: the option is also given as --tolerance"},
+           {fk + "--set tolerance=1e-3 --set tolerance=1e-4",
+            "--set: expected each option once, got 'tolerance' twice"},
+           {"fk --robot pneumatic_finger --res 4 --actuation 1.2 --param design_grid=0 "
+            "--param design_grid=1",
+            "--param: expected each parameter once, got 'design_grid' twice"}}) {
     const CliRun r = Cli(c.args);
     EXPECT_EQ(r.code, 2) << c.args << "\n" << r.out;
     EXPECT_NE(r.out.find(c.expect), std::string::npos) << c.args << "\n" << r.out;
