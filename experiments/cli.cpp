@@ -88,6 +88,13 @@ int RunCli(int argc, char** argv, bool rethrow) {
               " processes, but only `softkin dataset` and `softkin run` (sweeps) share work over "
               "MPI ranks; run `softkin " +
               name + "` as one process");
+        // An empty value (an unset shell variable, --json "") is never a silent default.
+        for (const CLI::Option* o : c.app->get_options())
+          if (o->get_expected_min() > 0)
+            for (const std::string& v : o->results())
+              if (v.empty())
+                throw std::invalid_argument(o->get_name() +
+                                            ": expected a value, got an empty string");
         return c.run();
       }
     return 0;

@@ -85,6 +85,8 @@ TEST(Cli, BadOutputsAndValuesAreRefusedBeforeAnyWork) {
             "--seed: required with --random: expected an integer >= 0, got -5"},
            {"dataset --robot three_chamber --grid 2 --points tip,tip --out " + dir + "/d.csv",
             "--points: expected each point once, got 'tip' twice"},
+           // An empty value (an unset shell variable) is not "no file".
+           {fk + "--vtu \"\"", "--vtu: expected a value, got an empty string"},
            // One value per option: no repeat silently wins.
            {fk + "--set tolerance=1e-3 --tolerance 1e-5",
             "--set tolerance: the option is also given as --tolerance"},
