@@ -332,8 +332,17 @@ IkPath MakeIkPath(const nlohmann::json& spec, const std::string& where, Kinemati
     if (!spec.contains("file") || !spec["file"].is_string())
       Bad(where + ".file", "expected a file name");
     std::filesystem::path f = spec["file"].get<std::string>();
-    if (f.is_relative()) f = std::filesystem::path(SOFTKIN_SOURCE_DIR) / f;
-    Eigen::MatrixX3d w = ReadWaypoints(f.lexically_normal().string());
+    const bool relative = f.is_relative();
+    if (relative) f = std::filesystem::path(SOFTKIN_SOURCE_DIR) / f;
+    Eigen::MatrixX3d w;
+    try {
+      w = ReadWaypoints(f.lexically_normal().string());
+    } catch (const std::invalid_argument& e) {
+      Bad(where + ".file",
+          std::string(e.what()) + (relative ? " (a relative file is read from the source tree, " +
+                                                  std::string(SOFTKIN_SOURCE_DIR) + ")"
+                                            : ""));
+    }
     path.info["file_resolved"] = f.lexically_normal().string();
     path.info["file_waypoints"] = w.rows();
     if (spec.contains("stride")) {

@@ -584,6 +584,17 @@ TEST(Cli, IkExperimentsRunTinyConfigsAndRejectBadPaths) {
   r = Cli("run " + cfg + " --no-plot --results " + dir);
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("paths[0].type"), std::string::npos) << r.out;
+  // A waypoint file that is not there is named with its key and where it was looked for.
+  std::ofstream(cfg) << R"({"name": "tiny_traj", "experiment": "ik_trajectory", "seed": 2,
+    "robot": "cable_finger", "res": 5, "samples_per_axis": 2, "solver": {"gradient_tolerance": 1e-3},
+    "paths": [{"name": "seg", "type": "file", "file": "no/such/waypoints.txt"}]})";
+  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("paths[0].file: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("no/such/waypoints.txt: cannot open the waypoint file (a relative file is "
+                       "read from the source tree"),
+            std::string::npos)
+      << r.out;
   std::ofstream(cfg) << R"({"name": "tiny_m", "experiment": "ik_methods", "seed": 2,
     "robot": "cable_finger", "res": 5, "methods": ["softls", "newton"], "path": {}})";
   r = Cli("run " + cfg + " --no-plot --results " + dir);
