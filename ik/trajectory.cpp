@@ -2,11 +2,11 @@
 
 #include "softkin/ik/objectives.hpp"
 #include "softkin/solver/common/output_file.hpp"
+#include "softkin/solver/common/text_format.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <fstream>
 #include <iomanip>
 #include <map>
@@ -75,13 +75,10 @@ std::string LoadCache(const std::string& path,
       return path + ":" + std::to_string(lineno) + ": expected " + std::to_string(n + 3) +
              " columns, found " + std::to_string(row.size());
     for (int a = 0; a < n; ++a)
-      if (row[a] < lower[a] || row[a] > upper[a]) {
-        char buf[160];
-        std::snprintf(buf, sizeof buf,
-                      ": c%d = %.10g is outside the actuator's range [%.10g, %.10g]", a, row[a],
-                      lower[a], upper[a]);
-        return path + ":" + std::to_string(lineno) + buf;
-      }
+      if (row[a] < lower[a] || row[a] > upper[a])
+        return path + ":" + std::to_string(lineno) + ": c" + std::to_string(a) + " = " +
+               FormatNumber(row[a], 10) + " is outside the actuator's range [" +
+               FormatNumber(lower[a], 10) + ", " + FormatNumber(upper[a], 10) + "]";
     rows.push_back(std::move(row));
   }
   for (const auto& [k, v] : header) {

@@ -458,22 +458,21 @@ DatasetRunSummary GenerateDataset(Kinematics& kin, const DatasetSampling& sampli
   bool fresh = true;
   if (fs::exists(opt.out) && (fs::file_size(opt.out) > 0 || fs::exists(SidecarPath(opt.out)))) {
     // A refusal leaves no empty file behind where the lock created one.
-    nlohmann::json side;
     try {
-      side = ReadSidecar(opt.out);
+      const nlohmann::json side = ReadSidecar(opt.out);
+      std::string d = KeyDifferences(config, side["config"], "config");
+      if (d.empty()) d = KeyDifferences(shard, side["shard"], "shard");
+      if (!d.empty())
+        throw std::invalid_argument(opt.out +
+                                    " exists and was made with another configuration (its "
+                                    "sidecar " +
+                                    SidecarPath(opt.out) + " differs at '" + d +
+                                    "'); refusing to overwrite it: remove it "
+                                    "or choose another output");
     } catch (...) {
       if (!existed) fs::remove(opt.out);
       throw;
     }
-    std::string d = KeyDifferences(config, side["config"], "config");
-    if (d.empty()) d = KeyDifferences(shard, side["shard"], "shard");
-    if (!d.empty() && !existed) fs::remove(opt.out);
-    if (!d.empty())
-      throw std::invalid_argument(opt.out +
-                                  " exists and was made with another configuration (its sidecar " +
-                                  SidecarPath(opt.out) + " differs at '" + d +
-                                  "'); refusing to overwrite it: remove it "
-                                  "or choose another output");
     const RawLines raw = ReadRawLines(opt.out, header, range.first);
     if (static_cast<long long>(raw.lines.size()) > range.count)
       Bad(opt.out, static_cast<long long>(range.count) + 2,

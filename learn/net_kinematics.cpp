@@ -78,10 +78,11 @@ void LearnedNets::Save(const std::string& dir) const {
   j["lower"] = ToJson(lower);
   j["upper"] = ToJson(upper);
   j["rest"] = ToJson(rest);
+  const std::vector<std::string> paths = Files(dir);  // nets.json, then one per network
   nlohmann::json files = nlohmann::json::object();
   for (int i = 0; i < 4; ++i) {
     const Fnn* f = NetByName(*this, i);
-    const fs::path file = fs::path(dir) / (std::string(kNetNames[i]) + ".fnn");
+    const fs::path file = paths[1 + i];
     if (f->num_layers() > 0) {
       f->Save(file.string());
       files[kNetNames[i]] = file.filename().string();
@@ -91,7 +92,7 @@ void LearnedNets::Save(const std::string& dir) const {
   }
   j["networks"] = files;
   j["info"] = info;
-  WriteTextFile((fs::path(dir) / "nets.json").string(), j.dump(2) + "\n");
+  WriteTextFile(paths[0], j.dump(2) + "\n");
 }
 
 std::vector<std::string> LearnedNets::Files(const std::string& dir) {
