@@ -80,13 +80,14 @@ void SimulatorKinematics::Init(const SimulatorKinematicsOptions& options, const 
   const Scene& scene = model_->scene();
   fk_ = fk ? *fk : scene.solver;
   if (!fk_.IsValid(&why)) throw std::invalid_argument("solver options: " + why);
-  // lg, lg-aa and newton stop at the same local-global equilibrium, which 'implicit'
+  // lg, lg-aa, newton and auto stop at the same local-global equilibrium, which 'implicit'
   // differentiates; the other solvers minimise other problems.
   if (options_.jacobian == JacobianMode::kImplicit && fk_.solver != FkSolverType::kLg &&
-      fk_.solver != FkSolverType::kLgAa && fk_.solver != FkSolverType::kNewton)
+      fk_.solver != FkSolverType::kLgAa && fk_.solver != FkSolverType::kNewton &&
+      fk_.solver != FkSolverType::kAuto)
     throw std::invalid_argument(
         "jacobian 'implicit' differentiates the local-global equilibrium; it needs solver lg, "
-        "lg-aa or newton, got '" +
+        "lg-aa, newton or auto, got '" +
         ToString(fk_.solver) + "' (use fd or fd-warm with other solvers)");
   solver_ = MakeFkSolver(model_, fk_);
   warm_solver_.reset();

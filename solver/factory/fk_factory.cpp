@@ -4,6 +4,7 @@
 #include "softkin/solver/baselines/nlp_solvers.hpp"
 #include "softkin/solver/collision/collision_response.hpp"
 #include "softkin/solver/fk/local_global.hpp"
+#include "softkin/solver/newton/auto_solver.hpp"
 #include "softkin/solver/newton/newton_solver.hpp"
 
 #include <stdexcept>
@@ -29,6 +30,8 @@ std::unique_ptr<FkSolver> MakeFkSolver(std::shared_ptr<const Model> model,
       return std::make_unique<LocalGlobalSolver>(std::move(model), options, SpringResponse);
     case FkSolverType::kNewton:
       return std::make_unique<NewtonSolver>(std::move(model), options, SpringResponse);
+    case FkSolverType::kAuto:
+      return std::make_unique<AutoSolver>(std::move(model), options, SpringResponse);
     case FkSolverType::kCeres:
     case FkSolverType::kIpoptLbfgs:
     case FkSolverType::kIpoptNewton:

@@ -14,6 +14,7 @@ constexpr EnumName<FkSolverType> kSolverNames[] = {
     {FkSolverType::kLg, "lg"},
     {FkSolverType::kLgAa, "lg-aa"},
     {FkSolverType::kNewton, "newton"},
+    {FkSolverType::kAuto, "auto"},
     {FkSolverType::kCeres, "ceres"},
     {FkSolverType::kIpoptLbfgs, "ipopt-lbfgs"},
     {FkSolverType::kIpoptNewton, "ipopt-newton"},

@@ -110,6 +110,7 @@ enum class FkSolverType {
   kLg,                 ///< "lg": plain local-global (Algorithm 1)
   kLgAa,               ///< "lg-aa": Anderson-accelerated local-global
   kNewton,             ///< "newton": Newton-Krylov on the same equilibrium (solver/newton/)
+  kAuto,               ///< "auto": lg-aa, then newton if lg-aa is slow (solver/newton/auto_solver)
   kCeres,              ///< "ceres": the energy by Ceres (solver/baselines/nlp_solvers.hpp)
   kIpoptLbfgs,         ///< "ipopt-lbfgs": the energy by Ipopt with L-BFGS
   kIpoptNewton,        ///< "ipopt-newton": the energy by Ipopt with the exact Hessian

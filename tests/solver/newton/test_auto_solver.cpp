@@ -1,0 +1,160 @@
+/// \file test_auto_solver.cpp
+/// The "auto" FK solver (solver/newton/auto_solver.hpp): lg-aa's answer where lg-aa converges
+/// within its round, newton's from the same start where it does not, a second round when lg-aa is
+/// nearly done, the user's cap, scenes newton does not cover, and bad limits.
+#include "softkin/solver/factory/fk_factory.hpp"
+#include "softkin/solver/newton/auto_solver.hpp"
+#include "softkin/solver/robots/robots.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+
+namespace softkin {
+namespace {
+
+FkOptions Options(const std::string& solver) {
+  FkOptions o;
+  o.solver = FkSolverTypeFromString(solver);
+  o.threads = 1;
+  return o;
+}
+
+double MaxDistance(const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b) {
+  return (a - b).rowwise().norm().maxCoeff();
+}
+
+// Where lg-aa converges within its round, auto is lg-aa: the same state, iterations and no note.
+TEST(AutoSolver, IsLgAaWhereLgAaConvergesWithinItsRound) {
+  auto model = std::make_shared<const Model>(MakeRobot("three_chamber", 3));
+  const Eigen::Vector3d c(1.6, 1.0, 1.2);
+  const FkResult lg = MakeFkSolver(model, Options("lg-aa"))->Solve(c);
+  auto solver = MakeFkSolver(model, Options("auto"));
+  EXPECT_EQ(solver->name(), "auto");
+  const FkResult au = solver->Solve(c);
+  ASSERT_EQ(lg.status, FkStatus::Converged) << lg.BriefReport();
+  ASSERT_LT(lg.iterations, AutoSolver::Limits().lg_iterations);
+  EXPECT_EQ(au.status, FkStatus::Converged) << au.BriefReport();
+  EXPECT_EQ(au.solver, "auto");
+  EXPECT_EQ(au.iterations, lg.iterations);
+  EXPECT_EQ(au.message, "");
+  EXPECT_EQ(MaxDistance(au.positions, lg.positions), 0.0);
+  // A warm start too.
+  const Eigen::Vector3d c2(1.7, 1.0, 1.2);
+  const FkResult lg2 = MakeFkSolver(model, Options("lg-aa"))->Solve(c2, &lg.positions);
+  const FkResult au2 = solver->Solve(c2, &au.positions);
+  EXPECT_EQ(au2.iterations, lg2.iterations);
+  EXPECT_EQ(MaxDistance(au2.positions, lg2.positions), 0.0);
+}
+
+// On the thin strip lg-aa needs about 4,000 iterations at alpha 1.1 (docs/newton.md): auto stops
+// it after its round and returns newton's answer from the rest shape, and says so.
+TEST(AutoSolver, SwitchesToNewtonWhereLgAaCrawls) {
+  auto model = std::make_shared<const Model>(MakeRobot("bilayer_strip", 1));
+  const Eigen::VectorXd c = Eigen::VectorXd::Constant(1, 1.1);
+  const FkResult nw = MakeFkSolver(model, Options("newton"))->Solve(c);
+  const FkResult au = MakeFkSolver(model, Options("auto"))->Solve(c);
+  ASSERT_EQ(nw.status, FkStatus::Converged) << nw.BriefReport();
+  EXPECT_EQ(au.status, FkStatus::Converged) << au.BriefReport();
+  EXPECT_NE(au.message.find("auto: lg-aa had not converged after 500 iterations"),
+            std::string::npos)
+      << au.message;
+  EXPECT_NE(au.message.find("solved with newton from the rest shape"), std::string::npos)
+      << au.message;
+  EXPECT_EQ(au.iterations, 500 + nw.iterations);
+  EXPECT_EQ(au.linear_iterations, nw.linear_iterations);
+  EXPECT_LT(MaxDistance(au.positions, nw.positions), 1e-9 * model->size());
+  EXPECT_LE(au.gradient_ratio, 1e-6);
+}
+
+// lg-aa a few iterations short of done gets a second round (no switch); otherwise it switches.
+TEST(AutoSolver, NearlyConvergedLgAaGetsASecondRound) {
+  auto model = std::make_shared<const Model>(MakeRobot("three_chamber", 3));
+  const Eigen::Vector3d c(1.6, 1.0, 1.2);
+  const FkResult lg = MakeFkSolver(model, Options("lg-aa"))->Solve(c);
+  ASSERT_EQ(lg.status, FkStatus::Converged) << lg.BriefReport();
+  ASSERT_GT(lg.iterations, 10);
+  AutoSolver::Limits limits;
+  limits.lg_iterations = lg.iterations - 3;  // stops lg-aa 3 iterations short
+  limits.near_factor = 1e12;                 // any ratio counts as near
+  AutoSolver near(model, Options("auto"));
+  near.set_limits(limits);
+  const FkResult a = near.Solve(c);
+  EXPECT_EQ(a.status, FkStatus::Converged) << a.BriefReport();
+  EXPECT_EQ(a.message, "");
+  EXPECT_GE(a.iterations, lg.iterations);
+  EXPECT_EQ(a.linear_iterations, 0);  // no Newton products
+  EXPECT_LT(MaxDistance(a.positions, lg.positions), 1e-3 * model->size());
+
+  limits.near_factor = 1.0;  // never near: newton takes over
+  AutoSolver far(model, Options("auto"));
+  far.set_limits(limits);
+  const FkResult b = far.Solve(c);
+  EXPECT_EQ(b.status, FkStatus::Converged) << b.BriefReport();
+  EXPECT_NE(b.message.find("solved with newton"), std::string::npos) << b.message;
+  EXPECT_GT(b.linear_iterations, 0);
+  EXPECT_LT(MaxDistance(b.positions, lg.positions), 1e-3 * model->size());
+}
+
+// A user's cap at or below the round is lg-aa's cap: no switch.
+TEST(AutoSolver, UsersCapBelowTheRoundIsLgAasCap) {
+  auto model = std::make_shared<const Model>(MakeRobot("bilayer_strip", 1));
+  const Eigen::VectorXd c = Eigen::VectorXd::Constant(1, 1.1);
+  FkOptions o = Options("auto");
+  o.max_iterations = 200;
+  const FkResult au = MakeFkSolver(model, o)->Solve(c);
+  EXPECT_EQ(au.status, FkStatus::IterationCap) << au.BriefReport();
+  EXPECT_EQ(au.iterations, 200);
+  EXPECT_EQ(au.linear_iterations, 0);
+  EXPECT_EQ(au.message.find("newton"), std::string::npos) << au.message;
+}
+
+// Scenes newton does not cover are lg-aa's with its full cap, without a switch.
+TEST(AutoSolver, ScenesNewtonDoesNotCoverAreLgAas) {
+  Scene s = MakeRobot("three_chamber", 3);
+  s.body[0].law = MaterialLaw::kMooneyRivlin;
+  s.body[0].c1 = 0.0418;
+  s.body[0].c2 = 0.0106;
+  auto model = std::make_shared<const Model>(s);
+  const Eigen::Vector3d c(1.4, 1.0, 1.0);
+  AutoSolver solver(model, Options("auto"));
+  AutoSolver::Limits limits;
+  limits.lg_iterations = 5;  // would switch after 5 iterations on a covered scene
+  solver.set_limits(limits);
+  const FkResult au = solver.Solve(c);
+  const FkResult lg = MakeFkSolver(model, Options("lg-aa"))->Solve(c);
+  ASSERT_EQ(lg.status, FkStatus::Converged) << lg.BriefReport();
+  ASSERT_GT(lg.iterations, 5);
+  EXPECT_EQ(au.status, FkStatus::Converged) << au.BriefReport();
+  EXPECT_EQ(au.iterations, lg.iterations);
+  EXPECT_EQ(au.linear_iterations, 0);
+  EXPECT_EQ(MaxDistance(au.positions, lg.positions), 0.0);
+}
+
+TEST(AutoSolver, BadLimitsNameTheFieldAndTheRange) {
+  auto model = std::make_shared<const Model>(MakeRobot("three_chamber", 3));
+  AutoSolver solver(model, Options("auto"));
+  auto error = [&](const AutoSolver::Limits& l) {
+    try {
+      solver.set_limits(l);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  AutoSolver::Limits l;
+  l.lg_iterations = 0;
+  EXPECT_NE(error(l).find("lg_iterations must be an integer >= 1, got 0"), std::string::npos)
+      << error(l);
+  l = {};
+  l.near_factor = std::nan("");
+  EXPECT_NE(error(l).find("near_factor must be a number >= 1, got nan"), std::string::npos)
+      << error(l);
+  EXPECT_EQ(error({}), "");
+  EXPECT_EQ(FkSolverTypeFromString("auto"), FkSolverType::kAuto);
+}
+
+}  // namespace
+}  // namespace softkin
