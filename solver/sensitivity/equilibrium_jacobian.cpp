@@ -110,6 +110,8 @@ struct EquilibriumJacobianWorkspace::Impl {
   bool project = false;
   int fresh_rounds = -1;  ///< GMRES rounds of the first solve after the last factorisation
   std::vector<std::vector<double>> blocks;  ///< per thread: 9 values per A entry (K_local)
+  std::vector<int> diag_pos;  ///< per free coordinate: the index of its diagonal entry in P
+  Eigen::VectorXd a_diag;     ///< per free coordinate: A's diagonal entry of its vertex
   int factorizations = 0;
 
   void Build(const Model& m) {
@@ -157,6 +159,15 @@ struct EquilibriumJacobianWorkspace::Impl {
     p_src.resize(P.nonZeros());
     for (Eigen::Index k = 0; k < P.nonZeros(); ++k)
       p_src[k] = static_cast<int>(std::lround(P.valuePtr()[k]));
+    diag_pos.assign(nf, -1);
+    a_diag.resize(nf);
+    for (int col = 0; col < nf; ++col)
+      for (int k = P.outerIndexPtr()[col]; k < P.outerIndexPtr()[col + 1]; ++k)
+        if (P.innerIndexPtr()[k] == col) diag_pos[col] = k;
+    for (int v = 0; v < nv; ++v)
+      for (int d = 0; d < 3; ++d)
+        if (fidx[3 * static_cast<size_t>(v) + d] >= 0)
+          a_diag[fidx[3 * static_cast<size_t>(v) + d]] = A.coeff(v, v);
     analyzed = false;
   }
 };
@@ -209,6 +220,14 @@ bool FactorLocalPreconditioner(const Model& model, const EquilibriumLinearizatio
     const double* B = w->blocks[0].data();
     double* Pv = w->P.valuePtr();
     for (Eigen::Index k = 0; k < w->P.nonZeros(); ++k) Pv[k] = B[w->p_src[k]];
+    // A coordinate that no element holds: the inner vertices of a vented chamber (the unloaded
+    // side of a signed actuator), whose targets are their current shape (H_e = 0), so H has a
+    // zero row and column there and the step leaves them. P takes A's diagonal for them, which
+    // keeps it definite without coupling them to anything (finger_manipulator res 8).
+    for (size_t j = 0; j < w->diag_pos.size(); ++j) {
+      double& pjj = Pv[w->diag_pos[j]];
+      if (std::abs(pjj) <= 1e-10 * w->a_diag[j]) pjj = w->a_diag[j];
+    }
     if (!w->analyzed) {
       cholmod_common& cc = w->llt.cholmod();
       cc.print = 0;  // silent: "not positive definite" is handled here
