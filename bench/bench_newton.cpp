@@ -17,7 +17,9 @@
 // with 2 mm cells along the length) and the unstructured Gmsh strip of the same size
 // (scenes/bilayer_strip_gmsh.json, 12,397 tets, data/strip/) at alpha 1.1 and 1.5; pneumatic_finger
 // res 8 at alpha 5, and res 12 (46.7k tets) from rest to the end of its range, alpha 10;
-// three_chamber res 5 at (1.5, 1, 1).
+// three_chamber res 5 at (1.5, 1, 1); finger_manipulator res 8 and 10 at (0.5, 0, 0); cable_finger
+// res 8 at (0.8, 0.8, 0.8) (lg-aa and auto only: newton takes about 3 minutes there,
+// docs/newton.md). "auto" (the default solver) runs beside both on every case.
 #include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/robots/robots.hpp"
 #include "softkin/solver/scene/scene_json.hpp"
@@ -99,6 +101,14 @@ void BM_FingerRes12Alpha10(benchmark::State& state, const char* solver) {
 }
 void BM_ThreeChamber(benchmark::State& state, const char* solver) {
   Solve(state, "three_chamber", 5, solver, Eigen::Vector3d(1.5, 1.0, 1.0));
+}
+void BM_Manipulator(benchmark::State& state, int res, const char* solver) {
+  Solve(state, "finger_manipulator", res, solver, Eigen::Vector3d(0.5, 0.0, 0.0));
+}
+void BM_Manipulator_r8(benchmark::State& s, const char* solver) { BM_Manipulator(s, 8, solver); }
+void BM_Manipulator_r10(benchmark::State& s, const char* solver) { BM_Manipulator(s, 10, solver); }
+void BM_CableFinger(benchmark::State& state, const char* solver) {
+  Solve(state, "cable_finger", 8, solver, Eigen::Vector3d(0.8, 0.8, 0.8));
 }
 
 void BM_Strip_r1_a1_1(benchmark::State& s, const char* solver) { BM_Strip(s, 1, 1.1, solver); }
@@ -198,6 +208,42 @@ BENCHMARK_CAPTURE(BM_ThreeChamber, lg_aa, "lg-aa")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip12k_a1_1, auto, "auto") -> Unit(benchmark::kMillisecond) -> UseRealTime()
+    -> Iterations(1);
+BENCHMARK_CAPTURE(BM_Strip12k_a1_5, auto, "auto") -> Unit(benchmark::kMillisecond) -> UseRealTime()
+    -> Iterations(1);
+BENCHMARK_CAPTURE(BM_Finger, auto, "auto") -> Unit(benchmark::kMillisecond) -> UseRealTime()
+    -> Iterations(1);
+BENCHMARK_CAPTURE(BM_FingerRes12Alpha10, auto, "auto") -> Unit(benchmark::kMillisecond)
+    -> UseRealTime() -> Iterations(1);
+BENCHMARK_CAPTURE(BM_ThreeChamber, auto, "auto") -> Unit(benchmark::kMillisecond) -> UseRealTime()
+    -> Iterations(1);
+BENCHMARK_CAPTURE(BM_Manipulator_r8, newton, "newton")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_Manipulator_r8, lg_aa, "lg-aa")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_Manipulator_r8, auto, "auto") -> Unit(benchmark::kMillisecond) -> UseRealTime()
+    -> Iterations(1);
+BENCHMARK_CAPTURE(BM_Manipulator_r10, newton, "newton")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_Manipulator_r10, lg_aa, "lg-aa")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_Manipulator_r10, auto, "auto") -> Unit(benchmark::kMillisecond)
+    -> UseRealTime() -> Iterations(1);
+BENCHMARK_CAPTURE(BM_CableFinger, lg_aa, "lg-aa")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_CableFinger, auto, "auto") -> Unit(benchmark::kMillisecond) -> UseRealTime()
+    -> Iterations(1);
 
 }  // namespace
 }  // namespace softkin

@@ -121,15 +121,17 @@ def scene_from_arrays(vertices, elements, tags, regions, fixed, markers=(), moti
 
 class FkSolver:
     """A forward-kinematics solver on one scene, reused across solves (it keeps the model's
-    factorisation). ``solver`` is one of lg, lg-aa, newton, ceres, ipopt-lbfgs, ipopt-newton,
-    ipopt-hard, calculix-linear, calculix-nonlinear; the other keyword arguments are the scene
-    JSON's ``solver`` options (e.g. max_iterations=20000, tolerance=1e-7, threads=2), over the
-    scene's own.
+    factorisation). ``solver`` is one of lg, lg-aa, newton, auto, ceres, ipopt-lbfgs,
+    ipopt-newton, ipopt-hard, calculix-linear, calculix-nonlinear (None: the scene's own, auto
+    unless the scene says otherwise); the other keyword arguments are the scene JSON's
+    ``solver`` options (e.g. max_iterations=20000, tolerance=1e-7, threads=2), over the scene's
+    own.
     """
 
-    def __init__(self, scene, solver="lg-aa", **options):
+    def __init__(self, scene, solver=None, **options):
         options = dict(options)
-        options["solver"] = solver
+        if solver is not None:
+            options["solver"] = solver
         self._impl = _softkin._FkSolver(scene, _json.dumps(options))
 
     @property
@@ -169,7 +171,7 @@ class FkSolver:
         return f"<softkin.FkSolver {self.name} on {self.scene!r}>"
 
 
-def solve_fk(scene, c, solver="lg-aa", **options):
+def solve_fk(scene, c, solver=None, **options):
     """One shot: builds an FkSolver and solves for ``c``."""
     return FkSolver(scene, solver=solver, **options).solve(c)
 
@@ -182,9 +184,10 @@ class SimulatorKinematics(_softkin._SimulatorKinematics):
     forgets it). ``solver`` and ``options`` as for FkSolver."""
 
     def __init__(self, scene, jacobian="implicit", points=(), fd_step=1.0 / 160.0,
-                 solver="lg-aa", **options):
+                 solver=None, **options):
         options = dict(options)
-        options["solver"] = solver
+        if solver is not None:
+            options["solver"] = solver
         super().__init__(scene, jacobian, list(points), float(fd_step), _json.dumps(options))
 
 

@@ -141,9 +141,10 @@ void from_json(const nlohmann::json& j, AndersonSafeguard& v);
 constexpr int kMaxThreads = 256;
 
 struct FkOptions {
-  /// The solver: lg (plain local-global, Algorithm 1), lg-aa (Anderson-accelerated), or one of the
-  /// general-purpose optimisers and FEM baselines (FkSolverType).
-  FkSolverType solver = FkSolverType::kLgAa;
+  /// The solver: lg (plain local-global, Algorithm 1), lg-aa (Anderson-accelerated), newton,
+  /// auto (lg-aa, then newton where lg-aa is slow: the default), or one of the general-purpose
+  /// optimisers and FEM baselines (FkSolverType).
+  FkSolverType solver = FkSolverType::kAuto;
   int max_iterations = 10000;
   /// Stop when every vertex moves less than tolerance * model size in one iteration ...
   double tolerance = 1e-5;

@@ -59,7 +59,7 @@ TEST(SceneJsonRealMesh, FingerChamber1Loads) {
 
   std::string why;
   EXPECT_TRUE(s.solver.IsValid(&why)) << why;
-  EXPECT_EQ(s.solver.solver, FkSolverType::kLgAa);
+  EXPECT_EQ(s.solver.solver, FkSolverType::kAuto);
 }
 
 // ------------------------------------------------------------------------------------------------
