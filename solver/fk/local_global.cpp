@@ -1,5 +1,6 @@
 #include "softkin/solver/fk/local_global.hpp"
 
+#include "softkin/solver/common/text_format.hpp"
 #include "softkin/solver/fk/anderson.hpp"
 #include "softkin/solver/fk/energy.hpp"
 #include "softkin/solver/fk/targets.hpp"
@@ -241,6 +242,19 @@ bool LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
       r->status = FkStatus::Converged;
       return true;
     }
+    // The checkpoint is judged at the first checked iterate from its iteration on (a rejected
+    // Anderson step skips this test).
+    if (!checkpoint_passed_ && checkpoint_iteration_ > 0 &&
+        r->iterations >= checkpoint_iteration_) {
+      checkpoint_passed_ = true;
+      if (r->gradient_ratio > checkpoint_ratio_) {
+        r->status = FkStatus::IterationCap;
+        r->message = "stopped at the checkpoint after " + std::to_string(r->iterations) +
+                     " iterations (residual ratio " + FormatNumber(r->gradient_ratio) + ", above " +
+                     FormatNumber(checkpoint_ratio_) + ")";
+        return true;
+      }
+    }
     if (aa_on) {
       const Eigen::VectorXd& xn = aa.Compute(Gf, step);
       Gprev = Gf;
@@ -268,6 +282,7 @@ FkResult LocalGlobalSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c
     return r;
   }
   if (warm_start) m.ApplyConstraints(c, &r.positions);
+  checkpoint_passed_ = false;
   const Eigen::VectorXd rest = m.scene().rest_actuation();
   const int K = warm_start ? 1 : options_.continuation_steps;  // a warm start is already close
   std::optional<Clock::time_point> deadline;

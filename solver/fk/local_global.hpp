@@ -53,6 +53,16 @@ class LocalGlobalSolver : public FkSolver {
  public:
   const FkOptions& options() const { return options_; }
 
+  /// A checkpoint for callers that switch solvers when local-global is slow (auto_solver.hpp):
+  /// when a Solve() reaches `iteration` iterations (at its first checked iterate from there on)
+  /// with its residual ratio above `max_ratio`, it stops there with status iteration_cap and a
+  /// message saying so. iteration <= 0: none (the default). Until then the iterates are exactly
+  /// those without a checkpoint.
+  void set_checkpoint(int iteration, double max_ratio) {
+    checkpoint_iteration_ = iteration;
+    checkpoint_ratio_ = max_ratio;
+  }
+
  private:
   /// One continuation stage: iterate from X towards the solution for c; accumulates into r.
   /// With detect_tangle, returns false (status diverged) when the contact response tangled
@@ -66,8 +76,11 @@ class LocalGlobalSolver : public FkSolver {
   std::vector<double> ratios_;
   double total_weight_ = 0.0;  // sum of w_i Vol_i: the scale of the residual's round-off floor
   const std::chrono::steady_clock::time_point* deadline_ = nullptr;  // during Solve(), or none
-  Eigen::VectorXd ref_c_;   // actuation of the cached reference residual
-  double ref_value_ = 0.0;  // ||2 (A X_rest - B(X_rest; ref_c_))||
+  Eigen::VectorXd ref_c_;         // actuation of the cached reference residual
+  double ref_value_ = 0.0;        // ||2 (A X_rest - B(X_rest; ref_c_))||
+  int checkpoint_iteration_ = 0;  // set_checkpoint
+  double checkpoint_ratio_ = 0.0;
+  bool checkpoint_passed_ = false;  // in this Solve()
 };
 
 }  // namespace softkin

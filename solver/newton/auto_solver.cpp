@@ -1,12 +1,12 @@
 #include "softkin/solver/newton/auto_solver.hpp"
 
 #include "softkin/solver/common/text_format.hpp"
-#include "softkin/solver/fk/local_global.hpp"
 #include "softkin/solver/newton/newton_solver.hpp"
 #include "softkin/solver/sensitivity/equilibrium_jacobian.hpp"
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 
 namespace softkin {
@@ -25,6 +25,7 @@ AutoSolver::AutoSolver(std::shared_ptr<const Model> model, const FkOptions& opti
   if (!options_.IsValid(&why)) throw std::invalid_argument("solver options: " + why);
   newton_covers_ = EquilibriumJacobianUnsupported(*model_).empty() &&
                    !ContactHandlingActive(model_->scene(), options_.collision);
+  set_limits(limits_);
 }
 
 void AutoSolver::set_limits(const Limits& limits) {
@@ -34,62 +35,70 @@ void AutoSolver::set_limits(const Limits& limits) {
   if (!(limits.near_factor >= 1.0))
     throw std::invalid_argument("auto solver: near_factor must be a number >= 1, got " +
                                 FormatNumber(limits.near_factor));
+  if (!(limits.newton_time_factor > 0.0) || !std::isfinite(limits.newton_time_factor))
+    throw std::invalid_argument("auto solver: newton_time_factor must be a number > 0, got " +
+                                FormatNumber(limits.newton_time_factor));
   limits_ = limits;
-  lg_.reset();
+  lg_ = std::make_unique<LocalGlobalSolver>(
+      model_, With(FkSolverType::kLgAa, options_.max_iterations, options_.time_limit_s), contacts_);
+  if (newton_covers_ && limits_.lg_iterations < options_.max_iterations)
+    lg_->set_checkpoint(limits_.lg_iterations, limits_.near_factor * options_.gradient_tolerance);
 }
 
-std::unique_ptr<FkSolver> AutoSolver::Make(FkSolverType type, int max_iterations,
-                                           double time_limit_s) const {
+FkOptions AutoSolver::With(FkSolverType type, int max_iterations, double time_limit_s) const {
   FkOptions o = options_;
   o.solver = type;
   o.max_iterations = max_iterations;
   o.time_limit_s = time_limit_s;
-  if (type == FkSolverType::kNewton) return std::make_unique<NewtonSolver>(model_, o, contacts_);
-  return std::make_unique<LocalGlobalSolver>(model_, o, contacts_);
+  return o;
 }
 
 FkResult AutoSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c,
                                const Eigen::MatrixX3d* warm_start) {
   const auto t0 = Clock::now();
-  const int cap = options_.max_iterations;
-  const double limit = options_.time_limit_s;
-  // The time left of this call's limit (0: none).
-  auto left = [&]() { return limit > 0 ? std::max(1e-3, limit - Seconds(t0, Clock::now())) : 0.0; };
-  const int first = newton_covers_ ? std::min(cap, limits_.lg_iterations) : cap;
-  if (limit > 0 || !lg_) lg_ = Make(FkSolverType::kLgAa, first, limit);
   FkResult lg = lg_->Solve(c, warm_start);
-  int lg_iterations = lg.iterations;
-  double lg_local = lg.local_time_s, lg_global = lg.global_time_s;
-  if (lg.status == FkStatus::IterationCap && lg.iterations < cap &&
-      lg.gradient_ratio <= limits_.near_factor * options_.gradient_tolerance) {
-    // Nearly there: one more round from where it stopped.
-    const Eigen::MatrixX3d X = lg.positions;
-    lg = Make(FkSolverType::kLgAa, std::min(limits_.lg_iterations, cap - lg_iterations), left())
-             ->Solve(c, &X);
-    lg_iterations += lg.iterations;
-    lg_local += lg.local_time_s;
-    lg_global += lg.global_time_s;
-  }
-  lg.iterations = lg_iterations;
-  lg.local_time_s = lg_local;
-  lg.global_time_s = lg_global;
   lg.solver = name();
-  const bool switch_to_newton = lg.status == FkStatus::IterationCap && lg_iterations < cap;
-  if (!switch_to_newton) {
-    lg.time_s = Seconds(t0, Clock::now());
-    return lg;
+  // Stopped at the checkpoint: an iteration cap below the user's.
+  const bool stopped = newton_covers_ && lg.status == FkStatus::IterationCap &&
+                       lg.iterations < options_.max_iterations;
+  if (!stopped) return lg;
+
+  // newton from the same start, within its budget and the user's time limit.
+  const double limit = options_.time_limit_s;
+  auto left = [&]() { return limit > 0 ? std::max(1e-3, limit - Seconds(t0, Clock::now())) : 0.0; };
+  const double budget = limits_.newton_time_factor * Seconds(t0, Clock::now());
+  const bool user_bound = limit > 0 && left() <= budget;
+  NewtonSolver newton(
+      model_, With(FkSolverType::kNewton, options_.max_iterations, user_bound ? left() : budget),
+      contacts_);
+  FkResult nw = newton.Solve(c, warm_start);
+  std::string note = "auto: lg-aa was at residual ratio " + FormatNumber(lg.gradient_ratio) +
+                     " after " + std::to_string(lg.iterations) + " iterations; ";
+  const std::string from = warm_start ? "the warm start" : "the rest shape";
+  FkResult r;
+  if (nw.status == FkStatus::Converged || nw.status == FkStatus::Inverted || user_bound) {
+    r = std::move(nw);
+    note += "solved with newton from " + from;
+  } else {
+    // newton did not make it within its budget: lg-aa goes on from where it stopped.
+    const Eigen::MatrixX3d X = lg.positions;
+    LocalGlobalSolver rest(
+        model_, With(FkSolverType::kLgAa, options_.max_iterations - lg.iterations, left()),
+        contacts_);
+    r = rest.Solve(c, &X);
+    note += "newton from " + from + " had not converged after " + FormatNumber(budget, 3) + " s (" +
+            FkStatusToString(nw.status) + ", " + std::to_string(nw.iterations) +
+            " iterations); continued with lg-aa from where it stopped";
+    r.iterations += nw.iterations;
+    r.linear_iterations = nw.linear_iterations;
+    r.local_time_s += nw.local_time_s;
+    r.global_time_s += nw.global_time_s;
   }
-  if (limit > 0 || !newton_) newton_ = Make(FkSolverType::kNewton, cap, left());
-  FkResult r = newton_->Solve(c, warm_start);
-  const std::string note = "auto: lg-aa had not converged after " + std::to_string(lg_iterations) +
-                           " iterations (residual ratio " + FormatNumber(lg.gradient_ratio) +
-                           "); solved with newton from " +
-                           (warm_start ? "the warm start" : "the rest shape");
   r.message = r.message.empty() ? note : note + "; " + r.message;
   r.solver = name();
-  r.iterations += lg_iterations;
-  r.local_time_s += lg_local;
-  r.global_time_s += lg_global;
+  r.iterations += lg.iterations;
+  r.local_time_s += lg.local_time_s;
+  r.global_time_s += lg.global_time_s;
   r.time_s = Seconds(t0, Clock::now());
   return r;
 }

@@ -1,25 +1,31 @@
 #pragma once
 /// \file auto_solver.hpp
-/// The "auto" FK solver: lg-aa where it converges quickly, newton where it would crawl.
+/// The "auto" FK solver (the default): lg-aa where it converges quickly, newton where it crawls.
 ///
 /// lg-aa is the faster solver where it converges in a few hundred iterations (compact robots,
 /// warm-started sweeps), newton where lg-aa needs thousands (thin, bending-dominated bodies; far
 /// actuations from rest): one factorisation of newton's preconditioner costs about as much as
 /// 300-1,500 lg-aa iterations (docs/newton.md). Which case a solve is cannot be told beforehand,
-/// so "auto" runs lg-aa first, for at most Limits::lg_iterations iterations (another round of
-/// as many if by then the residual ratio is within Limits::near_factor of gradient_tolerance),
-/// and if lg-aa has not converged by then it solves again with newton from the same start (the
-/// warm start or the rest shape: newton does worse from lg-aa's half-converged state, whose soft
-/// bending mode is partly bent). The worst case is the lg-aa iterations spent before the switch;
-/// the message says when it switched. Both stop at the same equilibrium by the same test, so the
-/// answer is the one either would give.
+/// so "auto" runs lg-aa, and if after Limits::lg_iterations iterations its residual ratio is
+/// still above Limits::near_factor times gradient_tolerance (it is then far from done), it
+/// solves again with newton from the same start (the warm start or the rest shape: newton does
+/// worse from lg-aa's half-converged state, whose soft bending mode is partly bent). Otherwise
+/// lg-aa simply goes on: until the switch its iterates are lg-aa's, so where lg-aa is quick the
+/// answer, iterations and time are lg-aa's.
+///
+/// newton gets Limits::newton_time_factor times the time lg-aa has spent. If it has not
+/// converged by then (newton has cases it handles badly: cable_finger res 8, docs/newton.md),
+/// lg-aa continues from where it stopped, so the worst case costs lg-aa's own time plus that
+/// budget. The message says when it switched and how it ended. Both solvers stop at the same
+/// equilibrium by the same test.
 ///
 /// Scenes newton does not cover (Mooney-Rivlin bodies, active collision response) are solved by
-/// lg-aa alone, with the full iteration cap and no message. A user's max_iterations at or below
-/// lg_iterations is lg-aa's cap, and then there is no switch. FkResult::iterations adds the lg-aa
-/// iterations before the switch to newton's (and its fallback's).
+/// lg-aa alone. A user's max_iterations at or below lg_iterations is lg-aa's cap, with no
+/// switch. FkResult::iterations adds lg-aa's iterations before the switch to newton's (and to
+/// those of an lg-aa continuation).
 #include "softkin/solver/fk/contact_term.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
+#include "softkin/solver/fk/local_global.hpp"
 
 #include <memory>
 #include <string>
@@ -36,11 +42,13 @@ class AutoSolver : public FkSolver {
 
   /// When lg-aa hands over to newton.
   struct Limits {
-    /// lg-aa iterations before the switch (per round).
+    /// The lg-aa iteration at which the switch is decided.
     int lg_iterations = 500;
-    /// A second round of lg_iterations is given when lg-aa's residual ratio after the first is
-    /// at most near_factor * gradient_tolerance (it is then usually a few iterations from done).
+    /// lg-aa goes on if its residual ratio then is at most near_factor * gradient_tolerance.
     double near_factor = 100.0;
+    /// newton may take newton_time_factor times the time lg-aa has spent; past that (or if it
+    /// ends without converging) lg-aa continues from where it stopped.
+    double newton_time_factor = 8.0;
   };
   /// Throws std::invalid_argument naming the field and its valid range for a bad value.
   void set_limits(const Limits& limits);
@@ -51,14 +59,14 @@ class AutoSolver : public FkSolver {
 
  private:
   /// A solver of type `type` with the user's options, `max_iterations` and `time_limit_s`.
-  std::unique_ptr<FkSolver> Make(FkSolverType type, int max_iterations, double time_limit_s) const;
+  FkOptions With(FkSolverType type, int max_iterations, double time_limit_s) const;
 
   FkOptions options_;
   Limits limits_;
   ContactTermFactory contacts_;
-  bool newton_covers_ = true;         ///< the scene is one newton solves (no fallback)
-  std::unique_ptr<FkSolver> lg_;      ///< lg-aa capped at lg_iterations (or the full cap)
-  std::unique_ptr<FkSolver> newton_;  ///< kept across calls: its preconditioner is reused
+  bool newton_covers_ = true;  ///< the scene is one newton solves (no fallback)
+  /// lg-aa with the user's options and the checkpoint (kept: its reference residual is cached)
+  std::unique_ptr<LocalGlobalSolver> lg_;
 };
 
 }  // namespace softkin
