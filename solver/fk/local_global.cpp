@@ -242,19 +242,7 @@ bool LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
       r->status = FkStatus::Converged;
       return true;
     }
-    // The checkpoint is judged at the first checked iterate from its iteration on (a rejected
-    // Anderson step skips this test).
-    if (!checkpoint_passed_ && checkpoint_iteration_ > 0 &&
-        r->iterations >= checkpoint_iteration_) {
-      checkpoint_passed_ = true;
-      if (r->gradient_ratio > checkpoint_ratio_) {
-        r->status = FkStatus::IterationCap;
-        r->message = "stopped at the checkpoint after " + std::to_string(r->iterations) +
-                     " iterations (residual ratio " + FormatNumber(r->gradient_ratio) + ", above " +
-                     FormatNumber(checkpoint_ratio_) + ")";
-        return true;
-      }
-    }
+    if (StopsAtCheckpoint(r)) return true;
     if (aa_on) {
       const Eigen::VectorXd& xn = aa.Compute(Gf, step);
       Gprev = Gf;
@@ -269,6 +257,20 @@ bool LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
   X = X_good;  // never return an unchecked (extrapolated) iterate
   r->status = FkStatus::IterationCap;
   r->message = "iteration cap of " + std::to_string(options_.max_iterations) + " reached";
+  return true;
+}
+
+bool LocalGlobalSolver::StopsAtCheckpoint(FkResult* r) {
+  // Judged at the first checked iterate from the checkpoint's iteration on (a rejected Anderson
+  // step does not reach this test).
+  if (checkpoint_passed_ || checkpoint_iteration_ <= 0 || r->iterations < checkpoint_iteration_)
+    return false;
+  checkpoint_passed_ = true;
+  if (!(r->gradient_ratio > checkpoint_ratio_)) return false;
+  r->status = FkStatus::IterationCap;
+  r->message = "stopped at the checkpoint after " + std::to_string(r->iterations) +
+               " iterations (residual ratio " + FormatNumber(r->gradient_ratio) + ", above " +
+               FormatNumber(checkpoint_ratio_) + ")";
   return true;
 }
 

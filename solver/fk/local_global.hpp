@@ -68,6 +68,9 @@ class LocalGlobalSolver : public FkSolver {
   /// With detect_tangle, returns false (status diverged) when the contact response tangled
   /// (above); otherwise true.
   bool SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X, FkResult* r, bool detect_tangle);
+  /// Whether the iterate just checked stops the solve at the checkpoint (set_checkpoint); if so,
+  /// r gets status iteration_cap and the message.
+  bool StopsAtCheckpoint(FkResult* r);
   static constexpr int kMaxCutBacks = 6;
   FkOptions options_;
   ContactTermFactory contacts_;

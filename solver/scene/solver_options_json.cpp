@@ -111,7 +111,8 @@ const std::vector<Row>& Rows() {
       Option("solver", &F::solver,
              "lg: plain local-global (Algorithm 1); lg-aa: Anderson-accelerated local-global; "
              "newton: Newton-Krylov on the same equilibrium, with load stepping; auto: lg-aa, "
-             "switching to newton from the same start after 500 lg-aa iterations; ceres, "
+             "or newton from the same start if lg-aa is far from the tolerance after 500 "
+             "iterations (docs/newton.md); ceres, "
              "ipopt-lbfgs, ipopt-newton: the same energy minimised by Ceres or Ipopt; "
              "ipopt-hard: body energy with hard actuation constraints; calculix-linear, "
              "calculix-nonlinear: FEM baselines by CalculiX (docs/solvers.md)."),

@@ -59,7 +59,7 @@ TEST(SceneJsonRealMesh, FingerChamber1Loads) {
 
   std::string why;
   EXPECT_TRUE(s.solver.IsValid(&why)) << why;
-  EXPECT_EQ(s.solver.solver, FkSolverType::kAuto);
+  EXPECT_EQ(s.solver.solver, FkSolverType::kLgAa);  // the scene file names it
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -836,9 +836,10 @@ TEST(SceneJsonErrors, ValidateMessagePassesThrough) {
 TEST(SceneJsonErrors, SolverOptions) {
   json j = TinyScene();
   j["solver"]["solver"] = "newtonian";
-  ExpectSceneError(j, {"solver.solver: expected one of: lg, lg-aa, newton, ceres, ipopt-lbfgs, "
-                       "ipopt-newton, ipopt-hard, calculix-linear, calculix-nonlinear, got "
-                       "\"newtonian\""});
+  ExpectSceneError(j,
+                   {"solver.solver: expected one of: lg, lg-aa, newton, auto, ceres, ipopt-lbfgs, "
+                    "ipopt-newton, ipopt-hard, calculix-linear, calculix-nonlinear, got "
+                    "\"newtonian\""});
   j = TinyScene();
   j["solver"]["anderson_window"] = 0;
   ExpectSceneError(j, {"solver.anderson_window: expected an integer in [1, 50], got 0"});

@@ -249,11 +249,11 @@ TEST(SolverOptionsJson, EnumNamesAreOneListPerOption) {
   for (const std::string& n : ObstacleSpringNames())
     EXPECT_EQ(ToString(ObstacleSpringFromString(n)), n);
   for (const std::string& n : MaterialLawNames()) EXPECT_EQ(ToString(MaterialLawFromString(n)), n);
-  EXPECT_EQ(FkSolverTypeNames().size(), 9u);
-  ExpectError(
-      [] { (void)FkSolverTypeFromString("newtonian"); },
-      {"unknown FK solver 'newtonian'; expected one of: lg, lg-aa, newton, ceres, ipopt-lbfgs, "
-       "ipopt-newton, ipopt-hard, calculix-linear, calculix-nonlinear"});
+  EXPECT_EQ(FkSolverTypeNames().size(), 10u);
+  ExpectError([] { (void)FkSolverTypeFromString("newtonian"); },
+              {"unknown FK solver 'newtonian'; expected one of: lg, lg-aa, newton, auto, ceres, "
+               "ipopt-lbfgs, "
+               "ipopt-newton, ipopt-hard, calculix-linear, calculix-nonlinear"});
   ExpectError([] { (void)MaterialLawFromString("ogden"); }, {"'ogden'", "blend, mooney-rivlin"});
   auto choices = [](const std::string& path) {
     for (const auto& k : scene_json_detail::KeyTable())
