@@ -73,32 +73,48 @@ FkResult AutoSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c,
       contacts_);
   FkResult nw = newton.Solve(c, warm_start);
   std::string note = "auto: lg-aa was at residual ratio " + FormatNumber(lg.gradient_ratio) +
-                     " after " + std::to_string(lg.iterations) + " iterations; ";
-  const std::string from = warm_start ? "the warm start" : "the rest shape";
+                     " after " + std::to_string(lg.iterations) + " iterations; newton from " +
+                     (warm_start ? "the warm start" : "the rest shape");
+  // The result, and the counts of the solves that are not in it.
   FkResult r;
-  if (nw.status == FkStatus::Converged || nw.status == FkStatus::Inverted || user_bound) {
+  int iterations = lg.iterations;
+  double local_s = lg.local_time_s, global_s = lg.global_time_s;
+  if (nw.status == FkStatus::Converged || nw.status == FkStatus::Inverted) {
     r = std::move(nw);
-    note += "solved with newton from " + from;
+    note += " solved it";
+  } else if (user_bound) {
+    // The user's time is up. newton's last state may belong to an intermediate load step, so
+    // the answer is lg-aa's state at the checkpoint, never a worse one.
+    note += std::string(" had not converged when the time limit ran out (") +
+            FkStatusToString(nw.status) + ", " + std::to_string(nw.iterations) +
+            " iterations); returned lg-aa's state";
+    iterations = nw.iterations;
+    local_s = nw.local_time_s;
+    global_s = nw.global_time_s;
+    r = std::move(lg);
+    r.linear_iterations = nw.linear_iterations;
+    r.status = FkStatus::TimeLimit;
+    r.message = "time limit of " + FormatNumber(limit) + " s reached";
   } else {
     // newton did not make it within its budget: lg-aa goes on from where it stopped.
+    note += " had not converged after " + FormatNumber(budget, 3) + " s (" +
+            FkStatusToString(nw.status) + ", " + std::to_string(nw.iterations) +
+            " iterations); continued with lg-aa from where it stopped";
     const Eigen::MatrixX3d X = lg.positions;
     LocalGlobalSolver rest(
         model_, With(FkSolverType::kLgAa, options_.max_iterations - lg.iterations, left()),
         contacts_);
     r = rest.Solve(c, &X);
-    note += "newton from " + from + " had not converged after " + FormatNumber(budget, 3) + " s (" +
-            FkStatusToString(nw.status) + ", " + std::to_string(nw.iterations) +
-            " iterations); continued with lg-aa from where it stopped";
-    r.iterations += nw.iterations;
+    iterations += nw.iterations;
+    local_s += nw.local_time_s;
+    global_s += nw.global_time_s;
     r.linear_iterations = nw.linear_iterations;
-    r.local_time_s += nw.local_time_s;
-    r.global_time_s += nw.global_time_s;
   }
   r.message = r.message.empty() ? note : note + "; " + r.message;
   r.solver = name();
-  r.iterations += lg.iterations;
-  r.local_time_s += lg.local_time_s;
-  r.global_time_s += lg.global_time_s;
+  r.iterations += iterations;
+  r.local_time_s += local_s;
+  r.global_time_s += global_s;
   r.time_s = Seconds(t0, Clock::now());
   return r;
 }
