@@ -267,6 +267,7 @@ bool LocalGlobalSolver::StopsAtCheckpoint(FkResult* r) {
     return false;
   checkpoint_passed_ = true;
   if (!(r->gradient_ratio > checkpoint_ratio_)) return false;
+  checkpoint_stopped_ = true;
   r->status = FkStatus::IterationCap;
   r->message = "stopped at the checkpoint after " + std::to_string(r->iterations) +
                " iterations (residual ratio " + FormatNumber(r->gradient_ratio) + ", above " +
@@ -284,7 +285,7 @@ FkResult LocalGlobalSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c
     return r;
   }
   if (warm_start) m.ApplyConstraints(c, &r.positions);
-  checkpoint_passed_ = false;
+  checkpoint_passed_ = checkpoint_stopped_ = false;
   const Eigen::VectorXd rest = m.scene().rest_actuation();
   const int K = warm_start ? 1 : options_.continuation_steps;  // a warm start is already close
   std::optional<Clock::time_point> deadline;
@@ -344,7 +345,8 @@ FkResult LocalGlobalSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c
       h = 0.5 * (t_next - t);
       continue;
     }
-    if (r.status == FkStatus::Diverged || r.status == FkStatus::TimeLimit) break;
+    if (r.status == FkStatus::Diverged || r.status == FkStatus::TimeLimit || checkpoint_stopped_)
+      break;  // (a stop at the checkpoint ends the whole solve, not only its stage)
     t = t_next;
   }
   if (cuts > 0) {

@@ -83,7 +83,8 @@ class LocalGlobalSolver : public FkSolver {
   double ref_value_ = 0.0;        // ||2 (A X_rest - B(X_rest; ref_c_))||
   int checkpoint_iteration_ = 0;  // set_checkpoint
   double checkpoint_ratio_ = 0.0;
-  bool checkpoint_passed_ = false;  // in this Solve()
+  bool checkpoint_passed_ = false;   // in this Solve()
+  bool checkpoint_stopped_ = false;  // in this Solve(): it stopped there
 };
 
 }  // namespace softkin

@@ -74,6 +74,24 @@ TEST(AutoSolver, SwitchesToNewtonWhereLgAaCrawls) {
   EXPECT_LE(au.gradient_ratio, 1e-6);
 }
 
+// With continuation steps the checkpoint counts all of them, and a stop there ends the solve
+// (not only its stage): auto then switches as without them.
+TEST(AutoSolver, CheckpointStopsASolveWithContinuationSteps) {
+  auto model = std::make_shared<const Model>(MakeRobot("bilayer_strip", 1));
+  const Eigen::VectorXd c = Eigen::VectorXd::Constant(1, 1.1);
+  FkOptions o = Options("auto");
+  o.continuation_steps = 2;
+  AutoSolver solver(model, o);
+  AutoSolver::Limits limits;
+  limits.newton_time_factor = 1e6;
+  solver.set_limits(limits);
+  const FkResult au = solver.Solve(c);
+  EXPECT_EQ(au.status, FkStatus::Converged) << au.BriefReport();
+  EXPECT_NE(au.message.find("newton from the rest shape solved it"), std::string::npos)
+      << au.message;
+  EXPECT_GT(au.linear_iterations, 0);
+}
+
 // lg-aa near the tolerance at the checkpoint goes on, and its iterates are lg-aa's own; far from
 // it, newton takes over.
 TEST(AutoSolver, LgAaNearTheToleranceAtTheCheckpointGoesOn) {
