@@ -18,6 +18,7 @@
 #include "softkin/solver/fk/rotation.hpp"
 #include "softkin/solver/fk/targets.hpp"
 #include "softkin/solver/mesh/io/mesh_io.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <benchmark/benchmark.h>
 #include <omp.h>
@@ -37,10 +38,6 @@ namespace softkin {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double Since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
 constexpr const char* kRobot = "pneumatic_finger";
 /// Resolutions of the sweep: 6.5k, 13.8k, 28.8k, 46.7k, 77.6k and 163k tets.
 const std::vector<int> kResolutions = {6, 8, 10, 12, 14, 18};
@@ -190,15 +187,15 @@ Baseline MeasureBaseline(const Fixture& f, const std::function<double()>& iterat
     auto t0 = Clock::now();
     Eigen::VectorXd Y = f.model->SolveFree(f.rhs_free);
     benchmark::DoNotOptimize(Y.data());
-    ts.push_back(Since(t0));
+    ts.push_back(SecondsSince(t0));
     t0 = Clock::now();
     double s = SvdPass(f.M, 0);
     benchmark::DoNotOptimize(s);
-    tv.push_back(Since(t0));
+    tv.push_back(SecondsSince(t0));
     t0 = Clock::now();
     s = PolarBatchPass(f.M, 0);
     benchmark::DoNotOptimize(s);
-    tp.push_back(Since(t0));
+    tp.push_back(SecondsSince(t0));
     if (iteration) ti.push_back(iteration());
   }
   return {Median(ts), Median(tv), Median(tp), ti.empty() ? 0.0 : Median(ti)};
@@ -306,7 +303,7 @@ void BM_LocalStepLaw(benchmark::State& state) {
     benchmark::DoNotOptimize(E);
     ++n;
   }
-  const double per = Since(t0) / std::max<int64_t>(n, 1);
+  const double per = SecondsSince(t0) / std::max<int64_t>(n, 1);
   if (!state.range(1)) blend_time[f.res] = per;
   if (state.range(1) && blend_time.count(f.res))
     state.counters["law_cost"] = per / blend_time[f.res];
@@ -376,7 +373,7 @@ void BM_HyperelasticGuard(benchmark::State& state) {
     benchmark::DoNotOptimize(sum);
     ++n;
   }
-  const double per = Since(t0) / std::max<int64_t>(n, 1);
+  const double per = SecondsSince(t0) / std::max<int64_t>(n, 1);
   if (!ref) cubic_time = per;
   if (ref && cubic_time > 0) state.counters["over_cubic"] = per / cubic_time;
   double max_dt = 0;
@@ -458,9 +455,9 @@ void BM_PolarPassBatch(benchmark::State& state) {
     const auto t2 = Clock::now();
     benchmark::DoNotOptimize(PolarEigenPass(f.M, threads));
     const auto t3 = Clock::now();
-    tb.push_back(std::chrono::duration<double>(t1 - t0).count());
-    ts.push_back(std::chrono::duration<double>(t2 - t1).count());
-    te.push_back(std::chrono::duration<double>(t3 - t2).count());
+    tb.push_back(Seconds(t0, t1));
+    ts.push_back(Seconds(t1, t2));
+    te.push_back(Seconds(t2, t3));
   }
   state.counters["single_vs_batch"] = Median(ts) / Median(tb);
   state.counters["eigen_vs_batch"] = Median(te) / Median(tb);
@@ -482,7 +479,7 @@ void BM_Iteration(benchmark::State& state) {
   auto one_iteration = [&]() {
     const auto t0 = Clock::now();
     FkResult r = solver.Solve(f.c, &f.X);
-    const double t = Since(t0);
+    const double t = SecondsSince(t0);
     benchmark::DoNotOptimize(r.energy);
     if (r.iterations != 1) ++bad;
     return t;
@@ -520,10 +517,10 @@ void BM_IterationMarginal(benchmark::State& state) {
   auto marginal = [&]() {
     auto t0 = Clock::now();
     FkResult r1 = one.Solve(f.c, &f.X);
-    const double t1 = Since(t0);
+    const double t1 = SecondsSince(t0);
     t0 = Clock::now();
     FkResult rk = many.Solve(f.c, &f.X);
-    const double tk = Since(t0);
+    const double tk = SecondsSince(t0);
     benchmark::DoNotOptimize(r1.energy + rk.energy);
     rejected += rk.aa_rejected;
     accepted += rk.aa_accepted;
@@ -605,7 +602,7 @@ void BM_FullBend(benchmark::State& state) {
       std::fprintf(stderr, "[full bend] step %2d alpha %.3f: %s (aa %d/%d accepted/rejected)\n", s,
                    c[0], r.BriefReport().c_str(), r.aa_accepted, r.aa_rejected);
     }
-    total += Since(t0);
+    total += SecondsSince(t0);
   }
   SizeCounters(state, f, false, false);
   using C = benchmark::Counter;
@@ -665,7 +662,7 @@ void BM_RobotSolve(benchmark::State& state) {
     model->GatherFree(B, &Bf);
     benchmark::DoNotOptimize(model->SolveFree(Bf).data());
   }
-  const double iter_s = Since(t0) / kReps;
+  const double iter_s = SecondsSince(t0) / kReps;
   state.SetLabel(info.name + " (" + FkStatusToString(r.status) + ")");
   state.counters["elements"] = sc.mesh.num_elements();
   state.counters["vertices"] = sc.mesh.num_vertices();

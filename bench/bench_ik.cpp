@@ -19,6 +19,7 @@
 #include "softkin/ik/pcc_kinematics.hpp"
 #include "softkin/ik/simulator_kinematics.hpp"
 #include "softkin/solver/robots/robots.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -115,8 +116,7 @@ void BM_SimulatorWaypoint(benchmark::State& state) {
     const long long rejected_before = f.kin->rejected_predictions();
     const auto t0 = std::chrono::steady_clock::now();
     r = SolveIk(*f.kin, objective, f.c_prev, opt);
-    state.SetIterationTime(
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    state.SetIterationTime(SecondsSince(t0));
     solves = f.kin->total_fk_solves() - before;
     rejected = f.kin->rejected_predictions() - rejected_before;
   }

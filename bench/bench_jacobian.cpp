@@ -33,6 +33,7 @@
 #include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/ik/simulator_kinematics.hpp"
 #include "softkin/solver/robots/robots.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -138,7 +139,7 @@ void BM_Jacobian(benchmark::State& state) {
   for (auto _ : state) {
     const auto t0 = Clock::now();
     const KinematicsEval e = k.Evaluate(f.c, true);
-    secs += std::chrono::duration<double>(Clock::now() - t0).count();
+    secs += SecondsSince(t0);
     ++n;
     if (!e.ok) {
       state.SkipWithError(e.message.c_str());

@@ -23,6 +23,7 @@
 #include "softkin/solver/robots/robot_twisting.hpp"
 #include "softkin/solver/robots/robots.hpp"
 #include "softkin/solver/remesh/tessellation.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -84,7 +85,7 @@ void BM_Tessellate(benchmark::State& state) {
   for (auto _ : state) {
     const auto t0 = std::chrono::steady_clock::now();
     const Mesh m = Tessellate(chamber, body, opt);
-    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    seconds += SecondsSince(t0);
     tets = m.num_tets();
     ++n;
   }

@@ -34,6 +34,7 @@
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/robots/robots.hpp"
 #include "softkin/solver/collision/spring_system.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -102,8 +103,7 @@ void BM_SpringUpdate(benchmark::State& state) {
     flip = !flip;
     benchmark::DoNotOptimize(sys.Solve(rhs));
   }
-  const double per = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() /
-                     std::max<double>(1, state.iterations());
+  const double per = SecondsSince(t0) / std::max<double>(1, state.iterations());
   auto& ref = RefactorTimes();
   const std::array<int, 3> key = {res, n, pair ? 1 : 0};
   if (refactor) ref[key] = per;
@@ -130,8 +130,7 @@ void BM_CollisionResponseUpdate(benchmark::State& state) {
     resp.Reset();
     benchmark::DoNotOptimize(resp.Update(X));
   }
-  const double per = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() /
-                     std::max<double>(1, state.iterations());
+  const double per = SecondsSince(t0) / std::max<double>(1, state.iterations());
   static std::map<int, double> point;
   if (!plane) point[res] = per;
   if (plane && point.count(res)) state.counters["vs_point"] = per / point[res];
@@ -142,7 +141,7 @@ void BM_CollisionResponseUpdate(benchmark::State& state) {
     const int reps = 5;
     const auto t1 = std::chrono::steady_clock::now();
     for (int i = 0; i < reps; ++i) benchmark::DoNotOptimize(solve(rhs));
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count() / reps;
+    return SecondsSince(t1) / reps;
   };
   const double solve_s = time_solves([&](const Eigen::VectorXd& b) { return resp.Solve(b); });
   const double base_s =
@@ -173,8 +172,7 @@ void BM_SelfTargetRule(benchmark::State& state) {
     resp.Reset();
     benchmark::DoNotOptimize(resp.Update(X));
   }
-  const double per = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() /
-                     std::max<double>(1, state.iterations());
+  const double per = SecondsSince(t0) / std::max<double>(1, state.iterations());
   static std::map<int, double> walk;
   if (!body_rule) walk[res] = per;
   if (body_rule && walk.count(res)) state.counters["vs_walk"] = per / walk[res];

@@ -9,6 +9,7 @@
 #include "softkin/solver/common/text_format.hpp"
 #include "softkin/solver/robots/robots.hpp"
 #include "softkin/solver/scene/scene_json.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -404,7 +405,7 @@ WaypointResult DirectWaypoint(const LearnedNets& nets, NetKinematics& kin, int i
                           : "direct: N_ik's answer is " + FormatNumber(w.error_mm) +
                                 " mm from the target, beyond lambda";
   w.evaluations = 1;
-  w.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  w.time_s = SecondsSince(t0);
   if (previous.size() == w.c.size()) {
     w.jump = (w.c - previous).cwiseAbs().maxCoeff();
     w.jump_fraction = (w.c - previous).cwiseAbs().cwiseQuotient(range).maxCoeff();

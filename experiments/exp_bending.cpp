@@ -8,6 +8,7 @@
 #include "softkin/solver/mesh/io/mesh_io.hpp"
 #include "softkin/solver/baselines/calculix_pressure.hpp"
 #include "softkin/solver/robots/robots.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -88,8 +89,7 @@ BendingParams ReadBendingParams(const Config& cfg) {
   p.milestones = cfg.NumberList("milestones_deg", {});
   const auto t_build0 = std::chrono::steady_clock::now();
   p.scene = ConfigRobot(cfg, p.robot, res);
-  p.robot_build_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_build0).count();
+  p.robot_build_s = SecondsSince(t_build0);
   p.opts = cfg.Solver(p.scene.solver);
   p.fem_laws = cfg.StringList("fem_laws", {});
   if (!p.fem_laws.empty()) {
@@ -245,9 +245,7 @@ nlohmann::json RunPneumaticBending(const Config& cfg, const std::string& dir, bo
   const Scene& scene = p.scene;
   const auto t_model0 = std::chrono::steady_clock::now();
   auto model = std::make_shared<const Model>(scene);
-  const double build_s =
-      p.robot_build_s +
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_model0).count();
+  const double build_s = p.robot_build_s + SecondsSince(t_model0);
   const BendingSweep b = Sweep(p, model, dir, verbose);
   const nlohmann::json fem = RunFem(p, *model, dir, verbose);
 

@@ -18,6 +18,7 @@
 #include "softkin/solver/remesh/remesh.hpp"
 #include "softkin/solver/robots/robot_twisting.hpp"
 #include "softkin/solver/robots/robots.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <algorithm>
 #include <array>
@@ -34,10 +35,6 @@ namespace softkin {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double Since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
 Eigen::Vector3d JsonVec(const Config& cfg, const std::string& key, const nlohmann::json& v) {
   if (!v.is_array() || v.size() != 3) cfg.Fail(key, "an array of 3 numbers [x, y, z]");
   Eigen::Vector3d out;
@@ -650,7 +647,7 @@ nlohmann::json RunCostsRobot(const Config& cfg, const CollisionCostsParams& p, c
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(cfg.path() + ": " + key + ": " + e.what());
   }
-  const double mesh_gen_s = Since(t0);
+  const double mesh_gen_s = SecondsSince(t0);
   if (rj.contains("obstacles")) scene.obstacles = ConfigObstacles(cfg, rj["obstacles"]);
   if (!rj.contains("actuation"))
     cfg.Fail(key + ".actuation", "an object {\"actuator\": end value}");

@@ -12,6 +12,7 @@
 #include "softkin/ik/trajectory.hpp"
 #include "softkin/learn/net_kinematics.hpp"
 #include "softkin/learn/train_nets.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -24,10 +25,6 @@
 namespace softkin {
 
 namespace {
-
-double Seconds(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // ---- Fig. 5.5: test error against the number of hidden layers h and neurons per layer b ----
 
@@ -314,7 +311,7 @@ nlohmann::json IkMethodRow(const IkMethodsSetup& s, const std::string& method, C
       pred = std::sqrt(r.objective);
       iters = r.summary.iterations;
     }
-    const double dt = Seconds(t0);
+    const double dt = SecondsSince(t0);
     // The error the simulator measures at the method's actuation.
     const KinematicsEval e = s.truth.Evaluate(c, false);
     const double err = e.ok ? (e.p.row(0) - s.targets.row(i)).norm() : -1.0;
@@ -364,7 +361,7 @@ nlohmann::json RunLearnIkMethods(const Config& cfg, const std::string& dir, bool
   const auto t_train = std::chrono::steady_clock::now();
   LearnedNets nets = CachedNets(d, dinfo["path"].get<std::string>(), p.spec.Tag(), p.nets,
                                 NetsCacheDir(dir), verbose);
-  const double train_s = Seconds(t_train);
+  const double train_s = SecondsSince(t_train);
   nets.Save(dir + "/nets");
   const double width = nets.info["dataset"]["workspace_width_mm"].get<double>();
   const double eps_mm = p.eps_pct / 100.0 * width;
@@ -552,7 +549,7 @@ MethodPath DirectPath(const LearnedNets& nets, const Eigen::MatrixX3d& waypoints
   for (int i = 0; i < waypoints.rows(); ++i) {
     const auto t0 = std::chrono::steady_clock::now();
     mp.cs.push_back(DirectIk(nets, waypoints.row(i).transpose()));
-    mp.times.push_back(Seconds(t0));
+    mp.times.push_back(SecondsSince(t0));
   }
   return mp;
 }

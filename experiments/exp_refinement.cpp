@@ -14,6 +14,7 @@
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/robots/robots.hpp"
 #include "softkin/solver/scene/solver_options_json.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -204,8 +205,7 @@ nlohmann::json SolveUnit(const Config& cfg, const RefinementCase& rc, const FkOp
     matched = m.matched;
   }
   // Wall time to the answer (with a volume target, every secant solve).
-  const double solve_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double solve_s = SecondsSince(t0);
   if (r.status == FkStatus::InvalidInput)
     throw std::invalid_argument(cfg.path() + ": " + rc.key + " ('" + rc.label + "'): " + r.message);
   const Eigen::VectorXd ratios =

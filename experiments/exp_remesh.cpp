@@ -9,6 +9,7 @@
 #include "softkin/solver/fk/model.hpp"
 #include "softkin/solver/remesh/remesh.hpp"
 #include "softkin/solver/robots/robot_twisting.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -72,7 +73,7 @@ TwistingRemeshParams ReadTwistingRemeshParams(const Config& cfg) {
              "twisting_robot (the twist is measured about its z axis over its 100 mm length)");
   const auto t_build0 = std::chrono::steady_clock::now();
   p.scene = ConfigRobot(cfg, p.robot, p.res);
-  p.build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_build0).count();
+  p.build_s = SecondsSince(t_build0);
   p.scene.solver = cfg.Solver(p.scene.solver);
   cfg.CheckNoUnknownKeys();
   const std::vector<double>& alphas = p.alphas;

@@ -4,6 +4,7 @@
 #include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/robots/robots.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -38,8 +39,7 @@ nlohmann::json SolveAtResolution(const Config& cfg, const ResolutionParams& p, i
   const auto t0 = std::chrono::steady_clock::now();
   Scene scene = ConfigRobot(cfg, p.robot, res);
   auto model = std::make_shared<const Model>(scene);
-  const double build_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double build_s = SecondsSince(t0);
   Eigen::VectorXd c = scene.rest_actuation();
   if (!p.actuation.empty()) {
     if (static_cast<Eigen::Index>(p.actuation.size()) != c.size())

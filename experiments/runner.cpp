@@ -5,6 +5,7 @@
 #include "softkin/experiments/mpi_job.hpp"
 #include "softkin/experiments/results.hpp"
 #include "softkin/solver/common/output_file.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -141,7 +142,7 @@ nlohmann::json RunExperiment(const std::string& config_path, const RunOptions& o
   nlohmann::json summary = fn(cfg, dir, opt.verbose && root);
   if (!root) return {};  // the other ranks computed units; rank 0 writes the results
   run["mpi_ranks"] = job.size;
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double wall = SecondsSince(t0);
   run["wall_time_s"] = wall;
   summary["name"] = cfg.name();
   summary["experiment"] = cfg.type();

@@ -3,6 +3,7 @@
 #include "softkin/experiments/sweep.hpp"
 
 #include "softkin/experiments/mpi_job.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -43,8 +44,7 @@ void Sweep::Run(const std::vector<nlohmann::json>& keys,
       }
       if (job.active())
         std::fprintf(stderr, "  %s: rank %d: unit %zu of %zu done in %.1f s\n", label_.c_str(),
-                     job.rank, i + 1, keys.size(),
-                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+                     job.rank, i + 1, keys.size(), SecondsSince(t0));
     }
     MpiBarrier();  // every rank has journaled its units
   }

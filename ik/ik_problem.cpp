@@ -1,4 +1,5 @@
 #include "softkin/ik/ik_problem.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <cmath>
 #include <sstream>
@@ -17,9 +18,7 @@ Eigen::VectorXd IkProblem::Project(const Eigen::Ref<const Eigen::VectorXd>& c) c
   return c.cwiseMax(lower()).cwiseMin(upper());
 }
 
-double IkProblem::elapsed_s() const {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-}
+double IkProblem::elapsed_s() const { return SecondsSince(start_); }
 
 bool IkProblem::Stalled(double o_prev, double o_now, double step, IkSummary* summary) const {
   if (o_prev - o_now <= options_.function_tolerance * o_prev) {

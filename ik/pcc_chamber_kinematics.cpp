@@ -1,4 +1,5 @@
 #include "softkin/ik/pcc_chamber_kinematics.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <ceres/jet.h>
 #include <Eigen/Dense>
@@ -140,7 +141,7 @@ KinematicsEval PccChamberKinematics::Evaluate(const Eigen::Ref<const Eigen::Vect
   }
   e.ok = e.p.allFinite() && (!with_jacobian || e.J.allFinite());
   if (!e.ok) e.message = "non-finite PCC tip";
-  e.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  e.time_s = SecondsSince(t0);
   return e;
 }
 

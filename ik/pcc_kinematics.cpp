@@ -1,4 +1,5 @@
 #include "softkin/ik/pcc_kinematics.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -111,7 +112,7 @@ KinematicsEval PccKinematics::Evaluate(const Eigen::Ref<const Eigen::VectorXd>& 
     e.J.block<1, 3>(3 * r + 2, 0) = dz_db * db_dc + dz_dsig * dsig_dc;
   }
   e.ok = true;
-  e.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  e.time_s = SecondsSince(t0);
   return e;
 }
 

@@ -3,6 +3,7 @@
 #include "softkin/solver/factory/fk_factory.hpp"
 
 #include "softkin/solver/mesh/mesh.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -53,9 +54,6 @@ bool SimulatorKinematicsOptions::IsValid(std::string* why) const {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-double Seconds(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double>(b - a).count();
-}
 }  // namespace
 
 SimulatorKinematics::SimulatorKinematics(const Scene& scene,

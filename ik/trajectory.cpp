@@ -3,6 +3,7 @@
 #include "softkin/ik/objectives.hpp"
 #include "softkin/solver/common/output_file.hpp"
 #include "softkin/solver/common/text_format.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -15,10 +16,6 @@
 
 namespace softkin {
 namespace {
-
-double Seconds(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 std::string JoinNumbers(const Eigen::VectorXd& v) {
   std::ostringstream s;
@@ -141,7 +138,7 @@ ConfigurationSamples SampleConfigurationSpace(Kinematics& kin, const std::string
     rejected = LoadCache(options.cache_file, header, n, kin.lower(), kin.upper(), &out);
     if (rejected.empty()) {
       out.cache_status = "loaded";
-      out.time_s = Seconds(t0);
+      out.time_s = SecondsSince(t0);
       return out;
     }
   }
@@ -187,7 +184,7 @@ ConfigurationSamples SampleConfigurationSpace(Kinematics& kin, const std::string
     file.Commit();
     out.cache_status = rejected.empty() ? "written" : "rebuilt: " + rejected;
   }
-  out.time_s = Seconds(t0);
+  out.time_s = SecondsSince(t0);
   return out;
 }
 
@@ -341,7 +338,7 @@ TrajectoryResult FollowTrajectory(Kinematics& kin,
     if (on_waypoint) on_waypoint(res.waypoints.back());
   }
   if (err_count > 0) res.mean_error_mm = err_sum / err_count;
-  res.total_time_s = Seconds(t0);
+  res.total_time_s = SecondsSince(t0);
   return res;
 }
 

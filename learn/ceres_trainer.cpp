@@ -1,4 +1,5 @@
 #include "softkin/learn/ceres_trainer.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <ceres/ceres.h>
 #include <omp.h>
@@ -18,10 +19,6 @@ constexpr int kSubBlock =
     16;  // samples per Jacobian kernel call (keeps Eigen's products serial-sized)
 
 using Clock = std::chrono::steady_clock;
-double Seconds(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
 // Ceres calls this from its own threads; Eigen must not open OpenMP teams from inside them.
 class SerialEigenScope {
  public:
@@ -81,7 +78,7 @@ class TargetCallback final : public ceres::IterationCallback {
     } else {
       sum_->train_mse.push_back(sum_->train_mse.back());  // rejected step: the loss stays
     }
-    sum_->time_s.push_back(Seconds(t0_));
+    sum_->time_s.push_back(SecondsSince(t0_));
     if (target_ > 0.0 && sum_->train_mse.back() <= target_) {
       if (sum_->time_to_target_s < 0.0) sum_->time_to_target_s = sum_->time_s.back();
       return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
@@ -189,7 +186,7 @@ CeresFitSummary FitFnnWithCeres(Fnn& net, const SampleSet& train, const CeresFit
   sum.initial_mse = 2.0 * csum.initial_cost / denom;
   sum.final_mse = 2.0 * csum.final_cost / denom;
   sum.reached_target = options.target_mse > 0.0 && sum.final_mse <= options.target_mse;
-  sum.total_time_s = Seconds(t0);
+  sum.total_time_s = SecondsSince(t0);
   return sum;
 }
 

@@ -2,6 +2,7 @@
 #include "softkin/solver/common/text_format.hpp"
 #include "softkin/solver/common/input_file.hpp"
 #include "softkin/solver/common/output_file.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -307,9 +308,9 @@ class Progress {
   void Update(long long done, bool force = false) {
     if (!on_) return;
     const auto now = Clock::now();
-    if (!force && std::chrono::duration<double>(now - last_).count() < 0.2) return;
+    if (!force && Seconds(last_, now) < 0.2) return;
     last_ = now;
-    const double el = std::chrono::duration<double>(now - t0_).count();
+    const double el = Seconds(t0_, now);
     const double rate = el > 0 ? (done - start_done_) / el : 0.0;
     const double eta = rate > 0 ? (total_ - done) / rate : 0.0;
     const int width = 30;
@@ -537,7 +538,7 @@ DatasetRunSummary GenerateDataset(Kinematics& kin, const DatasetSampling& sampli
   }
   bar.Finish(sum.already + sum.written);
   sum.fk_solves = kin.total_fk_solves() - solves0;
-  sum.time_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  sum.time_s = SecondsSince(t0);
   return sum;
 }
 

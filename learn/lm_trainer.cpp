@@ -2,6 +2,7 @@
 
 #include "softkin/learn/tiled_cholesky.hpp"
 #include "softkin/solver/fk/fk_options.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <omp.h>
 
@@ -24,10 +25,6 @@ constexpr int kCholeskyTile = 128;  // tile of the damped normal matrix's factor
 constexpr double kMuMin = 1e-20;    // trainlm's floor on mu
 
 using Clock = std::chrono::steady_clock;
-
-double Seconds(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 // While alive, the calling thread's OpenMP default team size is 1, which threads spawned by our
 // own parallel regions inherit. Eigen then never parallelises a product or factorisation by
@@ -242,7 +239,7 @@ LmSummary TrainLevenbergMarquardt(Fnn& net, const SampleSet& train, const Sample
   if (has_val) sum.val_mse.push_back(mse_of(net, va));
   if (has_test) sum.test_mse.push_back(mse_of(net, te));
   sum.mu.push_back(mu);
-  sum.time_s.push_back(Seconds(t0));
+  sum.time_s.push_back(SecondsSince(t0));
 
   Eigen::VectorXd best_w = w;
   double best_val = has_val ? sum.val_mse.back() : 0.0;
@@ -264,7 +261,7 @@ LmSummary TrainLevenbergMarquardt(Fnn& net, const SampleSet& train, const Sample
                    best_epoch, val_fail);
     std::fprintf(stderr, "  mu %.1e", mu);
     if (!sum.gradient_norm.empty()) std::fprintf(stderr, "  |grad| %.2e", sum.gradient_norm.back());
-    std::fprintf(stderr, "  %.1f s\n", Seconds(t0));
+    std::fprintf(stderr, "  %.1f s\n", SecondsSince(t0));
   };
   progress(0, true);
 
@@ -278,7 +275,7 @@ LmSummary TrainLevenbergMarquardt(Fnn& net, const SampleSet& train, const Sample
       sum.termination = LmTermination::kMaxEpochs;
       break;
     }
-    if (options.max_time_s > 0.0 && Seconds(t0) >= options.max_time_s) {
+    if (options.max_time_s > 0.0 && SecondsSince(t0) >= options.max_time_s) {
       sum.termination = LmTermination::kMaxTime;
       break;
     }
@@ -347,7 +344,7 @@ LmSummary TrainLevenbergMarquardt(Fnn& net, const SampleSet& train, const Sample
     if (has_val) sum.val_mse.push_back(accepted ? mse_of(net, va) : sum.val_mse.back());
     if (has_test) sum.test_mse.push_back(accepted ? mse_of(net, te) : sum.test_mse.back());
     sum.mu.push_back(mu);
-    sum.time_s.push_back(Seconds(t0));
+    sum.time_s.push_back(SecondsSince(t0));
     if (!accepted) {
       progress(epoch, true);
       sum.termination = LmTermination::kMuMax;
@@ -382,7 +379,7 @@ LmSummary TrainLevenbergMarquardt(Fnn& net, const SampleSet& train, const Sample
     sum.final_train_mse = loss;
   }
   sum.best_epoch = best_epoch;
-  sum.total_time_s = Seconds(t0);
+  sum.total_time_s = SecondsSince(t0);
   std::ostringstream msg;
   switch (sum.termination) {
     case LmTermination::kGoalReached:

@@ -1,6 +1,7 @@
 #include "softkin/learn/net_kinematics.hpp"
 
 #include "softkin/solver/common/output_file.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -225,7 +226,7 @@ KinematicsEval NetKinematics::Evaluate(const Eigen::Ref<const Eigen::VectorXd>& 
   for (int q = 0; q < P; ++q) e.p.row(q) = p.segment<3>(3 * q).transpose();
   if (with_jacobian) e.J = std::move(Js);
   e.ok = true;
-  e.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  e.time_s = SecondsSince(t0);
   return e;
 }
 

@@ -2,6 +2,7 @@
 
 #include "softkin/solver/fk/energy.hpp"
 #include "softkin/solver/fk/targets.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -23,10 +24,6 @@ namespace fs = std::filesystem;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double Seconds(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double>(b - a).count();
-}
-
 }  // namespace
 
 std::string InpNumber(double v) {

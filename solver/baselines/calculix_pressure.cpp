@@ -3,6 +3,7 @@
 #include "softkin/solver/baselines/calculix.hpp"
 #include "softkin/solver/baselines/ccx_run.hpp"
 #include "softkin/solver/mesh/element_faces.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -31,10 +32,6 @@ std::vector<bool> PrintedNodes(const PressureFemMesh& fem) {
       for (int m : f.mids)
         if (m >= 0) printed[m] = true;
   return printed;
-}
-
-double Seconds(std::chrono::steady_clock::time_point a, std::chrono::steady_clock::time_point b) {
-  return std::chrono::duration<double>(b - a).count();
 }
 
 }  // namespace

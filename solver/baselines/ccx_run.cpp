@@ -1,4 +1,5 @@
 #include "softkin/solver/baselines/ccx_run.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <cstdlib>
 #include <fstream>
@@ -59,10 +60,6 @@ CcxWorkFolder::~CcxWorkFolder() {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double Seconds(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double>(b - a).count();
-}
-
 /// Starts `ccx -i job` in folder `work` (no shell), its output going to `log`; returns the child's
 /// pid, or -1 if fork failed.
 pid_t StartCcx(const std::string& ccx, const fs::path& work, const std::string& log) {

@@ -5,6 +5,7 @@
 #include "softkin/solver/fk/rotation.hpp"
 #include "softkin/solver/fk/targets.hpp"
 #include "softkin/solver/common/text_format.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
@@ -23,10 +24,6 @@ namespace softkin {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double Seconds(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double>(b - a).count();
-}
-
 // ------------------------------------------------------------------------------------------------
 // The ratio-update loop shared by the optimiser-based solvers
 // ------------------------------------------------------------------------------------------------

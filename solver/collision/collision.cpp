@@ -1,4 +1,5 @@
 #include "softkin/solver/collision/collision.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <CGAL/AABB_face_graph_triangle_primitive.h>
 #include <CGAL/AABB_traits.h>
@@ -35,10 +36,6 @@ using FacePrimitive = CGAL::AABB_face_graph_triangle_primitive<SurfaceMesh>;
 using FaceTree = CGAL::AABB_tree<CGAL::AABB_traits<K, FacePrimitive>>;
 using Inside = CGAL::Side_of_triangle_mesh<SurfaceMesh, K>;
 using Clock = std::chrono::steady_clock;
-
-double Seconds(Clock::time_point a) {
-  return std::chrono::duration<double>(Clock::now() - a).count();
-}
 
 [[noreturn]] void Fail(const std::string& where, const std::string& what) {
   throw std::invalid_argument(where + ": " + what);
@@ -481,7 +478,7 @@ void SelfCollisionDetector::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) 
   } else if (method_ == Method::kGrid) {
     I.grid.Build(I.X, I.tets);
   }
-  build_s_ = Seconds(t0);
+  build_s_ = SecondsSince(t0);
 }
 
 namespace {
@@ -645,7 +642,7 @@ std::vector<SelfContact> SelfCollisionDetector::Detect() const {
     if (hit[q] >= 0) out.push_back({boundary_[q], hit[q]});
   narrow_tests_ = narrow;
   exact_tests_ = exact;
-  query_s_ = Seconds(t0);
+  query_s_ = SecondsSince(t0);
   return out;
 }
 

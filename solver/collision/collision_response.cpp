@@ -1,4 +1,5 @@
 #include "softkin/solver/collision/collision_response.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <algorithm>
 #include <array>
@@ -13,9 +14,6 @@ namespace softkin {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-double Since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 // Face j of a positively oriented tet (the face opposite vertex j), ordered so that its normal
 // (x1 - x0) x (x2 - x0) points out of the tet.
 constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
@@ -504,7 +502,7 @@ bool CollisionResponse::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) {
   }
   std::vector<ObstacleContact> obst;
   if (!obstacles_.empty()) obst = DetectObstacleContacts(obstacles_, X, check_vertices_);
-  stats_.check_s += Since(t0);
+  stats_.check_s += SecondsSince(t0);
   ++stats_.checks;
 
   const auto t1 = Clock::now();
@@ -585,7 +583,7 @@ bool CollisionResponse::Update(const Eigen::Ref<const Eigen::MatrixX3d>& X) {
       !std::equal(plane_.begin(), plane_.end(), planes_before.begin(), planes_before.end(),
                   [](const PlaneSpring& a, const PlaneSpring& b) { return a.vertex == b.vertex; });
   stats_.max_springs = std::max(stats_.max_springs, static_cast<int>(springs_.size()));
-  stats_.response_s += Since(t1);
+  stats_.response_s += SecondsSince(t1);
   return changed;
 }
 
@@ -635,7 +633,7 @@ bool CollisionResponse::Stiffen(int max_raises) {
   const auto t0 = Clock::now();
   system_.SetSprings(Stencils(), k_);
   RebuildPlanes(true);
-  stats_.response_s += Since(t0);
+  stats_.response_s += SecondsSince(t0);
   return true;
 }
 

@@ -1,4 +1,5 @@
 #include "softkin/solver/collision/spring_system.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <Eigen/Sparse>
 #include <cholmod.h>
@@ -15,9 +16,6 @@ namespace softkin {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-double Since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 }  // namespace
 
 struct SpringSystem::Impl {
@@ -133,7 +131,7 @@ bool SpringSystem::Modify(const std::vector<SpringStencil>& springs, bool add) {
     std::copy(Cx.begin(), Cx.end(), static_cast<double*>(C->x));
     const auto t0 = Clock::now();
     const int ok = cholmod_updown(add ? 1 : 0, C, F.L, &cm);
-    stats_.update_s += Since(t0);
+    stats_.update_s += SecondsSince(t0);
     cholmod_free_sparse(&C, &cm);
     stats_.columns_updated += r;
     since_refactor_ += r;
@@ -195,7 +193,7 @@ void SpringSystem::Refactor() {
       F.own_pattern = coupled;
     }
     const int ok = cholmod_factorize(&A, F.L, &cm);
-    stats_.refactor_s += Since(t0);
+    stats_.refactor_s += SecondsSince(t0);
     if (!ok || cm.status != CHOLMOD_OK)
       throw std::runtime_error("spring system: CHOLMOD could not factor A_ff + K (status " +
                                std::to_string(cm.status) + ")");
@@ -283,7 +281,7 @@ Eigen::VectorXd SpringSystem::Solve(const Eigen::VectorXd& rhs) const {
       solve_block(impl_->factors[model_.factor_of_axis(d)], rhs.data() + off, 1, y.data() + off);
     }
   }
-  stats_.solve_s += Since(t0);
+  stats_.solve_s += SecondsSince(t0);
   ++stats_.solves;
   return y;
 }

@@ -4,6 +4,7 @@
 #include "softkin/solver/fk/anderson.hpp"
 #include "softkin/solver/fk/energy.hpp"
 #include "softkin/solver/fk/targets.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -15,10 +16,6 @@ namespace softkin {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-double Seconds(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double>(b - a).count();
-}
-
 /// The prescribed coordinates' contribution A_fc x_c to the global system for actuation c (motion
 /// actuators move theirs with c): A X restricted to the free rows, every free coordinate zero.
 Eigen::VectorXd PrescribedRhs(const Model& m, const Eigen::VectorXd& c) {

@@ -1,6 +1,7 @@
 #include "softkin/solver/fk/model.hpp"
 
 #include "softkin/solver/fk/actuation.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <Eigen/Eigenvalues>
 
@@ -286,7 +287,7 @@ void Model::SetUpConstraints() {
     factor_of_axis_[d] = static_cast<int>(factors_.size());
     factors_.push_back(std::move(f));
   }
-  factor_time_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  factor_time_s_ = SecondsSince(t0);
 }
 
 double Model::GroupRatio(int g, const Eigen::Ref<const Eigen::VectorXd>& c) const {

@@ -3,6 +3,7 @@
 #include "softkin/solver/common/text_format.hpp"
 #include "softkin/solver/newton/newton_solver.hpp"
 #include "softkin/solver/sensitivity/equilibrium_jacobian.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -13,9 +14,6 @@ namespace softkin {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-double Seconds(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double>(b - a).count();
-}
 }  // namespace
 
 AutoSolver::AutoSolver(std::shared_ptr<const Model> model, const FkOptions& options,

@@ -9,6 +9,7 @@
 #include "softkin/solver/fk/targets.hpp"
 #include "softkin/solver/sensitivity/free_operator.hpp"
 #include "softkin/solver/sensitivity/gmres.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -19,10 +20,6 @@ namespace softkin {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-double Seconds(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double>(b - a).count();
-}
-
 /// Krylov products allowed per Newton step (no restart below this).
 constexpr int kMaxKrylov = 300;
 /// The largest Eisenstat-Walker forcing term (and the first one).

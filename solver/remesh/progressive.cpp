@@ -8,6 +8,7 @@
 #include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/fk/model.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -29,10 +30,6 @@ using Clock = std::chrono::steady_clock;
 constexpr double kRunawayExtent = 5.0;
 /// ... or whose chamber volume ratio exceeds this multiple of the ratio asked for.
 constexpr double kRunawayRatio = 2.0;
-
-double Seconds(Clock::time_point a) {
-  return std::chrono::duration<double>(Clock::now() - a).count();
-}
 
 bool InRegions(int tag, const std::vector<int>& regions) {
   return std::find(regions.begin(), regions.end(), tag) != regions.end();
@@ -164,7 +161,7 @@ ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target,
   };
   auto tb = Clock::now();
   std::unique_ptr<FkSolver> solver = build(res.scene);
-  double build_s = Seconds(tb);
+  double build_s = SecondsSince(tb);
 
   // The actuator value that asks for chamber volume alpha * V0 from the current chamber, whose
   // rest volume a whole re-tessellation may change slightly.
@@ -213,7 +210,7 @@ ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target,
       } catch (const std::runtime_error& e) {
         // Keep the state on the current mesh and go on up the ladder; the next check will try
         // again. The failed attempt's time is mesh generation time too.
-        st.mesh_seconds += Seconds(tr);
+        st.mesh_seconds += SecondsSince(tr);
         ++st.remesh_failures;
         ++res.remesh_failures;
         if (res.first_remesh_failure.empty())
@@ -230,7 +227,7 @@ ProgressiveResult SolveProgressive(const Scene& scene, double alpha_target,
       widen();
       tb = Clock::now();
       solver = build(res.scene);
-      st.solver_seconds += Seconds(tb);
+      st.solver_seconds += SecondsSince(tb);
     }
     if (st.status != FkStatus::Converged && res.status == FkStatus::Converged) {
       res.status = st.status;

@@ -7,6 +7,7 @@
 
 #include "softkin/solver/collision/collision.hpp"
 #include "softkin/solver/fk/model.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
@@ -30,10 +31,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 using Rows4 = Eigen::Matrix<double, 4, 3>;
-
-double Seconds(Clock::time_point a) {
-  return std::chrono::duration<double>(Clock::now() - a).count();
-}
 
 Rows4 TetRows(const Element& e, const Eigen::Ref<const Eigen::MatrixX3d>& X) {
   Rows4 r;
@@ -880,7 +877,7 @@ ChamberRemesh RemeshChamber(const Scene& scene, const Eigen::Ref<const Eigen::Ma
     only.method = RemeshMethod::ChamberOnly;
     try {
       ChamberRemesh r = RemeshChamber(scene, X, only);
-      r.seconds = Seconds(t0);
+      r.seconds = SecondsSince(t0);
       return r;
     } catch (const std::runtime_error& e) {
       method = out.method = RemeshMethod::Whole;
@@ -902,7 +899,7 @@ ChamberRemesh RemeshChamber(const Scene& scene, const Eigen::Ref<const Eigen::Ma
   out.chamber_rest_volume_after =
       RegionVolume(out.scene.mesh, out.scene.rest_positions_of(region), regions);
   out.chamber_volume_after = RegionVolume(out.scene.mesh, out.positions, regions);
-  out.seconds = Seconds(t0);
+  out.seconds = SecondsSince(t0);
   return out;
 }
 

@@ -6,6 +6,7 @@
 #include "softkin/solver/common/memory_guard.hpp"
 #include "softkin/solver/common/text_format.hpp"
 #include "softkin/solver/fk/actuation.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Mesh_complex_3_in_triangulation_3.h>
@@ -58,10 +59,6 @@ using C3t3 =
 using Criteria = CGAL::Mesh_criteria_3<MeshTr>;
 using RemeshTr = CGAL::Tetrahedral_remeshing::Remeshing_triangulation_3<K>;
 using Clock = std::chrono::steady_clock;
-
-double Seconds(Clock::time_point a) {
-  return std::chrono::duration<double>(Clock::now() - a).count();
-}
 
 std::string SourceOf(const TriangleSurface& s, const char* role) {
   return s.source.empty() ? std::string(role) : s.source;
@@ -315,7 +312,7 @@ Mesh Tessellate(const TriangleSurface& chamber_in, const TriangleSurface& body_i
           SignedVolume(e, mesh.vertices);
     report->chamber_enclosed = EnclosedVolume(chamber);
     report->body_enclosed = EnclosedVolume(body) - report->chamber_enclosed;
-    report->seconds = Seconds(t0);
+    report->seconds = SecondsSince(t0);
   }
   return mesh;
 }
@@ -604,7 +601,7 @@ RegionRemeshResult RemeshRegionInterior(const Mesh& mesh,
         "RemeshRegionInterior: the re-tessellated region " + std::to_string(region) + " has " +
         std::to_string(after.size()) + " boundary triangles, not the " +
         std::to_string(boundary_before.size()) + " it had; expected its boundary kept");
-  out.seconds = Seconds(t0);
+  out.seconds = SecondsSince(t0);
   return out;
 }
 

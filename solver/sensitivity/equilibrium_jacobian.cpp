@@ -13,6 +13,7 @@
 #include "softkin/solver/fk/actuation.hpp"
 #include "softkin/solver/fk/rotation.hpp"
 #include "softkin/solver/fk/targets.hpp"
+#include "softkin/solver/common/stopwatch.hpp"
 
 #include <Eigen/Eigenvalues>
 
@@ -394,8 +395,7 @@ bool SetLocalPreconditioner(const Model& model, const EquilibriumLinearization& 
     op->SetPreconditioner(nullptr);
     res->preconditioner = "A_ff (the local preconditioner is not positive definite)";
   }
-  res->preconditioner_time_s +=
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - tp).count();
+  res->preconditioner_time_s += SecondsSince(tp);
   return reused;
 }
 
@@ -501,7 +501,7 @@ EquilibriumJacobianResult ComputeEquilibriumJacobian(const Model& model,
   const ScopedBlasThreads one_blas_thread(1);  // single-RHS solves between OpenMP loops
   EquilibriumJacobianResult res;
   auto finish = [&]() {
-    res.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    res.time_s = SecondsSince(t0);
     return res;
   };
   std::vector<int> columns;
