@@ -1,6 +1,7 @@
 #include "softkin/solver/fk/fk_solver.hpp"
 
 #include "softkin/solver/fk/energy.hpp"
+#include "softkin/solver/fk/vented_vertices.hpp"
 #include "softkin/solver/mesh/element_geometry.hpp"
 
 #include <algorithm>
@@ -77,6 +78,9 @@ std::string FkResult::BriefReport() const {
 FkResult FkSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& c,
                          const Eigen::MatrixX3d* warm_start) {
   FkResult r = SolveImpl(c, warm_start);
+  // The inner vertices of vented chamber sides feel no force: every solver's answer puts them at
+  // the same place, inside their cavity (vented_vertices.hpp).
+  if (r.status != FkStatus::InvalidInput) PlaceVentedVertices(*model_, c, &r.positions);
   ReportInvertedElements(*model_, &r);
   if (r.status == FkStatus::Converged && r.inverted_elements > 0) {
     char buf[160];
