@@ -142,9 +142,7 @@ void WriteCalculixInput(const Model& model, const Eigen::Ref<const Eigen::Vector
     } else {
       const int g = std::stoi(name.substr(1));
       const Actuator& act = s.actuators[model.group_actuator(g)];
-      const int side = model.group_side(g);
-      const bool vented = side != 0 && side * c[model.group_actuator(g)] <= 0.0;
-      if (vented) {
+      if (model.GroupVented(g, c)) {
         E = 1e-3 * opt.young;
       } else {
         E = act.weight * opt.young;

@@ -92,6 +92,11 @@ class Model {
   double group_offset(int g) const { return groups_[g].offset; }
   /// The group's target ratio rho for actuation vector c (Actuator::SideRatio).
   double GroupRatio(int g, const Eigen::Ref<const Eigen::VectorXd>& c) const;
+  /// Whether group g is vented at c: the side of a signed actuator that c does not drive (its
+  /// elements follow the deformation with no energy; targets.hpp, kVented).
+  bool GroupVented(int g, const Eigen::Ref<const Eigen::VectorXd>& c) const {
+    return groups_[g].side != 0 && !(groups_[g].side * c[groups_[g].actuator] > 0.0);
+  }
   /// Actuator a's value implied by per-group achieved ratios (the inverse of GroupRatio; a motion
   /// actuator's value is prescribed exactly, so it is c[a]).
   double ActuatorValue(int a, const std::vector<double>& group_ratios,

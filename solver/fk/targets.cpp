@@ -30,8 +30,7 @@ void ComputeLocalRatios(const Model& model, const Eigen::Ref<const Eigen::Matrix
     const auto& ids = model.group_elements(g);
     const double M = model.group_rest_measure(g), LR = model.group_offset(g);
     const double rho = model.GroupRatio(g, c);
-    const int side = model.group_side(g);
-    const bool vented = side != 0 && !(side * c[model.group_actuator(g)] > 0.0);
+    const bool vented = model.GroupVented(g, c);
     // The measures in parallel (each element on its own), their sum in element order, so the
     // result does not depend on the number of threads.
     const int ng = static_cast<int>(ids.size());

@@ -95,7 +95,7 @@ bool EquilibriumLinearization::Setup(const Model& model,
   for (int g = 0; g < model.num_groups(); ++g) {
     GroupCache& gc = groups_[g];
     const int a = model.group_actuator(g), side = model.group_side(g);
-    gc.vented = side != 0 && !(side * c[a] > 0.0);
+    gc.vented = model.GroupVented(g, c);
     const double M = model.group_rest_measure(g), LR = model.group_offset(g);
     double Md = 0.0;
     for (int i : model.group_elements(g)) {

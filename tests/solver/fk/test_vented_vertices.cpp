@@ -37,11 +37,11 @@ Eigen::MatrixX3d Bent(const Model& m, const std::vector<int>& inner, double nois
   return X;
 }
 
-/// The vented elements at `c` (the test of ComputeLocalRatios).
+/// The vented elements at `c`.
 std::vector<char> Vented(const Model& m, const Eigen::VectorXd& c) {
   std::vector<char> vented(m.elements().size(), 0);
   for (int g = 0; g < m.num_groups(); ++g)
-    if (m.group_side(g) != 0 && !(m.group_side(g) * c[m.group_actuator(g)] > 0.0))
+    if (m.GroupVented(g, c))
       for (int i : m.group_elements(g)) vented[i] = 1;
   return vented;
 }
