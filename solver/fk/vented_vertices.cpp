@@ -87,6 +87,29 @@ void PlaceVentedVertices(const Model& model, const Eigen::Ref<const Eigen::Vecto
   const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(L);
   if (ldlt.info() != Eigen::Success) return;  // a vented region that touches nothing else
 
+  const double tolerance = kMoveTolerance * model.size();
+  // One local-global step of the fit at Y: the correction of the inner vertices (n x 3), from half
+  // the gradient of E with the rotations fitted at Y.
+  auto step_at = [&](const Eigen::MatrixX3d& Y) -> Eigen::MatrixX3d {
+    Eigen::MatrixX3d g = Eigen::MatrixX3d::Zero(n, 3);
+    for (int i : touching) {
+      const ModelElement& e = els[i];
+      ElemRows D = ElemRows::Zero();
+      for (int j = 0; j < e.k; ++j) D.row(j) = Y.row(e.v[j]);
+      CenterRows(D, e.k);
+      const Eigen::Matrix3d R = BestRotation(D.transpose() * e.rest);  // rows past k are zero
+      const ElemRows r = D - e.rest * R.transpose();
+      for (int j = 0; j < e.k; ++j)
+        if (index[e.v[j]] >= 0) g.row(index[e.v[j]]) += e.wv * r.row(j);
+    }
+    return -ldlt.solve(g);
+  };
+  // Already placed (the default solver's inner solve, or newton's lg-aa fallback, has done it):
+  // one step that moves nothing confirms it.
+  {
+    const Eigen::MatrixX3d step = step_at(*X);
+    if (step.allFinite() && step.rowwise().norm().maxCoeff() <= tolerance) return;
+  }
   // Start: the rest positions moved by the harmonic extension of the other vertices'
   // displacements (exact when nothing moved, and when everything translates), then local-global
   // iterations on the corrections, so that a state at rest stays at rest to round-off.
@@ -105,21 +128,8 @@ void PlaceVentedVertices(const Model& model, const Eigen::Ref<const Eigen::Vecto
   }
   const Eigen::MatrixX3d start = ldlt.solve(rhs);
   for (int q = 0; q < n; ++q) Y.row(inner[q]) = model.rest_positions().row(inner[q]) + start.row(q);
-  const double tolerance = kMoveTolerance * model.size();
   for (int it = 0; it < kMaxIterations; ++it) {
-    // Half the gradient of E at the inner vertices, with the rotations fitted at Y.
-    Eigen::MatrixX3d g = Eigen::MatrixX3d::Zero(n, 3);
-    for (int i : touching) {
-      const ModelElement& e = els[i];
-      ElemRows D = ElemRows::Zero();
-      for (int j = 0; j < e.k; ++j) D.row(j) = Y.row(e.v[j]);
-      CenterRows(D, e.k);
-      const Eigen::Matrix3d R = BestRotation(D.transpose() * e.rest);  // rows past k are zero
-      const ElemRows r = D - e.rest * R.transpose();
-      for (int j = 0; j < e.k; ++j)
-        if (index[e.v[j]] >= 0) g.row(index[e.v[j]]) += e.wv * r.row(j);
-    }
-    const Eigen::MatrixX3d step = -ldlt.solve(g);
+    const Eigen::MatrixX3d step = step_at(Y);
     if (!step.allFinite()) return;
     for (int q = 0; q < n; ++q) Y.row(inner[q]) += step.row(q);
     if (step.rowwise().norm().maxCoeff() <= tolerance) break;
