@@ -114,7 +114,8 @@ ManipDesign MakeManipDesign() {
 
 /// The manipulator with its nominal dimensions at every resolution (grid lines on each of them,
 /// parts cut into cells of about 20 / res mm; an even count across the spine, so y = 10 is a
-/// grid line and the mesh is mirror-symmetric about it): 1.5 mm walls, floor and roof, 4 mm
+/// grid line and the mesh is mirror-symmetric about it, and an even count between the floor and
+/// the roof, so it is mirror-symmetric about z = 6 too): 1.5 mm walls, floor and roof, 4 mm
 /// cavities, 7 mm wide chamber rows beside a 3 mm spine.
 Mesh DesignGridManipulatorMesh(int res, const ManipDesign& d) {
   const double h = kManipWidth / res, pitch = kManipWall + kManipCavity;
@@ -136,7 +137,11 @@ Mesh DesignGridManipulatorMesh(int res, const ManipDesign& d) {
       bx.end());
   const auto xs = DesignLines(bx, h);
   const auto ys = DesignLines({0.0, y1, y2, y3, y4, kManipWidth}, h, {false, false, true});
-  const auto zs = DesignLines({0.0, kManipWall, kManipThick - kManipWall, kManipThick}, h);
+  // An even count between the floor and the roof: the mirrored voxel split (mesh_gen.hpp) is then
+  // symmetric about the mid-thickness z = 6, so the motion stays in its plane (with an odd
+  // count every tet leans one way and the tip left the plane by up to 1.6 mm).
+  const auto zs = DesignLines({0.0, kManipWall, kManipThick - kManipWall, kManipThick}, h,
+                              {false, true, false});
   return RectilinearTetMesh(xs, ys, zs, [&](const Eigen::Vector3d& c, const Eigen::Vector3i&) {
     for (int q = 0; q < 2; ++q)
       if (c.x() > d.joint_end[q] - kManipJoint && c.x() < d.joint_end[q]) return 8;
@@ -229,7 +234,8 @@ RobotEntry FingerManipulatorEntry() {
        {"design_grid", 0.0, 0.0, 1.0,
         "0: features snap to whole cells of 20/res mm (walls and cavities change with res, res "
         "even); 1: grid lines on the nominal dimensions (1.5 mm walls, floor and roof, six 4 mm "
-        "cavities per section, 3 mm spine) at every res, mirror-symmetric about y = 10"}}};
+        "cavities per section, 3 mm spine) at every res, mirror-symmetric about y = 10 and z = "
+        "6"}}};
   return {info, kManipMinRes, kManipMaxRes, &MakeFingerManipulator};
 }
 

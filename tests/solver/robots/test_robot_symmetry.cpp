@@ -43,6 +43,7 @@ TEST(RobotSymmetry, MirrorSymmetricDesignsBendInTheirPlane) {
     SCOPED_TRACE(c.robot + " res " + std::to_string(c.res));
     const Scene s = MakeRobot(c.robot, c.res);
     EXPECT_EQ(UnmatchedMirrorVertices(s.mesh, c.plane_y), 0);
+    EXPECT_EQ(test::UnmatchedMirrorElements(s.mesh, 1, c.plane_y), 0);
     auto model = std::make_shared<const Model>(s);
     const Eigen::VectorXd a =
         Eigen::Map<const Eigen::VectorXd>(c.actuation.data(), c.actuation.size());
