@@ -13,18 +13,31 @@
 namespace softkin {
 namespace test {
 
+/// A position rounded to 1e-6 mm, to find coincident vertices.
+using PositionKey = std::array<long, 3>;
+inline PositionKey KeyOf(const Eigen::Vector3d& p) {
+  return {std::lround(p.x() * 1e6), std::lround(p.y() * 1e6), std::lround(p.z() * 1e6)};
+}
+
+/// Each vertex by its position (KeyOf).
+inline std::map<PositionKey, int> VerticesByPosition(const Mesh& mesh) {
+  std::map<PositionKey, int> at;
+  for (int v = 0; v < mesh.num_vertices(); ++v) at[KeyOf(mesh.vertices.row(v).transpose())] = v;
+  return at;
+}
+
+/// The mirror image of p about the plane x_axis = plane.
+inline Eigen::Vector3d Mirrored(Eigen::Vector3d p, int axis, double plane) {
+  p[axis] = 2 * plane - p[axis];
+  return p;
+}
+
 /// Vertices without a mirror image about the plane y = plane_y (to 1e-6 mm).
 inline int UnmatchedMirrorVertices(const Mesh& mesh, double plane_y) {
-  auto key = [](double x, double y, double z) {
-    return std::array<long, 3>{std::lround(x * 1e6), std::lround(y * 1e6), std::lround(z * 1e6)};
-  };
-  std::map<std::array<long, 3>, int> at;
-  for (int v = 0; v < mesh.num_vertices(); ++v)
-    at[key(mesh.vertices(v, 0), mesh.vertices(v, 1), mesh.vertices(v, 2))] = v;
+  const auto at = VerticesByPosition(mesh);
   int unmatched = 0;
   for (int v = 0; v < mesh.num_vertices(); ++v)
-    unmatched +=
-        !at.count(key(mesh.vertices(v, 0), 2 * plane_y - mesh.vertices(v, 1), mesh.vertices(v, 2)));
+    unmatched += !at.count(KeyOf(Mirrored(mesh.vertices.row(v).transpose(), 1, plane_y)));
   return unmatched;
 }
 
@@ -33,12 +46,7 @@ inline int UnmatchedMirrorVertices(const Mesh& mesh, double plane_y) {
 /// chambers). A mesh can have every vertex mirrored and still not be symmetric: its tets'
 /// diagonals may all lean one way. Elements with a vertex that has no mirror image count.
 inline int UnmatchedMirrorElements(const Mesh& mesh, int axis, double plane) {
-  auto key = [](Eigen::Vector3d p) {
-    return std::array<long, 3>{std::lround(p.x() * 1e6), std::lround(p.y() * 1e6),
-                               std::lround(p.z() * 1e6)};
-  };
-  std::map<std::array<long, 3>, int> at;
-  for (int v = 0; v < mesh.num_vertices(); ++v) at[key(mesh.vertices.row(v).transpose())] = v;
+  const auto at = VerticesByPosition(mesh);
   auto sorted_ids = [](const Element& e) {  // the vertex ids in increasing order, then -1s
     std::array<int, 6> ids = e.v;
     for (int a = 1; a < e.k(); ++a)
@@ -52,9 +60,7 @@ inline int UnmatchedMirrorElements(const Mesh& mesh, int axis, double plane) {
     Element m = e;
     bool found = true;
     for (int q = 0; q < e.k() && found; ++q) {
-      Eigen::Vector3d p = mesh.vertices.row(e.v[q]).transpose();
-      p[axis] = 2 * plane - p[axis];
-      const auto it = at.find(key(p));
+      const auto it = at.find(KeyOf(Mirrored(mesh.vertices.row(e.v[q]).transpose(), axis, plane)));
       found = it != at.end();
       if (found) m.v[q] = it->second;
     }
