@@ -545,7 +545,7 @@ TEST(Robots, DefaultResolutionScenesHaveTheirSizes) {
       {"pneumatic_finger", 46656, 9490, 130, 1, 3},
       {"three_chamber", 35280, 6929, 169, 3, 1},
       {"cable_finger", 25200, 5533, 121, 3, 3},
-      {"finger_manipulator", 13200, 3024, 54, 3, 3},
+      {"finger_manipulator", 15840, 3528, 63, 3, 3},
       {"multi_segment_gripper", 19296, 4284, 63, 3, 5},
       {"dea_crawler", 896, 783, 27, 1, 4},
       {"bimaterial_bar", 2592, 700, 25, 2, 4},

@@ -471,7 +471,7 @@ TEST(RobotGrid, FingerManipulatorDesignGridKeepsItsDimensionsAndSymmetry) {
     EXPECT_LT(tip.y(), 10.0 - 20.0);  // it bends towards -y
     EXPECT_NEAR(tip.z(), 6.0, 1e-4 * s.mesh.size());
   }
-  EXPECT_EQ(MakeRobot("finger_manipulator", 8).mesh.num_elements(), 13200);
+  EXPECT_EQ(MakeRobot("finger_manipulator", 8).mesh.num_elements(), 15840);
   EXPECT_THROW(MakeRobot("finger_manipulator", 8, {{"design_grid", 0.5}}), std::invalid_argument);
 }
 
