@@ -32,16 +32,16 @@ namespace {
 // (the thesis's pressure in bar, its sign picking the side); v > 0 drives the +y chambers to
 // volume ratio 1 + gain v and bends the section towards -y, v < 0 the -y chambers and bends it
 // towards +y. The thesis's sections bend up to 120 degrees; this geometric model reaches less.
-// At the defaults (gain 4, chamber weight 20) section 1 turns at v = 3 by 43 / 73 / 95 degrees
+// At the defaults (gain 4, chamber weight 20) section 1 turns at v = 3 by 43 / 75 / 97 degrees
 // at res 6 / 8 / 12: walls snap to whole cells (3.3 / 2.5 / 1.7 mm for the 1.5 mm design), and
-// thinner walls let the chambers grow more (at res 8 they reach volume ratio 9.8 of the 13
+// thinner walls let the chambers grow more (at res 8 they reach volume ratio 9.9 of the 13
 // asked: the actuation elements are soft constraints, Eq. 2.10, held back by the rigid walls,
-// floor and roof). With the thesis's weight 5 and gain 2 it is 38 degrees at res 8. A
+// floor and roof). With the thesis's weight 5 and gain 2 it is 41 degrees at res 8. A
 // PneuNet-style variant with gaps between the chamber boxes did not bend more (50). The mesh is
 // mirror-symmetric about y = 10 (res is even), so v and -v give mirror images, and about its
-// mid-thickness (an odd count of cell layers is cut into one more), so the motion stays in x-y. Markers: tip (distal
-// face x = L), j1, j2 (the connectors' distal faces: the ends of sections 1 and 2).
-// With design_grid = 1 the grid lines sit on the nominal dimensions instead, at any res
+// mid-thickness (an odd count of cell layers is cut into one more), so the motion stays in x-y.
+// Markers: tip (distal face x = L), j1, j2 (the connectors' distal faces: the ends of sections 1
+// and 2). With design_grid = 1 the grid lines sit on the nominal dimensions instead, at any res
 // (DesignGridManipulatorMesh; docs/fidelity.md has what it changes, and that it still does not
 // converge under refinement).
 // ================================================================================================
