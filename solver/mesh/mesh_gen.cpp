@@ -1,5 +1,6 @@
 #include "softkin/solver/mesh/mesh_gen.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -47,6 +48,37 @@ Mesh VoxelTetMesh(const Eigen::Vector3d& origin, double h, const Eigen::Vector3i
   for (int d = 0; d < 3; ++d)
     for (int i = 0; i <= cells[d]; ++i) lines[d].push_back(origin[d] + h * double(i));
   return RectilinearTetMesh(lines[0], lines[1], lines[2], classify);
+}
+
+Mesh SymmetricVoxelTetMesh(const Eigen::Vector3d& origin, double h, const Eigen::Vector3i& cells,
+                           const std::array<bool, 3>& even, const VoxelClassifier& classify) {
+  if (!(h > 0.0) || !std::isfinite(h))
+    throw std::invalid_argument("SymmetricVoxelTetMesh: cell size h must be > 0, got " +
+                                std::to_string(h));
+  if (cells.minCoeff() < 1)
+    throw std::invalid_argument("SymmetricVoxelTetMesh: every cell count must be >= 1");
+  if (!classify) throw std::invalid_argument("SymmetricVoxelTetMesh: no cell classifier given");
+  std::array<std::vector<double>, 3> lines;
+  for (int d = 0; d < 3; ++d) {
+    const int n = cells[d], m = even[d] ? n + n % 2 : n;
+    for (int i = 0; i <= m; ++i)  // an axis left as it is gets VoxelTetMesh's lines exactly
+      lines[d].push_back(origin[d] + (m == n ? h * double(i) : h * n * double(i) / m));
+  }
+  // The original cell holding a new cell's centre. With m = n + 1 even and n odd, a centre sits at
+  // (2i + 1) n / (2m) cells, never on a line, so mirrored cells map to mirrored cells.
+  return RectilinearTetMesh(
+      lines[0], lines[1], lines[2], [&](const Eigen::Vector3d& c, const Eigen::Vector3i& g) {
+        Eigen::Vector3i k;
+        Eigen::Vector3d centre;  // of the original cell, as VoxelTetMesh computes it
+        for (int d = 0; d < 3; ++d) {
+          k[d] = static_cast<int>(lines[d].size()) - 1 == cells[d]
+                     ? g[d]
+                     : std::clamp(static_cast<int>(std::floor((c[d] - origin[d]) / h)), 0,
+                                  cells[d] - 1);
+          centre[d] = 0.5 * ((origin[d] + h * double(k[d])) + (origin[d] + h * double(k[d] + 1)));
+        }
+        return classify(centre, k);
+      });
 }
 
 Mesh RectilinearTetMesh(const std::vector<double>& xs, const std::vector<double>& ys,

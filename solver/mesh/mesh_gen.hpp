@@ -43,6 +43,18 @@ using VoxelClassifier =
 Mesh VoxelTetMesh(const Eigen::Vector3d& origin, double h, const Eigen::Vector3i& cells,
                   const VoxelClassifier& classify);
 
+/// VoxelTetMesh made mirror-symmetric about the box's mid-plane normal to each axis d with
+/// `even[d]`. The mirrored split is symmetric about a mid-plane only over an even count of cells
+/// across it; over an odd count every tet leans the same way and a symmetric design bends out of
+/// its plane. So an odd cells[d] is cut into cells[d] + 1 cells of equal size over the same length
+/// h * cells[d] (non-cubic cells). Each new cell takes the tag of the original cell that holds its
+/// centre: `classify` is called with that original cell's centre and index, so a classifier
+/// symmetric in the original cells stays symmetric, and the box does not change; a feature's
+/// width changes by less than one cell (a wall of one cell of 5 becomes one of 6 equal cells, the
+/// middle cell becomes two). An even count is left as it is.
+Mesh SymmetricVoxelTetMesh(const Eigen::Vector3d& origin, double h, const Eigen::Vector3i& cells,
+                           const std::array<bool, 3>& even, const VoxelClassifier& classify);
+
 /// The same split on a rectilinear grid: cell (i, j, k) spans [xs[i], xs[i+1]] x [ys[j], ys[j+1]]
 /// x [zs[k], zs[k+1]], so grid lines can sit on a design's dimensions (walls, layers) whatever
 /// the cell size; `classify` gets the cell's centre and index. Each axis needs at least 2

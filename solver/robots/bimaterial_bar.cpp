@@ -38,7 +38,8 @@ Scene MakeBimaterialBar(int res, const RobotParams& P) {
   auto cell = [&](const Eigen::Vector3d&, const Eigen::Vector3i& c) { return c[0] < ni ? 0 : 1; };
   Scene s;
   s.name = "bimaterial_bar";
-  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, res, res), cell);
+  s.mesh = SymmetricVoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, res, res),
+                                 {false, true, true}, cell);
   s.body[0] = Material{"A", P.at("r_omega_a"), P.at("weight_a")};
   s.body[1] = Material{"B", P.at("r_omega_b"), P.at("weight_b")};
   const double eps = 1e-6 * h, xmax = nx * h;

@@ -54,7 +54,8 @@ Scene MakeCableFinger(int res, const RobotParams&) {
   };
   Scene s;
   s.name = "cable_finger";
-  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, res, nz), cell);
+  s.mesh = SymmetricVoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, res, nz),
+                                 {false, true, false}, cell);
   s.body[0] = Material{"body", 1.0, 1.0};
   // Bridge cells actually present (snapped): the path spans them at their mid-height.
   const double zmax = nz * h;

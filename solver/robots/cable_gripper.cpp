@@ -43,7 +43,8 @@ Scene MakeCableGripper(int res, const RobotParams& P) {
   };
   Scene s;
   s.name = "cable_gripper";
-  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, res, nz), cell);
+  s.mesh = SymmetricVoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, res, nz),
+                                 {false, true, false}, cell);
   s.body[0] = Material{"link", P.at("link_r_omega"), P.at("link_weight")};
   s.body[2] = Material{"joint", P.at("joint_r_omega"), P.at("joint_weight")};
   // The channel cells actually present (snapped): the path spans them at their mid-height.

@@ -208,23 +208,17 @@ Scene MakeFingerManipulator(int res, const RobotParams& P) {
     return 0;
   };
   const double joint_end[2] = {joints[0].second * h, joints[1].second * h};
-  // The mirrored voxel split (mesh_gen.hpp) is symmetric about the mid-thickness only over an
-  // even count of cell layers. An odd count (5 at the default res 8, 7 at res 12) is cut into one
-  // layer more, of equal height, over the same thickness; the floor, roof and cavities keep the
-  // layers whose centres lie in their cells. With the odd count every tet leaned one way and the
-  // tip left its plane (2.6 mm at s1 = 0.5 at res 8, 5.6 mm at s1 = 3). Cutting only the middle
-  // layer in two was measured too: its half-height tets folded, 72 inverted elements at s1 = 3
-  // with the thesis's weight 5 and gain 2, where the equal layers have none.
-  std::vector<double> xs(nx + 1), ys(ny + 1), zs;
-  for (int i = 0; i <= nx; ++i) xs[i] = i * h;
-  for (int j = 0; j <= ny; ++j) ys[j] = j * h;
-  const int lz = nz + nz % 2;
-  for (int k = 0; k <= lz; ++k) zs.push_back(k * (nz * h) / lz);
-  const auto layer = [&](const Eigen::Vector3d& c, const Eigen::Vector3i& g) {
-    const int k = std::min(nz - 1, static_cast<int>(std::floor(c.z() / h)));
-    return cell(c, Eigen::Vector3i(g[0], g[1], k));
-  };
-  return FinishManipulator(P, RectilinearTetMesh(xs, ys, zs, layer), joint_end);
+  // Mirror-symmetric about y = 10 (res is even) and about the mid-thickness: an odd count of
+  // cell layers (5 at the default res 8, 7 at res 12) is cut into one layer more, of equal height
+  // (SymmetricVoxelTetMesh). With the odd count every tet leaned one way and the tip left its
+  // plane (2.6 mm at s1 = 0.5 at res 8, 5.6 mm at s1 = 3). Cutting only the middle layer in two
+  // was measured too: its half-height tets folded, 72 inverted elements at s1 = 3 with the
+  // thesis's weight 5 and gain 2, where the equal layers have none.
+  return FinishManipulator(
+      P,
+      SymmetricVoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz),
+                            {false, true, true}, cell),
+      joint_end);
 }
 
 }  // namespace

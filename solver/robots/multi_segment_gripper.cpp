@@ -163,7 +163,8 @@ Scene MakeMultiSegmentGripper(int res, const RobotParams& P) {
     return 0;
   };
   Scene s;
-  s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz), cell);
+  s.mesh = SymmetricVoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz),
+                                 {false, true, false}, cell);
   FinishGripper(res, rows[2].x0 * h, nx * h, layer * h, P.at("chamber_weight"), &s);
   return s;
 }

@@ -124,10 +124,11 @@ Scene MakePneumaticFinger(int res, const RobotParams& P) {
   s.name = "pneumatic_finger";
   s.mesh = DesignGridFlag("pneumatic_finger", P)
                ? DesignGridFingerMesh(res)
-               : VoxelTetMesh(Eigen::Vector3d::Zero(), L.h, Eigen::Vector3i(L.nx, L.ny, L.nz),
-                              [&L](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
-                                return FingerCell(L, c[0], c[1], c[2]);
-                              });
+               : SymmetricVoxelTetMesh(Eigen::Vector3d::Zero(), L.h,
+                                       Eigen::Vector3i(L.nx, L.ny, L.nz), {false, true, false},
+                                       [&L](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
+                                         return FingerCell(L, c[0], c[1], c[2]);
+                                       });
   s.body[0] = Material{"body", kFingerBodyROmega, 1.0};
   s.body[2] = Material{"inextensible", 1.0, kFingerLayerWeight};
   Actuator a;

@@ -76,7 +76,8 @@ ScfMesh SnappedScfMesh(double h, double wall_mm) {
     return inside ? 1 : 0;
   };
   ScfMesh out;
-  out.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz), cell);
+  out.mesh = SymmetricVoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz),
+                                   {false, true, false}, cell);
   for (int q = 1; q < chambers; ++q) out.slits.push_back((proximal + q * pitch) * h);
   out.z_floor = (base + floor) * h;
   return out;

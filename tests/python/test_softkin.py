@@ -126,7 +126,7 @@ def test_options_are_the_scene_json_keys_with_its_messages(finger):
         softkin.FkSolver(finger, solver="magic")
     with pytest.raises(ValueError, match=r"c \(one value per actuator\): expected 1 value"):
         softkin.FkSolver(finger).solve([1.0, 2.0])
-    with pytest.raises(ValueError, match="warm_start: expected 930 rows"):
+    with pytest.raises(ValueError, match="warm_start: expected 1085 rows"):
         softkin.FkSolver(finger).solve(2.0, warm_start=np.zeros((3, 3)))
 
 

@@ -3,6 +3,7 @@
 // component code) so they test the generators independently of mesh.cpp.
 #include "softkin/solver/mesh/mesh_gen.hpp"
 #include "softkin/solver/robots/robots.hpp"
+#include "tests/solver/robots/mirror_test_util.hpp"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -329,6 +330,57 @@ TEST(MeshGenVoxel, RejectsBadArguments) {
                               [](const Eigen::Vector3d&, const Eigen::Vector3i&) { return -1; });
   EXPECT_EQ(m.num_vertices(), 0);
   EXPECT_EQ(m.num_elements(), 0);
+}
+
+// SymmetricVoxelTetMesh: an even count is VoxelTetMesh's grid exactly; an odd count across a
+// mirror axis becomes one more cell of equal size over the same box, each new cell tagged as the
+// original cell holding its centre; the tets are then mirror images about the mid-plane, which
+// the plain split over an odd count is not (every one of its tets leans the same way).
+TEST(MeshGenVoxel, SymmetricGridCutsAnOddCountIntoOneMoreCell) {
+  const double h = 1.5;
+  const Eigen::Vector3d o(1, -2, 0.5);
+  // A design symmetric in y over 5 cells: walls j = 0 and 4 (tag 0), a cavity j = 1..3 (tag 1).
+  auto design = [&](const Eigen::Vector3d& centre, const Eigen::Vector3i& c) {
+    EXPECT_NEAR(centre[1], o[1] + (c[1] + 0.5) * h, 1e-12);  // the original cell's centre
+    EXPECT_GE(c[1], 0);
+    EXPECT_LT(c[1], 5);
+    return c[1] == 0 || c[1] == 4 ? 0 : 1;
+  };
+  const Eigen::Vector3i n(4, 5, 3);
+  const Mesh plain = VoxelTetMesh(o, h, n, design);
+  const Mesh sym = SymmetricVoxelTetMesh(o, h, n, {false, true, false}, design);
+  const double mid = o[1] + 2.5 * h;
+  EXPECT_EQ(test::UnmatchedMirrorElements(plain, 1, mid), plain.num_elements());
+  EXPECT_EQ(test::UnmatchedMirrorElements(sym, 1, mid), 0);
+  EXPECT_EQ(sym.num_elements(), 6 * 4 * 6 * 3);  // 6 cells across y instead of 5
+  ExpectWellFormed(sym, "symmetric grid");
+  // The same box, the same total volume; the walls are one of six equal cells each.
+  EXPECT_LT((sym.vertices.colwise().minCoeff() - plain.vertices.colwise().minCoeff()).norm(),
+            1e-12);
+  EXPECT_LT((sym.vertices.colwise().maxCoeff() - plain.vertices.colwise().maxCoeff()).norm(),
+            1e-12);
+  EXPECT_NEAR(TotalVolume(sym), TotalVolume(plain), 1e-9);
+  double wall = 0;
+  for (const auto& e : sym.elements)
+    if (e.region == 0) wall += TetVol(sym, e);
+  EXPECT_NEAR(wall, 2 * (5 * h / 6) * 4 * h * 3 * h, 1e-9);
+  // Even counts, and axes not asked for, keep VoxelTetMesh's mesh bit for bit.
+  const Mesh even = SymmetricVoxelTetMesh(
+      o, h, Eigen::Vector3i(4, 4, 5), {true, true, false},
+      [](const Eigen::Vector3d& c, const Eigen::Vector3i& k) { return (c.x() > 2.0) + k[2] % 2; });
+  const Mesh ref = VoxelTetMesh(
+      o, h, Eigen::Vector3i(4, 4, 5),
+      [](const Eigen::Vector3d& c, const Eigen::Vector3i& k) { return (c.x() > 2.0) + k[2] % 2; });
+  ASSERT_EQ(even.num_elements(), ref.num_elements());
+  EXPECT_EQ(even.vertices, ref.vertices);
+  for (int e = 0; e < ref.num_elements(); ++e) {
+    EXPECT_EQ(even.elements[e].v, ref.elements[e].v);
+    EXPECT_EQ(even.elements[e].region, ref.elements[e].region);
+  }
+  EXPECT_THROW(SymmetricVoxelTetMesh(o, 0.0, n, {true, true, true}, design), std::invalid_argument);
+  EXPECT_THROW(SymmetricVoxelTetMesh(o, h, Eigen::Vector3i(1, 0, 1), {true, true, true}, design),
+               std::invalid_argument);
+  EXPECT_THROW(SymmetricVoxelTetMesh(o, h, n, {true, true, true}, nullptr), std::invalid_argument);
 }
 
 // ---------------------------------------------------------------------------------------------

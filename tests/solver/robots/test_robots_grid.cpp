@@ -367,7 +367,7 @@ TEST(RobotGrid, PneumaticFingerDesignGridKeepsItsDimensionsAndSymmetry) {
   const FkResult r = MakeFkSolver(model, FkOptions{})->Solve(Eigen::VectorXd::Constant(1, 2.0));
   ASSERT_EQ(r.status, FkStatus::Converged) << r.message;
   const Eigen::RowVector3d tip = s.marker_positions(r.positions).row(s.marker_index("tip"));
-  EXPECT_NEAR(tip.y(), 10.0, 1e-4);  // odd res: the snapped grid drifts sideways
+  EXPECT_NEAR(tip.y(), 10.0, 1e-4);  // odd res: in the mirror plane
   EXPECT_LT(tip.z(), 0.0);
   EXPECT_THROW(MakeRobot("pneumatic_finger", 7, {{"design_grid", 0.5}}), std::invalid_argument);
 }
