@@ -86,7 +86,9 @@ TEST(RobotSymmetry, MirrorSymmetricDesignsBendInTheirPlane) {
     SCOPED_TRACE(c.robot + " res " + std::to_string(c.res));
     const Mesh mesh = MakeRobot(c.robot, c.res).mesh;
     EXPECT_EQ(test::UnmatchedMirrorElements(mesh, 1, c.plane_y), 0);
-    if (c.robot == "bimaterial_bar") EXPECT_EQ(test::UnmatchedMirrorElements(mesh, 2, 6.0), 0);
+    if (c.robot == "bimaterial_bar") {
+      EXPECT_EQ(test::UnmatchedMirrorElements(mesh, 2, 6.0), 0);
+    }
   }
   // The strip at res 3 (W / h = 15 cubic cells) is cut into an even 16 across its width.
   EXPECT_EQ(UnmatchedMirrorVertices(MakeRobot("bilayer_strip", 3).mesh, 5.0), 0);
