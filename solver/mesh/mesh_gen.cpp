@@ -29,6 +29,19 @@ Element MakeTet(int a, int b, int c, int d, int region) {
   return e;
 }
 
+// The arguments of a regular voxel grid, checked before any line is made; `who` names the caller.
+void CheckVoxelGrid(const char* who, double h, const Eigen::Vector3i& cells,
+                    const VoxelClassifier& classify) {
+  if (!(h > 0.0) || !std::isfinite(h))
+    throw std::invalid_argument(std::string(who) + ": cell size h must be > 0, got " +
+                                std::to_string(h));
+  if (cells.minCoeff() < 1)
+    throw std::invalid_argument(std::string(who) + ": every cell count must be >= 1");
+  if (!classify) throw std::invalid_argument(std::string(who) + ": no cell classifier given");
+  if (std::int64_t(cells[0] + 1) * (cells[1] + 1) * (cells[2] + 1) > std::int64_t(1) << 30)
+    throw std::invalid_argument(std::string(who) + ": grid too large");
+}
+
 }  // namespace
 
 // ------------------------------------------------------------------------------------------------
@@ -37,13 +50,7 @@ Element MakeTet(int a, int b, int c, int d, int region) {
 
 Mesh VoxelTetMesh(const Eigen::Vector3d& origin, double h, const Eigen::Vector3i& cells,
                   const VoxelClassifier& classify) {
-  if (!(h > 0.0) || !std::isfinite(h))
-    throw std::invalid_argument("VoxelTetMesh: cell size h must be > 0, got " + std::to_string(h));
-  if (cells.minCoeff() < 1)
-    throw std::invalid_argument("VoxelTetMesh: every cell count must be >= 1");
-  if (!classify) throw std::invalid_argument("VoxelTetMesh: no cell classifier given");
-  if (std::int64_t(cells[0] + 1) * (cells[1] + 1) * (cells[2] + 1) > std::int64_t(1) << 30)
-    throw std::invalid_argument("VoxelTetMesh: grid too large");
+  CheckVoxelGrid("VoxelTetMesh", h, cells, classify);
   std::array<std::vector<double>, 3> lines;
   for (int d = 0; d < 3; ++d)
     for (int i = 0; i <= cells[d]; ++i) lines[d].push_back(origin[d] + h * double(i));
@@ -52,12 +59,7 @@ Mesh VoxelTetMesh(const Eigen::Vector3d& origin, double h, const Eigen::Vector3i
 
 Mesh SymmetricVoxelTetMesh(const Eigen::Vector3d& origin, double h, const Eigen::Vector3i& cells,
                            const std::array<bool, 3>& even, const VoxelClassifier& classify) {
-  if (!(h > 0.0) || !std::isfinite(h))
-    throw std::invalid_argument("SymmetricVoxelTetMesh: cell size h must be > 0, got " +
-                                std::to_string(h));
-  if (cells.minCoeff() < 1)
-    throw std::invalid_argument("SymmetricVoxelTetMesh: every cell count must be >= 1");
-  if (!classify) throw std::invalid_argument("SymmetricVoxelTetMesh: no cell classifier given");
+  CheckVoxelGrid("SymmetricVoxelTetMesh", h, cells, classify);
   std::array<std::vector<double>, 3> lines;
   for (int d = 0; d < 3; ++d) {
     const int n = cells[d], m = even[d] ? n + n % 2 : n;
