@@ -38,8 +38,8 @@ namespace {
 // asked: the actuation elements are soft constraints, Eq. 2.10, held back by the rigid walls,
 // floor and roof). With the thesis's weight 5 and gain 2 it is 41 degrees at res 8. A
 // PneuNet-style variant with gaps between the chamber boxes did not bend more (50). The mesh is
-// mirror-symmetric about y = 10 (res is even), so v and -v give mirror images, and about its
-// mid-thickness (an odd count of cell layers is cut into one more), so the motion stays in x-y.
+// mirror-symmetric about y = 10, so v and -v give mirror images, and about its mid-thickness, so
+// the motion stays in x-y (an odd count of cells across either plane is cut into one more).
 // Markers: tip (distal face x = L), j1, j2 (the connectors' distal faces: the ends of sections 1
 // and 2). With design_grid = 1 the grid lines sit on the nominal dimensions instead, at any res
 // (DesignGridManipulatorMesh; docs/fidelity.md has what it changes, and that it still does not
@@ -165,11 +165,6 @@ Scene MakeFingerManipulator(int res, const RobotParams& P) {
     const ManipDesign d = MakeManipDesign();
     return FinishManipulator(P, DesignGridManipulatorMesh(res, d), d.joint_end);
   }
-  if (res % 2 != 0)
-    throw std::invalid_argument(
-        "finger_manipulator: --res must be even (mirror symmetry about "
-        "the mid-plane y = 10), got " +
-        std::to_string(res));
   const double h = kManipWidth / res;
   const int ny = res, nz = static_cast<int>(std::lround(kManipThick / h));
   const int wall = Cells(kManipWall, h), cav = Cells(kManipCavity, h);
@@ -208,12 +203,13 @@ Scene MakeFingerManipulator(int res, const RobotParams& P) {
     return 0;
   };
   const double joint_end[2] = {joints[0].second * h, joints[1].second * h};
-  // Mirror-symmetric about y = 10 (res is even) and about the mid-thickness: an odd count of
-  // cell layers (5 at the default res 8, 7 at res 12) is cut into one layer more, of equal height
-  // (SymmetricVoxelTetMesh). With the odd count every tet leaned one way and the tip left its
-  // plane (2.6 mm at s1 = 0.5 at res 8, 5.6 mm at s1 = 3). Cutting only the middle layer in two
-  // was measured too: its half-height tets folded, 72 inverted elements at s1 = 3 with the
-  // thesis's weight 5 and gain 2, where the equal layers have none.
+  // Mirror-symmetric about y = 10 and about the mid-thickness: an odd count of cells across either
+  // plane (res across the width at odd res; 5 layers through the thickness at the default res 8,
+  // 7 at res 12) is cut into one more, of equal size (SymmetricVoxelTetMesh). With the odd count
+  // every tet leaned one way and the tip left its plane (2.6 mm at s1 = 0.5 at res 8, 5.6 mm at s1
+  // = 3). Cutting only the middle layer in two was measured too: its half-height tets folded, 72
+  // inverted elements at s1 = 3 with the thesis's weight 5 and gain 2, where the equal layers have
+  // none.
   return FinishManipulator(
       P,
       SymmetricVoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, ny, nz),
@@ -233,8 +229,7 @@ RobotEntry FingerManipulatorEntry() {
       "v > 0 inflates the +y chambers to volume ratio 1 + gain v (bending towards -y), v < 0 the "
       "-y chambers. Redundant: m = 3, n = 2. Markers: tip, j1, j2 (ends of sections 1 and 2).",
       kManipDefaultRes,
-      "cells across the 20 mm width (cell size 20/res mm), integer in [6, 24], even unless "
-      "design_grid = 1",
+      "cells across the 20 mm width (cell size 20/res mm), integer in [6, 24]",
       {{"gain", kManipGain, 0.1, 10.0,
         "volume ratio per unit of actuation: a chamber side reaches 1 + gain |v|"},
        {"spine_weight", 20.0, 0.01, 100.0, "element weight of the central spine"},
@@ -242,8 +237,9 @@ RobotEntry FingerManipulatorEntry() {
         "element weight of the chambers' actuation elements"},
        {"body_r_omega", 1.0, 0.0, 1.0, "R_omega of the body material (walls, floor, roof)"},
        {"design_grid", 0.0, 0.0, 1.0,
-        "0: features snap to whole cells of 20/res mm (walls and cavities change with res, res "
-        "even); 1: grid lines on the nominal dimensions (1.5 mm walls, floor and roof, six 4 mm "
+        "0: features snap to whole cells of 20/res mm (walls and cavities change with res; an odd "
+        "count of cells across a mirror plane is cut into one more); 1: grid lines on the nominal "
+        "dimensions (1.5 mm walls, floor and roof, six 4 mm "
         "cavities per section, 3 mm spine) at every res, mirror-symmetric about y = 10 and z = "
         "6"}}};
   return {info, kManipMinRes, kManipMaxRes, &MakeFingerManipulator};

@@ -339,7 +339,6 @@ TEST(RobotParams, UnknownOrOutOfRangeParametersAreRejectedByName) {
         << e.what();
   }
   EXPECT_THROW(MakeRobot("three_chamber", 3, {{"gain", 1}}), std::invalid_argument);
-  EXPECT_THROW(MakeRobot("finger_manipulator", 7), std::invalid_argument);  // odd res
 }
 
 }  // namespace
