@@ -30,7 +30,8 @@ namespace {
 // pinned (the stance foot), the bottom of the front leg has only z held (it slides on the
 // ground). Markers: tip (front face x = 60), rear_foot / front_foot (centroids of the leg
 // bottoms), apex (the frame's top surface at x = 30). The leg spacing is front_foot - rear_foot.
-// Resolution: prisms per 20 mm of width (in-plane cell 20 / res mm).
+// Resolution: prisms per 20 mm of width (in-plane cell 20 / res mm); an odd res has res + 1 across
+// the width, so that the mesh is mirror-symmetric about y = 10.
 // ================================================================================================
 
 constexpr int kCrawlMinRes = 4, kCrawlMaxRes = 40, kCrawlDefaultRes = 8;
@@ -39,8 +40,11 @@ constexpr double kCrawlLength = 60.0, kCrawlWidth = 20.0, kCrawlLeg = 5.0, kCraw
                  kCrawlInit = 0.7;
 
 Scene MakeDeaCrawler(int res, const RobotParams& P) {
+  // PrismGridMesh's triangulation is symmetric about every grid line, and the mid-width y = 10 is
+  // one only over an even number of cells: an odd res is cut into res + 1 across the same width.
   const double h = kCrawlWidth / res;
-  const int nx = static_cast<int>(std::lround(kCrawlLength / h)), ny = res;
+  const int nx = static_cast<int>(std::lround(kCrawlLength / h)), ny = res + (res & 1);
+  const double hy = kCrawlWidth / ny;
   // Layers: legs split into cells of about h, then the membrane and the frame.
   const int leg_layers = std::max(1, static_cast<int>(std::lround(kCrawlLegHeight / h)));
   std::vector<double> z;
@@ -55,7 +59,7 @@ Scene MakeDeaCrawler(int res, const RobotParams& P) {
   };
   Scene s;
   s.name = "dea_crawler";
-  s.mesh = PrismGridMesh(Eigen::Vector3d::Zero(), h, h, Eigen::Vector2i(nx, ny), z, cell);
+  s.mesh = PrismGridMesh(Eigen::Vector3d::Zero(), h, hy, Eigen::Vector2i(nx, ny), z, cell);
   s.body[0] = Material{"frame", 1.0, P.at("frame_weight")};
   s.body[2] = Material{"elastomer", 1.0, 1.0};
   s.body[3] = Material{"leg", 1.0, 20.0};
@@ -98,7 +102,8 @@ RobotEntry DeaCrawlerEntry() {
       "pre-stretched state. The rear foot is pinned, the front foot slides on the x-y plane (z "
       "held). Markers: tip, rear_foot, front_foot, apex (top of the frame at mid-length).",
       kCrawlDefaultRes,
-      "prisms across the 20 mm width (in-plane cell 20/res mm), integer in [4, 40]",
+      "prisms along 20 mm (in-plane cell 20/res mm; an odd res has res + 1 across the width, "
+      "for mirror symmetry about y = 10), integer in [4, 40]",
       {{"frame_thickness", kCrawlFrame, 0.2, 5.0, "thickness of the frame layer, mm"},
        {"frame_weight", 1.0, 0.01, 100.0, "element weight of the frame (membrane: 1, DEA: 5)"}}};
   return {info, kCrawlMinRes, kCrawlMaxRes, &MakeDeaCrawler};

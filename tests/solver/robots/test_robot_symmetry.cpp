@@ -3,7 +3,8 @@
 // (every actuator spans both sides of the plane) keeps its markers on the plane. The voxel split
 // is mirrored cell by cell (mesh_gen.hpp), which is symmetric over an even number of cells
 // across the plane; the voxel robots cut an odd count into one more cell
-// (SymmetricVoxelTetMesh), so they are symmetric at odd resolutions too. Before, at res 5 and 7
+// (SymmetricVoxelTetMesh), so they are symmetric at odd resolutions too, and so does the prism
+// grid of dea_crawler (its diagonals alternate cell by cell). Before, at res 5 and 7
 // every tet leaned one way and the tips drifted off the plane (pneumatic_finger res 7 at alpha 3
 // by 0.52 mm, multi_segment_gripper res 7 at (3, 3, 3) by 1.2 mm).
 #include "softkin/solver/factory/fk_factory.hpp"
@@ -40,6 +41,7 @@ TEST(RobotSymmetry, MirrorSymmetricDesignsBendInTheirPlane) {
       {"multi_segment_gripper", 6, 10.0, {3.0, 3.0, 3.0}},
       {"cable_gripper", 6, 10.0, {0.8}},
       {"dea_crawler", 8, 10.0, {0.85}},
+      {"dea_crawler", 5, 10.0, {0.85}},
       {"bilayer_strip", 1, 5.0, {1.1}},
   };
   for (const MirrorCase& c : cases) {
@@ -81,6 +83,7 @@ TEST(RobotSymmetry, MirrorSymmetricDesignsBendInTheirPlane) {
                                                {"multi_segment_gripper", 7, 10.0},
                                                {"cable_gripper", 7, 10.0},
                                                {"selfcollision_finger", 5, 10.0},
+                                               {"dea_crawler", 7, 10.0},
                                                {"bimaterial_bar", 3, 6.0},
                                                {"bimaterial_bar", 5, 6.0}}) {
     SCOPED_TRACE(c.robot + " res " + std::to_string(c.res));
