@@ -38,13 +38,16 @@ constexpr int kMemMinRes = 10, kMemMaxRes = 60, kMemDefaultRes = 20;
 constexpr double kMemSide = 250.0, kMemChamberHeight = 40.0, kMemGap = 2.0, kMemMaxAlpha = 4.0;
 
 Scene MakeMembrane(int res, const RobotParams& P) {
-  const double h = kMemSide / res;
-  const int n = res;
+  // An even count of cells across: the voxel split is mirrored cell by cell, so it is symmetric
+  // about the mid-planes x, y = 125 only then (an odd res takes res + 1 cells).
+  const int n = res + (res & 1);
+  const double h = kMemSide / n;
   const int gap = static_cast<int>(std::lround(P.at("chamber_gap")));
   if (std::abs(P.at("chamber_gap") - gap) > 1e-9)
     throw std::invalid_argument("membrane: chamber_gap: expected an integer number of cells, got " +
                                 std::to_string(P.at("chamber_gap")));
-  // Chamber width in cells: 1 margin + nc + gap + nc + (the rest) margin.
+  // Chamber width in cells: 1 margin + nc + gap + nc + (the rest) margin. An odd gap leaves one
+  // more cell of margin on the far sides: that layout is off-centre by half a cell.
   const int nc = (n - 2 - gap) / 2;
   if (nc < 3)
     throw std::invalid_argument("membrane: chamber_gap = " + std::to_string(gap) +
@@ -121,11 +124,13 @@ RobotEntry MembraneEntry() {
       "Self-collision response on. Markers: tip (membrane top centre), q1..q4 (membrane top above "
       "each chamber).",
       kMemDefaultRes,
-      "cells across the 250 mm side (cell size 250/res mm), integer in [10, 60]",
+      "cells across the 250 mm side (cell size 250/res mm; an odd res takes res + 1, so that the "
+      "mesh is mirror-symmetric about x = 125 and y = 125), integer in [10, 60]",
       {{"chamber_gap", 2.0, 1.0, 10.0,
         "cells between neighbouring chambers (integer). With 1 the swelling chambers' side walls "
         "press on each other and the contact response breaks down at res 24 "
-        "(docs/collision_response.md)"}}};
+        "(docs/collision_response.md). An odd gap leaves the far margins one cell wider than the "
+        "near ones, so the layout is off-centre by half a cell"}}};
   return {info, kMemMinRes, kMemMaxRes, &MakeMembrane};
 }
 

@@ -93,6 +93,13 @@ TEST(RobotSymmetry, MirrorSymmetricDesignsBendInTheirPlane) {
       EXPECT_EQ(test::UnmatchedMirrorElements(mesh, 2, 6.0), 0);
     }
   }
+  // The membrane's 2 x 2 chambers, about both mid-planes: an odd res takes one more cell across.
+  for (int res : {11, 20}) {
+    SCOPED_TRACE("membrane res " + std::to_string(res));
+    const Mesh mesh = MakeRobot("membrane", res).mesh;
+    EXPECT_EQ(test::UnmatchedMirrorElements(mesh, 0, 125.0), 0);
+    EXPECT_EQ(test::UnmatchedMirrorElements(mesh, 1, 125.0), 0);
+  }
   // The strip at res 3 (W / h = 15 cubic cells) is cut into an even 16 across its width.
   EXPECT_EQ(UnmatchedMirrorVertices(MakeRobot("bilayer_strip", 3).mesh, 5.0), 0);
   // The 12,000-tet strip of the benchmarks: 50 x 10 x 4 cells of 2 x 1 x 1 mm, same outline.
