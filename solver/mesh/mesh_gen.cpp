@@ -184,7 +184,9 @@ int ConcentricDisk::sector(int p) const {
 
 long ConcentricDisk::key(int p) const {
   const int j = ring[p];
-  return j == 0 ? 0L : long(j) * (2L * rings + 1) + index[p] % (2 * j);
+  if (j == 0) return 0L;
+  const int u = index[p] % (2 * j);  // the angular index within the sector
+  return long(j) * (2L * rings + 1) + std::min(u, 2 * j - u);  // folded: mirror invariant
 }
 
 int ConcentricDisk::rotated(int p, int s) const {
@@ -227,12 +229,16 @@ ConcentricDisk MakeConcentricDisk(double radius, int rings) {
   }
   // Ring 1 fan around the centre.
   for (int o = 0; o < 6; ++o) d.triangles.push_back({0, d.id(1, o), d.id(1, o + 1)});
-  // Rings j-1, j: merge the points by angle i/n (compared exactly as integers).
+  // Rings j-1, j: point i of a ring of n points owns the angles (i -+ 1/2) / n turns, and two
+  // points of consecutive rings are joined where their intervals overlap: the strip advances on
+  // the ring whose current interval ends first, (2i + 1) / 2n (compared exactly as integers).
+  // The rule is symmetric under reflection i -> -i as well as under rotation, and it never ties:
+  // (2i + 1) j and (2o + 1) (j - 1) differ in parity.
   for (int j = 2; j <= rings; ++j) {
     const long n0 = 6L * (j - 1), n1 = 6L * j;
     long i = 0, o = 0;
     while (i < n0 || o < n1) {
-      const bool inner = (o == n1) || (i < n0 && (i + 1) * n1 < (o + 1) * n0);
+      const bool inner = (o == n1) || (i < n0 && (2 * i + 1) * n1 < (2 * o + 1) * n0);
       if (inner) {
         d.triangles.push_back({d.id(j - 1, int(i)), d.id(j, int(o)), d.id(j - 1, int(i + 1))});
         ++i;

@@ -90,11 +90,13 @@ Mesh PrismGridMesh(const Eigen::Vector3d& origin, double hx, double hy,
 
 /// A disk triangulated in concentric rings: ring 0 is the centre point, ring j (1 <= j <= rings)
 /// has 6j points at radius radius * j / rings and angles 2*pi*i / (6j), i = 0 .. 6j-1, measured
-/// from the first in-plane axis towards the second. Consecutive rings are joined by merging their
-/// points by angle (exact integer comparison; on a tie the outer ring advances first), giving
-/// 6 * (2j - 1) triangles between rings j-1 and j and 6 * rings^2 triangles in all. Because 3
-/// divides 6j and the merge rule depends only on angles, rotating by 120 degrees maps the point
-/// set and the triangle set exactly onto themselves: point (j, i) -> (j, i + 2j mod 6j).
+/// from the first in-plane axis towards the second. Point i of ring j owns the angles
+/// (i -+ 1/2) / (6j) turns; consecutive rings are joined where those intervals overlap (exact
+/// integer comparison, never a tie), giving 6 * (2j - 1) triangles between rings j-1 and j and
+/// 6 * rings^2 triangles in all. The rule depends only on angles, so the triangle set is mapped
+/// exactly onto itself by rotation by 120 degrees, point (j, i) -> (j, i + 2j mod 6j), and by the
+/// reflection across the first in-plane axis, (j, i) -> (j, -i mod 6j): the dihedral symmetry of
+/// three chambers on the axes 0, 120 and 240 degrees (or 60, 180 and 300).
 struct ConcentricDisk {
   double radius = 0.0;  ///< mm
   int rings = 0;
@@ -108,8 +110,8 @@ struct ConcentricDisk {
   int id(int j, int i) const;
   /// Sector s in {0, 1, 2} of a non-centre point: i / (2j). The centre has sector 0.
   int sector(int p) const;
-  /// Ordering key invariant under the 120-degree rotation: ring * 2*rings + (i mod 2j).
-  /// Distinct for the vertices of any one triangle.
+  /// Ordering key invariant under the 120-degree rotation and the reflection: ring * (2*rings + 1)
+  /// + min(u, 2j - u) with u = i mod 2j. Distinct for the vertices of any one triangle.
   long key(int p) const;
   /// Point id of the image of point p under rotation by s * 120 degrees (s may be negative).
   int rotated(int p, int s) const;
@@ -147,16 +149,17 @@ struct DiskElementInfo {
 using DiskRegionFn = std::function<int(const DiskElementInfo&)>;
 
 /// Extrudes MakeConcentricDisk(radius, rings) along `axis` into `layers` equal layers of prisms
-/// and splits each prism into 3 tets with a rule that is conforming and 3-fold symmetric: the
-/// triangle's vertices are ordered a < b < c by ConcentricDisk::key (invariant under the rotation),
+/// and splits each prism into 3 tets with a rule that is conforming and as symmetric as the disk:
+/// the triangle's vertices are ordered a < b < c by ConcentricDisk::key (invariant under the
+/// rotation and the reflection),
 /// every vertical quad face gets the diagonal from the lower-key vertex's bottom copy to the
 /// higher-key vertex's top copy (a property of the edge alone, so both prisms sharing a face
 /// agree), and the tets are (a_b,b_b,c_b,c_t), (a_b,b_b,b_t,c_t), (a_b,a_t,b_t,c_t) (b = bottom, t
 /// = top), flipped where needed to be positively oriented. Output: #V = (layers+1) * #P vertices
 /// (mm; vertex id = layer * #P + disk point id) and 18 * rings^2 * layers tets with regions from
-/// `region` (a null function tags everything 0). Rotation by 120 degrees about the axis maps
-/// vertices and tets onto themselves. Throws std::invalid_argument on bad parameters or a negative
-/// region tag.
+/// `region` (a null function tags everything 0). Rotation by 120 degrees about the axis and the
+/// reflection across the first in-plane axis map vertices and tets onto themselves. Throws
+/// std::invalid_argument on bad parameters or a negative region tag.
 Mesh ExtrudedDiskTetMesh(const DiskExtrusion& params, const DiskRegionFn& region = nullptr);
 
 /// In-plane axes (first, second) used for `axis` by ExtrudedDiskTetMesh: axis 0 -> (1, 2),

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 namespace softkin {
 namespace robots_detail {
@@ -26,13 +27,33 @@ namespace {
 // Inflating chamber k alone bends the tip away from it, towards phi_k + 180 = 0, 120, 240 deg:
 // the three petal directions of the 'flower' trajectory, visited in the order c1, c2, c3.
 // Chamber elements are the tets whose centroid lies inside a chamber; tags are assigned on the
-// canonical (sector-0) copy of every tet, so the tagging is exactly 3-fold symmetric.
+// canonical (sector-0) copy of every tet, so the tagging is exactly 3-fold symmetric. The mesh is
+// also mirror-symmetric about each chamber's plane (ConcentricDisk), so inflating one chamber, or
+// the other two equally, bends the robot in that plane.
 // ================================================================================================
 
 constexpr int kThreeMinRes = 3, kThreeMaxRes = 16, kThreeDefaultRes = 7;
 constexpr double kThreeRadius = 24.0, kThreeLength = 136.0;
 constexpr double kChamberRadius = 7.0, kChamberOffset = 13.0, kChamberY0 = 8.0, kChamberY1 = 128.0;
 constexpr double kChamberAngle0 = 180.0;  // degrees, chamber 0 (c1)
+
+/// Two chambers that share a vertex would be one cavity. Where the tagging by centroid puts tets
+/// of two chambers on a common vertex (at res 3, on the mirror plane between two chambers), every
+/// chamber tet on that vertex stays body: a rule as symmetric as the mesh.
+void SeparateChambers(Mesh* mesh) {
+  std::vector<int> owner(mesh->num_vertices(), 0);
+  std::vector<char> shared(mesh->num_vertices(), 0);
+  for (const Element& e : mesh->elements)
+    if (e.region != 0)
+      for (int j = 0; j < e.k(); ++j) {
+        int& o = owner[e.v[j]];
+        if (o != 0 && o != e.region) shared[e.v[j]] = 1;
+        o = e.region;
+      }
+  for (Element& e : mesh->elements)
+    for (int j = 0; j < e.k() && e.region != 0; ++j)
+      if (shared[e.v[j]]) e.region = 0;
+}
 
 Scene MakeThreeChamber(int res, const RobotParams& P) {
   const double chamber_radius = P.at("chamber_radius");
@@ -60,6 +81,7 @@ Scene MakeThreeChamber(int res, const RobotParams& P) {
   Scene s;
   s.name = "three_chamber";
   s.mesh = ExtrudedDiskTetMesh(p, region);
+  SeparateChambers(&s.mesh);
   s.body[0] = Material{"body", 1.0, 1.0};
   for (int k = 0; k < 3; ++k) {
     Actuator a;
@@ -88,7 +110,8 @@ RobotEntry ThreeChamberEntry() {
       "y = long axis (y = 0 fixed, tip face y = 136); angles phi = atan2(z, x) in the x-z plane. "
       "Chambers c1, c2, c3 (regions 1-3, pneumatic, volume ratio in [1, 3]): radius 7 mm, 13 mm "
       "from the axis at phi = 180, 300, 60 degrees, y in [8, 128]; body region 0. The mesh is "
-      "exactly invariant under rotation by 120 degrees about y (c1 -> c2 -> c3). Marker: tip "
+      "exactly invariant under rotation by 120 degrees about y (c1 -> c2 -> c3) and under the "
+      "mirror z -> -z (c2 <-> c3). Marker: tip "
       "(top face y = 136).",
       kThreeDefaultRes,
       "number of concentric rings of the cross-section disk (radial spacing 24/res mm; layers "

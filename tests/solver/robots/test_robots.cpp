@@ -205,14 +205,20 @@ std::array<int, 4> SortedTet(const Element& e, const std::vector<int>& map) {
   return t;
 }
 
-// Checks that rotating by 120 degrees maps the vertex set onto itself and every tet with region r
-// onto a tet with region region_map(r).
-template <class RegionMap>
-void ExpectThreeFold(const Mesh& m, int a, int b, RegionMap region_map) {
-  const std::vector<int> map = VertexMap(
-      m, [&](const Eigen::Vector3d& x) { return Rot120(x, a, b); }, 1e-9);
+// Reflection across the plane x_b = 0 (in the plane of coordinates (a, b): across axis a).
+Eigen::Vector3d Reflect(const Eigen::Vector3d& x, int b) {
+  Eigen::Vector3d y = x;
+  y[b] = -x[b];
+  return y;
+}
+
+// Checks that the isometry f maps the vertex set onto itself and every tet with region r onto a
+// tet with region region_map(r).
+template <class F, class RegionMap>
+void ExpectMapsOntoItself(const Mesh& m, F f, RegionMap region_map) {
+  const std::vector<int> map = VertexMap(m, f, 1e-9);
   const int missing = static_cast<int>(std::count(map.begin(), map.end(), -1));
-  ASSERT_EQ(missing, 0) << "vertices without a rotated image";
+  ASSERT_EQ(missing, 0) << "vertices without an image";
   std::vector<int> sorted = map;
   std::sort(sorted.begin(), sorted.end());
   EXPECT_TRUE(std::adjacent_find(sorted.begin(), sorted.end()) == sorted.end())
@@ -232,6 +238,13 @@ void ExpectThreeFold(const Mesh& m, int a, int b, RegionMap region_map) {
   }
   EXPECT_EQ(unmatched, 0);
   EXPECT_EQ(wrong_region, 0);
+}
+
+// Rotation by 120 degrees in the plane of coordinates (a, b).
+template <class RegionMap>
+void ExpectThreeFold(const Mesh& m, int a, int b, RegionMap region_map) {
+  ExpectMapsOntoItself(
+      m, [&](const Eigen::Vector3d& x) { return Rot120(x, a, b); }, region_map);
 }
 
 Eigen::Vector3d Centroid(const Mesh& m, const std::vector<int>& vs) {
@@ -478,6 +491,11 @@ TEST(MeshGenDisk, ExtrusionIsExactlyThreeFoldSymmetric) {
     });
     EXPECT_EQ(checked, m.num_elements());
     ExpectThreeFold(m, pl[0], pl[1], [](int r) { return (r + 1) % 3; });
+    // And the reflection across the first in-plane axis.
+    const Mesh plain = ExtrudedDiskTetMesh(p);
+    ExpectMapsOntoItself(
+        plain, [&](const Eigen::Vector3d& x) { return Reflect(x, pl[1]); },
+        [](int r) { return r; });
   }
 }
 
@@ -775,12 +793,18 @@ TEST(RobotsThreeChamber, DimensionsActuatorsFixedAndTip) {
   EXPECT_NEAR(c1.y(), 68.0, 2.0);
 }
 
-TEST(RobotsThreeChamber, ExactlyThreeFoldSymmetricWithEqualChambers) {
+TEST(RobotsThreeChamber, ExactlyThreeFoldAndMirrorSymmetricWithEqualChambers) {
   for (int res : {3, 7}) {
     SCOPED_TRACE(res);
     const Scene s = MakeRobot("three_chamber", res);
     // phi = atan2(z, x): rotate from +x towards +z; chamber k -> k+1, body -> body.
     ExpectThreeFold(s.mesh, 0, 2, [](int r) { return r == 0 ? 0 : 1 + r % 3; });
+    // The mirror z -> -z through c1's axis (phi = 180 degrees) keeps c1 and swaps c2 and c3.
+    ExpectMapsOntoItself(
+        s.mesh, [](const Eigen::Vector3d& x) { return Reflect(x, 2); },
+        [](int r) { return r == 2   ? 3
+                           : r == 3 ? 2
+                                    : r; });
     const double v1 = TotalVolume(s.mesh, 1), v2 = TotalVolume(s.mesh, 2),
                  v3 = TotalVolume(s.mesh, 3);
     EXPECT_GT(v1, 0.0);
