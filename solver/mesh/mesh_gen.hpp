@@ -151,11 +151,10 @@ using DiskRegionFn = std::function<int(const DiskElementInfo&)>;
 /// Extrudes MakeConcentricDisk(radius, rings) along `axis` into `layers` equal layers of prisms
 /// and splits each prism into 3 tets with a rule that is conforming and as symmetric as the disk:
 /// the triangle's vertices are ordered a < b < c by ConcentricDisk::key (invariant under the
-/// rotation and the reflection),
-/// every vertical quad face gets the diagonal from the lower-key vertex's bottom copy to the
-/// higher-key vertex's top copy (a property of the edge alone, so both prisms sharing a face
-/// agree), and the tets are (a_b,b_b,c_b,c_t), (a_b,b_b,b_t,c_t), (a_b,a_t,b_t,c_t) (b = bottom, t
-/// = top), flipped where needed to be positively oriented. Output: #V = (layers+1) * #P vertices
+/// rotation and the reflection), every vertical quad face gets the diagonal from the lower-key
+/// vertex's bottom copy to the higher-key vertex's top copy (a property of the edge alone, so
+/// both prisms sharing a face agree), and the tets are (a_b,b_b,c_b,c_t), (a_b,b_b,b_t,c_t),
+/// (a_b,a_t,b_t,c_t) (b = bottom, t = top), flipped where needed to be positively oriented. Output: #V = (layers+1) * #P vertices
 /// (mm; vertex id = layer * #P + disk point id) and 18 * rings^2 * layers tets with regions from
 /// `region` (a null function tags everything 0). Rotation by 120 degrees about the axis and the
 /// reflection across the first in-plane axis map vertices and tets onto themselves. Throws

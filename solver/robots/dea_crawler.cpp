@@ -102,8 +102,8 @@ RobotEntry DeaCrawlerEntry() {
       "pre-stretched state. The rear foot is pinned, the front foot slides on the x-y plane (z "
       "held). Markers: tip, rear_foot, front_foot, apex (top of the frame at mid-length).",
       kCrawlDefaultRes,
-      "prisms along 20 mm (in-plane cell 20/res mm; an odd res has res + 1 across the width, "
-      "for mirror symmetry about y = 10), integer in [4, 40]",
+      "prisms per 20 mm (in-plane cell 20/res mm; an odd res has res + 1 across the 20 mm "
+      "width, for mirror symmetry about y = 10), integer in [4, 40]",
       {{"frame_thickness", kCrawlFrame, 0.2, 5.0, "thickness of the frame layer, mm"},
        {"frame_weight", 1.0, 0.01, 100.0, "element weight of the frame (membrane: 1, DEA: 5)"}}};
   return {info, kCrawlMinRes, kCrawlMaxRes, &MakeDeaCrawler};
