@@ -154,11 +154,12 @@ using DiskRegionFn = std::function<int(const DiskElementInfo&)>;
 /// rotation and the reflection), every vertical quad face gets the diagonal from the lower-key
 /// vertex's bottom copy to the higher-key vertex's top copy (a property of the edge alone, so
 /// both prisms sharing a face agree), and the tets are (a_b,b_b,c_b,c_t), (a_b,b_b,b_t,c_t),
-/// (a_b,a_t,b_t,c_t) (b = bottom, t = top), flipped where needed to be positively oriented. Output: #V = (layers+1) * #P vertices
-/// (mm; vertex id = layer * #P + disk point id) and 18 * rings^2 * layers tets with regions from
-/// `region` (a null function tags everything 0). Rotation by 120 degrees about the axis and the
-/// reflection across the first in-plane axis map vertices and tets onto themselves. Throws
-/// std::invalid_argument on bad parameters or a negative region tag.
+/// (a_b,a_t,b_t,c_t) (b = bottom, t = top), flipped where needed to be positively oriented.
+/// Output: #V = (layers+1) * #P vertices (mm; vertex id = layer * #P + disk point id) and
+/// 18 * rings^2 * layers tets with regions from `region` (a null function tags everything 0).
+/// Rotation by 120 degrees about the axis and the reflection across the first in-plane axis map
+/// vertices and tets onto themselves. Throws std::invalid_argument on bad parameters or a negative
+/// region tag.
 Mesh ExtrudedDiskTetMesh(const DiskExtrusion& params, const DiskRegionFn& region = nullptr);
 
 /// In-plane axes (first, second) used for `axis` by ExtrudedDiskTetMesh: axis 0 -> (1, 2),
