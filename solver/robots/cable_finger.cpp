@@ -10,6 +10,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace softkin {
 namespace robots_detail {
@@ -32,7 +33,10 @@ namespace {
 // shortened top side becomes the concave one and the tip curls up, towards +z. Range s in
 // [0.5, 1] (rest 1): up to 50 % shortening.
 // Resolution: cells across the 25 mm width (cell size 25/res); features snap to the cells whose
-// centres they contain.
+// centres they contain. With design_grid = 1 the grid lines sit on the design's dimensions
+// instead (the teeth, gaps, base and bridge floor), each part cut into cells of about 25/res mm
+// and an even number across the width, so the knuckles, bridges and base are the same at every
+// res and the mesh is mirror-symmetric about y = 12.5.
 // ================================================================================================
 
 constexpr int kCableMinRes = 5, kCableMaxRes = 30, kCableDefaultRes = 10;
@@ -41,28 +45,49 @@ constexpr double kCableBase = 5.0, kCableBridgeFloor = 17.5;
 constexpr double kCableGaps[3][2] = {{15.0, 25.0}, {50.0, 60.0}, {85.0, 95.0}};
 constexpr double kCableMinShortening = 0.5;
 
-Scene MakeCableFinger(int res, const RobotParams&) {
+/// Region of the cell whose centre is (x, z): the base and teeth 0, bridge k + 1, else empty.
+int CableCell(double x, double z) {
+  if (z < kCableBase) return 0;
+  for (int k = 0; k < 3; ++k)
+    if (x > kCableGaps[k][0] && x < kCableGaps[k][1]) return z > kCableBridgeFloor ? k + 1 : -1;
+  return 0;
+}
+
+Scene MakeCableFinger(int res, const RobotParams& P) {
   const double h = kCableWidth / res;
+  const bool design = DesignGridFlag("cable_finger", P);
   const int nx = static_cast<int>(std::lround(kCableLength / h));
   const int nz = static_cast<int>(std::lround(kCableHeight / h));
-  auto cell = [&](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
-    const double x = (c[0] + 0.5) * h, z = (c[2] + 0.5) * h;
-    if (z < kCableBase) return 0;
-    for (int k = 0; k < 3; ++k)
-      if (x > kCableGaps[k][0] && x < kCableGaps[k][1]) return z > kCableBridgeFloor ? k + 1 : -1;
-    return 0;
-  };
   Scene s;
   s.name = "cable_finger";
-  s.mesh = SymmetricVoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, res, nz),
-                                 {false, true, false}, cell);
+  if (design) {
+    std::vector<double> bx = {0.0};
+    for (const auto& gap : kCableGaps) bx.insert(bx.end(), {gap[0], gap[1]});
+    bx.push_back(kCableLength);
+    s.mesh = RectilinearTetMesh(
+        DesignLines(bx, h), DesignLines({0.0, kCableWidth}, h, {true}),
+        DesignLines({0.0, kCableBase, kCableBridgeFloor, kCableHeight}, h),
+        [](const Eigen::Vector3d& c, const Eigen::Vector3i&) { return CableCell(c.x(), c.z()); });
+  } else {
+    s.mesh = SymmetricVoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, res, nz),
+                                   {false, true, false},
+                                   [&](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
+                                     return CableCell((c[0] + 0.5) * h, (c[2] + 0.5) * h);
+                                   });
+  }
   s.body[0] = Material{"body", 1.0, 1.0};
-  // Bridge cells actually present (snapped): the path spans them at their mid-height.
-  const double zmax = nz * h;
-  const double zmid = 0.5 * (std::ceil(kCableBridgeFloor / h - 0.5) * h + zmax);
+  // Bridge cells actually present (snapped, or on the design lines): the path spans them at their
+  // mid-height.
+  const double zmax = design ? kCableHeight : nz * h;
+  const double zmid = design ? 0.5 * (kCableBridgeFloor + kCableHeight)
+                             : 0.5 * (std::ceil(kCableBridgeFloor / h - 0.5) * h + zmax);
   for (int k = 0; k < 3; ++k) {
     double x0 = kInf, x1 = -kInf;
-    for (int i = 0; i < nx; ++i) {
+    if (design) {
+      x0 = kCableGaps[k][0];
+      x1 = kCableGaps[k][1];
+    }
+    for (int i = 0; i < nx && !design; ++i) {
       const double x = (i + 0.5) * h;
       if (x > kCableGaps[k][0] && x < kCableGaps[k][1]) {
         x0 = std::min(x0, i * h);
@@ -83,7 +108,7 @@ Scene MakeCableFinger(int res, const RobotParams&) {
               Eigen::Vector3d(x1, 0.5 * kCableWidth, zmid)};
     s.actuators.push_back(a);
   }
-  const double eps = 1e-6 * h, xmax = nx * h;
+  const double eps = 1e-6 * h, xmax = design ? kCableLength : nx * h;
   s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
   AddDistalFaceMarkers(xmax, zmax, eps, &s);
   s.validate();
@@ -102,8 +127,12 @@ RobotEntry CableFingerEntry() {
       "each tendon's path runs along x through its bridge). Markers: tip (face x = 120), tip_top / "
       "tip_bottom (top / bottom quarter of that face).",
       kCableDefaultRes,
-      "cells across the 25 mm width (cell size 25/res mm), integer in [5, 30]",
-      {}};
+      "cells across the 25 mm width (cell size 25/res mm), integer in [5, 30]; features snap "
+      "to whole cells unless design_grid = 1",
+      {{"design_grid", 0.0, 0.0, 1.0,
+        "0: teeth, gaps, base and bridges snap to whole cells of 25/res mm (their sizes change "
+        "with res); 1: grid lines on the nominal dimensions (5 mm base, 10 mm gaps, bridges from "
+        "z = 17.5) at every res, mirror-symmetric about y = 12.5"}}};
   return {info, kCableMinRes, kCableMaxRes, &MakeCableFinger};
 }
 

@@ -371,6 +371,62 @@ TEST(RobotGrid, PneumaticFingerDesignGridKeepsItsDimensionsAndSymmetry) {
   EXPECT_THROW(MakeRobot("pneumatic_finger", 7, {{"design_grid", 0.5}}), std::invalid_argument);
 }
 
+// cable_finger with design_grid = 1: each knuckle's bridge is the nominal 10 x 25 x 7.5 mm block
+// and its tendon 10 mm long at every res (snapped, both change with res: the gaps are 8.33 and
+// 12.5 mm wide at res 6 and 8), the mesh is mirror-symmetric about y = 12.5, and at the default
+// res 10, where the design's dimensions fall on whole cells, it is the snapped mesh itself.
+TEST(RobotGrid, CableFingerDesignGridKeepsItsDimensionsAndSymmetry) {
+  auto bridge_volume = [](const Mesh& mesh, int region) {
+    double v = 0.0;
+    for (const Element& e : mesh.elements)
+      if (e.region == region) {
+        const Eigen::Vector3d a = mesh.vertices.row(e.v[0]).transpose();
+        v += (mesh.vertices.row(e.v[1]).transpose() - a)
+                 .dot((mesh.vertices.row(e.v[2]).transpose() - a)
+                          .cross(mesh.vertices.row(e.v[3]).transpose() - a)) /
+             6.0;
+      }
+    return v;
+  };
+  const double nominal = 10.0 * 25.0 * 7.5;
+  bool snapped_differs = false;
+  for (int res : {6, 7, 9, 13}) {
+    const Scene s = MakeRobot("cable_finger", res, {{"design_grid", 1.0}});
+    const Model m(s);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(bridge_volume(s.mesh, k + 1), nominal, 1e-9 * nominal) << "res " << res;
+      EXPECT_NEAR(m.actuator_rest_measure(k), 10.0, 1e-9) << "res " << res;
+    }
+    EXPECT_NEAR(s.mesh.vertices.col(0).maxCoeff(), 120.0, 1e-9);
+    EXPECT_NEAR(s.mesh.vertices.col(2).maxCoeff(), 25.0, 1e-9);
+    EXPECT_EQ(test::UnmatchedMirrorVertices(s.mesh, 12.5), 0) << "res " << res;
+    EXPECT_EQ(test::UnmatchedMirrorElements(s.mesh, 1, 12.5), 0) << "res " << res;
+    const Scene snapped = MakeRobot("cable_finger", res);
+    snapped_differs |= std::abs(bridge_volume(snapped.mesh, 1) - nominal) > 1.0;
+  }
+  EXPECT_TRUE(snapped_differs);  // the design grid is not what the default grid already was
+  // Res 10: the design's dimensions are whole cells of 2.5 mm, and the two meshes coincide.
+  const Scene d10 = MakeRobot("cable_finger", 10, {{"design_grid", 1.0}});
+  const Scene s10 = MakeRobot("cable_finger", 10);
+  ASSERT_EQ(d10.mesh.num_vertices(), s10.mesh.num_vertices());
+  ASSERT_EQ(d10.mesh.num_elements(), s10.mesh.num_elements());
+  EXPECT_EQ(test::VerticesByPosition(d10.mesh).size(), test::VerticesByPosition(s10.mesh).size());
+  const auto at = test::VerticesByPosition(s10.mesh);
+  int missing = 0;
+  for (int v = 0; v < d10.mesh.num_vertices(); ++v)
+    missing += !at.count(test::KeyOf(d10.mesh.vertices.row(v).transpose()));
+  EXPECT_EQ(missing, 0);
+  // A bend at an odd res stays in the mirror plane and curls the tip up (+z).
+  const Scene s = MakeRobot("cable_finger", 7, {{"design_grid", 1.0}});
+  auto model = std::make_shared<const Model>(s);
+  const FkResult r = MakeFkSolver(model, FkOptions{})->Solve(Eigen::Vector3d(0.8, 0.8, 0.8));
+  ASSERT_EQ(r.status, FkStatus::Converged) << r.message;
+  const Eigen::RowVector3d tip = s.marker_positions(r.positions).row(s.marker_index("tip"));
+  EXPECT_NEAR(tip.y(), 12.5, 1e-4);
+  EXPECT_GT(tip.z(), 25.0);
+  EXPECT_THROW(MakeRobot("cable_finger", 7, {{"design_grid", 2.0}}), std::invalid_argument);
+}
+
 // chamber_weight is the chamber elements' w_i of Eq. 2.10: the default is the thesis's 5, and a
 // softer fill lags its target, so at the same alpha it reaches a smaller volume and bends less.
 TEST(RobotGrid, PneumaticFingerChamberWeightSoftensTheFill) {
