@@ -82,16 +82,17 @@ Scene MakeCableFinger(int res, const RobotParams& P) {
   const double zmid = design ? 0.5 * (kCableBridgeFloor + kCableHeight)
                              : 0.5 * (std::ceil(kCableBridgeFloor / h - 0.5) * h + zmax);
   for (int k = 0; k < 3; ++k) {
-    double x0 = kInf, x1 = -kInf;
-    if (design) {
-      x0 = kCableGaps[k][0];
-      x1 = kCableGaps[k][1];
-    }
-    for (int i = 0; i < nx && !design; ++i) {
-      const double x = (i + 0.5) * h;
-      if (x > kCableGaps[k][0] && x < kCableGaps[k][1]) {
-        x0 = std::min(x0, i * h);
-        x1 = std::max(x1, (i + 1) * h);
+    // The bridge's extent along x: the gap itself on the design grid, else its snapped cells.
+    double x0 = kCableGaps[k][0], x1 = kCableGaps[k][1];
+    if (!design) {
+      x0 = kInf;
+      x1 = -kInf;
+      for (int i = 0; i < nx; ++i) {
+        const double x = (i + 0.5) * h;
+        if (x > kCableGaps[k][0] && x < kCableGaps[k][1]) {
+          x0 = std::min(x0, i * h);
+          x1 = std::max(x1, (i + 1) * h);
+        }
       }
     }
     if (!(x1 > x0))
