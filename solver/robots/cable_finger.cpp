@@ -6,7 +6,6 @@
 
 #include <Eigen/Core>
 
-#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -55,12 +54,9 @@ int CableCell(double x, double z) {
 
 Scene MakeCableFinger(int res, const RobotParams& P) {
   const double h = kCableWidth / res;
-  const bool design = DesignGridFlag("cable_finger", P);
-  const int nx = static_cast<int>(std::lround(kCableLength / h));
-  const int nz = static_cast<int>(std::lround(kCableHeight / h));
   Scene s;
   s.name = "cable_finger";
-  if (design) {
+  if (DesignGridFlag("cable_finger", P)) {
     std::vector<double> bx = {0.0};
     for (const auto& gap : kCableGaps) bx.insert(bx.end(), {gap[0], gap[1]});
     bx.push_back(kCableLength);
@@ -69,6 +65,8 @@ Scene MakeCableFinger(int res, const RobotParams& P) {
         DesignLines({0.0, kCableBase, kCableBridgeFloor, kCableHeight}, h),
         [](const Eigen::Vector3d& c, const Eigen::Vector3i&) { return CableCell(c.x(), c.z()); });
   } else {
+    const int nx = static_cast<int>(std::lround(kCableLength / h));
+    const int nz = static_cast<int>(std::lround(kCableHeight / h));
     s.mesh = SymmetricVoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, res, nz),
                                    {false, true, false},
                                    [&](const Eigen::Vector3d&, const Eigen::Vector3i& c) {
@@ -76,28 +74,22 @@ Scene MakeCableFinger(int res, const RobotParams& P) {
                                    });
   }
   s.body[0] = Material{"body", 1.0, 1.0};
-  // Bridge cells actually present (snapped, or on the design lines): the path spans them at their
-  // mid-height.
-  const double zmax = design ? kCableHeight : nz * h;
-  const double zmid = design ? 0.5 * (kCableBridgeFloor + kCableHeight)
-                             : 0.5 * (std::ceil(kCableBridgeFloor / h - 0.5) * h + zmax);
-  for (int k = 0; k < 3; ++k) {
-    // The bridge's extent along x: the gap itself on the design grid, else its snapped cells.
-    double x0 = kCableGaps[k][0], x1 = kCableGaps[k][1];
-    if (!design) {
-      x0 = kInf;
-      x1 = -kInf;
-      for (int i = 0; i < nx; ++i) {
-        const double x = (i + 0.5) * h;
-        if (x > kCableGaps[k][0] && x < kCableGaps[k][1]) {
-          x0 = std::min(x0, i * h);
-          x1 = std::max(x1, (i + 1) * h);
-        }
+  // The mesh as built (snapped, or on the design lines) decides the far faces and each bridge's
+  // box; the tendon spans its bridge along x at the bridge's mid-height.
+  Eigen::Array3d lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) lo[k].setConstant(kInf), hi[k].setConstant(-kInf);
+  for (const Element& e : s.mesh.elements)
+    if (e.region > 0)
+      for (int j = 0; j < e.k(); ++j) {
+        const Eigen::Array3d v = s.mesh.vertices.row(e.v[j]).transpose().array();
+        lo[e.region - 1] = lo[e.region - 1].min(v);
+        hi[e.region - 1] = hi[e.region - 1].max(v);
       }
-    }
-    if (!(x1 > x0))
+  for (int k = 0; k < 3; ++k) {
+    if (!(hi[k].x() > lo[k].x()))
       throw std::invalid_argument("cable_finger: knuckle " + std::to_string(k + 1) +
                                   " vanished at res " + std::to_string(res));
+    const double zmid = 0.5 * (lo[k].z() + hi[k].z());
     Actuator a;
     a.name = "t" + std::to_string(k + 1);
     a.type = ActuatorType::Cable;
@@ -105,13 +97,14 @@ Scene MakeCableFinger(int res, const RobotParams& P) {
     a.rest = 1.0;
     a.min = kCableMinShortening;
     a.max = 1.0;
-    a.path = {Eigen::Vector3d(x0, 0.5 * kCableWidth, zmid),
-              Eigen::Vector3d(x1, 0.5 * kCableWidth, zmid)};
+    a.path = {Eigen::Vector3d(lo[k].x(), 0.5 * kCableWidth, zmid),
+              Eigen::Vector3d(hi[k].x(), 0.5 * kCableWidth, zmid)};
     s.actuators.push_back(a);
   }
-  const double eps = 1e-6 * h, xmax = design ? kCableLength : nx * h;
+  const double eps = 1e-6 * h;
   s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
-  AddDistalFaceMarkers(xmax, zmax, eps, &s);
+  AddDistalFaceMarkers(s.mesh.vertices.col(0).maxCoeff(), s.mesh.vertices.col(2).maxCoeff(), eps,
+                       &s);
   s.validate();
   return s;
 }

@@ -5,6 +5,7 @@
 #include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/fk/model.hpp"
+#include "softkin/solver/mesh/element_geometry.hpp"
 #include "softkin/solver/remesh/remesh.hpp"
 #include "softkin/solver/robots/robots.hpp"
 #include "tests/solver/robots/mirror_test_util.hpp"
@@ -379,13 +380,10 @@ TEST(RobotGrid, CableFingerDesignGridKeepsItsDimensionsAndSymmetry) {
   auto bridge_volume = [](const Mesh& mesh, int region) {
     double v = 0.0;
     for (const Element& e : mesh.elements)
-      if (e.region == region) {
-        const Eigen::Vector3d a = mesh.vertices.row(e.v[0]).transpose();
-        v += (mesh.vertices.row(e.v[1]).transpose() - a)
-                 .dot((mesh.vertices.row(e.v[2]).transpose() - a)
-                          .cross(mesh.vertices.row(e.v[3]).transpose() - a)) /
+      if (e.region == region)
+        v += TetVolume6(mesh.vertices.row(e.v[0]), mesh.vertices.row(e.v[1]),
+                        mesh.vertices.row(e.v[2]), mesh.vertices.row(e.v[3])) /
              6.0;
-      }
     return v;
   };
   const double nominal = 10.0 * 25.0 * 7.5;
