@@ -7,8 +7,6 @@
 
 #include <Eigen/Core>
 
-#include <algorithm>
-#include <cmath>
 #include <vector>
 
 namespace softkin {
@@ -25,7 +23,10 @@ namespace {
 // y = z = 6, range [-180, 180]) and "stretch" (mm along +x, range [0, 40]). Each material's
 // R_omega and weight are parameters. Markers: tip (end face), interface (the cells' face nearest
 // the interface plane), a_mid / b_mid (the cross-sections midway through each material).
-// Resolution: cells across the 12 mm side (cell 12 / res mm); the interface snaps to a cell face.
+// Resolution: cells across the 12 mm side (cell about 12 / res mm). Grid lines sit on the ends,
+// the interface and the two mid-sections at every res, so the bar is 80 mm long, the interface
+// where the parameter puts it and every marker on its nominal plane, whatever the cell size; an
+// even count of cells across each side keeps the mesh mirror-symmetric about y = 6 and z = 6.
 // ================================================================================================
 
 constexpr int kBarMinRes = 2, kBarMaxRes = 24, kBarDefaultRes = 4;
@@ -33,18 +34,20 @@ constexpr double kBarLength = 80.0, kBarSide = 12.0;
 
 Scene MakeBimaterialBar(int res, const RobotParams& P) {
   const double h = kBarSide / res;
-  const int nx = static_cast<int>(std::lround(kBarLength / h));
-  const int ni = std::clamp(static_cast<int>(std::lround(P.at("interface") * nx)), 1, nx - 1);
-  auto cell = [&](const Eigen::Vector3d&, const Eigen::Vector3i& c) { return c[0] < ni ? 0 : 1; };
+  const double xi = P.at("interface") * kBarLength;
+  const double xa = 0.5 * xi, xb = 0.5 * (xi + kBarLength);
+  const auto side = DesignLines({0.0, kBarSide}, h, {true});
+  auto cell = [&](const Eigen::Vector3d& c, const Eigen::Vector3i&) { return c.x() < xi ? 0 : 1; };
   Scene s;
   s.name = "bimaterial_bar";
-  s.mesh = SymmetricVoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(nx, res, res),
-                                 {false, true, true}, cell);
+  s.mesh = RectilinearTetMesh(DesignLines({0.0, xa, xi, xb, kBarLength}, h), side, side, cell);
   s.body[0] = Material{"A", P.at("r_omega_a"), P.at("weight_a")};
   s.body[1] = Material{"B", P.at("r_omega_b"), P.at("weight_b")};
-  const double eps = 1e-6 * h, xmax = nx * h;
-  const std::vector<int> end =
-      VerticesOnPlane(s.mesh, Eigen::Vector3d(xmax, 0, 0), Eigen::Vector3d::UnitX(), eps);
+  const double eps = 1e-6 * h;
+  auto plane = [&](double x) {
+    return VerticesOnPlane(s.mesh, Eigen::Vector3d(x, 0, 0), Eigen::Vector3d::UnitX(), eps);
+  };
+  const std::vector<int> end = plane(kBarLength);
   Actuator tw;
   tw.name = "twist";
   tw.type = ActuatorType::Twist;
@@ -60,14 +63,11 @@ Scene MakeBimaterialBar(int res, const RobotParams& P) {
   st.min = 0.0;
   st.max = 40.0;
   s.actuators = {tw, st};
-  s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), eps);
-  auto plane = [&](int i) {
-    return VerticesOnPlane(s.mesh, Eigen::Vector3d(i * h, 0, 0), Eigen::Vector3d::UnitX(), eps);
-  };
+  s.fixed = plane(0.0);
   s.markers.push_back({"tip", end});
-  s.markers.push_back({"interface", plane(ni)});
-  s.markers.push_back({"a_mid", plane(ni / 2)});
-  s.markers.push_back({"b_mid", plane((ni + nx) / 2)});
+  s.markers.push_back({"interface", plane(xi)});
+  s.markers.push_back({"a_mid", plane(xa)});
+  s.markers.push_back({"b_mid", plane(xb)});
   s.validate();
   return s;
 }
@@ -83,9 +83,9 @@ RobotEntry BimaterialBarEntry() {
       "bar's axis, [-180, 180]) and 'stretch' (mm along +x, [0, 40]). Markers: tip, interface, "
       "a_mid, b_mid.",
       kBarDefaultRes,
-      "cells across the 12 mm side (cell size 12/res mm), integer in [2, 24]",
+      "cells across the 12 mm side (cell size about 12/res mm; an odd res gets one more), integer in [2, 24]",
       {{"interface", 0.5, 0.05, 0.95,
-        "interface position as a fraction of the length (snapped to a cell face)"},
+        "interface position as a fraction of the length (a grid line at every res)"},
        {"r_omega_a", 1.0, 0.0, 1.0, "R_omega of material A"},
        {"r_omega_b", 1.0, 0.0, 1.0, "R_omega of material B"},
        {"weight_a", 1.0, 1e-3, 1e3, "element weight of material A"},

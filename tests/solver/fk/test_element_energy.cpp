@@ -88,7 +88,8 @@ TEST(ElementEnergy, StrainFormIsInvariantUnderRigidMotionAndScalesAsTheVolume) {
 }
 
 // On a mesh whose elements are all congruent (cubic cells) the two forms differ by one constant
-// factor, so they give the same state: bimaterial_bar res 2 (6 mm cubes), stretched and twisted.
+// factor, so they give the same state: bimaterial_bar res 6 (2 mm cubes: its grid lines every
+// 20 mm along the bar divide into whole cells), stretched and twisted.
 TEST(ElementEnergy, SameStateOnAMeshOfCongruentElements) {
   FkOptions o;
   o.solver = FkSolverType::kLgAa;
@@ -96,9 +97,9 @@ TEST(ElementEnergy, SameStateOnAMeshOfCongruentElements) {
   o.gradient_tolerance = 1e-10;
   o.max_iterations = 100000;
   const Eigen::VectorXd c = Eigen::Vector2d(40.0, 10.0);
-  auto shape = std::make_shared<const Model>(MakeRobot("bimaterial_bar", 2));
+  auto shape = std::make_shared<const Model>(MakeRobot("bimaterial_bar", 6));
   auto strain =
-      std::make_shared<const Model>(MakeRobot("bimaterial_bar", 2, {{"element_energy", 1.0}}));
+      std::make_shared<const Model>(MakeRobot("bimaterial_bar", 6, {{"element_energy", 1.0}}));
   EXPECT_EQ(strain->scene().element_energy, ElementEnergy::kStrain);
   EXPECT_EQ(shape->scene().element_energy, ElementEnergy::kShape);
   const FkResult a = MakeFkSolver(shape, o)->Solve(c);
@@ -108,8 +109,8 @@ TEST(ElementEnergy, SameStateOnAMeshOfCongruentElements) {
   ASSERT_GT(a.energy, 1.0);
   EXPECT_LT((a.positions - b.positions).rowwise().norm().maxCoeff(), 1e-6 * shape->size());
   // The constant: a tet of a cube of side h (three edges along the axes) has |N V^t|^2 = 2.5 h^2,
-  // so the strain form divides by 2.5 h^2 / 3 = 30 mm^2 at h = 6 mm.
-  EXPECT_NEAR(a.energy / b.energy, 2.5 * 36.0 / 3.0, 1e-6 * 30.0);
+  // so the strain form divides by 2.5 h^2 / 3 = 10/3 mm^2 at h = 2 mm.
+  EXPECT_NEAR(a.energy / b.energy, 2.5 * 4.0 / 3.0, 1e-6 * 10.0 / 3.0);
 }
 
 // A 40 x 4 x 4 mm bar of one material whose cells are 2 x 1 x 1 mm for x < 20 and 1 mm cubes

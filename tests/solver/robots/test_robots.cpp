@@ -618,7 +618,7 @@ TEST(Robots, DefaultResolutionScenesHaveTheirSizes) {
       {"finger_manipulator", 15840, 3528, 63, 3, 3},
       {"multi_segment_gripper", 19296, 4284, 63, 3, 5},
       {"dea_crawler", 896, 783, 27, 1, 4},
-      {"bimaterial_bar", 2592, 700, 25, 2, 4},
+      {"bimaterial_bar", 2688, 725, 25, 2, 4},
       {"cable_gripper", 15360, 3321, 81, 1, 4},
       {"selfcollision_finger", 13824, 3447, 63, 1, 3},
       {"membrane", 7008, 2178, 484, 4, 5},
