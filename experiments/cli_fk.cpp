@@ -3,6 +3,7 @@
 #include "softkin/experiments/cli_args.hpp"
 #include "softkin/experiments/results.hpp"
 #include "softkin/solver/factory/fk_factory.hpp"
+#include "softkin/solver/common/text_format.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/mesh/io/mesh_io.hpp"
 #include "softkin/solver/robots/robots.hpp"
@@ -143,6 +144,11 @@ int RunFkCommand(const FkCommandArgs& a) {
       std::cerr << "fk: step " << step << "/" << steps << ": " << status << ", " << iterations
                 << " iterations so far, " << sec << " s\n";
     };
+  // A long solve says how it is going (every 10 s; a short one prints nothing).
+  opt.on_progress = [](int iterations, double ratio, double sec) {
+    std::cerr << "fk: " << iterations << " iterations, residual ratio " << FormatNumber(ratio, 3)
+              << ", " << FormatNumber(sec, 3) << " s\n";
+  };
   auto model = std::make_shared<const Model>(scene);
   FkResult r = MakeFkSolver(model, opt)->Solve(c);
   if (r.status == FkStatus::InvalidInput) {

@@ -3,7 +3,9 @@
 // change from one resolution to the next says whether the answer converges. (The tracked point
 // is the marker `tip` unless the case names another.) A pneumatic case may instead prescribe the
 // chambers' volume ratios: then each resolution is solved at the actuation that reaches them
-// (matched_volume.hpp), so that the robots are compared at equal chamber volume. Each
+// (matched_volume.hpp), so that the robots are compared at equal chamber volume. A case solves
+// with its robot's own solver options (the contact robots' self-collision response), with the
+// config's solver object and the case's solver on top. Each
 // resolution of each case is a unit of a journaled sweep (sweep.hpp): rerun, a killed run solves
 // only what is missing, and under mpirun the ranks share the units.
 #include "softkin/experiments/matched_volume.hpp"
@@ -35,6 +37,7 @@ struct RefinementCase {
   std::vector<double> volume;     ///< instead of actuation: the chambers' volume ratios
   std::vector<int> resolutions;   ///< increasing, at least 4
   std::string solver;             ///< "": the config's solver.solver
+  FkOptions opts;  ///< the robot's own solver options (collision response), the config's on top
 };
 
 std::string CaseKeys() {
@@ -130,9 +133,12 @@ Scene CaseRobot(const Config& cfg, const RefinementCase& rc, int res) {
 }
 
 /// The case's robot at its first resolution takes its actuation and has its marker (checked
-/// for every case before any runs).
-void CheckCase(const Config& cfg, const RefinementCase& rc) {
+/// for every case before any runs); sets the case's solver options from the robot's.
+void CheckCase(const Config& cfg, RefinementCase* c) {
+  const RefinementCase& rc = *c;
   const Scene scene = CaseRobot(cfg, rc, rc.resolutions.front());
+  c->opts = cfg.Solver(scene.solver);
+  if (!rc.solver.empty()) c->opts.solver = FkSolverTypeFromString(rc.solver);
   const bool by_volume = !rc.volume.empty();
   const std::string key = rc.key + (by_volume ? ".volume_ratio" : ".actuation");
   const size_t n = by_volume ? rc.volume.size() : rc.actuation.size();
@@ -161,14 +167,8 @@ std::string Joined(const Eigen::VectorXd& v) {
   return s;
 }
 
-/// The case's solver options: the config's, with the case's own solver if it names one.
-FkOptions CaseOptions(const RefinementCase& rc, FkOptions opts) {
-  if (!rc.solver.empty()) opts.solver = FkSolverTypeFromString(rc.solver);
-  return opts;
-}
-
 /// The journal key of one resolution of a case: every setting that determines its row.
-nlohmann::json UnitKey(const RefinementCase& rc, const FkOptions& opts, int res) {
+nlohmann::json UnitKey(const RefinementCase& rc, int res) {
   return {{"label", rc.label},
           {"robot", rc.robot},
           {"robot_params", rc.params},
@@ -176,12 +176,11 @@ nlohmann::json UnitKey(const RefinementCase& rc, const FkOptions& opts, int res)
           {"actuation", rc.actuation},
           {"volume_ratio", rc.volume},
           {"res", res},
-          {"solver", SolverOptionsToJson(CaseOptions(rc, opts))}};
+          {"solver", SolverOptionsToJson(rc.opts)}};
 }
 
 /// One resolution of a case, solved: its row (without the columns that compare resolutions).
-nlohmann::json SolveUnit(const Config& cfg, const RefinementCase& rc, const FkOptions& opts,
-                         int res, bool verbose) {
+nlohmann::json SolveUnit(const Config& cfg, const RefinementCase& rc, int res, bool verbose) {
   // A volume ratio of 1 leaves that chamber at rest (its volume then follows its neighbours').
   std::vector<bool> loaded;
   for (double v : rc.volume) loaded.push_back(v != 1.0);
@@ -190,7 +189,7 @@ nlohmann::json SolveUnit(const Config& cfg, const RefinementCase& rc, const FkOp
   const Eigen::RowVector3d lo = scene.mesh.vertices.colwise().minCoeff();
   const Eigen::RowVector3d hi = scene.mesh.vertices.colwise().maxCoeff();
   auto model = std::make_shared<const Model>(scene);
-  auto solver = MakeFkSolver(model, CaseOptions(rc, opts));
+  auto solver = MakeFkSolver(model, rc.opts);
   FkResult r;
   Eigen::VectorXd c;
   bool matched = true;
@@ -235,8 +234,8 @@ nlohmann::json SolveUnit(const Config& cfg, const RefinementCase& rc, const FkOp
 /// One case from the rows of its resolutions, in order: the change from the previous resolution
 /// (left empty on the first) and the distance to the finest mesh's point, per row, written to
 /// the CSV; the summary entry, with whether the changes shrink.
-nlohmann::json FinishCase(const RefinementCase& rc, const FkOptions& opts,
-                          std::vector<nlohmann::json> rows, CsvWriter* csv) {
+nlohmann::json FinishCase(const RefinementCase& rc, std::vector<nlohmann::json> rows,
+                          CsvWriter* csv) {
   auto tip = [&](size_t i) {
     return Eigen::Vector3d(rows[i]["tip_x"].get<double>(), rows[i]["tip_y"].get<double>(),
                            rows[i]["tip_z"].get<double>());
@@ -259,7 +258,8 @@ nlohmann::json FinishCase(const RefinementCase& rc, const FkOptions& opts,
           {"robot", rc.robot},
           {"robot_params", rc.params},
           {"marker", rc.marker},
-          {"solver", ToString(CaseOptions(rc, opts).solver)},
+          {"solver", ToString(rc.opts.solver)},
+          {"self_collision", rc.opts.collision.self},
           {"actuation", rc.actuation},
           {"volume_ratio", rc.volume},
           {"resolutions", rc.resolutions},
@@ -274,10 +274,10 @@ nlohmann::json FinishCase(const RefinementCase& rc, const FkOptions& opts,
 }  // namespace
 
 nlohmann::json RunRefinement(const Config& cfg, const std::string& dir, bool verbose) {
-  const std::vector<RefinementCase> cases = ReadCases(cfg);
-  const FkOptions opts = cfg.Solver(FkOptions{});
+  std::vector<RefinementCase> cases = ReadCases(cfg);
+  (void)cfg.Solver(FkOptions{});  // checks the solver object before any robot is built
   cfg.CheckNoUnknownKeys();
-  for (const auto& rc : cases) CheckCase(cfg, rc);
+  for (auto& rc : cases) CheckCase(cfg, &rc);
   if (cfg.check_only()) return {};
   // Each resolution of each case is a unit, journaled as it finishes: a killed run rerun with
   // the same command solves only what is missing, and under mpirun the ranks share the units.
@@ -290,12 +290,11 @@ nlohmann::json RunRefinement(const Config& cfg, const std::string& dir, bool ver
   for (size_t c = 0; c < cases.size(); ++c)
     for (int res : cases[c].resolutions) {
       units.push_back({c, res});
-      keys.push_back(UnitKey(cases[c], opts, res));
+      keys.push_back(UnitKey(cases[c], res));
     }
   Sweep sweep(dir + "/refinement.jsonl", "refinement_convergence", verbose);
-  sweep.Run(keys, [&](size_t i) {
-    return SolveUnit(cfg, cases[units[i].c], opts, units[i].res, verbose);
-  });
+  sweep.Run(keys,
+            [&](size_t i) { return SolveUnit(cfg, cases[units[i].c], units[i].res, verbose); });
   if (!Sweep::WritesResults()) return {};
   CsvWriter csv(dir + "/refinement.csv",
                 {"case", "res", "n_vertices", "n_elements", "tip_x", "tip_y", "tip_z", "change_mm",
@@ -308,7 +307,7 @@ nlohmann::json RunRefinement(const Config& cfg, const std::string& dir, bool ver
     std::vector<nlohmann::json> rows(sweep.rows().begin() + next,
                                      sweep.rows().begin() + next + rc.resolutions.size());
     next += rc.resolutions.size();
-    out.push_back(FinishCase(rc, opts, std::move(rows), &csv));
+    out.push_back(FinishCase(rc, std::move(rows), &csv));
     shrinking += out.back()["changes_shrink"].get<bool>();
   }
   return {{"cases", out},

@@ -136,6 +136,8 @@ bool FkOptions::IsValid(std::string* why) const {
     return bad("threads: expected an integer in [0, " + std::to_string(kMaxThreads) + "]");
   if (!(time_limit_s >= 0.0) || !std::isfinite(time_limit_s))
     return bad("time_limit_s: expected a number >= 0 (0: no limit)");
+  if (!(progress_interval_s > 0.0) || !std::isfinite(progress_interval_s))
+    return bad("progress_interval_s: expected a number > 0");
   if (!collision.IsValid(why)) return false;
   return true;
 }

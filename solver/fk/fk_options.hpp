@@ -175,6 +175,11 @@ struct FkOptions {
   std::function<void(int step, int steps, const std::string& status, int iterations,
                      double seconds)>
       on_step;
+  /// Progress report during one long solve: called by lg, lg-aa and newton about every
+  /// progress_interval_s seconds with the iterations so far, the residual ratio of the last
+  /// checked iterate (FkResult::gradient_ratio) and the seconds since Solve() began. Empty: none.
+  std::function<void(int iterations, double residual_ratio, double seconds)> on_progress;
+  double progress_interval_s = 10.0;  ///< seconds between two on_progress calls (> 0)
 
   bool IsValid(std::string* why) const;
 };

@@ -222,6 +222,7 @@ bool LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
       ref = std::max({ref, grad, 1e-8 * total_weight_ * m.size()});
     }
     r->gradient_ratio = ref > 0 ? grad / ref : 0.0;
+    ReportProgress(*r);
     const double move = MaxRelativeMove(m, step, &Mv);
     r->max_move = move;
     // A residual at round-off level (e.g. at the rest actuation, where the reference is itself
@@ -257,6 +258,13 @@ bool LocalGlobalSolver::SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X
   return true;
 }
 
+void LocalGlobalSolver::ReportProgress(const FkResult& r) {
+  if (!options_.on_progress || Seconds(reported_, Clock::now()) < options_.progress_interval_s)
+    return;
+  reported_ = Clock::now();
+  options_.on_progress(r.iterations, r.gradient_ratio, Seconds(started_, reported_));
+}
+
 bool LocalGlobalSolver::StopsAtCheckpoint(FkResult* r) {
   // Judged at the first checked iterate from the checkpoint's iteration on (a rejected Anderson
   // step does not reach this test).
@@ -276,6 +284,7 @@ FkResult LocalGlobalSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c
                                       const Eigen::MatrixX3d* warm_start) {
   const Model& m = *model_;
   const auto t0 = Clock::now();
+  started_ = reported_ = t0;
   FkResult r;
   if (!StartResult(c, warm_start, &r)) {
     r.time_s = Seconds(t0, Clock::now());

@@ -70,6 +70,8 @@ class LocalGlobalSolver : public FkSolver {
   bool SolveStage(const Eigen::VectorXd& c, Eigen::MatrixX3d* X, FkResult* r, bool detect_tangle);
   /// Whether the iterate just checked stops the solve at the checkpoint (set_checkpoint); if so,
   /// r gets status iteration_cap and the message.
+  /// Calls options_.on_progress if progress_interval_s has passed since the last call.
+  void ReportProgress(const FkResult& r);
   bool StopsAtCheckpoint(FkResult* r);
   static constexpr int kMaxCutBacks = 6;
   FkOptions options_;
@@ -79,6 +81,7 @@ class LocalGlobalSolver : public FkSolver {
   std::vector<double> ratios_;
   double total_weight_ = 0.0;  // sum of w_i Vol_i: the scale of the residual's round-off floor
   const std::chrono::steady_clock::time_point* deadline_ = nullptr;  // during Solve(), or none
+  std::chrono::steady_clock::time_point started_, reported_;  // Solve()'s start, last progress
   Eigen::VectorXd ref_c_;         // actuation of the cached reference residual
   double ref_value_ = 0.0;        // ||2 (A X_rest - B(X_rest; ref_c_))||
   int checkpoint_iteration_ = 0;  // set_checkpoint

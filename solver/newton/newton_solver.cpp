@@ -251,6 +251,10 @@ NewtonSolver::StepEnd NewtonSolver::NewtonStep(const Eigen::VectorXd& c, bool fi
   history_.clear();
   for (int it = 0;; ++it) {
     history_.push_back(s.residual);
+    if (options_.on_progress && Seconds(reported_, Clock::now()) >= options_.progress_interval_s) {
+      reported_ = Clock::now();  // the ratio is the load step's own until the last step
+      options_.on_progress(r->iterations, s.residual / ref, Seconds(started_, reported_));
+    }
     // Convergence: the local-global test at s (its step, and the residual ratio).
     if (final) {
       const Eigen::VectorXd step = -m.SolveFree(s.g);
@@ -470,6 +474,7 @@ FkResult NewtonSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c_in,
                                  const Eigen::MatrixX3d* warm_start) {
   const Model& m = *model_;
   const auto t0 = Clock::now();
+  started_ = reported_ = t0;
   // The factor's solves are single right-hand sides between OpenMP loops: BLAS threads only
   // compete with the OpenMP ones (blas_threads.hpp).
   const ScopedBlasThreads one_blas_thread(1);

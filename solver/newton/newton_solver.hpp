@@ -152,6 +152,7 @@ class NewtonSolver : public FkSolver {
   int factorizations_ = 0;
   int stalls_ = 0;  ///< GMRES solves with a fresh factor that stalled, in this Solve()
   std::optional<std::chrono::steady_clock::time_point> deadline_;
+  std::chrono::steady_clock::time_point started_, reported_;  ///< Solve()'s start, last progress
   Eigen::VectorXd ref_c_;
   double ref_value_ = 0.0;
 };

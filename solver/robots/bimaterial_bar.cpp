@@ -83,7 +83,8 @@ RobotEntry BimaterialBarEntry() {
       "bar's axis, [-180, 180]) and 'stretch' (mm along +x, [0, 40]). Markers: tip, interface, "
       "a_mid, b_mid.",
       kBarDefaultRes,
-      "cells across the 12 mm side (cell size about 12/res mm; an odd res gets one more), integer in [2, 24]",
+      "cells across the 12 mm side (cell size about 12/res mm; an odd res gets one more), integer "
+      "in [2, 24]",
       {{"interface", 0.5, 0.05, 0.95,
         "interface position as a fraction of the length (a grid line at every res)"},
        {"r_omega_a", 1.0, 0.0, 1.0, "R_omega of material A"},

@@ -14,12 +14,14 @@
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <random>
 #include <string>
+#include <vector>
 
 namespace softkin {
 namespace {
@@ -278,6 +280,49 @@ TEST(LocalGlobal, StatusReporting) {
   for (const FkResult* r : {&out, &low, &nan, &len, &w}) EXPECT_TRUE(r->positions.allFinite());
   // The solver is still usable afterwards.
   EXPECT_EQ(solver->Solve(Vec({1.2, 1.0, 1.0})).status, FkStatus::Converged);
+}
+
+// on_progress reports a long solve as it goes: lg, lg-aa and newton call it at most once per
+// progress_interval_s with the iterations so far (non-decreasing), a finite residual ratio and
+// the seconds since Solve() began; the final state is the same as without it. A zero interval
+// is refused by name.
+TEST(LocalGlobal, ProgressIsReportedDuringASolve) {
+  auto model = std::make_shared<const Model>(ThreeChamber3());
+  for (FkSolverType type : {FkSolverType::kLg, FkSolverType::kLgAa, FkSolverType::kNewton}) {
+    SCOPED_TRACE(ToString(type));
+    FkOptions o = Opts();
+    o.solver = type;
+    const FkResult plain = MakeFkSolver(model, o)->Solve(Vec({1.5, 1.0, 1.0}));
+    std::vector<std::array<double, 3>> calls;
+    o.progress_interval_s = 1e-9;  // every iteration
+    o.on_progress = [&calls](int iterations, double ratio, double sec) {
+      calls.push_back({static_cast<double>(iterations), ratio, sec});
+    };
+    const FkResult r = MakeFkSolver(model, o)->Solve(Vec({1.5, 1.0, 1.0}));
+    ASSERT_EQ(r.status, FkStatus::Converged) << r.BriefReport();
+    EXPECT_LT((r.positions - plain.positions).cwiseAbs().maxCoeff(), 1e-9 * model->size());
+    ASSERT_GE(calls.size(), 2u);
+    // At most one call per iteration (newton: and one at the start of each load step).
+    EXPECT_LE(calls.size(), static_cast<size_t>(r.iterations + r.load_steps + 1));
+    for (size_t i = 0; i < calls.size(); ++i) {
+      EXPECT_TRUE(std::isfinite(calls[i][1]));
+      EXPECT_GE(calls[i][2], 0.0);
+      EXPECT_LE(calls[i][2], r.time_s);
+      if (i > 0) {
+        EXPECT_GE(calls[i][0], calls[i - 1][0]);
+      }
+    }
+    // With the default interval of 10 s a solve this short reports nothing.
+    o.progress_interval_s = 10.0;
+    calls.clear();
+    MakeFkSolver(model, o)->Solve(Vec({1.5, 1.0, 1.0}));
+    EXPECT_TRUE(calls.empty());
+  }
+  FkOptions bad = Opts();
+  bad.progress_interval_s = 0.0;
+  std::string why;
+  EXPECT_FALSE(bad.IsValid(&why));
+  EXPECT_NE(why.find("progress_interval_s"), std::string::npos) << why;
 }
 
 // Continuation in 4 steps must reach the single-step answer. (Fails at present: stage 2,

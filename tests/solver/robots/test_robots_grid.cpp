@@ -12,10 +12,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <functional>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <string>
 
@@ -423,6 +425,59 @@ TEST(RobotGrid, CableFingerDesignGridKeepsItsDimensionsAndSymmetry) {
   EXPECT_NEAR(tip.y(), 12.5, 1e-4);
   EXPECT_GT(tip.z(), 25.0);
   EXPECT_THROW(MakeRobot("cable_finger", 7, {{"design_grid", 2.0}}), std::invalid_argument);
+}
+
+// membrane with design_grid = 1 keeps the default res 20's dimensions at every res: a 10.5 mm
+// membrane 2 mm above the roofs at z = 37.5, and four cavities of 75 x 75 x 12.5 mm inside
+// 12.5 mm walls; the mesh is mirror-symmetric about x = 125 and y = 125, and at res 20 it is the
+// snapped mesh itself. Snapped, the membrane is one cell less 2 mm thick (18.8 mm at res 12).
+TEST(RobotGrid, MembraneDesignGridKeepsItsDimensionsAndSymmetry) {
+  auto region_volume = [](const Mesh& mesh, int region) {
+    double v = 0.0;
+    for (const Element& e : mesh.elements)
+      if (e.region == region)
+        v += TetVolume6(mesh.vertices.row(e.v[0]), mesh.vertices.row(e.v[1]),
+                        mesh.vertices.row(e.v[2]), mesh.vertices.row(e.v[3])) /
+             6.0;
+    return v;
+  };
+  auto membrane_z = [](const Scene& s) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const Element& e : s.mesh.elements)
+      if (e.region == 0)
+        for (int q = 0; q < e.k(); ++q) {
+          lo = std::min(lo, s.mesh.vertices(e.v[q], 2));
+          hi = std::max(hi, s.mesh.vertices(e.v[q], 2));
+        }
+    return std::make_pair(lo, hi);
+  };
+  const double cavity = 75.0 * 75.0 * 12.5, membrane = 250.0 * 250.0 * 10.5;
+  for (int res : {12, 13, 24, 32}) {
+    const Scene s = MakeRobot("membrane", res, {{"design_grid", 1.0}});
+    for (int q = 0; q < 4; ++q)
+      EXPECT_NEAR(region_volume(s.mesh, 2 + q), cavity, 1e-9 * cavity) << "res " << res;
+    EXPECT_NEAR(region_volume(s.mesh, 0), membrane, 1e-9 * membrane) << "res " << res;
+    const auto [lo, hi] = membrane_z(s);
+    EXPECT_NEAR(lo, 39.5, 1e-9) << "res " << res;
+    EXPECT_NEAR(hi, 50.0, 1e-9) << "res " << res;
+    EXPECT_EQ(test::UnmatchedMirrorElements(s.mesh, 0, 125.0), 0) << "res " << res;
+    EXPECT_EQ(test::UnmatchedMirrorElements(s.mesh, 1, 125.0), 0) << "res " << res;
+    EXPECT_TRUE(s.solver.collision.self);
+  }
+  const Scene snapped = MakeRobot("membrane", 12);
+  EXPECT_NEAR(membrane_z(snapped).second - membrane_z(snapped).first, 250.0 / 12 - 2.0, 1e-9);
+  // Res 20: the design's dimensions are whole cells of 12.5 mm, and the two meshes coincide.
+  const Scene d20 = MakeRobot("membrane", 20, {{"design_grid", 1.0}});
+  const Scene s20 = MakeRobot("membrane", 20);
+  ASSERT_EQ(d20.mesh.num_vertices(), s20.mesh.num_vertices());
+  ASSERT_EQ(d20.mesh.num_elements(), s20.mesh.num_elements());
+  const auto at = test::VerticesByPosition(s20.mesh);
+  int missing = 0;
+  for (int v = 0; v < d20.mesh.num_vertices(); ++v)
+    missing += !at.count(test::KeyOf(d20.mesh.vertices.row(v).transpose()));
+  EXPECT_EQ(missing, 0);
+  EXPECT_EQ(d20.fixed.size(), s20.fixed.size());
+  EXPECT_THROW(MakeRobot("membrane", 20, {{"design_grid", 0.5}}), std::invalid_argument);
 }
 
 // chamber_weight is the chamber elements' w_i of Eq. 2.10: the default is the thesis's 5, and a
