@@ -113,7 +113,8 @@ Scene MakeMembrane(int res, const RobotParams& P) {
   } else {
     s.mesh = VoxelTetMesh(Eigen::Vector3d::Zero(), h, Eigen::Vector3i(n, n, L.hc + 1), cell);
   }
-  // The membrane is a separate body: lift it off the roofs by kMemGap.
+  // The membrane is a separate body: cut it from the roofs and raise its bottom face by kMemGap
+  // (an air gap taken from its thickness).
   const double z_roof = L.roof(), t = L.h;
   CutSlit(
       &s.mesh, [&](const Eigen::Vector3d& p) { return std::abs(p.z() - z_roof) < 1e-6 * h; },
