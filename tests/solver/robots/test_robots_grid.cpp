@@ -374,27 +374,41 @@ TEST(RobotGrid, PneumaticFingerDesignGridKeepsItsDimensionsAndSymmetry) {
   EXPECT_THROW(MakeRobot("pneumatic_finger", 7, {{"design_grid", 0.5}}), std::invalid_argument);
 }
 
+/// The volume of a region's tets.
+double RegionVolume(const Mesh& mesh, int region) {
+  double v = 0.0;
+  for (const Element& e : mesh.elements)
+    if (e.region == region)
+      v += TetVolume6(mesh.vertices.row(e.v[0]), mesh.vertices.row(e.v[1]),
+                      mesh.vertices.row(e.v[2]), mesh.vertices.row(e.v[3])) /
+           6.0;
+  return v;
+}
+
+/// a and b have the same vertex positions (in any order) and as many elements.
+void ExpectSameVerticesAndElementCount(const Mesh& a, const Mesh& b) {
+  ASSERT_EQ(a.num_vertices(), b.num_vertices());
+  ASSERT_EQ(a.num_elements(), b.num_elements());
+  const auto at = test::VerticesByPosition(b);
+  EXPECT_EQ(at.size(), static_cast<size_t>(b.num_vertices()));  // no two vertices coincide
+  int missing = 0;
+  for (int v = 0; v < a.num_vertices(); ++v)
+    missing += !at.count(test::KeyOf(a.vertices.row(v).transpose()));
+  EXPECT_EQ(missing, 0);
+}
+
 // cable_finger with design_grid = 1: each knuckle's bridge is the nominal 10 x 25 x 7.5 mm block
 // and its tendon 10 mm long at every res (snapped, both change with res: the gaps are 8.33 and
 // 12.5 mm wide at res 6 and 8), the mesh is mirror-symmetric about y = 12.5, and at the default
 // res 10, where the design's dimensions fall on whole cells, it is the snapped mesh itself.
 TEST(RobotGrid, CableFingerDesignGridKeepsItsDimensionsAndSymmetry) {
-  auto bridge_volume = [](const Mesh& mesh, int region) {
-    double v = 0.0;
-    for (const Element& e : mesh.elements)
-      if (e.region == region)
-        v += TetVolume6(mesh.vertices.row(e.v[0]), mesh.vertices.row(e.v[1]),
-                        mesh.vertices.row(e.v[2]), mesh.vertices.row(e.v[3])) /
-             6.0;
-    return v;
-  };
   const double nominal = 10.0 * 25.0 * 7.5;
   bool snapped_differs = false;
   for (int res : {6, 7, 9, 13}) {
     const Scene s = MakeRobot("cable_finger", res, {{"design_grid", 1.0}});
     const Model m(s);
     for (int k = 0; k < 3; ++k) {
-      EXPECT_NEAR(bridge_volume(s.mesh, k + 1), nominal, 1e-9 * nominal) << "res " << res;
+      EXPECT_NEAR(RegionVolume(s.mesh, k + 1), nominal, 1e-9 * nominal) << "res " << res;
       EXPECT_NEAR(m.actuator_rest_measure(k), 10.0, 1e-9) << "res " << res;
     }
     EXPECT_NEAR(s.mesh.vertices.col(0).maxCoeff(), 120.0, 1e-9);
@@ -402,20 +416,13 @@ TEST(RobotGrid, CableFingerDesignGridKeepsItsDimensionsAndSymmetry) {
     EXPECT_EQ(test::UnmatchedMirrorVertices(s.mesh, 12.5), 0) << "res " << res;
     EXPECT_EQ(test::UnmatchedMirrorElements(s.mesh, 1, 12.5), 0) << "res " << res;
     const Scene snapped = MakeRobot("cable_finger", res);
-    snapped_differs |= std::abs(bridge_volume(snapped.mesh, 1) - nominal) > 1.0;
+    snapped_differs |= std::abs(RegionVolume(snapped.mesh, 1) - nominal) > 1.0;
   }
   EXPECT_TRUE(snapped_differs);  // the design grid is not what the default grid already was
   // Res 10: the design's dimensions are whole cells of 2.5 mm, and the two meshes coincide.
   const Scene d10 = MakeRobot("cable_finger", 10, {{"design_grid", 1.0}});
   const Scene s10 = MakeRobot("cable_finger", 10);
-  ASSERT_EQ(d10.mesh.num_vertices(), s10.mesh.num_vertices());
-  ASSERT_EQ(d10.mesh.num_elements(), s10.mesh.num_elements());
-  EXPECT_EQ(test::VerticesByPosition(d10.mesh).size(), test::VerticesByPosition(s10.mesh).size());
-  const auto at = test::VerticesByPosition(s10.mesh);
-  int missing = 0;
-  for (int v = 0; v < d10.mesh.num_vertices(); ++v)
-    missing += !at.count(test::KeyOf(d10.mesh.vertices.row(v).transpose()));
-  EXPECT_EQ(missing, 0);
+  ExpectSameVerticesAndElementCount(d10.mesh, s10.mesh);
   // A bend at an odd res stays in the mirror plane and curls the tip up (+z).
   const Scene s = MakeRobot("cable_finger", 7, {{"design_grid", 1.0}});
   auto model = std::make_shared<const Model>(s);
@@ -432,15 +439,6 @@ TEST(RobotGrid, CableFingerDesignGridKeepsItsDimensionsAndSymmetry) {
 // 12.5 mm walls; the mesh is mirror-symmetric about x = 125 and y = 125, and at res 20 it is the
 // snapped mesh itself. Snapped, the membrane is one cell less 2 mm thick (18.8 mm at res 12).
 TEST(RobotGrid, MembraneDesignGridKeepsItsDimensionsAndSymmetry) {
-  auto region_volume = [](const Mesh& mesh, int region) {
-    double v = 0.0;
-    for (const Element& e : mesh.elements)
-      if (e.region == region)
-        v += TetVolume6(mesh.vertices.row(e.v[0]), mesh.vertices.row(e.v[1]),
-                        mesh.vertices.row(e.v[2]), mesh.vertices.row(e.v[3])) /
-             6.0;
-    return v;
-  };
   auto membrane_z = [](const Scene& s) {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (const Element& e : s.mesh.elements)
@@ -455,8 +453,8 @@ TEST(RobotGrid, MembraneDesignGridKeepsItsDimensionsAndSymmetry) {
   for (int res : {12, 13, 24, 32}) {
     const Scene s = MakeRobot("membrane", res, {{"design_grid", 1.0}});
     for (int q = 0; q < 4; ++q)
-      EXPECT_NEAR(region_volume(s.mesh, 2 + q), cavity, 1e-9 * cavity) << "res " << res;
-    EXPECT_NEAR(region_volume(s.mesh, 0), membrane, 1e-9 * membrane) << "res " << res;
+      EXPECT_NEAR(RegionVolume(s.mesh, 2 + q), cavity, 1e-9 * cavity) << "res " << res;
+    EXPECT_NEAR(RegionVolume(s.mesh, 0), membrane, 1e-9 * membrane) << "res " << res;
     const auto [lo, hi] = membrane_z(s);
     EXPECT_NEAR(lo, 39.5, 1e-9) << "res " << res;
     EXPECT_NEAR(hi, 50.0, 1e-9) << "res " << res;
@@ -469,13 +467,7 @@ TEST(RobotGrid, MembraneDesignGridKeepsItsDimensionsAndSymmetry) {
   // Res 20: the design's dimensions are whole cells of 12.5 mm, and the two meshes coincide.
   const Scene d20 = MakeRobot("membrane", 20, {{"design_grid", 1.0}});
   const Scene s20 = MakeRobot("membrane", 20);
-  ASSERT_EQ(d20.mesh.num_vertices(), s20.mesh.num_vertices());
-  ASSERT_EQ(d20.mesh.num_elements(), s20.mesh.num_elements());
-  const auto at = test::VerticesByPosition(s20.mesh);
-  int missing = 0;
-  for (int v = 0; v < d20.mesh.num_vertices(); ++v)
-    missing += !at.count(test::KeyOf(d20.mesh.vertices.row(v).transpose()));
-  EXPECT_EQ(missing, 0);
+  ExpectSameVerticesAndElementCount(d20.mesh, s20.mesh);
   EXPECT_EQ(d20.fixed.size(), s20.fixed.size());
   EXPECT_THROW(MakeRobot("membrane", 20, {{"design_grid", 0.5}}), std::invalid_argument);
 }
