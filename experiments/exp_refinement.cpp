@@ -14,6 +14,7 @@
 #include "softkin/experiments/sweep.hpp"
 #include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
+#include "softkin/solver/robots/robot_twisting.hpp"
 #include "softkin/solver/robots/robots.hpp"
 #include "softkin/solver/scene/solver_options_json.hpp"
 #include "softkin/solver/common/stopwatch.hpp"
@@ -36,8 +37,11 @@ struct RefinementCase {
   std::vector<double> actuation;  ///< one value per actuator
   std::vector<double> volume;     ///< instead of actuation: the chambers' volume ratios
   std::vector<int> resolutions;   ///< increasing, at least 4
-  std::string solver;             ///< "": the config's solver.solver
-  FkOptions opts;  ///< the robot's own solver options (collision response), the config's on top
+  /// If set (non-zero), each row also records the marker's twist about this axis (degrees,
+  /// TwistAboutAxisDegrees of its rest and deformed vertices): what a twisting robot does.
+  Eigen::Vector3d twist_axis = Eigen::Vector3d::Zero();
+  std::string solver;  ///< "": the config's solver.solver
+  FkOptions opts;      ///< the robot's own solver options (collision response), the config's on top
 };
 
 std::string CaseKeys() {
@@ -48,7 +52,8 @@ std::string CaseKeys() {
          "volume ratios to reach, one per actuator, all unsigned pneumatic; 1 leaves a chamber at "
          "rest), "
          "resolutions (array of at least "
-         "4 increasing integers)";
+         "4 increasing integers), twist_axis (3 numbers, not all 0: also record the marker's "
+         "twist about this axis, degrees; the marker needs 3 or more vertices)";
 }
 
 RefinementCase ReadCase(const Config& cfg, const nlohmann::json& c, const std::string& key) {
@@ -83,6 +88,15 @@ RefinementCase ReadCase(const Config& cfg, const nlohmann::json& c, const std::s
           cfg.Fail(key + ".volume_ratio", "an array of positive numbers");
         rc.volume.push_back(x.get<double>());
       }
+    } else if (k == "twist_axis") {
+      const std::string expected = "an array of 3 numbers, not all zero";
+      if (!v.is_array() || v.size() != 3) cfg.Fail(key + ".twist_axis", expected);
+      for (int i = 0; i < 3; ++i) {
+        if (!v[i].is_number()) cfg.Fail(key + ".twist_axis", expected);
+        rc.twist_axis[i] = v[i].get<double>();
+      }
+      if (!(rc.twist_axis.norm() > 0) || !rc.twist_axis.allFinite())
+        cfg.Fail(key + ".twist_axis", expected);
     } else if (k == "resolutions" && v.is_array()) {
       for (const auto& x : v) {
         if (!x.is_number_integer() || x.get<int>() < 1)
@@ -152,8 +166,12 @@ void CheckCase(const Config& cfg, RefinementCase* c) {
         cfg.Fail(key, "a robot whose actuators are all unsigned pneumatic ones ('" + rc.robot +
                           "' has " + (a.is_signed() ? "signed " : "") +
                           ActuatorTypeToString(a.type) + " actuator '" + a.name + "')");
-  if (scene.marker_index(rc.marker) < 0)
-    cfg.Fail(rc.key + ".marker", "a marker of '" + rc.robot + "' (softkin robots)");
+  const int mi = scene.marker_index(rc.marker);
+  if (mi < 0) cfg.Fail(rc.key + ".marker", "a marker of '" + rc.robot + "' (softkin robots)");
+  if (rc.twist_axis.norm() > 0 && scene.markers[mi].vertices.size() < 3)
+    cfg.Fail(rc.key + ".twist_axis", "a marker of 3 or more vertices to measure a twist ('" +
+                                         rc.marker + "' has " +
+                                         std::to_string(scene.markers[mi].vertices.size()) + ")");
 }
 
 /// The values joined by spaces (one CSV field).
@@ -169,14 +187,29 @@ std::string Joined(const Eigen::VectorXd& v) {
 
 /// The journal key of one resolution of a case: every setting that determines its row.
 nlohmann::json UnitKey(const RefinementCase& rc, int res) {
-  return {{"label", rc.label},
-          {"robot", rc.robot},
-          {"robot_params", rc.params},
-          {"marker", rc.marker},
-          {"actuation", rc.actuation},
-          {"volume_ratio", rc.volume},
-          {"res", res},
-          {"solver", SolverOptionsToJson(rc.opts)}};
+  nlohmann::json key = {{"label", rc.label},
+                        {"robot", rc.robot},
+                        {"robot_params", rc.params},
+                        {"marker", rc.marker},
+                        {"actuation", rc.actuation},
+                        {"volume_ratio", rc.volume},
+                        {"res", res},
+                        {"solver", SolverOptionsToJson(rc.opts)}};
+  if (rc.twist_axis.norm() > 0)
+    key["twist_axis"] = {rc.twist_axis[0], rc.twist_axis[1], rc.twist_axis[2]};
+  return key;
+}
+
+/// The twist (degrees) of marker `mi`'s vertices from the rest positions to X, about `axis`.
+double MarkerTwist(const Scene& scene, int mi, const Eigen::MatrixX3d& X,
+                   const Eigen::Vector3d& axis) {
+  const std::vector<int>& v = scene.markers[mi].vertices;
+  Eigen::MatrixX3d P(v.size(), 3), Q(v.size(), 3);
+  for (size_t i = 0; i < v.size(); ++i) {
+    P.row(i) = scene.mesh.vertices.row(v[i]);
+    Q.row(i) = X.row(v[i]);
+  }
+  return TwistAboutAxisDegrees(P, Q, axis);
 }
 
 /// One resolution of a case, solved: its row (without the columns that compare resolutions).
@@ -213,22 +246,25 @@ nlohmann::json SolveUnit(const Config& cfg, const RefinementCase& rc, int res, b
   if (verbose)
     std::fprintf(stderr, "  %s res %d: %d elements, %s\n", rc.label.c_str(), res,
                  scene.mesh.num_elements(), r.BriefReport().c_str());
-  return {{"case", rc.label},
-          {"res", res},
-          {"n_vertices", scene.mesh.num_vertices()},
-          {"n_elements", scene.mesh.num_elements()},
-          {"length_mm", (hi - lo).maxCoeff()},
-          {"tip_x", p[0]},
-          {"tip_y", p[1]},
-          {"tip_z", p[2]},
-          {"energy", r.energy},
-          {"iterations", r.iterations},
-          {"solve_s", solve_s},
-          {"inverted", r.inverted_elements},
-          {"status", FkStatusToString(r.status)},
-          {"actuation", Joined(c)},
-          {"volume_ratio", Joined(ratios)},
-          {"volume_matched", matched}};
+  nlohmann::json row = {{"case", rc.label},
+                        {"res", res},
+                        {"n_vertices", scene.mesh.num_vertices()},
+                        {"n_elements", scene.mesh.num_elements()},
+                        {"length_mm", (hi - lo).maxCoeff()},
+                        {"tip_x", p[0]},
+                        {"tip_y", p[1]},
+                        {"tip_z", p[2]},
+                        {"energy", r.energy},
+                        {"iterations", r.iterations},
+                        {"solve_s", solve_s},
+                        {"inverted", r.inverted_elements},
+                        {"status", FkStatusToString(r.status)},
+                        {"actuation", Joined(c)},
+                        {"volume_ratio", Joined(ratios)},
+                        {"volume_matched", matched}};
+  if (rc.twist_axis.norm() > 0)
+    row["twist_deg"] = MarkerTwist(scene, tip, r.positions, rc.twist_axis);
+  return row;
 }
 
 /// One case from the rows of its resolutions, in order: the change from the previous resolution
@@ -240,7 +276,7 @@ nlohmann::json FinishCase(const RefinementCase& rc, std::vector<nlohmann::json> 
     return Eigen::Vector3d(rows[i]["tip_x"].get<double>(), rows[i]["tip_y"].get<double>(),
                            rows[i]["tip_z"].get<double>());
   };
-  std::vector<double> changes, to_finest;
+  std::vector<double> changes, to_finest, twists;
   bool shrink = true, all_converged = true;
   for (size_t i = 0; i < rows.size(); ++i) {
     to_finest.push_back((tip(i) - tip(rows.size() - 1)).norm());
@@ -251,24 +287,27 @@ nlohmann::json FinishCase(const RefinementCase& rc, std::vector<nlohmann::json> 
       shrink &= changes.size() < 2 || changes.back() <= changes[changes.size() - 2];
     }
     all_converged &= rows[i]["status"] == "converged" && rows[i]["volume_matched"].get<bool>();
+    if (rows[i].contains("twist_deg")) twists.push_back(rows[i]["twist_deg"].get<double>());
     csv->RowJson(rows[i]);
   }
   const double length = rows.back()["length_mm"].get<double>();
-  return {{"label", rc.label},
-          {"robot", rc.robot},
-          {"robot_params", rc.params},
-          {"marker", rc.marker},
-          {"solver", ToString(rc.opts.solver)},
-          {"self_collision", rc.opts.collision.self},
-          {"actuation", rc.actuation},
-          {"volume_ratio", rc.volume},
-          {"resolutions", rc.resolutions},
-          {"length_mm", length},
-          {"tip_changes_mm", changes},
-          {"tip_to_finest_mm", to_finest},
-          {"last_change_percent_of_length", 100.0 * changes.back() / length},
-          {"changes_shrink", shrink},
-          {"all_converged", all_converged}};
+  nlohmann::json summary = {{"label", rc.label},
+                            {"robot", rc.robot},
+                            {"robot_params", rc.params},
+                            {"marker", rc.marker},
+                            {"solver", ToString(rc.opts.solver)},
+                            {"self_collision", rc.opts.collision.self},
+                            {"actuation", rc.actuation},
+                            {"volume_ratio", rc.volume},
+                            {"resolutions", rc.resolutions},
+                            {"length_mm", length},
+                            {"tip_changes_mm", changes},
+                            {"tip_to_finest_mm", to_finest},
+                            {"last_change_percent_of_length", 100.0 * changes.back() / length},
+                            {"changes_shrink", shrink},
+                            {"all_converged", all_converged}};
+  if (!twists.empty()) summary["twist_deg"] = twists;
+  return summary;
 }
 
 }  // namespace
@@ -298,8 +337,8 @@ nlohmann::json RunRefinement(const Config& cfg, const std::string& dir, bool ver
   if (!Sweep::WritesResults()) return {};
   CsvWriter csv(dir + "/refinement.csv",
                 {"case", "res", "n_vertices", "n_elements", "tip_x", "tip_y", "tip_z", "change_mm",
-                 "to_finest_mm", "energy", "iterations", "solve_s", "inverted", "status",
-                 "actuation", "volume_ratio", "volume_matched"});
+                 "to_finest_mm", "twist_deg", "energy", "iterations", "solve_s", "inverted",
+                 "status", "actuation", "volume_ratio", "volume_matched"});
   nlohmann::json out = nlohmann::json::array();
   int shrinking = 0;
   size_t next = 0;

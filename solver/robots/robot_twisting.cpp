@@ -196,6 +196,7 @@ Scene MakeTwistingRobot(int res, const RobotParams& P) {
   a.rest = 1.0;
   a.min = 1.0;
   a.max = Param(P, "max_ratio", kTwistDefaultMaxRatio);
+  a.weight = Param(P, "chamber_weight", Actuator{}.weight);
   s.actuators.push_back(a);
   const double eps = 1e-6 * kTwistLength;
   s.fixed = VerticesOnPlane(s.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), eps);
@@ -228,7 +229,10 @@ RobotEntry TwistingRobotEntry() {
       "Markers: tip (face z = 100), tip_rim (its vertex nearest (10, 0, 100)).",
       kTwistDefaultRes,
       "Mesh_3 cell size 8/res mm (facet size the same, facet distance 0.05 of it), integer in "
-      "[1, 6]; 6.2k / 10.8k / 18.0k / 29.2k tets at res 1 / 2 / 3 / 4 (docs/remeshing.md)",
+      "[1, 12]; 6.2k / 10.8k / 18.0k / 29.2k / 73k / 154k / 288k tets at res 1 / 2 / 3 / 4 / 6 / "
+      "8 / 10. Res 1 (the default, for remeshing) is coarse: the 2.5 mm wall outside the chamber "
+      "is under one cell, and the tip twists 6.5 degrees at alpha = 2 against about 21 at res 8-10 "
+      "(docs/fidelity.md)",
       {{"helix_radius", 5.0, 2.0, 7.0, "radius of the chamber's helical centreline, mm"},
        {"tube_radius", 2.5, 1.0, 4.0,
         "radius of the chamber tube, mm (helix_radius + tube_radius <= 9)"},
@@ -245,7 +249,8 @@ RobotEntry TwistingRobotEntry() {
         "top of the chamber's volume-ratio range. Solved on the initial mesh the body stays free "
         "of inverted elements up to about 3 (res 1: one inverted tet at 3.5 with the Mooney-Rivlin "
         "body, at 4 with shape blending); beyond, chamber-wall tets fold. Raise it (to 120) with "
-        "progressive remeshing (fig3_7_twisting_remesh) or to study the folded states"}}};
+        "progressive remeshing (fig3_7_twisting_remesh) or to study the folded states"},
+       ChamberWeightParam()}};
   return {info, kTwistMinRes, kTwistMaxRes, &MakeTwistingRobot};
 }
 

@@ -30,7 +30,7 @@ namespace softkin {
 
 constexpr double kTwistBodyRadius = 10.0, kTwistLength = 100.0;
 constexpr double kTwistHelixZ0 = 8.0, kTwistHelixZ1 = 92.0;
-constexpr int kTwistMinRes = 1, kTwistMaxRes = 6, kTwistDefaultRes = 1;
+constexpr int kTwistMinRes = 1, kTwistMaxRes = 12, kTwistDefaultRes = 1;
 /// The chamber's volume ratio: the largest the robot_param max_ratio may set (the thesis's range,
 /// reached with progressive remeshing), and its default (what the initial mesh reaches without
 /// inverted elements).

@@ -335,9 +335,10 @@ TEST(Cli, RefinementCanCompareAtEqualChamberVolume) {
     std::vector<std::string> f;
     std::stringstream ls(line);
     for (std::string x; std::getline(ls, x, ',');) f.push_back(x);
-    ASSERT_EQ(f.size(), 17u) << line;
-    EXPECT_EQ(f[16], "true") << line;
-    std::istringstream ratios(f[15]), actuation(f[14]);
+    ASSERT_EQ(f.size(), 18u) << line;
+    EXPECT_EQ(f[9], "") << line;  // twist_deg: this case measures no twist
+    EXPECT_EQ(f[17], "true") << line;
+    std::istringstream ratios(f[16]), actuation(f[15]);
     double v1 = 0, c1 = 0;
     ratios >> v1;
     actuation >> c1;
@@ -370,11 +371,61 @@ TEST(Cli, RefinementCanCompareAtEqualChamberVolume) {
       std::vector<std::string> f;
       std::stringstream ls(l);
       for (std::string x; std::getline(ls, x, ',');) f.push_back(x);
-      f.at(11).clear();  // solve_s
+      f.at(12).clear();  // solve_s
       for (const auto& x : f) out += x + ",";
       out += "\n";
     }
     return out;
   };
   EXPECT_EQ(without_times(ReadAll(dir + "/tiny_ref/refinement.csv")), without_times(csv));
+}
+
+TEST(Cli, RefinementRecordsTheTwistAboutAnAxis) {
+  const std::string dir = TempDir("refinement_twist");
+  const std::string bad = dir + "/bad.json";
+  std::ofstream(bad) << R"({"name": "bad_twist", "experiment": "refinement", "seed": 1,
+    "cases": [{"label": "b", "robot": "bimaterial_bar", "actuation": [30, 0],
+               "twist_axis": [0, 0, 0], "resolutions": [2, 3, 4, 6]}]})";
+  CliRun r = Cli("run " + bad + " --no-plot --results " + dir);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find(bad + ": cases[0].twist_axis: expected an array of 3 numbers, not all zero"),
+            std::string::npos)
+      << r.out;
+  // One vertex has no twist.
+  std::ofstream(bad) << R"({"name": "bad_twist", "experiment": "refinement", "seed": 1,
+    "cases": [{"label": "w", "robot": "twisting_robot", "marker": "tip_rim", "actuation": [2],
+               "twist_axis": [0, 0, 1], "resolutions": [1, 2, 3, 4]}]})";
+  r = Cli("run " + bad + " --no-plot --results " + dir);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("cases[0].twist_axis: expected a marker of 3 or more vertices to measure "
+                       "a twist ('tip_rim' has 1)"),
+            std::string::npos)
+      << r.out;
+
+  // The bar's end face is turned by the motion actuator 'twist' (degrees about +x): the recorded
+  // twist of marker 'tip' is that angle at every resolution, and about -x its negative.
+  const std::string good = dir + "/good.json";
+  std::ofstream(good) << R"({"name": "tiny_twist", "experiment": "refinement", "seed": 1,
+    "cases": [{"label": "x", "robot": "bimaterial_bar", "actuation": [30, 0],
+               "twist_axis": [2, 0, 0], "resolutions": [2, 3, 4, 6]},
+              {"label": "minus x", "robot": "bimaterial_bar", "actuation": [30, 0],
+               "twist_axis": [-1, 0, 0], "resolutions": [2, 3, 4, 6]},
+              {"label": "interface", "robot": "bimaterial_bar", "marker": "interface",
+               "actuation": [30, 0], "twist_axis": [1, 0, 0], "resolutions": [2, 3, 4, 6]}]})";
+  r = Cli("run " + good + " --no-plot --results " + dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto j = nlohmann::json::parse(ReadAll(dir + "/tiny_twist/summary.json"));
+  ASSERT_EQ(j["cases"].size(), 3u);
+  for (int k = 0; k < 2; ++k) {
+    const auto& t = j["cases"][k]["twist_deg"];
+    ASSERT_EQ(t.size(), 4u) << j;
+    for (const auto& deg : t) EXPECT_NEAR(deg.get<double>(), k == 0 ? 30.0 : -30.0, 1e-6) << j;
+  }
+  // The interface of two equal halves turns part of the way, the same way.
+  for (const auto& deg : j["cases"][2]["twist_deg"]) {
+    EXPECT_GT(deg.get<double>(), 1.0) << j;
+    EXPECT_LT(deg.get<double>(), 29.0) << j;
+  }
+  const std::string csv = ReadAll(dir + "/tiny_twist/refinement.csv");
+  EXPECT_NE(csv.find("change_mm,to_finest_mm,twist_deg,energy"), std::string::npos) << csv;
 }
