@@ -66,6 +66,21 @@ double EquivalentStrain(const Eigen::Matrix3d& F) {
   return std::sqrt(2.0 / 3.0 * e.squaredNorm());
 }
 
+Eigen::Matrix3d EquivalentStrainGradient(const Eigen::Matrix3d& F) {
+  const Eigen::Matrix3d C = F.transpose() * F;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(C);  // iterative: backward stable
+  const Eigen::Vector3d mu = es.eigenvalues();
+  if (!(mu.minCoeff() > 1e-12)) return Eigen::Matrix3d::Zero();
+  Eigen::Vector3d e = 0.5 * mu.array().log().matrix();
+  e.array() -= e.mean();
+  const double eps = std::sqrt(2.0 / 3.0 * e.squaredNorm());
+  if (!(eps >= 1e-12)) return Eigen::Matrix3d::Zero();
+  // (dev e) C^-1 in C's eigenbasis: diag(e_i / mu_i).
+  const Eigen::Matrix3d& V = es.eigenvectors();
+  const Eigen::Vector3d w = e.cwiseQuotient(mu);
+  return (2.0 / (3.0 * eps)) * F * (V * w.asDiagonal() * V.transpose());
+}
+
 ROmegaCurve::ROmegaCurve(std::vector<double> eps, std::vector<double> rho)
     : eps_(std::move(eps)), rho_(std::move(rho)) {
   if (eps_.empty() || eps_.size() != rho_.size())
@@ -84,6 +99,12 @@ double ROmegaCurve::operator()(double eps) const {
   const size_t j = std::upper_bound(eps_.begin(), eps_.end(), eps) - eps_.begin();  // 1..n-1
   const double t = (eps - eps_[j - 1]) / (eps_[j] - eps_[j - 1]);
   return (1.0 - t) * rho_[j - 1] + t * rho_[j];
+}
+
+double ROmegaCurve::Slope(double eps) const {
+  if (eps < eps_.front() || eps >= eps_.back()) return 0.0;
+  const size_t j = std::upper_bound(eps_.begin(), eps_.end(), eps) - eps_.begin();  // 1..n-1
+  return (rho_[j] - rho_[j - 1]) / (eps_[j] - eps_[j - 1]);
 }
 
 double CurveUniaxialStress(const ROmegaCurve& curve, double lambda, double* lateral,

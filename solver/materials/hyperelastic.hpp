@@ -67,6 +67,14 @@ double CurveUniaxialStress(const ROmegaCurve& curve, double lambda, double* late
 /// floored at 1e-6).
 double EquivalentStrain(const Eigen::Matrix3d& F);
 
+/// The gradient d eps / dF of EquivalentStrain (Frobenius pairing: d eps = <G, dF>). With
+/// C = F^T F and e = ln(C) / 2 (the Hencky strain of U), eps^2 = 2/3 |dev e|^2 gives
+///     G = (2 / (3 eps)) F (dev e) C^-1,
+/// a smooth function of C computed from a backward-stable eigendecomposition, so it stays accurate
+/// where principal stretches coincide. Zero where eps < 1e-12 (eps is a norm of the strain and has
+/// no derivative at zero; Eq. 3.6 multiplies it by a zero difference there) or where F is singular.
+Eigen::Matrix3d EquivalentStrainGradient(const Eigen::Matrix3d& F);
+
 /// R_omega as a function of strain: linear between knots, constant outside them.
 class ROmegaCurve {
  public:
@@ -74,6 +82,9 @@ class ROmegaCurve {
   /// Knots with strictly increasing eps and rho in [0, 1]; throws std::invalid_argument otherwise.
   ROmegaCurve(std::vector<double> eps, std::vector<double> rho);
   double operator()(double eps) const;
+  /// d R_omega / d eps: the slope of the knot interval that holds eps, 0 outside the knots (where
+  /// the curve is constant). At a knot, the slope of the interval to its right.
+  double Slope(double eps) const;
   const std::vector<double>& eps() const { return eps_; }
   const std::vector<double>& rho() const { return rho_; }
   bool empty() const { return eps_.empty(); }

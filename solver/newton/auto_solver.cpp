@@ -21,8 +21,7 @@ AutoSolver::AutoSolver(std::shared_ptr<const Model> model, const FkOptions& opti
     : FkSolver(std::move(model)), options_(options), contacts_(std::move(contacts)) {
   std::string why;
   if (!options_.IsValid(&why)) throw std::invalid_argument("solver options: " + why);
-  newton_covers_ = EquilibriumJacobianUnsupported(*model_).empty() &&
-                   !ContactHandlingActive(model_->scene(), options_.collision);
+  newton_covers_ = !ContactHandlingActive(model_->scene(), options_.collision);
   set_limits(limits_);
 }
 

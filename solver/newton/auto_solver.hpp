@@ -19,10 +19,9 @@
 /// budget. The message says when it switched and how it ended. Both solvers stop at the same
 /// equilibrium by the same test.
 ///
-/// Scenes newton does not cover (Mooney-Rivlin bodies, active collision response) are solved by
-/// lg-aa alone. A user's max_iterations at or below lg_iterations is lg-aa's cap, with no
-/// switch. FkResult::iterations adds lg-aa's iterations before the switch to newton's (and to
-/// those of an lg-aa continuation).
+/// Scenes newton does not cover (active collision response) are solved by lg-aa alone. A user's
+/// max_iterations at or below lg_iterations is lg-aa's cap, with no switch. FkResult::iterations
+/// adds lg-aa's iterations before the switch to newton's (and to those of an lg-aa continuation).
 #include "softkin/solver/fk/contact_term.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/fk/local_global.hpp"

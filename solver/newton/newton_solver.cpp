@@ -490,10 +490,6 @@ FkResult NewtonSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c_in,
   if (options_.time_limit_s > 0)
     deadline_ = t0 + std::chrono::duration_cast<Clock::duration>(
                          std::chrono::duration<double>(options_.time_limit_s));
-  const std::string unsupported = EquilibriumJacobianUnsupported(m);
-  if (!unsupported.empty())  // the reason, without the implicit Jacobian's advice
-    return Fallback(c, warm_start, warm_start ? "the warm start" : "the rest shape",
-                    "not used (" + unsupported.substr(0, unsupported.find(';')) + ")", r, t0);
   if (ContactHandlingActive(m.scene(), options_.collision))
     return Fallback(c, warm_start, warm_start ? "the warm start" : "the rest shape",
                     "not used (collision response is on)", r, t0);

@@ -34,8 +34,8 @@
 ///    fresh factor of P (P far from H: strongly indefinite or non-normal systems; Limits), the
 ///    remaining actuation is left to lg-aa from the last converged state, and the message says
 ///    so. Scenes Newton does not cover
-///    (Mooney-Rivlin bodies, active collision response: EquilibriumJacobianUnsupported and
-///    ContactHandlingActive) are solved by lg-aa outright, with a message.
+///    (active collision response: ContactHandlingActive) are solved by lg-aa outright, with a
+///    message.
 /// FkResult::iterations counts Newton iterations (plus the fallback's local-global ones),
 /// linear_iterations the Krylov products and load_steps the converged load steps; local_time_s is
 /// the time of the residual evaluations, global_time_s that of the Newton directions (the

@@ -64,16 +64,6 @@ bool EquilibriumJacobianOptions::IsValid(std::string* why) const {
   return true;
 }
 
-std::string EquilibriumJacobianUnsupported(const Model& model) {
-  const auto& els = model.elements();
-  for (size_t i = 0; i < els.size(); ++i)
-    if (els[i].role == ElementRole::Body && els[i].curve)
-      return "element " + std::to_string(i) +
-             " has a hyperelastic (Mooney-Rivlin) body material, which implicit differentiation "
-             "does not support; use the fd or fd-warm Jacobian";
-  return "";
-}
-
 Eigen::MatrixX3d PrescribedDerivative(const Model& model,
                                       const Eigen::Ref<const Eigen::VectorXd>& c, int a) {
   Eigen::MatrixX3d dXc = Eigen::MatrixX3d::Zero(model.num_vertices(), 3);

@@ -27,12 +27,17 @@
 /// Jacobian of the local-global map, whose spectrum the local-global iteration itself contracts;
 /// GMRES needs far fewer products than that iteration.
 ///
-/// Supported: body elements with the blend law (Eq. 2.3-2.5), pneumatic, cable and DEA actuation
-/// elements (vented chambers too), fixed / held coordinates and motion actuators. Not supported
-/// (Setup fails with a message): hyperelastic (Mooney-Rivlin) body elements and collision springs
-/// (the caller must check FkOptions::collision itself; this file only sees the energy). Clamped
-/// quantities (kMinMeasure floors, the blend scale capped at 10) have zero derivative, which is
-/// their true one-sided derivative.
+///   - hyperelastic bodies (Eq. 3.6-3.7), T = c Bl with Bl = t R P + (1 - t) D, t = R_omega(eps),
+///     c = cbrt(Vol_0 / Vol(Bl)): dBl = dt (R P - D) + t d(R P) + (1 - t) dD, dt = R_omega'(eps)
+///     <d eps/dF, dF> (EquivalentStrainGradient; F = D^T P (P^T P)^-1), or on the blend-volume
+///     floor the dt that keeps Vol(Bl) at the floor; dc = -(c / 3) <grad Vol(Bl), dBl> / Vol(Bl).
+/// Supported: body elements with the blend law (Eq. 2.3-2.5) or a Mooney-Rivlin curve, pneumatic,
+/// cable and DEA actuation elements (vented chambers too), fixed / held coordinates and motion
+/// actuators. Not supported: collision springs (the caller must check FkOptions::collision
+/// itself; this file only sees the energy). Clamped quantities (kMinMeasure floors, the blend
+/// scale capped at 10, R_omega beyond the curve's last knot) have zero derivative, which is their
+/// true one-sided derivative; at a knot of the piecewise-linear R_omega curve the slope of the
+/// interval to its right is used.
 #include "softkin/solver/fk/model.hpp"
 
 #include <Eigen/CholmodSupport>
@@ -132,17 +137,14 @@ struct EquilibriumJacobianOptions {
   bool IsValid(std::string* why) const;
 };
 
-/// "" if implicit differentiation supports every element of the model; else the reason.
-std::string EquilibriumJacobianUnsupported(const Model& model);
-
 /// The linearisation of the right-hand side B(X, c) of the global step (AssembleRhs of the targets
 /// of ComputeLocalRatios/LocalStep) at one state: caches per element the best rotation and the
 /// inverse of tr(S) I - S, per group its current measures and normalisation.
 class EquilibriumLinearization {
  public:
   /// Linearises at positions X (#V x 3, mm) and actuation c (#actuators). Returns false with the
-  /// reason in *why for unsupported elements (EquilibriumJacobianUnsupported) or a degenerate
-  /// element (flat or inverted: tr(S) I - S singular), true otherwise.
+  /// reason in *why for a degenerate element (flat or inverted: tr(S) I - S singular), true
+  /// otherwise.
   bool Setup(const Model& model, const Eigen::Ref<const Eigen::MatrixX3d>& X,
              const Eigen::Ref<const Eigen::VectorXd>& c, std::string* why, int threads = 0);
   /// dB = the directional derivative of B(X, c) (#V x 3) along positions dX (#V x 3, mm; every
@@ -165,6 +167,17 @@ class EquilibriumLinearization {
   /// For rigid bodies A - K is then the ARAP Hessian. Used to build a preconditioner.
   Eigen::SparseMatrix<double> LocalStiffness() const;
   const Model& model() const { return *model_; }
+
+  /// Hyperelastic body elements (Eq. 3.6-3.7): T = c Bl, Bl = t R P + (1 - t) D with
+  /// t = R_omega(eps(D)) (or the blend-volume floor's weight), c = cbrt(Vol_0 / Vol(Bl)).
+  struct HyperCache {
+    ElemRows diff;      ///< R P - D (rows), the direction t moves Bl in
+    ElemRows blend;     ///< Bl
+    ElemRows vol_grad;  ///< d Vol(Bl) / d Bl
+    ElemRows drho;      ///< d R_omega / dD (curve slope times d eps / dD); unused on the floor
+    double t = 0.0, c = 1.0, vol = 0.0;
+    bool floor = false;  ///< t from the blend-volume floor (HyperelasticBlendWeight), not the curve
+  };
 
  private:
   /// dT of element i for a centred change dD of its rows and dr of its ratio; Ps / dPs0 are the
@@ -196,6 +209,7 @@ class EquilibriumLinearization {
   std::vector<ElemRows> rotated_rest_;
   std::vector<Eigen::Matrix3d> rotated_sinv_;
   std::vector<ElemRows> vol_grad_;      ///< d Vol / dD of blended bodies with an active scale
+  std::vector<HyperCache> hyper_;       ///< per element if the model has hyperelastic bodies
   std::vector<double> measure_;         ///< m_i (floored) of actuation elements
   std::vector<char> measure_active_;    ///< m_i above its floor
   std::vector<ElemRows> measure_grad_;  ///< dm_i/dD of actuation elements (others unused)
@@ -226,8 +240,8 @@ struct EquilibriumJacobianResult {
 /// actuators in `columns` (empty: all, in order). `initial_guess` (optional, 3 #V x #columns in the
 /// layout of dXdc, e.g. the previous Jacobian of a path) starts each Krylov solve from its free
 /// coordinates instead of 0; the tolerance stays relative to the right-hand side, so a close guess
-/// saves products without loosening the result. ok = false with a message for unsupported
-/// elements, degenerate elements or a Krylov solve that does not reach options.tolerance within
+/// saves products without loosening the result. ok = false with a message for degenerate
+/// elements or a Krylov solve that does not reach options.tolerance within
 /// options.max_iterations (never NaN). Uses the model's CHOLMOD factors, so not concurrently on
 /// one Model. `workspace` (optional) keeps the "local" preconditioner's pattern and symbolic
 /// analysis between calls on the same model.

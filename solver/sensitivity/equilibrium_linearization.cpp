@@ -7,6 +7,7 @@
 #include "softkin/solver/fk/actuation.hpp"
 #include "softkin/solver/fk/rotation.hpp"
 #include "softkin/solver/fk/targets.hpp"
+#include "softkin/solver/materials/hyperelastic.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -57,10 +58,33 @@ inline Eigen::Matrix3d PolarDerivativeW(const Eigen::Matrix3d& R, const Eigen::M
   return Skew(Sinv * AxialOfSkewPart(R.transpose() * dM));
 }
 
+/// The data of a hyperelastic body element's target derivative at centred rows D with best
+/// rotation R (ElementTarget's hyperelastic branch, targets.cpp, step by step).
+void SetupHyperelastic(const ModelElement& e, const ElemRows& D, const Eigen::Matrix3d& R,
+                       EquilibriumLinearization::HyperCache* h) {
+  const int k = e.k;
+  const ElemRows RP = e.rest * R.transpose();  // rows past k are zero
+  const Eigen::Matrix3d F = DeformationGradient(e, D);
+  const double eps = EquivalentStrain(F);
+  const double rho = (*e.curve)(eps);
+  h->t = HyperelasticBlendWeight(RP, D, k, rho, e.rest_volume);
+  h->floor = h->t != rho;
+  h->diff = RP - D;
+  h->blend = h->t * RP + (1.0 - h->t) * D;
+  h->vol = RowsVolume(h->blend, k);
+  h->c = std::cbrt(e.rest_volume / h->vol);
+  h->vol_grad = RowsVolumeGradient(h->blend, k);
+  // d eps = <G, dF> with dF = dD^T P (P^T P)^-1, so d eps / dD = P (P^T P)^-1 G^T.
+  const auto P = e.rest.topRows(k);
+  const Eigen::Matrix3d Ginv = (P.transpose() * P).inverse();
+  h->drho.setZero();
+  h->drho.topRows(k) = e.curve->Slope(eps) * (P * (Ginv * EquivalentStrainGradient(F).transpose()));
+}
+
 /// Whether element e's target derivative takes the closed form of ApplyRhsDerivativeBatch: a
 /// rigid body (R_omega = 1), or a pneumatic element that is not vented (its ratio r).
 inline bool HasClosedFormDerivative(const ModelElement& e, double r) {
-  return (e.role == ElementRole::Body && e.r_omega >= 1.0) ||
+  return (e.role == ElementRole::Body && e.r_omega >= 1.0 && !e.curve) ||
          (e.role == ElementRole::Pneumatic && r != kVented);
 }
 
@@ -72,11 +96,6 @@ bool EquilibriumLinearization::Setup(const Model& model,
                                      int threads) {
   model_ = &model;
   threads_ = threads;
-  const std::string unsupported = EquilibriumJacobianUnsupported(model);
-  if (!unsupported.empty()) {
-    if (why) *why = unsupported;
-    return false;
-  }
   X_ = X;
   ComputeLocalRatios(model, X_, c, &ratios_);
   const auto& els = model.elements();
@@ -89,6 +108,12 @@ bool EquilibriumLinearization::Setup(const Model& model,
   if (static_cast<int>(vol_grad_.size()) != ne) vol_grad_.resize(ne);
   if (static_cast<int>(rotated_rest_.size()) != ne) rotated_rest_.resize(ne);
   if (static_cast<int>(rotated_sinv_.size()) != ne) rotated_sinv_.resize(ne);
+  const bool any_curve =
+      std::any_of(els.begin(), els.end(), [](const ModelElement& e) { return e.curve; });
+  if (!any_curve)
+    hyper_.clear();
+  else if (static_cast<int>(hyper_.size()) != ne)
+    hyper_.resize(ne);
 
   // Groups: current measures and the normalisation of ComputeLocalRatios.
   groups_.assign(model.num_groups(), GroupCache());
@@ -148,6 +173,10 @@ bool EquilibriumLinearization::Setup(const Model& model,
       rotated_rest_[i].topRows(e.k).noalias() = P * ec.R.transpose();
       rotated_sinv_[i].noalias() = ec.R * ec.Sinv * ec.R.transpose();
     }
+    if (e.curve) {
+      SetupHyperelastic(e, D, ec.R, &hyper_[i]);
+      continue;
+    }
     if (e.role != ElementRole::Body || e.r_omega < 1.0) rows_[i] = D;
     if (e.role == ElementRole::Body && e.r_omega < 1.0) {
       const double vd = RowsVolume(D, e.k);
@@ -192,6 +221,18 @@ void EquilibriumLinearization::ElementTargetDerivative(int i, bool vented, const
   const Eigen::Matrix3d Rt = ec.R.transpose();
   if (vented) {
     *dT = dD;  // vented: T = D
+  } else if (e.curve) {
+    // T = c Bl, Bl = t R P + (1 - t) D (Eq. 3.6-3.7); d(R P) = P dR^T = -P W R^T.
+    const HyperCache& h = hyper_[i];
+    const Eigen::Matrix3d W = PolarDerivativeW(ec.R, ec.Sinv, dD.transpose() * P);
+    const ElemRows dRP = -(P * (W * Rt));
+    const ElemRows moved = h.t * dRP + (1.0 - h.t) * dD;  // dBl at a fixed t
+    const double dt =
+        h.floor ? -h.vol_grad.cwiseProduct(moved).sum() / h.vol_grad.cwiseProduct(h.diff).sum()
+                : h.drho.cwiseProduct(dD).sum();
+    const ElemRows dBl = moved + dt * h.diff;
+    const double dc = -(h.c / 3.0) * h.vol_grad.cwiseProduct(dBl).sum() / h.vol;
+    *dT = dc * h.blend + h.c * dBl;
   } else if (e.role == ElementRole::Body) {
     const Eigen::Matrix3d dM = dD.transpose() * P;
     const Eigen::Matrix3d W = PolarDerivativeW(ec.R, ec.Sinv, dM);
