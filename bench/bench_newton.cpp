@@ -13,7 +13,8 @@
 //   per_vertex          wall time per vertex
 // Compare solvers as the ratio of their times within one run (the machine is shared):
 //   build/bin/bench_newton --benchmark_filter='Strip'
-// Cases: bilayer_strip res 1 and 2 (3.6k and 24k tets) and the 12k-tet strip of issue #33 (res 2
+// Cases: bilayer_strip res 1 and 2 (3.6k and 24k tets), res 1 with an Ecoflex 00-30 Mooney-Rivlin
+// body (hyperelastic = 1; StripMR), and the 12k-tet strip of issue #33 (res 2
 // with 2 mm cells along the length) and the unstructured Gmsh strip of the same size
 // (scenes/bilayer_strip_gmsh.json, 12,397 tets, data/strip/) at alpha 1.1 and 1.5; pneumatic_finger
 // res 8 at alpha 5, and res 12 (46.7k tets) from rest to the end of its range, alpha 10;
@@ -87,6 +88,9 @@ Eigen::VectorXd One(double v) { return Eigen::VectorXd::Constant(1, v); }
 void BM_Strip(benchmark::State& state, int res, double alpha, const char* solver) {
   Solve(state, "bilayer_strip", res, solver, One(alpha));
 }
+void BM_StripMooneyRivlin(benchmark::State& state, double alpha, const char* solver) {
+  Solve(state, "bilayer_strip", 1, solver, One(alpha), {{"hyperelastic", 1.0}});
+}
 void BM_Strip12k(benchmark::State& state, double alpha, const char* solver) {
   Solve(state, "bilayer_strip", 2, solver, One(alpha), {{"cell_length", 2.0}});
 }
@@ -115,6 +119,12 @@ void BM_Strip_r1_a1_1(benchmark::State& s, const char* solver) { BM_Strip(s, 1, 
 void BM_Strip_r1_a1_5(benchmark::State& s, const char* solver) { BM_Strip(s, 1, 1.5, solver); }
 void BM_Strip_r2_a1_1(benchmark::State& s, const char* solver) { BM_Strip(s, 2, 1.1, solver); }
 void BM_Strip_r2_a1_5(benchmark::State& s, const char* solver) { BM_Strip(s, 2, 1.5, solver); }
+void BM_StripMR_r1_a1_1(benchmark::State& s, const char* solver) {
+  BM_StripMooneyRivlin(s, 1.1, solver);
+}
+void BM_StripMR_r1_a1_5(benchmark::State& s, const char* solver) {
+  BM_StripMooneyRivlin(s, 1.5, solver);
+}
 void BM_Strip12k_a1_1(benchmark::State& s, const char* solver) { BM_Strip12k(s, 1.1, solver); }
 void BM_Strip12k_a1_5(benchmark::State& s, const char* solver) { BM_Strip12k(s, 1.5, solver); }
 void BM_GmshStrip_a1_1(benchmark::State& s, const char* solver) { BM_GmshStrip(s, 1.1, solver); }
@@ -149,6 +159,22 @@ BENCHMARK_CAPTURE(BM_Strip_r2_a1_5, newton, "newton")
     ->UseRealTime()
     ->Iterations(1);
 BENCHMARK_CAPTURE(BM_Strip_r2_a1_5, lg_aa, "lg-aa")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_StripMR_r1_a1_1, newton, "newton")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_StripMR_r1_a1_1, lg_aa, "lg-aa")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_StripMR_r1_a1_5, newton, "newton")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_StripMR_r1_a1_5, lg_aa, "lg-aa")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);

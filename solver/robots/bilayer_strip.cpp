@@ -4,6 +4,7 @@
 #include "softkin/solver/robots/robot_parts.hpp"
 
 #include "softkin/solver/common/text_format.hpp"
+#include "softkin/solver/materials/hyperelastic.hpp"
 #include "softkin/solver/mesh/mesh_gen.hpp"
 
 #include <Eigen/Core>
@@ -32,6 +33,7 @@ namespace {
 // 6 * 50 * 6 * 2 = 3,600 tets at the defaults, res 2 24,000, res 3 86,400 and res 4 192,000.
 // cell_length > 0 sets the cells' length along x instead (rounded to a whole number of cells):
 // res 2 with cell_length 2 is the 50 x 10 x 4-cell, 12,000-tet strip of issue #33.
+// hyperelastic = 1 makes the body Ecoflex 00-30 (Mooney-Rivlin, Eq. 3.6-3.7) instead.
 // Markers: tip (the x = L face), tip_top / tip_bottom (its top and bottom quarters in z).
 // ================================================================================================
 
@@ -60,7 +62,14 @@ Scene MakeBilayerStrip(int res, const RobotParams& P) {
   s.mesh = RectilinearTetMesh(
       lines(nx, dx), lines(ny, width / ny), lines(nz, h),
       [res](const Eigen::Vector3d&, const Eigen::Vector3i& c) { return c[2] < res ? 0 : 1; });
-  s.body[0] = Material{"body", 1.0, 1.0};
+  if (FlagParam("bilayer_strip", P, "hyperelastic", "Ch. 2 shape blending, R_omega 1",
+                "Ecoflex 00-30 Mooney-Rivlin")) {
+    MooneyRivlin eco;
+    NamedMooneyRivlin("ecoflex-00-30", &eco);
+    s.body[0] = Material{"ecoflex-00-30", 1.0, 1.0, MaterialLaw::kMooneyRivlin, eco.c1, eco.c2};
+  } else {
+    s.body[0] = Material{"body", 1.0, 1.0};
+  }
   Actuator a;
   a.name = "top";
   a.type = ActuatorType::Pneumatic;
@@ -88,7 +97,8 @@ RobotEntry BilayerStripEntry() {
       "mm (x = 0 clamped), y = width [0, 10], z = two 2 mm layers; the bottom layer is the body "
       "(region 0, R_omega 1), the top layer the pneumatic actuator 'top' (region 1, alpha in "
       "[1, 2]), so inflation curls the strip towards -z. Markers: tip, tip_top, tip_bottom. "
-      "Solved by newton unless --solver says otherwise (lg-aa needs thousands of iterations).",
+      "Solved by newton unless --solver says otherwise (lg-aa needs thousands of iterations). "
+      "hyperelastic = 1 makes the body Ecoflex 00-30 (Mooney-Rivlin).",
       kStripDefaultRes,
       "cells across one layer (cell size layer/res mm; an even count across the width, so "
       "the mesh is mirror-symmetric), integer in [1, 8]; res 1: 3,600 tets, res 2: 24,000",
@@ -97,7 +107,10 @@ RobotEntry BilayerStripEntry() {
        {"layer", 2.0, 0.25, 20.0, "thickness of each layer, mm"},
        {"cell_length", 0.0, 0.0, 50.0,
         "cell size along the length, mm (0: layer/res, cubic cells; else at least 0.25); res 2 "
-        "with cell_length 2 gives 12,000 tets"}}};
+        "with cell_length 2 gives 12,000 tets"},
+       {"hyperelastic", 0.0, 0.0, 1.0,
+        "0: the body is Ch. 2 shape blending with R_omega 1; 1: Ecoflex 00-30 Mooney-Rivlin "
+        "(Eq. 3.6-3.7)"}}};
   return {info, kStripMinRes, kStripMaxRes, &MakeBilayerStrip};
 }
 

@@ -4,6 +4,7 @@
 /// where it is not, lg-aa again when newton runs over its time budget, the user's cap, scenes
 /// newton does not cover, and bad limits.
 #include "softkin/solver/factory/fk_factory.hpp"
+#include "softkin/solver/fk/contact_term.hpp"
 #include "softkin/solver/newton/auto_solver.hpp"
 #include "softkin/solver/robots/robots.hpp"
 
@@ -183,20 +184,24 @@ TEST(AutoSolver, UsersCapBelowTheCheckpointIsLgAasCap) {
   EXPECT_EQ(au.message.find("newton"), std::string::npos) << au.message;
 }
 
-// Scenes newton does not cover are lg-aa's with its full cap, without a switch.
+// Scenes newton does not cover (an active collision response) are lg-aa's with its full cap,
+// without a switch.
 TEST(AutoSolver, ScenesNewtonDoesNotCoverAreLgAas) {
-  Scene s = MakeRobot("three_chamber", 3);
-  s.body[0].law = MaterialLaw::kMooneyRivlin;
-  s.body[0].c1 = 0.0418;
-  s.body[0].c2 = 0.0106;
+  const Scene s = MakeRobot("selfcollision_finger", 5);
   auto model = std::make_shared<const Model>(s);
-  const Eigen::Vector3d c(1.4, 1.0, 1.0);
-  AutoSolver solver(model, Options("auto"));
+  const Eigen::VectorXd c = Eigen::VectorXd::Constant(1, 1.5);
+  FkOptions oa = Options("auto"), ol = Options("lg-aa");
+  oa.collision = ol.collision = s.solver.collision;
+  ASSERT_TRUE(ContactHandlingActive(s, oa.collision));
+  // The factory gives the solver its contact term.
+  auto built = MakeFkSolver(model, oa);
+  auto* solver = dynamic_cast<AutoSolver*>(built.get());
+  ASSERT_NE(solver, nullptr);
   AutoSolver::Limits limits;
   limits.lg_iterations = 5;  // would switch after 5 iterations on a covered scene
-  solver.set_limits(limits);
-  const FkResult au = solver.Solve(c);
-  const FkResult lg = MakeFkSolver(model, Options("lg-aa"))->Solve(c);
+  solver->set_limits(limits);
+  const FkResult au = solver->Solve(c);
+  const FkResult lg = MakeFkSolver(model, ol)->Solve(c);
   ASSERT_EQ(lg.status, FkStatus::Converged) << lg.BriefReport();
   ASSERT_GT(lg.iterations, 5);
   EXPECT_EQ(au.status, FkStatus::Converged) << au.BriefReport();

@@ -341,6 +341,18 @@ TEST(RobotParams, UnknownOrOutOfRangeParametersAreRejectedByName) {
               std::string::npos)
         << e.what();
   }
+  try {
+    MakeRobot("bilayer_strip", 1, {{"hyperelastic", 0.5}});
+    ADD_FAILURE() << "no throw";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'hyperelastic' must be 0 (Ch. 2 shape blending, "
+                                         "R_omega 1) or 1 (Ecoflex 00-30 Mooney-Rivlin), got 0.5"),
+              std::string::npos)
+        << e.what();
+  }
+  const Scene mr = MakeRobot("bilayer_strip", 1, {{"hyperelastic", 1}});
+  EXPECT_TRUE(mr.body.at(0).hyperelastic());
+  EXPECT_FALSE(MakeRobot("bilayer_strip", 1).body.at(0).hyperelastic());
   EXPECT_THROW(MakeRobot("three_chamber", 3, {{"gain", 1}}), std::invalid_argument);
 }
 
