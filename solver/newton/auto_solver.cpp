@@ -21,7 +21,7 @@ AutoSolver::AutoSolver(std::shared_ptr<const Model> model, const FkOptions& opti
     : FkSolver(std::move(model)), options_(options), contacts_(std::move(contacts)) {
   std::string why;
   if (!options_.IsValid(&why)) throw std::invalid_argument("solver options: " + why);
-  newton_covers_ = !ContactHandlingActive(model_->scene(), options_.collision);
+  may_switch_ = !ContactHandlingActive(model_->scene(), options_.collision);
   set_limits(limits_);
 }
 
@@ -38,7 +38,7 @@ void AutoSolver::set_limits(const Limits& limits) {
   limits_ = limits;
   lg_ = std::make_unique<LocalGlobalSolver>(
       model_, With(FkSolverType::kLgAa, options_.max_iterations, options_.time_limit_s), contacts_);
-  if (newton_covers_ && limits_.lg_iterations < options_.max_iterations)
+  if (may_switch_ && limits_.lg_iterations < options_.max_iterations)
     lg_->set_checkpoint(limits_.lg_iterations, limits_.near_factor * options_.gradient_tolerance);
 }
 
@@ -56,8 +56,8 @@ FkResult AutoSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c,
   FkResult lg = lg_->Solve(c, warm_start);
   lg.solver = name();
   // Stopped at the checkpoint: an iteration cap below the user's.
-  const bool stopped = newton_covers_ && lg.status == FkStatus::IterationCap &&
-                       lg.iterations < options_.max_iterations;
+  const bool stopped =
+      may_switch_ && lg.status == FkStatus::IterationCap && lg.iterations < options_.max_iterations;
   if (!stopped) return lg;
 
   // newton from the same start, within its budget and the user's time limit.

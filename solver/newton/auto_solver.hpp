@@ -19,7 +19,10 @@
 /// budget. The message says when it switched and how it ended. Both solvers stop at the same
 /// equilibrium by the same test.
 ///
-/// Scenes newton does not cover (active collision response) are solved by lg-aa alone. A user's
+/// Scenes with an active collision response are solved by lg-aa alone: newton solves them too
+/// (when picked by name), but their answer depends on the path to it, and the switch would make
+/// a sweep's answers lg-aa's path at some points and newton's at others, by whether lg-aa
+/// converged within lg_iterations there (docs/newton.md). A user's
 /// max_iterations at or below lg_iterations is lg-aa's cap, with no switch. FkResult::iterations
 /// adds lg-aa's iterations before the switch to newton's (and to those of an lg-aa continuation).
 #include "softkin/solver/fk/contact_term.hpp"
@@ -63,7 +66,7 @@ class AutoSolver : public FkSolver {
   FkOptions options_;
   Limits limits_;
   ContactTermFactory contacts_;
-  bool newton_covers_ = true;  ///< the scene is one newton solves (no fallback)
+  bool may_switch_ = true;  ///< no collision response: the switch to newton is allowed
   /// lg-aa with the user's options and the checkpoint (kept: its reference residual is cached)
   std::unique_ptr<LocalGlobalSolver> lg_;
 };

@@ -53,6 +53,17 @@ constexpr int kMaxHalvings = 12;
 /// The tangent predictor of a load step is halved at most this many times to keep every body
 /// element upright that was (LoadSteps), then dropped.
 constexpr int kPredictorHalvings = 5;
+/// With contact response, the deepest new penetration a Newton trial point may make, in mean
+/// edge lengths (NewtonStep).
+constexpr double kContactDepth = 0.05;
+
+double MeanEdgeLength(const Model& m) {
+  const Mesh& mesh = m.mesh();
+  double sum = 0.0;
+  for (const Element& e : mesh.elements)
+    sum += (mesh.vertices.row(e.v[1]) - mesh.vertices.row(e.v[0])).norm();
+  return mesh.elements.empty() ? 0.0 : sum / static_cast<double>(mesh.elements.size());
+}
 }  // namespace
 
 NewtonSolver::NewtonSolver(std::shared_ptr<const Model> model, const FkOptions& options,
@@ -90,17 +101,49 @@ void NewtonSolver::Evaluate(const Eigen::VectorXd& c, State* s) {
   m.GatherFree(B_, &s->Bf);
   m.GatherFree(s->X, &s->x);
   m.GatherFree(m.A() * s->X, &s->g);  // A_ff x + A_fc x_c
+  if (active_contacts_) {
+    // The springs' E = sum k |c^T x - t|^2 with their targets held: K x joins A_ff x and the
+    // targets' part joins B_f, as in lg-aa's global step (contact_term.hpp).
+    s->energy += active_contacts_->Energy(s->X);
+    active_contacts_->AddToRhs(s->X, &s->Bf);
+    active_contacts_->AddSpringProduct(s->x, &s->g);
+  }
   s->g -= s->Bf;
   s->residual = 2.0 * s->g.norm();
   local_time_s_ += Seconds(t0, Clock::now());
 }
 
+Eigen::VectorXd NewtonSolver::ApplyH(FreeOperator* op, const Eigen::VectorXd& v) const {
+  Eigen::VectorXd y = op->Apply(v).col(0);
+  if (active_contacts_) active_contacts_->AddSpringProduct(v, &y);
+  return y;
+}
+
+Eigen::VectorXd NewtonSolver::SolveGlobal(const Eigen::VectorXd& v) const {
+  return active_contacts_ ? active_contacts_->Solve(v) : model_->SolveFree(v);
+}
+
+bool NewtonSolver::UpdateContacts(const Eigen::VectorXd& c, bool final, State* s) {
+  if (!active_contacts_) return false;
+  bool changed = active_contacts_->Update(s->X);
+  if (!changed && final)  // contacts left that the springs do not push out: stiffen them
+    changed = active_contacts_->HasHandledContacts(active_contacts_->Check(s->X)) &&
+              active_contacts_->Stiffen();
+  if (changed) Evaluate(c, s);
+  return changed;
+}
+
 double NewtonSolver::ReferenceResidual(const Eigen::VectorXd& c) {
   if (ref_c_.size() != c.size() || ref_c_ != c) {
+    // Without the contact springs: the rest shape is collision-free, and the reference must not
+    // depend on the spring set of the moment.
+    ContactTerm* const contacts = active_contacts_;
+    active_contacts_ = nullptr;
     State s;
     s.X = model_->rest_positions();
     model_->ApplyConstraints(c, &s.X);
     Evaluate(c, &s);
+    active_contacts_ = contacts;
     ref_value_ = s.residual;
     ref_c_ = c;
   }
@@ -130,7 +173,7 @@ bool NewtonSolver::Direction(const Eigen::VectorXd& c, const State& s, double et
     GmresColumn gm(-s.g, Eigen::VectorXd::Zero(s.g.size()), budget, budget, eta);
     while (!gm.done() &&
            !(gm.products() >= limits_.stall_products && gm.estimate() > limits_.stall_residual))
-      gm.Consume(op.Apply(op.Precondition(gm.Request())).col(0));
+      gm.Consume(ApplyH(&op, op.Precondition(gm.Request()).col(0)));
     gm.Stop();  // a stalled solve keeps what it has
     r->linear_iterations += gm.products();
     *d = op.Precondition(gm.y()).col(0);
@@ -188,7 +231,7 @@ void NewtonSolver::Smooth(const Eigen::VectorXd& c, State* s) {
   // A_ff the model already holds.
   const Model& m = *model_;
   for (int q = 0; q < kSmoothingSteps && std::isfinite(s->residual) && s->X.allFinite(); ++q) {
-    m.ScatterFree(s->x - m.SolveFree(s->g), &s->X);
+    m.ScatterFree(s->x - SolveGlobal(s->g), &s->X);
     Evaluate(c, s);
   }
 }
@@ -211,14 +254,14 @@ bool NewtonSolver::Acceleration(const Eigen::VectorXd& c, const State& s, const 
   Evaluate(c, probe);
   if (!std::isfinite(probe->residual) || !workspace_.factor()) return false;
   FreeOperator op(m, &lin_);  // lin_ is still set up at s (Direction)
-  const Eigen::VectorXd Hd = op.Apply(d).col(0);
+  const Eigen::VectorXd Hd = ApplyH(&op, d);
   const Eigen::VectorXd second = (2.0 / (h * h)) * (probe->g - s.g - h * Hd);
   op.SetPreconditioner(workspace_.factor());
   GmresColumn gm(-second, Eigen::VectorXd::Zero(second.size()), kAccelerationProducts,
                  kAccelerationProducts, kAccelerationForcing);
   while (!gm.done() &&
          !(gm.products() >= limits_.stall_products && gm.estimate() > limits_.stall_residual))
-    gm.Consume(op.Apply(op.Precondition(gm.Request())).col(0));
+    gm.Consume(ApplyH(&op, op.Precondition(gm.Request()).col(0)));
   gm.Stop();
   r->linear_iterations += gm.products() + 1;
   const Eigen::VectorXd a = op.Precondition(gm.y()).col(0);
@@ -236,6 +279,7 @@ NewtonSolver::StepEnd NewtonSolver::NewtonStep(const Eigen::VectorXd& c, bool fi
   s.X = *Xp;
   m.ApplyConstraints(c, &s.X);
   Evaluate(c, &s);
+  UpdateContacts(c, false, &s);
   if (!std::isfinite(s.residual)) {
     *why = "non-finite residual at the start of a load step";
     return StepEnd::Failed;
@@ -249,7 +293,14 @@ NewtonSolver::StepEnd NewtonSolver::NewtonStep(const Eigen::VectorXd& c, bool fi
   Eigen::VectorXd d;
   double eta = kMaxForcing, previous = s.residual;
   history_.clear();
+  bool checked = true;  // the contacts were checked at s
   for (int it = 0;; ++it) {
+    // The springs change only here, between iterations: each line search sees one energy.
+    if (!checked && UpdateContacts(c, false, &s)) {
+      eta = kMaxForcing;
+      previous = s.residual;
+    }
+    checked = false;
     history_.push_back(s.residual);
     if (options_.on_progress && Seconds(reported_, Clock::now()) >= options_.progress_interval_s) {
       reported_ = Clock::now();  // the ratio is the load step's own until the last step
@@ -257,7 +308,7 @@ NewtonSolver::StepEnd NewtonSolver::NewtonStep(const Eigen::VectorXd& c, bool fi
     }
     // Convergence: the local-global test at s (its step, and the residual ratio).
     if (final) {
-      const Eigen::VectorXd step = -m.SolveFree(s.g);
+      const Eigen::VectorXd step = -SolveGlobal(s.g);
       Mv.setZero();
       m.ScatterFree(step, &Mv);
       const double move = Mv.rowwise().norm().maxCoeff() / m.size();
@@ -267,6 +318,17 @@ NewtonSolver::StepEnd NewtonSolver::NewtonStep(const Eigen::VectorXd& c, bool fi
       if (move < options_.tolerance &&
           (r->gradient_ratio < options_.gradient_tolerance || roundoff)) {
         m.ScatterFree(s.x + step, &s.X);  // the local-global step, as lg-aa ends
+        // With contacts, only if a check of that state leaves the springs as they are (lg-aa's
+        // rule); else Newton goes on with the new springs.
+        if (active_contacts_) {
+          Evaluate(c, &s);
+          if (UpdateContacts(c, true, &s)) {
+            checked = true;
+            eta = kMaxForcing;
+            previous = s.residual;
+            continue;
+          }
+        }
         *Xp = s.X;
         return StepEnd::Converged;
       }
@@ -313,8 +375,22 @@ NewtonSolver::StepEnd NewtonSolver::NewtonStep(const Eigen::VectorXd& c, bool fi
     // of lg-aa's safeguard: with volume-coupled ratios or blended bodies the equilibrium is not a
     // minimum of the energy, and near it the residual decides).
     // The line search's rule at step t for the evaluated trial.
+    // With contacts, no trial point may push a vertex deeper into the robot or an obstacle than
+    // the larger of s's deepest contact and a tenth of the mean edge: a Newton step, unlike
+    // lg-aa's small ones, could otherwise carry a wall through another before any spring exists
+    // (selfcollision_finger res 5 ended tangled, 4 elements inverted). The springs for the
+    // shallow contacts it may make are added at the next iteration.
+    const double allowed_depth =
+        active_contacts_
+            ? std::max(active_contacts_->Check(s.X).max_penetration, kContactDepth * mean_edge_)
+            : 0.0;
+    auto shallow = [&]() {
+      return !active_contacts_ || active_contacts_->Check(trial.X).max_penetration <= allowed_depth;
+    };
     auto decreases = [&](double t) {
-      const double frozen = LocalStep(m, trial.X, s.ratios, &scratch_, options_.threads);
+      if (!shallow()) return false;
+      const double frozen = LocalStep(m, trial.X, s.ratios, &scratch_, options_.threads) +
+                            (active_contacts_ ? active_contacts_->Energy(trial.X) : 0.0);
       if (!std::isfinite(trial.residual) || !trial.X.allFinite() || !std::isfinite(frozen))
         return false;
       return frozen <= s.energy + kArmijo * t * slope ||
@@ -325,7 +401,7 @@ NewtonSolver::StepEnd NewtonSolver::NewtonStep(const Eigen::VectorXd& c, bool fi
     Evaluate(c, &trial);
     Smooth(c, &trial);
     bool accepted = std::isfinite(trial.residual) && trial.X.allFinite() &&
-                    trial.residual <= kGoodStep * s.residual;
+                    trial.residual <= kGoodStep * s.residual && shallow();
     int first_halving = 0;
     if (!accepted && !Acceleration(c, s, d, &probe, &Acc, r)) {
       // No acceleration: the path is the straight line, whose t = 1 trial is already evaluated.
@@ -371,7 +447,7 @@ bool NewtonSolver::Tangent(const Eigen::VectorXd& c, const Eigen::MatrixX3d& X,
   FreeOperator op(m, &lin_);
   op.SetPreconditioner(workspace_.factor());
   GmresColumn gm(rhs, Eigen::VectorXd::Zero(rhs.size()), kMaxKrylov, kMaxKrylov, 1e-3);
-  while (!gm.done()) gm.Consume(op.Apply(op.Precondition(gm.Request())).col(0));
+  while (!gm.done()) gm.Consume(ApplyH(&op, op.Precondition(gm.Request()).col(0)));
   r->linear_iterations += gm.products();
   const Eigen::VectorXd y = op.Precondition(gm.y()).col(0);
   r->global_time_s += Seconds(t0, Clock::now());
@@ -406,10 +482,18 @@ NewtonSolver::StepEnd NewtonSolver::LoadSteps(const Eigen::VectorXd& c0, const E
     Eigen::MatrixX3d trial = converged;
     if (have_tangent) {
       const int upright = CountInverted(m, converged).body;
+      // With contacts, it must not push a vertex deeper into another part than NewtonStep's
+      // trial points may.
+      const double depth = active_contacts_
+                               ? std::max(active_contacts_->Check(converged).max_penetration,
+                                          kContactDepth * mean_edge_)
+                               : 0.0;
       double scale = target - lambda;
       for (int q = 0; q <= kPredictorHalvings; ++q, scale *= 0.5) {
         trial = converged + scale * tangent;
-        if (CountInverted(m, trial).body <= upright) break;
+        if (CountInverted(m, trial).body <= upright &&
+            (!active_contacts_ || active_contacts_->Check(trial).max_penetration <= depth))
+          break;
         if (q == kPredictorHalvings) trial = converged;
       }
     }
@@ -490,9 +574,30 @@ FkResult NewtonSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c_in,
   if (options_.time_limit_s > 0)
     deadline_ = t0 + std::chrono::duration_cast<Clock::duration>(
                          std::chrono::duration<double>(options_.time_limit_s));
-  if (ContactHandlingActive(m.scene(), options_.collision))
-    return Fallback(c, warm_start, warm_start ? "the warm start" : "the rest shape",
-                    "not used (collision response is on)", r, t0);
+  active_contacts_ = nullptr;
+  if (ContactHandlingActive(m.scene(), options_.collision)) {
+    try {
+      if (!contacts_)
+        throw std::invalid_argument(
+            "scene '" + m.scene().name +
+            "' has collision handling on, and this solver was built without a contact term "
+            "(build it with MakeFkSolver, solver/factory/fk_factory.hpp, or turn "
+            "solver.collision off)");
+      if (!response_) response_ = contacts_(m, options_.collision);
+    } catch (const std::exception& e) {
+      r.status = FkStatus::InvalidInput;
+      r.message = e.what();
+      r.time_s = Seconds(t0, Clock::now());
+      return r;
+    }
+    response_->Reset();
+    active_contacts_ = response_.get();
+    if (mean_edge_ <= 0.0) mean_edge_ = MeanEdgeLength(m);
+  }
+  struct Release {
+    ContactTerm** p;
+    ~Release() { *p = nullptr; }
+  } release{&active_contacts_};
 
   Eigen::MatrixX3d X = r.positions;
   std::string why;
@@ -529,6 +634,14 @@ FkResult NewtonSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c_in,
     r.message = "iteration cap of " + std::to_string(options_.max_iterations) + " reached";
   ComputeLocalRatios(m, r.positions, c, &ratios_, &r.volume_ratios);
   r.energy = LocalStep(m, r.positions, ratios_, &weighted_, options_.threads);
+  if (active_contacts_) {
+    r.collision_active = true;
+    r.springs = active_contacts_->num_springs();
+    r.collision_stats = active_contacts_->stats();
+    const auto tc = Clock::now();
+    r.collision = active_contacts_->Check(r.positions);  // the exact check of the final state
+    r.collision_stats.check_s += Seconds(tc, Clock::now());
+  }
   r.time_s = Seconds(t0, Clock::now());
   return r;
 }

@@ -33,9 +33,12 @@
 ///  - fallback: when the step falls below 1/1024 of the range, or GMRES stalls twice with a
 ///    fresh factor of P (P far from H: strongly indefinite or non-normal systems; Limits), the
 ///    remaining actuation is left to lg-aa from the last converged state, and the message says
-///    so. Scenes Newton does not cover
-///    (active collision response: ContactHandlingActive) are solved by lg-aa outright, with a
-///    message.
+///    so;
+///  - collision response (ContactHandlingActive): the contact term's springs are quadratic with
+///    targets held fixed between checks, so they join g, H and the local-global steps exactly
+///    (Evaluate, ApplyH, Smooth). The contacts are checked and the springs updated before every
+///    Newton iteration, and a state that passes the stopping test is checked once more (its
+///    springs released or stiffened as lg-aa's final check does) before it is accepted.
 /// FkResult::iterations counts Newton iterations (plus the fallback's local-global ones),
 /// linear_iterations the Krylov products and load_steps the converged load steps; local_time_s is
 /// the time of the residual evaluations, global_time_s that of the Newton directions (the
@@ -43,6 +46,7 @@
 #include "softkin/solver/fk/contact_term.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/sensitivity/equilibrium_jacobian.hpp"
+#include "softkin/solver/sensitivity/free_operator.hpp"
 
 #include <chrono>
 #include <memory>
@@ -54,8 +58,8 @@ namespace softkin {
 
 class NewtonSolver : public FkSolver {
  public:
-  /// `contacts` is passed on to the lg-aa fallback for scenes with collision response
-  /// (MakeFkSolver passes the spring response of solver/collision/).
+  /// `contacts` builds the contact term of scenes with collision response (MakeFkSolver passes
+  /// the spring response of solver/collision/); the lg-aa fallback gets it too.
   NewtonSolver(std::shared_ptr<const Model> model, const FkOptions& options,
                ContactTermFactory contacts = {});
   std::string name() const override { return ToString(FkSolverType::kNewton); }
@@ -98,8 +102,16 @@ class NewtonSolver : public FkSolver {
   };
   enum class StepEnd { Converged, Failed, TimeLimit, IterationCap };
 
-  /// Evaluates s at positions s->X for actuation c (local step, right-hand side, residual).
+  /// Evaluates s at positions s->X for actuation c (local step, right-hand side, residual; the
+  /// contact springs' energy and terms when a contact term is active).
   void Evaluate(const Eigen::VectorXd& c, State* s);
+  /// H v for the linearisation lin_ is set up with, plus the springs' K v.
+  Eigen::VectorXd ApplyH(FreeOperator* op, const Eigen::VectorXd& v) const;
+  /// (A_ff + K_springs)^-1 v: the local-global step's solve.
+  Eigen::VectorXd SolveGlobal(const Eigen::VectorXd& v) const;
+  /// Contact check at s and the spring rule; re-evaluates s and returns true if the springs
+  /// changed. `final`: also stiffens the springs if handled contacts are left (lg-aa's last check).
+  bool UpdateContacts(const Eigen::VectorXd& c, bool final, State* s);
   /// Newton iterations at actuation c from *X. `final`: stop by the local-global test; else at
   /// |g| <= 1e-3 of its start. *X receives the last accepted iterate; *why the reason of a failure.
   StepEnd NewtonStep(const Eigen::VectorXd& c, bool final, Eigen::MatrixX3d* X, FkResult* r,
@@ -138,6 +150,9 @@ class NewtonSolver : public FkSolver {
   FkOptions options_;
   Limits limits_;
   ContactTermFactory contacts_;
+  std::unique_ptr<ContactTerm> response_;
+  ContactTerm* active_contacts_ = nullptr;  ///< response_ during a Solve with collision response
+  double mean_edge_ = 0.0;                  ///< of the rest mesh, mm (set with the contacts)
   std::vector<double> history_;
   EquilibriumLinearization lin_;
   EquilibriumJacobianWorkspace workspace_;

@@ -2,7 +2,7 @@
 /// The "auto" FK solver (solver/newton/auto_solver.hpp): lg-aa's answer where lg-aa converges
 /// within its first 500 iterations or is near the tolerance then, newton's from the same start
 /// where it is not, lg-aa again when newton runs over its time budget, the user's cap, scenes
-/// newton does not cover, and bad limits.
+/// with collision response, and bad limits.
 #include "softkin/solver/factory/fk_factory.hpp"
 #include "softkin/solver/fk/contact_term.hpp"
 #include "softkin/solver/newton/auto_solver.hpp"
@@ -184,9 +184,9 @@ TEST(AutoSolver, UsersCapBelowTheCheckpointIsLgAasCap) {
   EXPECT_EQ(au.message.find("newton"), std::string::npos) << au.message;
 }
 
-// Scenes newton does not cover (an active collision response) are lg-aa's with its full cap,
+// Scenes with an active collision response are lg-aa's with its full cap,
 // without a switch.
-TEST(AutoSolver, ScenesNewtonDoesNotCoverAreLgAas) {
+TEST(AutoSolver, ScenesWithCollisionResponseAreLgAas) {
   const Scene s = MakeRobot("selfcollision_finger", 5);
   auto model = std::make_shared<const Model>(s);
   const Eigen::VectorXd c = Eigen::VectorXd::Constant(1, 1.5);
@@ -198,7 +198,7 @@ TEST(AutoSolver, ScenesNewtonDoesNotCoverAreLgAas) {
   auto* solver = dynamic_cast<AutoSolver*>(built.get());
   ASSERT_NE(solver, nullptr);
   AutoSolver::Limits limits;
-  limits.lg_iterations = 5;  // would switch after 5 iterations on a covered scene
+  limits.lg_iterations = 5;  // would switch after 5 iterations on a scene without contacts
   solver->set_limits(limits);
   const FkResult au = solver->Solve(c);
   const FkResult lg = MakeFkSolver(model, ol)->Solve(c);
