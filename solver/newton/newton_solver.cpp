@@ -119,6 +119,11 @@ Eigen::VectorXd NewtonSolver::ApplyH(FreeOperator* op, const Eigen::VectorXd& v)
   return y;
 }
 
+double NewtonSolver::AllowedDepth(const Eigen::MatrixX3d& X) const {
+  if (!active_contacts_) return 0.0;
+  return std::max(active_contacts_->Check(X).max_penetration, kContactDepth * mean_edge_);
+}
+
 Eigen::VectorXd NewtonSolver::SolveGlobal(const Eigen::VectorXd& v) const {
   return active_contacts_ ? active_contacts_->Solve(v) : model_->SolveFree(v);
 }
@@ -380,10 +385,7 @@ NewtonSolver::StepEnd NewtonSolver::NewtonStep(const Eigen::VectorXd& c, bool fi
     // lg-aa's small ones, could otherwise carry a wall through another before any spring exists
     // (selfcollision_finger res 5 ended tangled, 4 elements inverted). The springs for the
     // shallow contacts it may make are added at the next iteration.
-    const double allowed_depth =
-        active_contacts_
-            ? std::max(active_contacts_->Check(s.X).max_penetration, kContactDepth * mean_edge_)
-            : 0.0;
+    const double allowed_depth = AllowedDepth(s.X);
     auto shallow = [&]() {
       return !active_contacts_ || active_contacts_->Check(trial.X).max_penetration <= allowed_depth;
     };
@@ -484,10 +486,7 @@ NewtonSolver::StepEnd NewtonSolver::LoadSteps(const Eigen::VectorXd& c0, const E
       const int upright = CountInverted(m, converged).body;
       // With contacts, it must not push a vertex deeper into another part than NewtonStep's
       // trial points may.
-      const double depth = active_contacts_
-                               ? std::max(active_contacts_->Check(converged).max_penetration,
-                                          kContactDepth * mean_edge_)
-                               : 0.0;
+      const double depth = AllowedDepth(converged);
       double scale = target - lambda;
       for (int q = 0; q <= kPredictorHalvings; ++q, scale *= 0.5) {
         trial = converged + scale * tangent;

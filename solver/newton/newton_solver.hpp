@@ -107,6 +107,9 @@ class NewtonSolver : public FkSolver {
   void Evaluate(const Eigen::VectorXd& c, State* s);
   /// H v for the linearisation lin_ is set up with, plus the springs' K v.
   Eigen::VectorXd ApplyH(FreeOperator* op, const Eigen::VectorXd& v) const;
+  /// With contacts, the deepest penetration a step from X may make: the deeper of X's deepest
+  /// contact and kContactDepth mean edges (newton_solver.cpp).
+  double AllowedDepth(const Eigen::MatrixX3d& X) const;
   /// (A_ff + K_springs)^-1 v: the local-global step's solve.
   Eigen::VectorXd SolveGlobal(const Eigen::VectorXd& v) const;
   /// Contact check at s and the spring rule; re-evaluates s and returns true if the springs
