@@ -381,7 +381,7 @@ NewtonSolver::StepEnd NewtonSolver::NewtonStep(const Eigen::VectorXd& c, bool fi
     // minimum of the energy, and near it the residual decides).
     // The line search's rule at step t for the evaluated trial.
     // With contacts, no trial point may push a vertex deeper into the robot or an obstacle than
-    // the larger of s's deepest contact and a tenth of the mean edge: a Newton step, unlike
+    // the larger of s's deepest contact and kContactDepth mean edges: a Newton step, unlike
     // lg-aa's small ones, could otherwise carry a wall through another before any spring exists
     // (selfcollision_finger res 5 ended tangled, 4 elements inverted). The springs for the
     // shallow contacts it may make are added at the next iteration.
