@@ -12,6 +12,7 @@
 
 #include <functional>
 #include <memory>
+#include <string>
 
 namespace softkin {
 
@@ -87,5 +88,12 @@ using ContactTermFactory = std::function<std::unique_ptr<ContactTerm>(
 /// Whether a scene with these options needs contact handling at all: self-collision is on, or
 /// obstacle response is on and the scene has obstacles.
 bool ContactHandlingActive(const Scene& scene, const CollisionOptions& options);
+
+/// A solver's contact term: *term if it is built already, else factory's for `model`. Returns
+/// false with *why (naming the scene) if there is no factory (a solver built without
+/// MakeFkSolver) or the factory refuses the scene.
+bool EnsureContactTerm(const ContactTermFactory& factory, const Model& model,
+                       const CollisionOptions& options, std::unique_ptr<ContactTerm>* term,
+                       std::string* why);
 
 }  // namespace softkin

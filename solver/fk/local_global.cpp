@@ -300,17 +300,8 @@ FkResult LocalGlobalSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c
                         std::chrono::duration<double>(options_.time_limit_s));
   deadline_ = deadline ? &*deadline : nullptr;
   if (ContactHandlingActive(m.scene(), options_.collision)) {
-    try {
-      if (!contacts_)
-        throw std::invalid_argument(
-            "scene '" + m.scene().name +
-            "' has collision handling on, and this solver was built without a contact term "
-            "(build it with MakeFkSolver, solver/factory/fk_factory.hpp, or turn "
-            "solver.collision off)");
-      if (!response_) response_ = contacts_(m, options_.collision);
-    } catch (const std::exception& e) {
+    if (!EnsureContactTerm(contacts_, m, options_.collision, &response_, &r.message)) {
       r.status = FkStatus::InvalidInput;
-      r.message = e.what();
       r.time_s = Seconds(t0, Clock::now());
       return r;
     }

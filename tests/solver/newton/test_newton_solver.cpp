@@ -292,6 +292,19 @@ TEST(NewtonSolver, MooneyRivlinBodyReachesLgAasState) {
       << nw.BriefReport() << " vs " << lg.BriefReport();
 }
 
+// A solver built without MakeFkSolver has no contact term: a scene with collision response is
+// refused with a message that names the scene and the way out, not solved without contacts.
+TEST(NewtonSolver, ContactSceneWithoutAContactTermIsRefusedByName) {
+  const Scene s = MakeRobot("selfcollision_finger", 5);
+  FkOptions o = Options("newton", 1e-5, 1e-6);
+  o.collision = s.solver.collision;
+  NewtonSolver solver(std::make_shared<const Model>(s), o);
+  const FkResult r = solver.Solve(Eigen::VectorXd::Constant(1, 1.5));
+  EXPECT_EQ(r.status, FkStatus::InvalidInput);
+  EXPECT_NE(r.message.find("scene '" + s.name + "'"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("MakeFkSolver"), std::string::npos) << r.message;
+}
+
 // Self-contact from rest in one call (selfcollision_finger res 5, alpha 2.5). With springs that
 // hold their targets between checks, the answer depends on the path the iteration takes to it:
 // lg-aa in one stage ends 6.3 mm from where lg-aa in 16 small stages does (the quasi-static path,
