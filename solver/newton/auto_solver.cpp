@@ -21,7 +21,7 @@ AutoSolver::AutoSolver(std::shared_ptr<const Model> model, const FkOptions& opti
     : FkSolver(std::move(model)), options_(options), contacts_(std::move(contacts)) {
   std::string why;
   if (!options_.IsValid(&why)) throw std::invalid_argument("solver options: " + why);
-  may_switch_ = !ContactHandlingActive(model_->scene(), options_.collision);
+  contacts_active_ = ContactHandlingActive(model_->scene(), options_.collision);
   set_limits(limits_);
 }
 
@@ -38,8 +38,6 @@ void AutoSolver::set_limits(const Limits& limits) {
   limits_ = limits;
   lg_ = std::make_unique<LocalGlobalSolver>(
       model_, With(FkSolverType::kLgAa, options_.max_iterations, options_.time_limit_s), contacts_);
-  if (may_switch_ && limits_.lg_iterations < options_.max_iterations)
-    lg_->set_checkpoint(limits_.lg_iterations, limits_.near_factor * options_.gradient_tolerance);
 }
 
 FkOptions AutoSolver::With(FkSolverType type, int max_iterations, double time_limit_s) const {
@@ -53,11 +51,16 @@ FkOptions AutoSolver::With(FkSolverType type, int max_iterations, double time_li
 FkResult AutoSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c,
                                const Eigen::MatrixX3d* warm_start) {
   const auto t0 = Clock::now();
+  // With contacts, only a solve from the rest shape may switch (the header says why).
+  const bool may_switch = (!contacts_active_ || warm_start == nullptr) &&
+                          limits_.lg_iterations < options_.max_iterations;
+  lg_->set_checkpoint(may_switch ? limits_.lg_iterations : 0,
+                      limits_.near_factor * options_.gradient_tolerance);
   FkResult lg = lg_->Solve(c, warm_start);
   lg.solver = name();
   // Stopped at the checkpoint: an iteration cap below the user's.
   const bool stopped =
-      may_switch_ && lg.status == FkStatus::IterationCap && lg.iterations < options_.max_iterations;
+      may_switch && lg.status == FkStatus::IterationCap && lg.iterations < options_.max_iterations;
   if (!stopped) return lg;
 
   // newton from the same start, within its budget and the user's time limit.

@@ -19,12 +19,14 @@
 /// budget. The message says when it switched and how it ended. Both solvers stop at the same
 /// equilibrium by the same test.
 ///
-/// Scenes with an active collision response are solved by lg-aa alone: newton solves them too
-/// (when picked by name), but their answer depends on the path to it, and the switch would make
-/// a sweep's answers lg-aa's path at some points and newton's at others, by whether lg-aa
-/// converged within lg_iterations there (docs/newton.md). A user's
-/// max_iterations at or below lg_iterations is lg-aa's cap, with no switch. FkResult::iterations
-/// adds lg-aa's iterations before the switch to newton's (and to those of an lg-aa continuation).
+/// Scenes with an active collision response switch only when solved from the rest shape. Their
+/// answer depends on the path to it: newton's load steps follow the quasi-static path, and lg-aa's
+/// one call from rest can end far from it (`selfcollision_finger` at alpha 2.5: 6-22 mm at res
+/// 5-8, docs/newton.md). In a warm-started sweep lg-aa's small steps follow that path too, and a
+/// switch there would make a sweep's answers lg-aa's at some points and newton's at others. A
+/// user's max_iterations at or below lg_iterations is lg-aa's cap, with no switch.
+/// FkResult::iterations adds lg-aa's iterations before the switch to newton's (and to those of an
+/// lg-aa continuation).
 #include "softkin/solver/fk/contact_term.hpp"
 #include "softkin/solver/fk/fk_solver.hpp"
 #include "softkin/solver/fk/local_global.hpp"
@@ -66,7 +68,7 @@ class AutoSolver : public FkSolver {
   FkOptions options_;
   Limits limits_;
   ContactTermFactory contacts_;
-  bool may_switch_ = true;  ///< no collision response: the switch to newton is allowed
+  bool contacts_active_ = false;  ///< the scene has an active collision response
   /// lg-aa with the user's options and the checkpoint (kept: its reference residual is cached)
   std::unique_ptr<LocalGlobalSolver> lg_;
 };

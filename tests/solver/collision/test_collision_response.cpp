@@ -599,20 +599,22 @@ TEST(CollisionResponse, SelfCollidingFingerBendsCollisionFreeWithBalancedForces)
 // From rest straight to alpha = 2, the first global step pushes the fingers' segments across
 // their 0.2 mm slits before any contact check; the springs then pull the wrong way and the state
 // tangles. lg-aa sees the tangle, restarts the stage with half the load step, and ends where an
-// explicit two-stage continuation ends.
+// explicit two-stage continuation ends. (lg-aa by name: `auto` hands such a cold solve to newton.)
 TEST(CollisionResponse, ColdSelfContactSolveCutsTheLoadStepBackWhenItTangles) {
   const Scene scene = MakeRobot("selfcollision_finger", 6, {});
   ASSERT_EQ(scene.solver.continuation_steps, 1);
   auto model = std::make_shared<const Model>(scene);
   Eigen::VectorXd c(1);
   c << 2.0;
-  const FkResult cold = MakeFkSolver(model, scene.solver)->Solve(c);
+  FkOptions lg = scene.solver;
+  lg.solver = FkSolverType::kLgAa;
+  const FkResult cold = MakeFkSolver(model, lg)->Solve(c);
   ASSERT_EQ(cold.status, FkStatus::Converged) << cold.BriefReport();
   EXPECT_NE(cold.message.find("cut the load step back 1 time(s)"), std::string::npos)
       << cold.message;
   EXPECT_TRUE(cold.collision.collision_free()) << cold.BriefReport();
   EXPECT_EQ(cold.inverted_elements, 0);
-  FkOptions two = scene.solver;
+  FkOptions two = lg;
   two.continuation_steps = 2;
   const FkResult staged = MakeFkSolver(model, two)->Solve(c);
   ASSERT_EQ(staged.status, FkStatus::Converged) << staged.BriefReport();

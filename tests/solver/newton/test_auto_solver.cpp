@@ -152,7 +152,7 @@ TEST(AutoSolver, UsersTimeLimitDuringNewtonReturnsLgAasState) {
   auto model = std::make_shared<const Model>(MakeRobot("bilayer_strip", 1));
   const Eigen::VectorXd c = Eigen::VectorXd::Constant(1, 1.5);
   FkOptions o = Options("auto");
-  o.time_limit_s = 0.15;  // newton needs about 15 iterations and 0.7 s here (docs/newton.md)
+  o.time_limit_s = 0.3;  // newton needs about 15 iterations and 0.7 s here (docs/newton.md)
   AutoSolver solver(model, o);
   AutoSolver::Limits limits;
   limits.lg_iterations = 5;
@@ -186,28 +186,48 @@ TEST(AutoSolver, UsersCapBelowTheCheckpointIsLgAasCap) {
 
 // Scenes with an active collision response are lg-aa's with its full cap,
 // without a switch.
-TEST(AutoSolver, ScenesWithCollisionResponseAreLgAas) {
+TEST(AutoSolver, ContactScenesSwitchFromRestOnlyAndKeepTheQuasiStaticPath) {
+  // selfcollision_finger res 5 at alpha 2.5: lg-aa's one call from rest ends 6 mm from the
+  // quasi-static path (tip z -7.2 mm against -13.5), newton's load steps on it (docs/newton.md).
   const Scene s = MakeRobot("selfcollision_finger", 5);
   auto model = std::make_shared<const Model>(s);
-  const Eigen::VectorXd c = Eigen::VectorXd::Constant(1, 1.5);
-  FkOptions oa = Options("auto"), ol = Options("lg-aa");
-  oa.collision = ol.collision = s.solver.collision;
+  const Eigen::VectorXd c = Eigen::VectorXd::Constant(1, 2.5);
+  FkOptions oa = Options("auto"), ol = Options("lg-aa"), on = Options("newton");
+  oa.collision = ol.collision = on.collision = s.solver.collision;
   ASSERT_TRUE(ContactHandlingActive(s, oa.collision));
-  // The factory gives the solver its contact term.
-  auto built = MakeFkSolver(model, oa);
+  const int tip = s.marker_index("tip");
+  auto tip_z = [&](const FkResult& r) { return s.marker_positions(r.positions)(tip, 2); };
+
+  // From rest lg-aa is far from the tolerance at its checkpoint, so auto solves with newton.
+  auto built = MakeFkSolver(model, oa);  // the factory gives the solver its contact term
   auto* solver = dynamic_cast<AutoSolver*>(built.get());
   ASSERT_NE(solver, nullptr);
-  AutoSolver::Limits limits;
-  limits.lg_iterations = 5;  // would switch after 5 iterations on a scene without contacts
-  solver->set_limits(limits);
   const FkResult au = solver->Solve(c);
+  ASSERT_EQ(au.status, FkStatus::Converged) << au.BriefReport();
+  EXPECT_NE(au.message.find("newton from the rest shape solved it"), std::string::npos)
+      << au.message;
+  EXPECT_TRUE(au.collision.collision_free()) << au.BriefReport();
+  const FkResult nw = MakeFkSolver(model, on)->Solve(c);
+  ASSERT_EQ(nw.status, FkStatus::Converged) << nw.BriefReport();
+  EXPECT_LT(MaxDistance(au.positions, nw.positions), 0.05);
   const FkResult lg = MakeFkSolver(model, ol)->Solve(c);
   ASSERT_EQ(lg.status, FkStatus::Converged) << lg.BriefReport();
-  ASSERT_GT(lg.iterations, 5);
-  EXPECT_EQ(au.status, FkStatus::Converged) << au.BriefReport();
-  EXPECT_EQ(au.iterations, lg.iterations);
-  EXPECT_EQ(au.linear_iterations, 0);
-  EXPECT_EQ(MaxDistance(au.positions, lg.positions), 0.0);
+  EXPECT_LT(tip_z(au), tip_z(lg) - 3.0) << "auto's tip is not past lg-aa's one-call tip";
+
+  // A warm-started contact solve is lg-aa's however early the checkpoint: a sweep keeps one
+  // solver's path.
+  AutoSolver::Limits limits;
+  limits.lg_iterations = 5;
+  solver->set_limits(limits);
+  const Eigen::VectorXd c2 = Eigen::VectorXd::Constant(1, 2.6);
+  const FkResult aw = solver->Solve(c2, &au.positions);
+  const FkResult lw = MakeFkSolver(model, ol)->Solve(c2, &au.positions);
+  ASSERT_EQ(lw.status, FkStatus::Converged) << lw.BriefReport();
+  ASSERT_GT(lw.iterations, 5);
+  EXPECT_EQ(aw.status, FkStatus::Converged) << aw.BriefReport();
+  EXPECT_EQ(aw.iterations, lw.iterations);
+  EXPECT_EQ(aw.linear_iterations, 0);
+  EXPECT_EQ(MaxDistance(aw.positions, lw.positions), 0.0);
 }
 
 TEST(AutoSolver, BadLimitsNameTheFieldAndTheRange) {
