@@ -38,8 +38,8 @@ namespace softkin {
 
 class AutoSolver : public FkSolver {
  public:
-  /// `contacts` goes to lg-aa for scenes with collision response (MakeFkSolver passes the spring
-  /// response of solver/collision/).
+  /// `contacts` goes to lg-aa and newton for scenes with collision response (MakeFkSolver passes
+  /// the spring response of solver/collision/).
   AutoSolver(std::shared_ptr<const Model> model, const FkOptions& options,
              ContactTermFactory contacts = {});
   std::string name() const override { return ToString(FkSolverType::kAuto); }

@@ -184,8 +184,8 @@ TEST(AutoSolver, UsersCapBelowTheCheckpointIsLgAasCap) {
   EXPECT_EQ(au.message.find("newton"), std::string::npos) << au.message;
 }
 
-// Scenes with an active collision response are lg-aa's with its full cap,
-// without a switch.
+// A scene with an active collision response switches only when solved from the rest shape;
+// a warm-started solve is lg-aa's with its full cap.
 TEST(AutoSolver, ContactScenesSwitchFromRestOnlyAndKeepTheQuasiStaticPath) {
   // selfcollision_finger res 5 at alpha 2.5: lg-aa's one call from rest ends 6 mm from the
   // quasi-static path (tip z -7.2 mm against -13.5), newton's load steps on it (docs/newton.md).
