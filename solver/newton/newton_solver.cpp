@@ -215,7 +215,12 @@ bool NewtonSolver::Direction(const Eigen::VectorXd& c, const State& s, double et
   // load steps do not make the linear systems easier.
   if (!ok && stalled && ++stalls_ >= kMaxStalls) {
     *why = "GMRES with a fresh preconditioner stalled " + std::to_string(stalls_) +
-           " times (the Newton systems are far from their projected Hessian here)";
+           " times (the Newton systems are far from their projected Hessian here";
+    // An inverted element's block of H is far from positive, so the projection changes it most:
+    // the message says how many there are (a crushed wall; docs/newton.md).
+    const int inverted = CountInverted(m, s.X).body;
+    if (inverted > 0) *why += "; " + std::to_string(inverted) + " body elements are inverted";
+    *why += ")";
     return false;
   }
   if (!d->allFinite()) {
