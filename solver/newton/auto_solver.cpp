@@ -95,6 +95,21 @@ FkResult AutoSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c,
     r.linear_iterations = nw.linear_iterations;
     r.status = FkStatus::TimeLimit;
     r.message = "time limit of " + FormatNumber(limit) + " s reached";
+  } else if (contacts_active_) {
+    // With contacts lg-aa's checkpoint state may belong to one of its intermediate stages (a
+    // load step cut back where the contact response tangled), and a new solve from it at the
+    // full actuation would start without that solve's springs: on membrane res 32 it tangled at
+    // once (docs/newton.md). So lg-aa solves again from the same start, whole.
+    note += " had not converged after " + FormatNumber(budget, 3) + " s (" +
+            FkStatusToString(nw.status) + ", " + std::to_string(nw.iterations) +
+            " iterations); solved again with lg-aa from the rest shape";
+    LocalGlobalSolver again(model_, With(FkSolverType::kLgAa, options_.max_iterations, left()),
+                            contacts_);
+    r = again.Solve(c, warm_start);
+    iterations += nw.iterations;
+    local_s += nw.local_time_s;
+    global_s += nw.global_time_s;
+    r.linear_iterations = nw.linear_iterations;
   } else {
     // newton did not make it within its budget: lg-aa goes on from where it stopped.
     note += " had not converged after " + FormatNumber(budget, 3) + " s (" +

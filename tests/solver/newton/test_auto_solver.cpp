@@ -228,6 +228,18 @@ TEST(AutoSolver, ContactScenesSwitchFromRestOnlyAndKeepTheQuasiStaticPath) {
   EXPECT_EQ(aw.iterations, lw.iterations);
   EXPECT_EQ(aw.linear_iterations, 0);
   EXPECT_EQ(MaxDistance(aw.positions, lw.positions), 0.0);
+
+  // From rest, when newton does not converge within its budget, lg-aa solves again from the rest
+  // shape, whole: its checkpoint state may belong to an intermediate stage, without the springs.
+  AutoSolver::Limits no_time;
+  no_time.newton_time_factor = 1e-9;  // newton's time is up at once
+  solver->set_limits(no_time);
+  const FkResult ag = solver->Solve(c);
+  EXPECT_NE(ag.message.find("solved again with lg-aa from the rest shape"), std::string::npos)
+      << ag.message;
+  EXPECT_EQ(ag.status, lg.status) << ag.BriefReport();
+  EXPECT_GT(ag.iterations, lg.iterations);
+  EXPECT_EQ(MaxDistance(ag.positions, lg.positions), 0.0);
 }
 
 TEST(AutoSolver, BadLimitsNameTheFieldAndTheRange) {
