@@ -15,9 +15,10 @@
 ///
 /// newton gets Limits::newton_time_factor times the time lg-aa has spent. If it has not
 /// converged by then (newton has cases it handles badly: cable_finger res 8, docs/newton.md),
-/// lg-aa continues from where it stopped, so the worst case costs lg-aa's own time plus that
-/// budget. The message says when it switched and how it ended. Both solvers stop at the same
-/// equilibrium by the same test.
+/// lg-aa continues from where it stopped (with contacts: solves again from the rest shape, since
+/// its checkpoint state may belong to an intermediate stage), so the worst case costs lg-aa's own
+/// time plus that budget. The message says when it switched and how it ended. Both solvers stop at
+/// the same equilibrium by the same test.
 ///
 /// Scenes with an active collision response switch only when solved from the rest shape. Their
 /// answer depends on the path to it: newton's load steps follow the quasi-static path, and lg-aa's
@@ -51,7 +52,7 @@ class AutoSolver : public FkSolver {
     /// lg-aa goes on if its residual ratio then is at most near_factor * gradient_tolerance.
     double near_factor = 100.0;
     /// newton may take newton_time_factor times the time lg-aa has spent; past that (or if it
-    /// ends without converging) lg-aa continues from where it stopped.
+    /// ends without converging) lg-aa continues from where it stopped (with contacts: from rest).
     double newton_time_factor = 8.0;
   };
   /// Throws std::invalid_argument naming the field and its valid range for a bad value.
