@@ -95,31 +95,23 @@ FkResult AutoSolver::SolveImpl(const Eigen::Ref<const Eigen::VectorXd>& c,
     r.linear_iterations = nw.linear_iterations;
     r.status = FkStatus::TimeLimit;
     r.message = "time limit of " + FormatNumber(limit) + " s reached";
-  } else if (contacts_active_) {
-    // With contacts lg-aa's checkpoint state may belong to one of its intermediate stages (a
-    // load step cut back where the contact response tangled), and a new solve from it at the
-    // full actuation would start without that solve's springs: on membrane res 32 it tangled at
-    // once (docs/newton.md). So lg-aa solves again from the same start, whole.
-    note += " had not converged after " + FormatNumber(budget, 3) + " s (" +
-            FkStatusToString(nw.status) + ", " + std::to_string(nw.iterations) +
-            " iterations); solved again with lg-aa from the rest shape";
-    LocalGlobalSolver again(model_, With(FkSolverType::kLgAa, options_.max_iterations, left()),
-                            contacts_);
-    r = again.Solve(c, warm_start);
-    iterations += nw.iterations;
-    local_s += nw.local_time_s;
-    global_s += nw.global_time_s;
-    r.linear_iterations = nw.linear_iterations;
   } else {
-    // newton did not make it within its budget: lg-aa goes on from where it stopped.
+    // newton did not make it within its budget: lg-aa goes on from where it stopped. With
+    // contacts that state may belong to one of lg-aa's intermediate stages (a load step cut back
+    // where the contact response tangled), and a new solve from it at the full actuation would
+    // start without that solve's springs (on membrane res 32 it tangled at once, docs/newton.md),
+    // so lg-aa solves again from the same start (the rest shape), whole.
+    const bool again = contacts_active_;
     note += " had not converged after " + FormatNumber(budget, 3) + " s (" +
-            FkStatusToString(nw.status) + ", " + std::to_string(nw.iterations) +
-            " iterations); continued with lg-aa from where it stopped";
+            FkStatusToString(nw.status) + ", " + std::to_string(nw.iterations) + " iterations); " +
+            (again ? "solved again with lg-aa from the rest shape"
+                   : "continued with lg-aa from where it stopped");
     const Eigen::MatrixX3d X = lg.positions;
     LocalGlobalSolver rest(
-        model_, With(FkSolverType::kLgAa, options_.max_iterations - lg.iterations, left()),
+        model_,
+        With(FkSolverType::kLgAa, options_.max_iterations - (again ? 0 : lg.iterations), left()),
         contacts_);
-    r = rest.Solve(c, &X);
+    r = rest.Solve(c, again ? warm_start : &X);
     iterations += nw.iterations;
     local_s += nw.local_time_s;
     global_s += nw.global_time_s;
