@@ -36,6 +36,11 @@ struct FidelityCase {
   int res = 0;
   std::map<std::string, double> params;
   std::vector<double> pressure;  ///< per actuator, MPa at the end of the ramp
+  /// The case's own FEM element and largest increment ("" / 0: the config's).
+  std::string fem_element;
+  double max_increment = 0;
+  /// Whether the case is compared again with the parameters fitted on calibrate_on.
+  bool calibrated = true;
 };
 
 struct FidelityParams {
@@ -53,7 +58,7 @@ FidelityParams ReadFidelityParams(const Config& cfg) {
   FidelityParams p;
   const nlohmann::json cases = cfg.Raw("cases");
   if (!cases.is_array() || cases.empty())
-    cfg.Fail("cases", "a non-empty array of {label, robot | scene, res, pressure}");
+    cfg.Fail("cases", "a non-empty array of {label, robot | scene, res, pressure, ...}");
   for (size_t i = 0; i < cases.size(); ++i) {
     const std::string key = "cases[" + std::to_string(i) + "]";
     const auto& c = cases[i];
@@ -75,10 +80,20 @@ FidelityParams ReadFidelityParams(const Config& cfg) {
           if (!x.is_number()) cfg.Fail(key + ".pressure", "an array of pressures (MPa)");
           fc.pressure.push_back(x.get<double>());
         }
+      } else if (k == "fem_element") {
+        fc.fem_element = v.is_string() ? v.get<std::string>() : v.dump();
+        CheckFemElement(cfg, key + ".fem_element", fc.fem_element);
+      } else if (k == "max_increment") {
+        fc.max_increment = v.is_number() ? v.get<double>() : 0.0;
+        CheckMaxIncrement(cfg, key + ".max_increment", fc.max_increment);
+      } else if (k == "calibrated") {
+        if (!v.is_boolean()) cfg.Fail(key + ".calibrated", "true or false");
+        fc.calibrated = v.get<bool>();
       } else {
         cfg.Fail(key + "." + k,
                  "one of label (string), robot (string), scene (path), res (positive integer), "
-                 "robot_params (object), pressure (array of MPa)");
+                 "robot_params (object), pressure (array of MPa), fem_element (C3D10 or C3D4), "
+                 "max_increment (fraction of the ramp), calibrated (boolean)");
       }
     }
     if (fc.label.empty()) cfg.Fail(key + ".label", "a name for the case");
@@ -108,10 +123,22 @@ FidelityParams ReadFidelityParams(const Config& cfg) {
       std::none_of(p.cases.begin(), p.cases.end(),
                    [&](const FidelityCase& c) { return c.label == p.calibrate_on; }))
     cfg.Fail("calibrate_on", "the label of one of the cases");
+  for (size_t i = 0; i < p.cases.size(); ++i)
+    if (p.cases[i].label == p.calibrate_on && !p.cases[i].calibrated)
+      cfg.Fail("cases[" + std::to_string(i) + "].calibrated",
+               "true (or absent) for the case that calibrate_on fits");
   for (double f : p.fractions)
     if (!(f > 0 && f <= 1)) cfg.Fail("fractions", "fractions of the FEM ramp in (0, 1]");
   if (p.slices < 2) cfg.Fail("slices", "an integer >= 2");
   return p;
+}
+
+/// The FEM options of case c: the config's, with the case's own element and increment.
+PressureFemOptions CaseFem(const FidelityParams& p, const FidelityCase& c) {
+  PressureFemOptions o = p.fem;
+  if (!c.fem_element.empty()) o.element = c.fem_element;
+  if (c.max_increment > 0) o.max_increment = c.max_increment;
+  return o;
 }
 
 Scene CaseScene(const Config& cfg, const FidelityCase& c) {
@@ -295,11 +322,12 @@ CaseData RunCase(const Config& cfg, const FidelityCase& fc, Scene scene, const F
     if (d.loaded[a] && d.lead < 0) d.lead = a;
   }
   d.tip = s.marker_index("tip");
+  const PressureFemOptions fem = CaseFem(p, fc);
   if (verbose)
-    std::fprintf(stderr, "  %s: FEM (%s, %s) on %d tets ...\n", fc.label.c_str(), p.fem.law.c_str(),
-                 p.fem.element.c_str(), s.mesh.num_elements());
+    std::fprintf(stderr, "  %s: FEM (%s, %s) on %d tets ...\n", fc.label.c_str(), fem.law.c_str(),
+                 fem.element.c_str(), s.mesh.num_elements());
   const Model model(s);
-  d.fem = RunPressureFem(model, pressure, p.fem);
+  d.fem = RunPressureFem(model, pressure, fem);
   if (!d.fem.ok)
     throw std::runtime_error(cfg.path() + ": case '" + fc.label + "': " + d.fem.message);
   if (d.fem.increments.empty())
@@ -351,7 +379,7 @@ nlohmann::json RunFidelityFem(const Config& cfg, const std::string& dir, bool ve
     if (scenes.back().marker_index("tip") < 0)
       cfg.Fail(key, "a robot or scene with a 'tip' marker");
     try {
-      BuildPressureFemMesh(Model(scenes.back()), p.fem.element);
+      BuildPressureFemMesh(Model(scenes.back()), CaseFem(p, p.cases[i]).element);
     } catch (const std::invalid_argument& e) {
       cfg.Fail(key, std::string("a scene the pressure FEM can mesh: ") + e.what());
     }
@@ -396,6 +424,7 @@ nlohmann::json RunFidelityFem(const Config& cfg, const std::string& dir, bool ve
                             {"robot", d.fc->robot.empty() ? d.scene.name : d.fc->robot},
                             {"res", d.fc->res},
                             {"tets", d.scene.mesh.num_elements()},
+                            {"fem_element", CaseFem(p, *d.fc).element},
                             {"fem_nodes", d.fem.nodes},
                             {"fem_elements", d.fem.elements},
                             {"fem_increments", d.fem.increments.size()},
@@ -407,9 +436,12 @@ nlohmann::json RunFidelityFem(const Config& cfg, const std::string& dir, bool ve
                             {"fem_end_bend_deg", NullIfNaN(d.fem_angles.back())},
                             {"length_mm", d.length}};
     if (!p.calibrate_on.empty())
-      entry["role"] = d.fc->label == p.calibrate_on ? "calibration" : "hold-out";
+      entry["role"] = d.fc->label == p.calibrate_on ? "calibration"
+                      : d.fc->calibrated            ? "hold-out"
+                                                    : "default parameters only";
     for (size_t vi = 0; vi < variants.size(); ++vi) {
       const auto& [vname, q] = variants[vi];
+      if (vname == "calibrated" && !d.fc->calibrated) continue;
       const auto model = std::make_shared<const Model>(WithParams(d.scene, q));
       const std::vector<Compared> rows = Compare(d, model, p);
       auto cold_solver = MakeFkSolver(model, p.opts);  // a fresh solver: nothing kept from above

@@ -19,11 +19,10 @@ PressureFemOptions ReadPressureFemOptions(const Config& cfg, double default_max_
   o.poisson = cfg.Number("poisson", 0.45);
   o.max_increment = cfg.Number("max_increment", default_max_increment);
   o.time_limit_s = cfg.Number("fem_time_limit_s", default_time_limit_s);
-  if (o.element != "C3D10" && o.element != "C3D4") cfg.Fail("fem_element", "C3D10 or C3D4");
+  CheckFemElement(cfg, "fem_element", o.element);
   if (!(o.young > 0)) cfg.Fail("young_mpa", "a positive Young's modulus (MPa)");
   if (!(o.poisson >= 0 && o.poisson < 0.5)) cfg.Fail("poisson", "a value in [0, 0.5)");
-  if (!(o.max_increment > 0 && o.max_increment <= 1))
-    cfg.Fail("max_increment", "a fraction of the ramp in (0, 1]");
+  CheckMaxIncrement(cfg, "max_increment", o.max_increment);
   if (!(o.time_limit_s >= 0)) cfg.Fail("fem_time_limit_s", "seconds >= 0 (0: no limit)");
   return o;
 }
@@ -31,6 +30,14 @@ PressureFemOptions ReadPressureFemOptions(const Config& cfg, double default_max_
 void CheckFemLaw(const Config& cfg, const std::string& key, const std::string& law) {
   if (law != "linear" && law != "neo-hooke")
     cfg.Fail(key, "linear (FEM 1) or neo-hooke (FEM 2), not '" + law + "'");
+}
+
+void CheckFemElement(const Config& cfg, const std::string& key, const std::string& element) {
+  if (element != "C3D10" && element != "C3D4") cfg.Fail(key, "C3D10 or C3D4");
+}
+
+void CheckMaxIncrement(const Config& cfg, const std::string& key, double max_increment) {
+  if (!(max_increment > 0 && max_increment <= 1)) cfg.Fail(key, "a fraction of the ramp in (0, 1]");
 }
 
 void CheckPressureFemCanRun(const Config& cfg, const std::string& key, const Scene& scene,

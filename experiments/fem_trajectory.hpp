@@ -27,6 +27,10 @@ PressureFemOptions ReadPressureFemOptions(const Config& cfg, double default_max_
 
 /// Fails on `key` unless law is "linear" or "neo-hooke".
 void CheckFemLaw(const Config& cfg, const std::string& key, const std::string& law);
+/// Fails on `key` unless element is "C3D10" or "C3D4".
+void CheckFemElement(const Config& cfg, const std::string& key, const std::string& element);
+/// Fails on `key` unless the largest increment is a fraction of the ramp in (0, 1].
+void CheckMaxIncrement(const Config& cfg, const std::string& key, double max_increment);
 
 /// Fails on `key`, before any work, if ccx is missing (with the install hint) or the FEM cannot
 /// mesh the scene with `element` (naming the chamber or actuator).

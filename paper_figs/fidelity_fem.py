@@ -81,7 +81,9 @@ def main(argv):
         a.grid(True, alpha=0.3)
         a.legend(fontsize=8)
         role = case.get("role", "")
-        a.set_title(f"{case.get('case')} ({case.get('tets')} tets{', ' + role if role else ''}): "
+        element = case.get("fem_element", summary.get("fem", {}).get("element"))
+        a.set_title(f"{case.get('case')} ({case.get('tets')} tets, FEM {element}"
+                    f"{', ' + role if role else ''}): "
                     f"centre lines at {', '.join(f'{100 * f:.0f}' for f in fractions)} % of the ramp",
                     fontsize=9)
         b = axes[ci][1]
@@ -106,7 +108,8 @@ def main(argv):
                f"{calib.get('chamber_weight_scale', 0):.3g}, body R_omega "
                f"{calib.get('body_r_omega', 0):.3g}")
     quick = " (quick run)" if summary.get("quick") else ""
-    fig.suptitle(f"SoftKin vs pressure FEM ({fem.get('element')}, {fem.get('law')}, E = "
+    elements = sorted({c.get("fem_element", fem.get("element")) for c in cases})
+    fig.suptitle(f"SoftKin vs pressure FEM ({' / '.join(elements)}, {fem.get('law')}, E = "
                  f"{fem.get('young_mpa')} MPa, nu = {fem.get('poisson')}) at equal chamber volume"
                  f"{fit}{quick}", fontsize=10)
     figlib.save_figure(fig, results, NAME)

@@ -244,6 +244,58 @@ TEST(Cli, CollisionSweepRejectsABadVariantBeforeRunningAny) {
   EXPECT_FALSE(std::filesystem::exists(dir + "/bad_sweep/steps.csv"));
 }
 
+// fidelity_fem: a case may run the FEM with its own element and increment (the thesis mesh is
+// out of reach of C3D10) and may be left out of the comparison with the fitted parameters; the
+// keys are checked before any FEM runs.
+TEST(Cli, FidelityCasesTakeTheirOwnFemElementAndMayStayUncalibrated) {
+  const std::string dir = TempDir("fidelity_cases");
+  const std::string cfg = dir + "/fid.json";
+  const std::string head = R"({"name": "tiny_fid", "experiment": "fidelity_fem", "seed": 1,
+    "fem_element": "C3D4", "max_increment": 0.25, "fractions": [1.0], "calibrate_on": "a",)";
+  std::ofstream(cfg) << head << R"( "cases": [
+    {"label": "a", "robot": "three_chamber", "res": 3, "pressure": [0.01, 0, 0]},
+    {"label": "b", "robot": "three_chamber", "res": 3, "pressure": [0.01, 0, 0],
+     "fem_element": "C3D8"}]})";
+  CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find(cfg + ": cases[1].fem_element: expected C3D10 or C3D4"), std::string::npos)
+      << r.out;
+  std::ofstream(cfg) << head << R"( "cases": [
+    {"label": "a", "robot": "three_chamber", "res": 3, "pressure": [0.01, 0, 0],
+     "calibrated": false}]})";
+  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("cases[0].calibrated: expected true (or absent) for the case that "
+                       "calibrate_on fits"),
+            std::string::npos)
+      << r.out;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/tiny_fid/summary.json"));
+  if (softkin::FindCcx().empty()) GTEST_SKIP() << softkin::CcxMissingMessage();
+
+  std::ofstream(cfg) << head << R"( "cases": [
+    {"label": "a", "robot": "three_chamber", "res": 3, "pressure": [0.01, 0, 0]},
+    {"label": "b", "robot": "three_chamber", "res": 3, "pressure": [0.01, 0, 0],
+     "fem_element": "C3D10", "max_increment": 1.0, "calibrated": false}]})";
+  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::ifstream f(dir + "/tiny_fid/summary.json");
+  const auto j = nlohmann::json::parse(f);
+  const auto& a = j["cases"][0];
+  const auto& b = j["cases"][1];
+  EXPECT_EQ(a["fem_element"], "C3D4");
+  EXPECT_EQ(b["fem_element"], "C3D10");
+  // The same mesh as quadratic tets: every edge gains a midpoint node.
+  EXPECT_GT(b["fem_nodes"].get<int>(), 2 * a["fem_nodes"].get<int>()) << b.dump();
+  // The whole ramp in one increment (the config's a quarter of it).
+  EXPECT_EQ(b["fem_increments"].get<int>(), 1) << b.dump();
+  EXPECT_GT(a["fem_increments"].get<int>(), 1) << a.dump();
+  EXPECT_EQ(a["role"], "calibration");
+  EXPECT_EQ(b["role"], "default parameters only");
+  EXPECT_TRUE(a.contains("calibrated") && a.contains("default")) << a.dump();
+  EXPECT_TRUE(b.contains("default")) << b.dump();
+  EXPECT_FALSE(b.contains("calibrated")) << b.dump();
+}
+
 // A solver scaling study reads every case before it solves: a bad solver name in the last case
 // fails at once with the key. A tiny valid one writes one converged row per (res, solver) and the
 // growth of the iteration count per solver.
