@@ -26,12 +26,11 @@ TEST(Cli, RunWritesSummaryWithConfigCommitAndMachine) {
   EXPECT_NE(r.out.find("tip_top"), std::string::npos) << r.out;
 
   // actuation_paths (Fig. 2.12): a group naming an unknown actuator is rejected with the key.
-  std::ofstream(cfg) << R"({"name": "tiny_paths", "experiment": "actuation_paths", "seed": 3,
-    "robot": "three_chamber", "res": 3, "paths": ["c1", "c1+c9"], "steps": 2})";
-  r = Cli("run " + cfg + " --no-plot --results " + dir);
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.out.find("paths"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("c1+c9"), std::string::npos) << r.out;
+  EXPECT_TRUE(RefusedWith(
+      RunConfig(cfg, R"({"name": "tiny_paths", "experiment": "actuation_paths", "seed": 3,
+    "robot": "three_chamber", "res": 3, "paths": ["c1", "c1+c9"], "steps": 2})",
+                dir),
+      {"paths", "c1+c9"}));
   std::ofstream(cfg) << R"({"name": "tiny_paths", "experiment": "actuation_paths", "seed": 3,
     "robot": "three_chamber", "res": 3, "paths": ["c1", "c1+c2+c3"], "steps": 2, "end_value": 1.5})";
   r = Cli("run " + cfg + " --no-plot --results " + dir);
@@ -71,28 +70,21 @@ TEST(Cli, RunWritesSummaryWithConfigCommitAndMachine) {
   // Rerunning the copy a run wrote (RESULTS/<name>/config.json) into the same results would
   // write over it (with the quick overrides resolved): refused, the file left as it was.
   const std::string copy = dir + "/tiny_aa/config.json", copy_text = ReadAll(copy);
-  r = Cli("run " + copy + " --no-plot --results " + dir);
-  EXPECT_EQ(r.code, 2) << r.out;
-  EXPECT_NE(r.out.find("is the same file as the input config"), std::string::npos) << r.out;
+  EXPECT_TRUE(RefusedWith(Cli("run " + copy + " --no-plot --results " + dir),
+                          {"is the same file as the input config"}));
   EXPECT_EQ(ReadAll(copy), copy_text);
 
-  std::ofstream(cfg)
-      << R"({"name": "tiny_aa", "experiment": "aa_ablation", "seed": 3, "robts": []})";
-  r = Cli("run " + cfg + " --no-plot --results " + dir);
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.out.find("robts"), std::string::npos) << r.out;
-  for (const char* bad : {R"(["lg-aa"])", R"(["newtn"])"}) {
-    std::ofstream(cfg) << R"({"name": "tiny_aa", "experiment": "aa_ablation", "seed": 3,
-      "solvers": )" << bad
-                       << "}";
-    r = Cli("run " + cfg + " --no-plot --results " + dir);
-    EXPECT_EQ(r.code, 2) << bad;
-    EXPECT_NE(r.out.find("solvers"), std::string::npos) << r.out;
+  EXPECT_TRUE(RefusedWith(
+      RunConfig(cfg, R"({"name": "tiny_aa", "experiment": "aa_ablation", "seed": 3, "robts": []})",
+                dir),
+      {"robts"}));
+  for (const std::string bad : {R"(["lg-aa"])", R"(["newtn"])"}) {
+    const std::string text =
+        R"({"name": "tiny_aa", "experiment": "aa_ablation", "seed": 3, "solvers": )" + bad + "}";
+    EXPECT_TRUE(RefusedWith(RunConfig(cfg, text, dir), {"solvers"})) << bad;
   }
-  std::ofstream(cfg) << R"({"name": "x", "experiment": "aa_ablation"})";
-  r = Cli("run " + cfg + " --no-plot --results " + dir);
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.out.find("seed"), std::string::npos) << r.out;
+  EXPECT_TRUE(
+      RefusedWith(RunConfig(cfg, R"({"name": "x", "experiment": "aa_ablation"})", dir), {"seed"}));
 }
 
 // Fig. 2.11 and Table 2.2 carry the pressure-driven FEM (calculix_pressure.hpp) beside SoftKin:
@@ -104,26 +96,21 @@ TEST(Cli, BendingAndSolverComparisonRunThePressureFem) {
   const std::string bend_base =
       R"("name": "tiny_fem", "experiment": "pneumatic_bending", "seed": 1,
          "robot": "pneumatic_finger", "res": 5, "steps": 2, "end_value": 1.4)";
-  std::ofstream(cfg) << "{" << bend_base << R"(, "fem_laws": ["rubber"],
-    "fem_pressure_mpa": 0.02})";
-  CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
-  EXPECT_EQ(r.code, 2) << r.out;
-  EXPECT_NE(r.out.find("fem_laws[0]"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("neo-hooke"), std::string::npos) << r.out;
-  std::ofstream(cfg) << "{" << bend_base << R"(, "fem_laws": ["linear"]})";
-  r = Cli("run " + cfg + " --no-plot --results " + dir);
-  EXPECT_EQ(r.code, 2) << r.out;
-  EXPECT_NE(r.out.find("fem_pressure_mpa"), std::string::npos) << r.out;
-  std::ofstream(cfg) << "{" << bend_base << R"(, "fem_laws": ["linear"],
-    "fem_pressure_mpa": 0.02, "fem_element": "C3D8"})";
-  r = Cli("run " + cfg + " --no-plot --results " + dir);
-  EXPECT_EQ(r.code, 2) << r.out;
-  EXPECT_NE(r.out.find("fem_element"), std::string::npos) << r.out;
+  EXPECT_TRUE(RefusedWith(
+      RunConfig(cfg, "{" + bend_base + R"(, "fem_laws": ["rubber"], "fem_pressure_mpa": 0.02})",
+                dir),
+      {"fem_laws[0]", "neo-hooke"}));
+  EXPECT_TRUE(RefusedWith(RunConfig(cfg, "{" + bend_base + R"(, "fem_laws": ["linear"]})", dir),
+                          {"fem_pressure_mpa"}));
+  EXPECT_TRUE(RefusedWith(RunConfig(cfg, "{" + bend_base + R"(, "fem_laws": ["linear"],
+    "fem_pressure_mpa": 0.02, "fem_element": "C3D8"})",
+                                    dir),
+                          {"fem_element"}));
   if (softkin::FindCcx().empty()) GTEST_SKIP() << softkin::CcxMissingMessage();
 
   std::ofstream(cfg) << "{" << bend_base << R"(, "fem_laws": ["neo-hooke"],
     "fem_pressure_mpa": 0.03, "fem_element": "C3D4", "max_increment": 0.5})";
-  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
   ASSERT_EQ(r.code, 0) << r.out;
   {
     std::ifstream f(dir + "/tiny_fem/summary.json");
@@ -199,28 +186,26 @@ TEST(Cli, CollisionCostsRejectsABadRemeshKeyBeforeRunningAny) {
            {R"({"d_max": 0.5})", "robots[1].remesh.d_max: expected"},
            {R"([4])", "robots[1].remesh: expected an object"}}) {
     SCOPED_TRACE(remesh);
-    std::ofstream(cfg) << R"({"name": "bad_costs", "experiment": "collision_costs", "seed": 1,
+    const CliRun r = RunConfig(cfg,
+                               R"({"name": "bad_costs", "experiment": "collision_costs", "seed": 1,
       "robots": [{"robot": "selfcollision_finger", "res": 5, "steps": 1, "actuation": {"chamber": 1.5}},
                  {"robot": "twisting_robot", "res": 1, "steps": 2, "actuation": {"chamber": 3.0},
-                  "remesh": )"
-                       << remesh << "}]}";
-    const CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
-    EXPECT_NE(r.code, 0);
-    EXPECT_NE(r.out.find(cfg + ": " + message), std::string::npos) << r.out;
+                  "remesh": )" + remesh +
+                                   "}]}",
+                               dir);
+    EXPECT_TRUE(RefusedWith(r, {cfg + ": " + message}));
     EXPECT_EQ(r.out.find("[selfcollision_finger 1/1]"), std::string::npos)
         << r.out;  // robot 0 never ran
   }
   // A robot's own collision options are checked up front too.
-  std::ofstream(cfg) << R"({"name": "bad_costs", "experiment": "collision_costs", "seed": 1,
+  const CliRun r =
+      RunConfig(cfg, R"({"name": "bad_costs", "experiment": "collision_costs", "seed": 1,
     "robots": [{"robot": "selfcollision_finger", "res": 5, "steps": 1, "actuation": {"chamber": 1.5}},
                {"robot": "membrane", "res": 10, "steps": 1, "actuation": {"c1": 1.5},
-                "collision": {"stiffness": "soft"}}]})";
-  const CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
-  EXPECT_NE(r.code, 0);
-  EXPECT_NE(
-      r.out.find(cfg + ": robots[1].collision.stiffness: expected a number > 0, got \"soft\""),
-      std::string::npos)
-      << r.out;
+                "collision": {"stiffness": "soft"}}]})",
+                dir);
+  EXPECT_TRUE(RefusedWith(
+      r, {cfg + ": robots[1].collision.stiffness: expected a number > 0, got \"soft\""}));
   EXPECT_EQ(r.out.find("[selfcollision_finger 1/1]"), std::string::npos) << r.out;
 }
 
@@ -229,17 +214,15 @@ TEST(Cli, CollisionCostsRejectsABadRemeshKeyBeforeRunningAny) {
 TEST(Cli, CollisionSweepRejectsABadVariantBeforeRunningAny) {
   const std::string dir = TempDir("collision_bad_variant");
   const std::string cfg = dir + "/bad.json";
-  std::ofstream(cfg) << R"({"name": "bad_sweep", "experiment": "collision_sweep", "seed": 1,
+  const CliRun r =
+      RunConfig(cfg, R"({"name": "bad_sweep", "experiment": "collision_sweep", "seed": 1,
     "robot": "selfcollision_finger", "res": 5, "steps": 1, "actuation": {"chamber": 1.5},
     "variants": [{"name": "ok", "collision": {"self": true}},
-                 {"name": "bad", "collision": {"self": true, "self_spring": "glue"}}]})";
-  const CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
-  EXPECT_NE(r.code, 0);
-  EXPECT_NE(
-      r.out.find(
-          cfg + ": variants[1].collision.self_spring: expected one of: target, pair, got \"glue\""),
-      std::string::npos)
-      << r.out;
+                 {"name": "bad", "collision": {"self": true, "self_spring": "glue"}}]})",
+                dir);
+  EXPECT_TRUE(RefusedWith(
+      r,
+      {cfg + ": variants[1].collision.self_spring: expected one of: target, pair, got \"glue\""}));
   EXPECT_EQ(r.out.find("[ok 1/1]"), std::string::npos) << r.out;  // variant 0 never ran
   EXPECT_FALSE(std::filesystem::exists(dir + "/bad_sweep/steps.csv"));
 }
@@ -252,23 +235,18 @@ TEST(Cli, FidelityCasesTakeTheirOwnFemElementAndMayStayUncalibrated) {
   const std::string cfg = dir + "/fid.json";
   const std::string head = R"({"name": "tiny_fid", "experiment": "fidelity_fem", "seed": 1,
     "fem_element": "C3D4", "max_increment": 0.25, "fractions": [1.0], "calibrate_on": "a",)";
-  std::ofstream(cfg) << head << R"( "cases": [
+  EXPECT_TRUE(RefusedWith(RunConfig(cfg, head + R"( "cases": [
     {"label": "a", "robot": "three_chamber", "res": 3, "pressure": [0.01, 0, 0]},
     {"label": "b", "robot": "three_chamber", "res": 3, "pressure": [0.01, 0, 0],
-     "fem_element": "C3D8"}]})";
-  CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
-  EXPECT_EQ(r.code, 2) << r.out;
-  EXPECT_NE(r.out.find(cfg + ": cases[1].fem_element: expected C3D10 or C3D4"), std::string::npos)
-      << r.out;
-  std::ofstream(cfg) << head << R"( "cases": [
+     "fem_element": "C3D8"}]})",
+                                    dir),
+                          {cfg + ": cases[1].fem_element: expected C3D10 or C3D4"}));
+  EXPECT_TRUE(RefusedWith(RunConfig(cfg, head + R"( "cases": [
     {"label": "a", "robot": "three_chamber", "res": 3, "pressure": [0.01, 0, 0],
-     "calibrated": false}]})";
-  r = Cli("run " + cfg + " --no-plot --results " + dir);
-  EXPECT_EQ(r.code, 2) << r.out;
-  EXPECT_NE(r.out.find("cases[0].calibrated: expected true (or absent) for the case that "
-                       "calibrate_on fits"),
-            std::string::npos)
-      << r.out;
+     "calibrated": false}]})",
+                                    dir),
+                          {"cases[0].calibrated: expected true (or absent) for the case that "
+                           "calibrate_on fits"}));
   EXPECT_FALSE(std::filesystem::exists(dir + "/tiny_fid/summary.json"));
   if (softkin::FindCcx().empty()) GTEST_SKIP() << softkin::CcxMissingMessage();
 
@@ -276,7 +254,7 @@ TEST(Cli, FidelityCasesTakeTheirOwnFemElementAndMayStayUncalibrated) {
     {"label": "a", "robot": "three_chamber", "res": 3, "pressure": [0.01, 0, 0]},
     {"label": "b", "robot": "three_chamber", "res": 3, "pressure": [0.01, 0, 0],
      "fem_element": "C3D10", "max_increment": 1.0, "calibrated": false}]})";
-  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
   ASSERT_EQ(r.code, 0) << r.out;
   std::ifstream f(dir + "/tiny_fid/summary.json");
   const auto j = nlohmann::json::parse(f);
@@ -302,15 +280,13 @@ TEST(Cli, FidelityCasesTakeTheirOwnFemElementAndMayStayUncalibrated) {
 TEST(Cli, SolverScalingChecksEveryCaseAndReportsTheGrowth) {
   const std::string dir = TempDir("solver_scaling");
   const std::string bad = dir + "/bad.json";
-  std::ofstream(bad) << R"({"name": "bad_scaling", "experiment": "solver_scaling", "seed": 1,
+  CliRun r = RunConfig(bad, R"({"name": "bad_scaling", "experiment": "solver_scaling", "seed": 1,
     "cases": [{"robot": "three_chamber", "resolutions": [3], "actuation": [1.2, 1, 1],
                "solvers": ["newton"]},
               {"robot": "three_chamber", "resolutions": [3], "actuation": [1.2, 1, 1],
-               "solvers": ["newtonn"]}]})";
-  CliRun r = Cli("run " + bad + " --no-plot --results " + dir);
-  EXPECT_NE(r.code, 0);
-  EXPECT_NE(r.out.find(bad + ": cases[1].solvers: expected FK solver names"), std::string::npos)
-      << r.out;
+               "solvers": ["newtonn"]}]})",
+                       dir);
+  EXPECT_TRUE(RefusedWith(r, {bad + ": cases[1].solvers: expected FK solver names"}));
   EXPECT_EQ(r.out.find("res 3 ("), std::string::npos) << r.out;  // nothing was solved
   const std::string good = dir + "/good.json";
   std::ofstream(good) << R"({"name": "tiny_scaling", "experiment": "solver_scaling", "seed": 1,
@@ -336,39 +312,33 @@ TEST(Cli, RefinementCanCompareAtEqualChamberVolume) {
   const std::string dir = TempDir("refinement_volume");
   const std::string bad = dir + "/bad.json";
   // A volume target needs pneumatic actuators; a case gives actuation or volume_ratio, not both.
-  std::ofstream(bad) << R"({"name": "bad_ref", "experiment": "refinement", "seed": 1,
+  EXPECT_TRUE(RefusedWith(
+      RunConfig(bad, R"({"name": "bad_ref", "experiment": "refinement", "seed": 1,
     "cases": [{"label": "c", "robot": "cable_finger", "volume_ratio": [1.1, 1.1, 1.1],
-               "resolutions": [5, 6, 7, 8]}]})";
-  CliRun r = Cli("run " + bad + " --no-plot --results " + dir);
-  EXPECT_EQ(r.code, 2) << r.out;
-  EXPECT_NE(r.out.find(bad + ": cases[0].volume_ratio: expected a robot whose actuators are all "
-                             "unsigned pneumatic ones ('cable_finger' has cable actuator 't1')"),
-            std::string::npos)
-      << r.out;
+               "resolutions": [5, 6, 7, 8]}]})",
+                dir),
+      {bad + ": cases[0].volume_ratio: expected a robot whose actuators are all unsigned "
+             "pneumatic ones ('cable_finger' has cable actuator 't1')"}));
   // A signed actuator inflates one of two chambers: no single volume ratio to match.
-  std::ofstream(bad) << R"({"name": "bad_ref", "experiment": "refinement", "seed": 1,
+  EXPECT_TRUE(RefusedWith(
+      RunConfig(bad, R"({"name": "bad_ref", "experiment": "refinement", "seed": 1,
     "cases": [{"label": "m", "robot": "finger_manipulator", "volume_ratio": [1.5, 1, 1],
-               "resolutions": [6, 7, 8, 9]}]})";
-  r = Cli("run " + bad + " --no-plot --results " + dir);
-  EXPECT_EQ(r.code, 2) << r.out;
-  EXPECT_NE(r.out.find("cases[0].volume_ratio: expected a robot whose actuators are all unsigned "
-                       "pneumatic ones ('finger_manipulator' has signed pneumatic actuator 's1')"),
-            std::string::npos)
-      << r.out;
-  std::ofstream(bad) << R"({"name": "bad_ref", "experiment": "refinement", "seed": 1,
+               "resolutions": [6, 7, 8, 9]}]})",
+                dir),
+      {"cases[0].volume_ratio: expected a robot whose actuators are all unsigned pneumatic ones "
+       "('finger_manipulator' has signed pneumatic actuator 's1')"}));
+  EXPECT_TRUE(
+      RefusedWith(RunConfig(bad, R"({"name": "bad_ref", "experiment": "refinement", "seed": 1,
     "cases": [{"label": "t", "robot": "three_chamber", "volume_ratio": [1.3, 1, 1],
-               "actuation": [1.3, 1, 1], "resolutions": [3, 4, 5, 6]}]})";
-  r = Cli("run " + bad + " --no-plot --results " + dir);
-  EXPECT_EQ(r.code, 2) << r.out;
-  EXPECT_NE(r.out.find("cases[0].actuation: expected exactly one of actuation and volume_ratio"),
-            std::string::npos)
-      << r.out;
+               "actuation": [1.3, 1, 1], "resolutions": [3, 4, 5, 6]}]})",
+                            dir),
+                  {"cases[0].actuation: expected exactly one of actuation and volume_ratio"}));
 
   const std::string good = dir + "/good.json";
   std::ofstream(good) << R"({"name": "tiny_ref", "experiment": "refinement", "seed": 1,
     "cases": [{"label": "t", "robot": "three_chamber", "volume_ratio": [1.3, 1, 1],
                "resolutions": [3, 4, 5, 6]}]})";
-  r = Cli("run " + good + " --no-plot --results " + dir);
+  CliRun r = Cli("run " + good + " --no-plot --results " + dir);
   ASSERT_EQ(r.code, 0) << r.out;
   const auto j = nlohmann::json::parse(ReadAll(dir + "/tiny_ref/summary.json"));
   const auto& c = j["cases"][0];
@@ -435,24 +405,20 @@ TEST(Cli, RefinementCanCompareAtEqualChamberVolume) {
 TEST(Cli, RefinementRecordsTheTwistAboutAnAxis) {
   const std::string dir = TempDir("refinement_twist");
   const std::string bad = dir + "/bad.json";
-  std::ofstream(bad) << R"({"name": "bad_twist", "experiment": "refinement", "seed": 1,
+  EXPECT_TRUE(
+      RefusedWith(RunConfig(bad, R"({"name": "bad_twist", "experiment": "refinement", "seed": 1,
     "cases": [{"label": "b", "robot": "bimaterial_bar", "actuation": [30, 0],
-               "twist_axis": [0, 0, 0], "resolutions": [2, 3, 4, 6]}]})";
-  CliRun r = Cli("run " + bad + " --no-plot --results " + dir);
-  EXPECT_EQ(r.code, 2) << r.out;
-  EXPECT_NE(r.out.find(bad + ": cases[0].twist_axis: expected an array of 3 numbers, not all zero"),
-            std::string::npos)
-      << r.out;
+               "twist_axis": [0, 0, 0], "resolutions": [2, 3, 4, 6]}]})",
+                            dir),
+                  {bad + ": cases[0].twist_axis: expected an array of 3 numbers, not all zero"}));
   // One vertex has no twist.
-  std::ofstream(bad) << R"({"name": "bad_twist", "experiment": "refinement", "seed": 1,
+  EXPECT_TRUE(RefusedWith(
+      RunConfig(bad, R"({"name": "bad_twist", "experiment": "refinement", "seed": 1,
     "cases": [{"label": "w", "robot": "twisting_robot", "marker": "tip_rim", "actuation": [2],
-               "twist_axis": [0, 0, 1], "resolutions": [1, 2, 3, 4]}]})";
-  r = Cli("run " + bad + " --no-plot --results " + dir);
-  EXPECT_EQ(r.code, 2) << r.out;
-  EXPECT_NE(r.out.find("cases[0].twist_axis: expected a marker of 3 or more vertices to measure "
-                       "a twist ('tip_rim' has 1)"),
-            std::string::npos)
-      << r.out;
+               "twist_axis": [0, 0, 1], "resolutions": [1, 2, 3, 4]}]})",
+                dir),
+      {"cases[0].twist_axis: expected a marker of 3 or more vertices to measure a twist "
+       "('tip_rim' has 1)"}));
 
   // The bar's end face is turned by the motion actuator 'twist' (degrees about +x): the recorded
   // twist of marker 'tip' is that angle at every resolution, and about -x its negative.
@@ -464,7 +430,7 @@ TEST(Cli, RefinementRecordsTheTwistAboutAnAxis) {
                "twist_axis": [-1, 0, 0], "resolutions": [2, 3, 4, 6]},
               {"label": "interface", "robot": "bimaterial_bar", "marker": "interface",
                "actuation": [30, 0], "twist_axis": [1, 0, 0], "resolutions": [2, 3, 4, 6]}]})";
-  r = Cli("run " + good + " --no-plot --results " + dir);
+  CliRun r = Cli("run " + good + " --no-plot --results " + dir);
   ASSERT_EQ(r.code, 0) << r.out;
   const auto j = nlohmann::json::parse(ReadAll(dir + "/tiny_twist/summary.json"));
   ASSERT_EQ(j["cases"].size(), 3u);
