@@ -17,11 +17,11 @@ using namespace softkin::cli_test;  // NOLINT: the helpers of every test here
 TEST(Cli, RunWritesSummaryWithConfigCommitAndMachine) {
   const std::string dir = TempDir("run");
   const std::string cfg = dir + "/tiny.json";
-  std::ofstream(cfg) << R"({"name": "tiny_bend", "experiment": "pneumatic_bending", "seed": 3,
-    "robot": "three_chamber", "res": 3, "actuator": "c1", "steps": 3,
-    "milestones_deg": [5], "end_value": 1.6})";
   // three_chamber has no tip_top/tip_bottom: the bending experiment must say so.
-  CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
+  CliRun r = RunConfig(cfg, R"({"name": "tiny_bend", "experiment": "pneumatic_bending", "seed": 3,
+    "robot": "three_chamber", "res": 3, "actuator": "c1", "steps": 3,
+    "milestones_deg": [5], "end_value": 1.6})",
+                       dir);
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.out.find("tip_top"), std::string::npos) << r.out;
 
@@ -31,9 +31,9 @@ TEST(Cli, RunWritesSummaryWithConfigCommitAndMachine) {
     "robot": "three_chamber", "res": 3, "paths": ["c1", "c1+c9"], "steps": 2})",
                 dir),
       {"paths", "c1+c9"}));
-  std::ofstream(cfg) << R"({"name": "tiny_paths", "experiment": "actuation_paths", "seed": 3,
-    "robot": "three_chamber", "res": 3, "paths": ["c1", "c1+c2+c3"], "steps": 2, "end_value": 1.5})";
-  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  r = RunConfig(cfg, R"({"name": "tiny_paths", "experiment": "actuation_paths", "seed": 3,
+    "robot": "three_chamber", "res": 3, "paths": ["c1", "c1+c2+c3"], "steps": 2, "end_value": 1.5})",
+                dir);
   ASSERT_EQ(r.code, 0) << r.out;
   {
     std::ifstream pf(dir + "/tiny_paths/summary.json");
@@ -46,9 +46,9 @@ TEST(Cli, RunWritesSummaryWithConfigCommitAndMachine) {
     EXPECT_NEAR(tip[2].get<double>(), 0.0, 1e-6);
   }
 
-  std::ofstream(cfg) << R"({"name": "tiny_aa", "experiment": "aa_ablation", "seed": 3,
-    "robots": ["three_chamber"], "resolutions": [3], "levels": [0.5, 1.0], "solvers": ["newton"]})";
-  r = Cli("run " + cfg + " --no-plot --results " + dir);
+  r = RunConfig(cfg, R"({"name": "tiny_aa", "experiment": "aa_ablation", "seed": 3,
+    "robots": ["three_chamber"], "resolutions": [3], "levels": [0.5, 1.0], "solvers": ["newton"]})",
+                dir);
   ASSERT_EQ(r.code, 0) << r.out;
   std::ifstream f(dir + "/tiny_aa/summary.json");
   const auto j = nlohmann::json::parse(f);
@@ -108,9 +108,9 @@ TEST(Cli, BendingAndSolverComparisonRunThePressureFem) {
                           {"fem_element"}));
   if (softkin::FindCcx().empty()) GTEST_SKIP() << softkin::CcxMissingMessage();
 
-  std::ofstream(cfg) << "{" << bend_base << R"(, "fem_laws": ["neo-hooke"],
-    "fem_pressure_mpa": 0.03, "fem_element": "C3D4", "max_increment": 0.5})";
-  CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
+  CliRun r = RunConfig(cfg, "{" + bend_base + R"(, "fem_laws": ["neo-hooke"],
+    "fem_pressure_mpa": 0.03, "fem_element": "C3D4", "max_increment": 0.5})",
+                       dir);
   ASSERT_EQ(r.code, 0) << r.out;
   {
     std::ifstream f(dir + "/tiny_fem/summary.json");
@@ -131,11 +131,11 @@ TEST(Cli, BendingAndSolverComparisonRunThePressureFem) {
     EXPECT_EQ(rows, fem["increments"].get<int>() + 1);  // the rest state, then each increment
   }
 
-  std::ofstream(cfg) << R"({"name": "tiny_table", "experiment": "solver_comparison", "seed": 1,
+  r = RunConfig(cfg, R"({"name": "tiny_table", "experiment": "solver_comparison", "seed": 1,
     "robot": "pneumatic_finger", "res": 5, "steps": 2, "end_value": 1.4, "time_limit_s": 60,
     "methods": ["lg-aa", "calculix-pressure-nonlinear"], "fem_pressure_mpa": 0.03,
-    "fem_element": "C3D4", "max_increment": 0.5})";
-  r = Cli("run " + cfg + " --no-plot --results " + dir);
+    "fem_element": "C3D4", "max_increment": 0.5})",
+                dir);
   ASSERT_EQ(r.code, 0) << r.out;
   std::ifstream f(dir + "/tiny_table/summary.json");
   const auto j = nlohmann::json::parse(f);
@@ -153,10 +153,11 @@ TEST(Cli, BendingAndSolverComparisonRunThePressureFem) {
 TEST(Cli, SolverComparisonBoundsTheOptimisersWhenLgAaEndsInverted) {
   const std::string dir = TempDir("table_inverted");
   const std::string cfg = dir + "/table.json";
-  std::ofstream(cfg) << R"({"name": "tiny_inverted", "experiment": "solver_comparison", "seed": 1,
+  const CliRun r =
+      RunConfig(cfg, R"({"name": "tiny_inverted", "experiment": "solver_comparison", "seed": 1,
     "robot": "pneumatic_finger", "res": 6, "steps": 2, "end_value": 10, "time_limit_s": 8,
-    "methods": ["lg-aa", "ceres"]})";
-  const CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
+    "methods": ["lg-aa", "ceres"]})",
+                dir);
   ASSERT_EQ(r.code, 0) << r.out;
   std::ifstream f(dir + "/tiny_inverted/summary.json");
   const auto j = nlohmann::json::parse(f);
@@ -250,11 +251,11 @@ TEST(Cli, FidelityCasesTakeTheirOwnFemElementAndMayStayUncalibrated) {
   EXPECT_FALSE(std::filesystem::exists(dir + "/tiny_fid/summary.json"));
   if (softkin::FindCcx().empty()) GTEST_SKIP() << softkin::CcxMissingMessage();
 
-  std::ofstream(cfg) << head << R"( "cases": [
+  CliRun r = RunConfig(cfg, head + R"( "cases": [
     {"label": "a", "robot": "three_chamber", "res": 3, "pressure": [0.01, 0, 0]},
     {"label": "b", "robot": "three_chamber", "res": 3, "pressure": [0.01, 0, 0],
-     "fem_element": "C3D10", "max_increment": 1.0, "calibrated": false}]})";
-  CliRun r = Cli("run " + cfg + " --no-plot --results " + dir);
+     "fem_element": "C3D10", "max_increment": 1.0, "calibrated": false}]})",
+                       dir);
   ASSERT_EQ(r.code, 0) << r.out;
   std::ifstream f(dir + "/tiny_fid/summary.json");
   const auto j = nlohmann::json::parse(f);
@@ -289,10 +290,10 @@ TEST(Cli, SolverScalingChecksEveryCaseAndReportsTheGrowth) {
   EXPECT_TRUE(RefusedWith(r, {bad + ": cases[1].solvers: expected FK solver names"}));
   EXPECT_EQ(r.out.find("res 3 ("), std::string::npos) << r.out;  // nothing was solved
   const std::string good = dir + "/good.json";
-  std::ofstream(good) << R"({"name": "tiny_scaling", "experiment": "solver_scaling", "seed": 1,
+  r = RunConfig(good, R"({"name": "tiny_scaling", "experiment": "solver_scaling", "seed": 1,
     "cases": [{"robot": "three_chamber", "resolutions": [3, 4], "actuation": [1.2, 1, 1],
-               "solvers": ["newton", "lg-aa"]}]})";
-  r = Cli("run " + good + " --no-plot --results " + dir);
+               "solvers": ["newton", "lg-aa"]}]})",
+                dir);
   ASSERT_EQ(r.code, 0) << r.out;
   const std::string csv = ReadAll(dir + "/tiny_scaling/scaling.csv");
   EXPECT_EQ(CountLines(csv), 5) << csv;  // header + 2 res x 2 solvers
@@ -335,10 +336,10 @@ TEST(Cli, RefinementCanCompareAtEqualChamberVolume) {
                   {"cases[0].actuation: expected exactly one of actuation and volume_ratio"}));
 
   const std::string good = dir + "/good.json";
-  std::ofstream(good) << R"({"name": "tiny_ref", "experiment": "refinement", "seed": 1,
+  CliRun r = RunConfig(good, R"({"name": "tiny_ref", "experiment": "refinement", "seed": 1,
     "cases": [{"label": "t", "robot": "three_chamber", "volume_ratio": [1.3, 1, 1],
-               "resolutions": [3, 4, 5, 6]}]})";
-  CliRun r = Cli("run " + good + " --no-plot --results " + dir);
+               "resolutions": [3, 4, 5, 6]}]})",
+                       dir);
   ASSERT_EQ(r.code, 0) << r.out;
   const auto j = nlohmann::json::parse(ReadAll(dir + "/tiny_ref/summary.json"));
   const auto& c = j["cases"][0];
@@ -423,14 +424,14 @@ TEST(Cli, RefinementRecordsTheTwistAboutAnAxis) {
   // The bar's end face is turned by the motion actuator 'twist' (degrees about +x): the recorded
   // twist of marker 'tip' is that angle at every resolution, and about -x its negative.
   const std::string good = dir + "/good.json";
-  std::ofstream(good) << R"({"name": "tiny_twist", "experiment": "refinement", "seed": 1,
+  CliRun r = RunConfig(good, R"({"name": "tiny_twist", "experiment": "refinement", "seed": 1,
     "cases": [{"label": "x", "robot": "bimaterial_bar", "actuation": [30, 0],
                "twist_axis": [2, 0, 0], "resolutions": [2, 3, 4, 6]},
               {"label": "minus x", "robot": "bimaterial_bar", "actuation": [30, 0],
                "twist_axis": [-1, 0, 0], "resolutions": [2, 3, 4, 6]},
               {"label": "interface", "robot": "bimaterial_bar", "marker": "interface",
-               "actuation": [30, 0], "twist_axis": [1, 0, 0], "resolutions": [2, 3, 4, 6]}]})";
-  CliRun r = Cli("run " + good + " --no-plot --results " + dir);
+               "actuation": [30, 0], "twist_axis": [1, 0, 0], "resolutions": [2, 3, 4, 6]}]})",
+                       dir);
   ASSERT_EQ(r.code, 0) << r.out;
   const auto j = nlohmann::json::parse(ReadAll(dir + "/tiny_twist/summary.json"));
   ASSERT_EQ(j["cases"].size(), 3u);
